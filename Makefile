@@ -1,0 +1,40 @@
+# Spindle quick start:  make run   (set up, build Release, run the default scene)
+#                       make test  (set up, build, run every test: Release, ASan+UBSan, TSan)
+JOBS ?= 2
+BUILD ?= build
+CMAKE_COMMON = -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
+# Sanitizer builds: optimised a little so Eigen-heavy tests stay quick; asserts on.
+SAN_FLAGS = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSPINDLE_BUILD_BENCH=OFF
+
+.PHONY: setup release run test test-release test-asan test-tsan bench accuracy clean
+
+setup:
+	@bash scripts/setup.sh
+
+release: setup
+	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_COMMON) >/dev/null
+	@cmake --build $(BUILD)/release -j$(JOBS)
+
+run: release
+	./$(BUILD)/release/apps/spindle run
+
+test: test-release test-asan test-tsan
+
+test-release: release
+	cd $(BUILD)/release && ctest --output-on-failure -j$(JOBS)
+
+test-asan: setup
+	@cmake -S . -B $(BUILD)/asan -DSPINDLE_SANITIZE=address $(SAN_FLAGS) $(CMAKE_COMMON) >/dev/null
+	@cmake --build $(BUILD)/asan -j$(JOBS)
+	cd $(BUILD)/asan && ctest --output-on-failure -j$(JOBS) -LE stability
+
+test-tsan: setup
+	@cmake -S . -B $(BUILD)/tsan -DSPINDLE_SANITIZE=thread $(SAN_FLAGS) -DSPINDLE_BUILD_APPS=OFF $(CMAKE_COMMON) >/dev/null
+	@cmake --build $(BUILD)/tsan -j$(JOBS)
+	cd $(BUILD)/tsan && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1" ctest --output-on-failure -j$(JOBS) -L threaded
+
+bench: release
+	@for b in $(BUILD)/release/bench/*/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
+
+clean:
+	rm -rf $(BUILD)

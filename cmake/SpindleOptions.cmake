@@ -1,0 +1,34 @@
+# Warnings (as errors on project code) and sanitizer flags, applied per target.
+
+function(spindle_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
+    -Wnon-virtual-dtor -Wcast-align -Woverloaded-virtual -Werror)
+endfunction()
+
+if(SPINDLE_SANITIZE STREQUAL "address")
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+elseif(SPINDLE_SANITIZE STREQUAL "thread")
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+  add_compile_definitions(SPINDLE_TSAN=1)
+elseif(NOT SPINDLE_SANITIZE STREQUAL "")
+  message(FATAL_ERROR "SPINDLE_SANITIZE must be '', 'address' or 'thread', got '${SPINDLE_SANITIZE}'")
+endif()
+
+# A library layer: include/ is public, src/ private; exported as spindle::<name>.
+function(spindle_add_layer name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(spindle_${name} ${ARG_SOURCES})
+  add_library(spindle::${name} ALIAS spindle_${name})
+  set_target_properties(spindle_${name} PROPERTIES EXPORT_NAME ${name} OUTPUT_NAME spindle_${name}
+    POSITION_INDEPENDENT_CODE ON)
+  target_include_directories(spindle_${name} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_link_libraries(spindle_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  spindle_target_defaults(spindle_${name})
+  install(TARGETS spindle_${name} EXPORT SpindleTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endfunction()
