@@ -1,0 +1,56 @@
+// Shapes: immutable geometry shared by bodies. A body's position is its shape's
+// origin; mass_properties() says where the centre of mass sits in that frame.
+// Factories validate their input and throw spindle::Error naming the field and value.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include <spindle/engine/math.hpp>
+
+namespace spindle {
+
+class ConvexHull;    // convex_hull.hpp
+class TriangleMesh;  // triangle_mesh.hpp
+
+enum class ShapeType : std::uint8_t { Sphere, Capsule, Box, ConvexHull, Plane, TriangleMesh, Count };
+
+const char* to_string(ShapeType type) noexcept;
+
+struct MassProperties {
+    Real mass = 0;
+    Vec3 center_of_mass = Vec3::Zero();  // in the shape's frame
+    Mat3 inertia = Mat3::Zero();         // about the centre of mass, in the shape's frame
+};
+
+struct Shape {
+    ShapeType type = ShapeType::Sphere;
+    Real radius = 0;                     // sphere, capsule
+    Real half_height = 0;                // capsule: segment from (0,-h,0) to (0,h,0)
+    Vec3 half_extents = Vec3::Zero();    // box
+    Vec3 normal = Vec3::UnitY();         // plane: points x with normal . x = offset (shape frame)
+    Real offset = 0;                     // plane
+    std::shared_ptr<const ConvexHull> hull;
+    std::shared_ptr<const TriangleMesh> mesh;
+
+    static Shape sphere(Real radius);
+    static Shape capsule(Real half_height, Real radius);
+    static Shape box(const Vec3& half_extents);
+    // Builds the hull of the points; rejects fewer than 4 points, non-finite points and
+    // flat or degenerate sets, naming what was wrong.
+    static Shape convex_hull(std::span<const Vec3> points);
+    static Shape plane(const Vec3& normal, Real offset);
+    // Static only. Rejects out-of-range indices and non-finite vertices; drops
+    // zero-area triangles.
+    static Shape triangle_mesh(std::span<const Vec3> vertices, std::span<const std::uint32_t> indices);
+
+    // Plane and triangle mesh can only belong to static bodies.
+    bool static_only() const noexcept { return type == ShapeType::Plane || type == ShapeType::TriangleMesh; }
+    // World bounds under transform x (a plane's bounds are huge).
+    Aabb bounds(const Transform& x) const;
+    // Mass, centre of mass and inertia for a uniform density (> 0). Throws for static-only shapes.
+    MassProperties mass_properties(Real density) const;
+};
+
+}  // namespace spindle
