@@ -1,0 +1,60 @@
+// Bodies as the user sees them: a small generational handle, a description to create
+// one from, and the motion state that the buffered accessors read and write.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <spindle/engine/math.hpp>
+#include <spindle/engine/shape.hpp>
+
+namespace spindle {
+
+// A body's name in its space. index is its slot; generation changes every time the
+// slot is reused, so a handle to a destroyed body is detected, never aliased.
+struct BodyHandle {
+    std::uint32_t index = 0;
+    std::uint32_t generation = 0;  // 0 never names a live body
+    bool valid_bits() const noexcept { return generation != 0; }
+    friend bool operator==(BodyHandle, BodyHandle) = default;
+};
+
+std::string to_string(BodyHandle handle);
+
+enum class MotionType : std::uint8_t {
+    Static,     // never moves; infinite mass
+    Kinematic,  // moves by its velocity; infinite mass; pushes dynamic bodies
+    Dynamic,    // moved by forces and contacts
+};
+
+// Everything that describes a body's motion at one instant.
+struct MotionState {
+    Vec3 position = Vec3::Zero();          // the shape's origin, world
+    Quat orientation = Quat::Identity();
+    Vec3 linear_velocity = Vec3::Zero();   // of the centre of mass
+    Vec3 angular_velocity = Vec3::Zero();  // world
+    Vec3 center_of_mass = Vec3::Zero();    // world; equals position for centred shapes
+};
+
+struct BodyDesc {
+    MotionType type = MotionType::Dynamic;
+    Shape shape = Shape::sphere(0.5);
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();  // normalised at creation; must not be zero
+    Vec3 linear_velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    Real density = 1000;  // kg/m^3; used when mass == 0
+    Real mass = 0;        // kg; > 0 overrides density (inertia scaled to match)
+    Real friction = 0.6;
+    Real restitution = 0;
+    Real gravity_scale = 1;
+    Real linear_damping = 0;   // 1/s; 0 costs nothing
+    Real angular_damping = 0;  // 1/s; 0 costs nothing
+    bool gyroscopic = false;   // implicit gyroscopic torque (spinning asymmetric bodies)
+    bool allow_interpolation = true;
+    bool allow_sleep = true;
+    bool fast = false;         // also swept against static geometry (continuous collision)
+    std::uint64_t user_data = 0;
+};
+
+}  // namespace spindle

@@ -1,0 +1,44 @@
+// Settings structs, with their defaults written in the struct.
+#pragma once
+
+#include <spindle/engine/math.hpp>
+
+namespace spindle {
+
+// Internal time stepping (the seed, section 1.A; design.md section 3).
+struct TimeStepSettings {
+    Real duration = 1.0 / 60.0;        // seconds per step
+    int max_steps_per_frame = 10;      // cap per update(); leftover beyond the cap's worth is dropped
+    int min_steps_per_frame = 0;       // steps taken by every update(dt) even without elapsed time
+    bool use_internal_time_stepping = false;
+};
+
+struct SolverSettings {
+    int substeps = 4;
+    int iterations = 1;             // solve iterations per substep
+    int relax_iterations = 1;       // relax iterations per substep
+    Real contact_hertz = 30;        // contact stiffness (capped at a quarter of the substep rate)
+    Real damping_ratio = 10;        // contact damping ratio
+    Real joint_hertz = 60;
+    Real joint_damping_ratio = 2;   // joint softness (0 hertz = rigid joints)
+    Real push_out_speed = 3;        // m/s: most speed used to push overlapping bodies apart
+    Real restitution_threshold = 1; // m/s: slower approaches do not bounce
+    Real speculative_distance = 0.04;  // m: contacts are made this far before touching
+    Real linear_slop = 0.005;       // m: allowed penetration
+};
+
+struct SleepSettings {
+    bool enabled = true;
+    Real time_to_sleep = 0.5;        // s a whole island must rest
+    Real linear_threshold = 0.05;    // m/s
+    Real angular_threshold = 0.05;   // rad/s
+};
+
+struct SpaceSettings {
+    Vec3 gravity{0, -9.81, 0};
+    TimeStepSettings time_step;
+    SolverSettings solver;
+    SleepSettings sleep;
+};
+
+}  // namespace spindle

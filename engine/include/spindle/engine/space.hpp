@@ -1,0 +1,112 @@
+// Space: the simulated world. update() runs the pipeline of design.md section 2:
+// ApplyWrites, k steps (collide, islands, solve, integrate, record), FlipReadBuffers.
+//
+// Threads. Three kinds of access, each with its own rule:
+//  - buffered accessors (position(), set_position(), motion_state(), add_force() ...):
+//    any thread, any time, concurrently with update(). Reads see the last published
+//    step (interpolated where asked), never a mix of two; writes take effect at the
+//    next update's ApplyWrites, the last write to a property winning.
+//  - internal accessors (internal_*): the live state. Only the thread that calls
+//    update(), and never during update().
+//  - structure (create_body, destroy_body, settings) and update(): one thread at a
+//    time, normally the physics loop thread (AsyncRunner::post runs a function there).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include <spindle/engine/body.hpp>
+#include <spindle/engine/settings.hpp>
+#include <spindle/engine/stats.hpp>
+
+namespace spindle {
+
+class JobSystem;
+class MotionStateManager;
+struct World;
+
+class Space {
+public:
+    // jobs: the scheduler that runs the parallel stages; null runs everything on the
+    // caller of update(). The JobSystem must outlive the Space.
+    explicit Space(const SpaceSettings& settings = {}, JobSystem* jobs = nullptr);
+    ~Space();
+    Space(const Space&) = delete;
+    Space& operator=(const Space&) = delete;
+
+    // ---- structure (update thread, or any thread while no update runs) ----
+    // Validates everything first; a rejected body leaves the space unchanged and the
+    // spindle::Error names the field and value.
+    BodyHandle create_body(const BodyDesc& desc);
+    void destroy_body(BodyHandle body);
+    bool contains(BodyHandle body) const noexcept;
+    std::size_t body_count() const noexcept;
+
+    // ---- update (one thread at a time) ----
+    // With internal time stepping: adds dt to the accumulator and takes the steps it
+    // holds (at least min, at most max_steps_per_frame). Without: exactly one step of
+    // TimeStepSettings::duration whatever dt is. Negative, NaN or infinite dt throws
+    // before anything changes.
+    void update(Real dt);
+    // One step of TimeStepSettings::duration (after ApplyWrites, before the flip).
+    void update();
+
+    // ---- buffered accessors (any thread, concurrently with update) ----
+    MotionState motion_state(BodyHandle body) const;  // interpolated where allowed
+    Vec3 position(BodyHandle body) const;
+    Quat orientation(BodyHandle body) const;
+    Vec3 center_of_mass(BodyHandle body) const;
+    Vec3 linear_velocity(BodyHandle body) const;
+    Vec3 angular_velocity(BodyHandle body) const;
+    void set_position(BodyHandle body, const Vec3& position);           // a teleport
+    void set_orientation(BodyHandle body, const Quat& orientation);     // a teleport
+    void set_linear_velocity(BodyHandle body, const Vec3& velocity);
+    void set_angular_velocity(BodyHandle body, const Vec3& velocity);
+    void set_motion_state(BodyHandle body, const MotionState& state);   // all of it; a teleport
+    // Accumulate until a step consumes them (an update that takes no step loses nothing).
+    void add_force(BodyHandle body, const Vec3& force);    // at the centre of mass, for one step
+    void add_torque(BodyHandle body, const Vec3& torque);  // for one step
+    void apply_impulse(BodyHandle body, const Vec3& impulse);
+    void apply_angular_impulse(BodyHandle body, const Vec3& impulse);
+    void wake(BodyHandle body);
+
+    // ---- internal accessors (update thread, between updates) ----
+    MotionState internal_motion_state(BodyHandle body) const;
+    Vec3 internal_position(BodyHandle body) const;
+    Quat internal_orientation(BodyHandle body) const;
+    Vec3 internal_linear_velocity(BodyHandle body) const;
+    Vec3 internal_angular_velocity(BodyHandle body) const;
+    void set_internal_motion_state(BodyHandle body, const MotionState& state);
+    bool internal_is_awake(BodyHandle body) const;
+    const BodyDesc& internal_desc(BodyHandle body) const;  // as created (shape, material, flags)
+
+    MotionStateManager& motion_states() noexcept;
+    const MotionStateManager& motion_states() const noexcept;
+
+    // Settings: read any time from the update thread; change between updates.
+    const SpaceSettings& settings() const noexcept;
+    void set_time_step(const TimeStepSettings& settings);
+    void set_solver(const SolverSettings& settings);
+    void set_sleep(const SleepSettings& settings);
+    void set_gravity(const Vec3& gravity);
+
+    // What the last update did (update thread).
+    const UpdateStats& last_update() const noexcept;
+    // Totals since creation (update thread).
+    const WorkCounters& counters() const noexcept;
+    // Time banked toward the next step, in seconds (internal time stepping).
+    Real accumulated_time() const noexcept;
+    // FNV-1a over every live body's position and orientation bits, in handle order.
+    std::uint64_t state_hash() const;
+
+    JobSystem& jobs() noexcept;
+    World& world() noexcept { return *m_world; }  // for stages and tests inside the engine
+
+private:
+    std::unique_ptr<World> m_world;
+};
+
+}  // namespace spindle

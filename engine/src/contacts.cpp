@@ -1,0 +1,50 @@
+// Contact bookkeeping: creation from pair keys, removal that keeps the order of the
+// remaining contacts (so the solver's order, and so its result, is deterministic).
+#include <algorithm>
+
+#include "broadphase_stage.hpp"
+#include "stages.hpp"
+
+namespace spindle {
+
+void create_contact(World& world, std::uint64_t key) {
+    if (world.contact_index.count(key)) return;
+    const auto a = static_cast<std::uint32_t>(key >> 32);
+    const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const Bodies& bodies = world.bodies;
+    Contact contact;
+    contact.body_a = a;
+    contact.body_b = b;
+    contact.key = key;
+    // Mixing rules as most engines: geometric mean friction, largest restitution.
+    contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
+    contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
+    world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
+    world.contacts.push_back(std::move(contact));
+}
+
+void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
+    if (positions.empty()) return;
+    for (std::uint32_t p : positions) world.contact_index.erase(world.contacts[p].key);
+    std::size_t next = 0, write = 0;
+    for (std::size_t read = 0; read < world.contacts.size(); ++read) {
+        if (next < positions.size() && positions[next] == read) {
+            ++next;
+            continue;
+        }
+        if (write != read) world.contacts[write] = std::move(world.contacts[read]);
+        world.contact_index[world.contacts[write].key] = static_cast<std::uint32_t>(write);
+        ++write;
+    }
+    world.contacts.resize(write);
+}
+
+void remove_contacts_of(World& world, std::uint32_t slot) {
+    std::vector<std::uint32_t> positions;
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        if (world.contacts[c].body_a == slot || world.contacts[c].body_b == slot) positions.push_back(c);
+    }
+    remove_contacts(world, positions);
+}
+
+}  // namespace spindle

@@ -1,0 +1,64 @@
+// Narrowphase stage: new manifolds for every awake contact, as parallel jobs; each
+// new point takes the impulses of the old point with the same feature id, so the
+// solver warm starts.
+#include <cmath>
+
+#include "stages.hpp"
+
+namespace spindle {
+namespace {
+
+constexpr int kMaxManifolds = 4;
+
+void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
+    for (int j = 0; j < fresh.point_count; ++j) {
+        ContactPoint& p = fresh.points[j];
+        for (int m = 0; m < old_contact.manifold_count; ++m) {
+            const ContactManifold& old = old_contact.manifold_at(m);
+            if (old.normal.dot(fresh.normal) < 0.9) continue;  // a different face of a mesh
+            for (int k = 0; k < old.point_count; ++k) {
+                if (old.points[k].geometry.id != p.geometry.id) continue;
+                p.normal_impulse = old.points[k].normal_impulse;
+                p.tangent_impulse[0] = old.points[k].tangent_impulse[0];
+                p.tangent_impulse[1] = old.points[k].tangent_impulse[1];
+            }
+        }
+    }
+}
+
+}  // namespace
+
+void update_narrowphase(World& world) {
+    const Bodies& b = world.bodies;
+    const SolverSettings& settings = world.settings.solver;
+    const Real dt = world.settings.time_step.duration;
+    const auto count = static_cast<std::uint32_t>(world.contacts.size());
+    world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        Manifold found[kMaxManifolds];
+        for (std::uint32_t c = lo; c < hi; ++c) {
+            Contact& contact = world.contacts[c];
+            if (contact.sleeping) continue;
+            const std::uint32_t a = contact.body_a, bb = contact.body_b;
+            // Speculative contacts reach as far as the bodies can close in one step.
+            const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
+            const Real speculative = settings.speculative_distance + closing;
+            const int n = collide(b.desc[a].shape, b.transform(a), b.desc[bb].shape, b.transform(bb), speculative,
+                                  found, kMaxManifolds);
+            ContactManifold fresh[kMaxManifolds];
+            for (int m = 0; m < n; ++m) {
+                fresh[m].normal = found[m].normal;
+                fresh[m].point_count = found[m].point_count;
+                for (int j = 0; j < found[m].point_count; ++j) fresh[m].points[j].geometry = found[m].points[j];
+                carry_impulses(contact, fresh[m]);
+            }
+            contact.manifold_count = n;
+            if (n > 0) contact.manifold = fresh[0];
+            if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
+        }
+    });
+    std::uint32_t touching = 0;
+    for (const Contact& contact : world.contacts) touching += contact.manifold_count > 0 ? 1u : 0u;
+    world.stats.contacts = touching;
+}
+
+}  // namespace spindle

@@ -1,0 +1,381 @@
+// The contact solver (soft step, as Box2D v3 and Box3D): per step, prepare
+// constraints from the manifolds and colour them; per substep, integrate velocities,
+// warm start, solve with soft position bias, integrate positions, relax without bias;
+// then restitution and storing impulses for the next step's warm start. Each colour is
+// solved as parallel jobs: no two constraints of a colour share a dynamic body, so
+// the result is bitwise the same for any number of workers.
+#include "solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "stages.hpp"
+
+namespace spindle {
+
+Softness make_softness(Real hertz, Real damping_ratio, Real h) {
+    if (hertz == 0) return {0, 1, 0};
+    const Real omega = 2 * kPi * hertz;
+    const Real a1 = 2 * damping_ratio + h * omega;
+    const Real a2 = h * omega * a1;
+    const Real a3 = 1 / (1 + a2);
+    return {omega / a1, a2 * a3, a3};
+}
+
+namespace {
+
+constexpr std::uint32_t kBodyGrain = 128;
+constexpr std::uint32_t kConstraintGrain = 32;
+
+// A tangent basis for a unit normal, the same for the same normal every time.
+void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
+    if (std::abs(n.x()) >= 0.57735) {
+        t1 = Vec3(n.y(), -n.x(), 0).normalized();
+    } else {
+        t1 = Vec3(0, n.z(), -n.y()).normalized();
+    }
+    t2 = n.cross(t1);
+}
+
+Real effective_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir) {
+    const Vec3 rna = ra.cross(dir);
+    const Vec3 rnb = rb.cross(dir);
+    const Real k = A.inv_mass + B.inv_mass + rna.dot(A.inv_inertia * rna) + rnb.dot(B.inv_inertia * rnb);
+    return k > 0 ? 1 / k : 0;
+}
+
+struct Velocities {
+    Vec3 va, wa, vb, wb;
+};
+
+inline Velocities load(const SolverBody& A, const SolverBody& B) { return {A.v, A.w, B.v, B.w}; }
+
+inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
+    // Only dynamic bodies are written: static and kinematic ones are shared by
+    // constraints of every colour.
+    if (A.dynamic) {
+        A.v = s.va;
+        A.w = s.wa;
+    }
+    if (B.dynamic) {
+        B.v = s.vb;
+        B.w = s.wb;
+    }
+}
+
+inline void apply(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& ra, const Vec3& rb,
+                  const Vec3& impulse) {
+    s.va -= A.inv_mass * impulse;
+    s.wa -= A.inv_inertia * ra.cross(impulse);
+    s.vb += B.inv_mass * impulse;
+    s.wb += B.inv_inertia * rb.cross(impulse);
+}
+
+inline Vec3 relative_velocity(const Velocities& s, const Vec3& ra, const Vec3& rb) {
+    return s.vb + s.wb.cross(rb) - s.va - s.wa.cross(ra);
+}
+
+void prepare(World& world, SolverScratch& scratch, Real h) {
+    const Bodies& b = world.bodies;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    scratch.bodies.resize(n + 1);
+    world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t i = world.awake[k];
+            SolverBody& sb = scratch.bodies[k];
+            sb.v = b.v[i];
+            sb.w = b.w[i];
+            sb.dp = Vec3::Zero();
+            sb.dq = Quat::Identity();
+            sb.dynamic = b.type[i] == MotionType::Dynamic;
+            sb.inv_mass = b.inv_mass[i];
+            sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+        }
+    });
+    scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
+
+    // Constraint list: one per touching manifold of an awake contact, in contact order.
+    scratch.constraints.clear();
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const Contact& contact = world.contacts[c];
+        if (contact.sleeping) continue;
+        for (int m = 0; m < contact.manifold_count; ++m) {
+            if (contact.manifold_at(m).point_count == 0) continue;
+            ContactConstraint& cc = scratch.constraints.emplace_back();
+            cc.contact = c;
+            cc.manifold = m;
+        }
+    }
+    auto solver_index = [&](std::uint32_t slot) {
+        const std::int32_t k = b.awake_index[slot];
+        return k >= 0 ? static_cast<std::uint32_t>(k) : n;
+    };
+    const auto count = static_cast<std::uint32_t>(scratch.constraints.size());
+    world.jobs->parallel_for("PrepareContacts", 0, count, kConstraintGrain,
+                             [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            ContactConstraint& cc = scratch.constraints[k];
+            const Contact& contact = world.contacts[cc.contact];
+            const ContactManifold& m = contact.manifold_at(cc.manifold);
+            cc.a = solver_index(contact.body_a);
+            cc.b = solver_index(contact.body_b);
+            const SolverBody& A = scratch.bodies[cc.a];
+            const SolverBody& B = scratch.bodies[cc.b];
+            cc.normal = m.normal;
+            tangent_basis(m.normal, cc.tangent[0], cc.tangent[1]);
+            cc.friction = contact.friction;
+            cc.restitution = contact.restitution;
+            const Vec3 g = world.settings.gravity;
+            cc.gravity_normal = cc.normal.dot((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g -
+                                              (A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g);
+            cc.point_count = m.point_count;
+            const Vec3 xa = b.x[contact.body_a];
+            const Vec3 xb = b.x[contact.body_b];
+            const Velocities s = load(A, B);
+            for (int j = 0; j < m.point_count; ++j) {
+                const ContactPoint& src = m.points[j];
+                ConstraintPoint& p = cc.points[j];
+                p.ra = src.geometry.point - xa;
+                p.rb = src.geometry.point - xb;
+                p.adjusted_separation = src.geometry.separation - cc.normal.dot(p.rb - p.ra);
+                p.normal_mass = effective_mass(A, B, p.ra, p.rb, cc.normal);
+                p.tangent_mass[0] = effective_mass(A, B, p.ra, p.rb, cc.tangent[0]);
+                p.tangent_mass[1] = effective_mass(A, B, p.ra, p.rb, cc.tangent[1]);
+                p.normal_impulse = src.normal_impulse;
+                p.tangent_impulse[0] = src.tangent_impulse[0];
+                p.tangent_impulse[1] = src.tangent_impulse[1];
+                p.max_normal_impulse = 0;
+                p.relative_velocity = cc.normal.dot(relative_velocity(s, p.ra, p.rb));
+            }
+        }
+    });
+    (void)h;
+}
+
+// Greedy colouring in constraint order (deterministic): the first colour whose
+// bodies do not include either dynamic body of the constraint.
+void color(World& world, SolverScratch& scratch) {
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    const std::size_t words = (n + 63) / 64;
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.colors[c].clear();
+        scratch.color_bits[c].assign(words, 0);
+    }
+    scratch.overflow.clear();
+    for (std::uint32_t k = 0; k < scratch.constraints.size(); ++k) {
+        const ContactConstraint& cc = scratch.constraints[k];
+        const bool dyn_a = scratch.bodies[cc.a].dynamic;
+        const bool dyn_b = scratch.bodies[cc.b].dynamic;
+        int chosen = -1;
+        for (int c = 0; c < kColorCount && chosen < 0; ++c) {
+            std::vector<std::uint64_t>& bits = scratch.color_bits[c];
+            if (dyn_a && (bits[cc.a / 64] >> (cc.a % 64) & 1)) continue;
+            if (dyn_b && (bits[cc.b / 64] >> (cc.b % 64) & 1)) continue;
+            if (dyn_a) bits[cc.a / 64] |= std::uint64_t{1} << (cc.a % 64);
+            if (dyn_b) bits[cc.b / 64] |= std::uint64_t{1} << (cc.b % 64);
+            chosen = c;
+        }
+        if (chosen >= 0) {
+            scratch.colors[chosen].push_back(k);
+        } else {
+            scratch.overflow.push_back(k);
+        }
+    }
+}
+
+void warm_start(ContactConstraint& cc, SolverBody* bodies) {
+    SolverBody& A = bodies[cc.a];
+    SolverBody& B = bodies[cc.b];
+    Velocities s = load(A, B);
+    for (int j = 0; j < cc.point_count; ++j) {
+        const ConstraintPoint& p = cc.points[j];
+        const Vec3 impulse =
+            p.normal_impulse * cc.normal + p.tangent_impulse[0] * cc.tangent[0] + p.tangent_impulse[1] * cc.tangent[1];
+        apply(A, B, s, p.ra, p.rb, impulse);
+    }
+    store(A, B, s);
+}
+
+struct SolveParams {
+    Softness soft;
+    Real inv_h = 0;
+    Real push_out = 0;
+    bool use_bias = true;
+};
+
+void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams& params) {
+    SolverBody& A = bodies[cc.a];
+    SolverBody& B = bodies[cc.b];
+    Velocities s = load(A, B);
+    const Vec3 dp = B.dp - A.dp;
+    for (int j = 0; j < cc.point_count; ++j) {
+        ConstraintPoint& p = cc.points[j];
+        // Current separation from the bodies' motion since the step began.
+        const Vec3 d = dp + (B.dq * p.rb - A.dq * p.ra);
+        const Real separation = cc.normal.dot(d) + p.adjusted_separation;
+        Real bias = 0, mass_scale = 1, impulse_scale = 0;
+        if (separation > 0) {
+            bias = separation * params.inv_h;  // speculative: may close the gap, no more
+        } else if (params.use_bias) {
+            bias = std::max(params.soft.bias_rate * separation, -params.push_out);
+            mass_scale = params.soft.mass_scale;
+            impulse_scale = params.soft.impulse_scale;
+        }
+        const Real vn = cc.normal.dot(relative_velocity(s, p.ra, p.rb));
+        Real impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        const Real total = std::max(p.normal_impulse + impulse, Real(0));
+        impulse = total - p.normal_impulse;
+        // Restitution bounces off the approach speed at impact: the speed when the
+        // point first pushes in this step, gravity of the earlier substeps included.
+        if (impulse > 0 && p.max_normal_impulse == 0) p.relative_velocity = std::min(p.relative_velocity, vn);
+        p.normal_impulse = total;
+        p.max_normal_impulse = std::max(p.max_normal_impulse, impulse);
+        apply(A, B, s, p.ra, p.rb, impulse * cc.normal);
+    }
+    if (cc.friction > 0) {
+        for (int j = 0; j < cc.point_count; ++j) {
+            ConstraintPoint& p = cc.points[j];
+            const Vec3 dv = relative_velocity(s, p.ra, p.rb);
+            const Real old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
+            Real new0 = old0 - p.tangent_mass[0] * cc.tangent[0].dot(dv);
+            Real new1 = old1 - p.tangent_mass[1] * cc.tangent[1].dot(dv);
+            // Coulomb's cone: the friction impulse stays within friction x normal impulse.
+            const Real limit = cc.friction * p.normal_impulse;
+            const Real length_sq = new0 * new0 + new1 * new1;
+            if (length_sq > limit * limit) {
+                const Real scale = limit / std::sqrt(length_sq);
+                new0 *= scale;
+                new1 *= scale;
+            }
+            p.tangent_impulse[0] = new0;
+            p.tangent_impulse[1] = new1;
+            apply(A, B, s, p.ra, p.rb, (new0 - old0) * cc.tangent[0] + (new1 - old1) * cc.tangent[1]);
+        }
+    }
+    store(A, B, s);
+}
+
+void apply_restitution(ContactConstraint& cc, SolverBody* bodies, Real threshold, Real h) {
+    if (cc.restitution == 0) return;
+    SolverBody& A = bodies[cc.a];
+    SolverBody& B = bodies[cc.b];
+    Velocities s = load(A, B);
+    for (int j = 0; j < cc.point_count; ++j) {
+        ConstraintPoint& p = cc.points[j];
+        // Only points that approached fast enough and actually pushed bounce.
+        if (p.relative_velocity > -threshold || p.max_normal_impulse == 0) continue;
+        const Real vn = cc.normal.dot(relative_velocity(s, p.ra, p.rb));
+        // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
+        // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
+        const Real approach = p.relative_velocity + cc.gravity_normal * h;
+        Real impulse = -p.normal_mass * (vn + cc.restitution * std::min(approach, Real(0)));
+        const Real total = std::max(p.normal_impulse + impulse, Real(0));
+        impulse = total - p.normal_impulse;
+        p.normal_impulse = total;
+        p.max_normal_impulse = std::max(p.max_normal_impulse, impulse);
+        apply(A, B, s, p.ra, p.rb, impulse * cc.normal);
+    }
+    store(A, B, s);
+}
+
+// Runs fn over every constraint, colour by colour (each colour in parallel), then
+// the overflow serially.
+template <typename F>
+void for_each_colored(World& world, SolverScratch& scratch, const char* name, F&& fn) {
+    for (int c = 0; c < kColorCount; ++c) {
+        const std::vector<std::uint32_t>& list = scratch.colors[c];
+        if (list.empty()) continue;
+        world.jobs->parallel_for(name, 0, static_cast<std::uint32_t>(list.size()), kConstraintGrain,
+                                 [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                                     for (std::uint32_t k = lo; k < hi; ++k) fn(scratch.constraints[list[k]]);
+                                 });
+    }
+    for (std::uint32_t k : scratch.overflow) fn(scratch.constraints[k]);
+}
+
+void finalize(World& world, SolverScratch& scratch) {
+    Bodies& b = world.bodies;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    world.jobs->parallel_for("FinalizeBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t i = world.awake[k];
+            const SolverBody& sb = scratch.bodies[k];
+            b.x[i] += sb.dp;
+            b.q[i] = (sb.dq * b.q[i]).normalized();
+            b.v[i] = sb.v;
+            b.w[i] = sb.w;
+            b.force[i] = Vec3::Zero();  // consumed by this step
+            b.torque[i] = Vec3::Zero();
+        }
+    });
+}
+
+void store_impulses(World& world, SolverScratch& scratch) {
+    const auto count = static_cast<std::uint32_t>(scratch.constraints.size());
+    world.jobs->parallel_for("StoreImpulses", 0, count, kConstraintGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const ContactConstraint& cc = scratch.constraints[k];
+            ContactManifold& m = world.contacts[cc.contact].manifold_at(cc.manifold);
+            for (int j = 0; j < cc.point_count; ++j) {
+                m.points[j].normal_impulse = cc.points[j].normal_impulse;
+                m.points[j].tangent_impulse[0] = cc.points[j].tangent_impulse[0];
+                m.points[j].tangent_impulse[1] = cc.points[j].tangent_impulse[1];
+                m.points[j].max_normal_impulse = cc.points[j].max_normal_impulse;
+                m.points[j].relative_velocity = cc.points[j].relative_velocity;
+            }
+        }
+    });
+}
+
+}  // namespace
+
+void solve(World& world, Real dt) {
+    SolverScratch& scratch = *world.solver;
+    const SolverSettings& settings = world.settings.solver;
+    const int substeps = settings.substeps;
+    const Real h = dt / substeps;
+
+    prepare(world, scratch, h);
+    color(world, scratch);
+    SolverBody* bodies = scratch.bodies.data();
+
+    SolveParams solve_params;
+    // The contact spring may not be stiffer than a quarter of the substep rate.
+    const Real hertz = std::min(settings.contact_hertz, Real(0.25) / h);
+    solve_params.soft = make_softness(hertz, settings.damping_ratio, h);
+    solve_params.inv_h = 1 / h;
+    solve_params.push_out = settings.push_out_speed;
+    SolveParams relax_params = solve_params;
+    relax_params.use_bias = false;
+
+    for (int sub = 0; sub < substeps; ++sub) {
+        integrate_velocities(world, bodies, h);
+        for_each_colored(world, scratch, "WarmStart", [&](ContactConstraint& cc) { warm_start(cc, bodies); });
+        for (int it = 0; it < settings.iterations; ++it) {
+            for_each_colored(world, scratch, "Solve", [&](ContactConstraint& cc) { solve_contact(cc, bodies, solve_params); });
+        }
+        integrate_positions(world, bodies, h);
+        for (int it = 0; it < settings.relax_iterations; ++it) {
+            for_each_colored(world, scratch, "Relax", [&](ContactConstraint& cc) { solve_contact(cc, bodies, relax_params); });
+        }
+    }
+    for_each_colored(world, scratch, "Restitution",
+                     [&](ContactConstraint& cc) { apply_restitution(cc, bodies, settings.restitution_threshold, h); });
+    store_impulses(world, scratch);
+    finalize(world, scratch);
+
+    // Work counters, derived from the constraint set (no per-point counting in the hot loop).
+    std::uint64_t points = 0, friction_points = 0, restitution_points = 0;
+    for (const ContactConstraint& cc : scratch.constraints) {
+        points += static_cast<std::uint64_t>(cc.point_count);
+        if (cc.friction > 0) friction_points += static_cast<std::uint64_t>(cc.point_count);
+        if (cc.restitution > 0) restitution_points += static_cast<std::uint64_t>(cc.point_count);
+    }
+    const auto passes = static_cast<std::uint64_t>(substeps * (settings.iterations + settings.relax_iterations));
+    world.counters.contact_points_solved += points * passes;
+    world.counters.friction_applied += friction_points * passes;
+    world.counters.restitution_applied += restitution_points;
+    world.counters.bodies_integrated += world.awake.size();
+}
+
+}  // namespace spindle

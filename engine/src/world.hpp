@@ -1,0 +1,158 @@
+// World: the live simulation state behind a Space, shared by the stages
+// (one file per stage: buffering.cpp, integrator.cpp, broadphase_stage.cpp,
+// narrowphase.cpp, islands.cpp, solver.cpp, record.cpp). Not thread safe by itself:
+// only the update thread touches it, and stages split work through the JobSystem.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <spindle/engine/body.hpp>
+#include <spindle/engine/collision.hpp>
+#include <spindle/engine/motion_state_manager.hpp>
+#include <spindle/engine/settings.hpp>
+#include <spindle/engine/stats.hpp>
+#include <spindle/scheduler/job_system.hpp>
+
+#include "write_buffer.hpp"
+
+namespace spindle {
+
+struct BroadphaseState;  // broadphase_stage.hpp
+struct SolverScratch;    // solver.hpp
+
+// Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
+// data (pose, velocity, mass) sits in its own arrays; the description (shape,
+// material, flags) is cold and read only when contacts are made or on demand.
+struct Bodies {
+    // Handle table.
+    std::vector<std::uint32_t> generation;  // current generation of each slot (odd history, never 0 when live)
+    std::vector<std::uint8_t> alive;
+    std::vector<std::uint32_t> free_slots;  // LIFO; reused slots get a new generation
+    std::uint32_t live = 0;
+
+    // Hot.
+    std::vector<MotionType> type;
+    std::vector<Vec3> x;   // centre of mass, world
+    std::vector<Quat> q;   // orientation
+    std::vector<Vec3> v;   // linear velocity
+    std::vector<Vec3> w;   // angular velocity, world
+    std::vector<Real> inv_mass;
+    std::vector<Mat3> inv_inertia_local;  // about the centre of mass, body frame
+    std::vector<Vec3> local_com;          // centre of mass in the shape's frame
+    std::vector<Vec3> force;              // accumulated, consumed by the next step
+    std::vector<Vec3> torque;
+    std::vector<Aabb> bounds;             // tight, world
+    std::vector<std::int32_t> proxy;      // broadphase proxy
+    std::vector<std::int32_t> awake_index;  // position in World::awake, -1 if static or asleep
+    std::vector<Real> sleep_time;
+    std::vector<std::int32_t> island;     // sleeping island id, -1 when awake
+
+    // Interpolation history (the last two recorded steps), origin pose.
+    std::vector<Vec3> history_position[2];
+    std::vector<Quat> history_orientation[2];
+    std::vector<std::uint8_t> interpolate;  // allow_interpolation
+
+    // Cold.
+    std::vector<BodyDesc> desc;
+
+    std::uint32_t capacity() const noexcept { return static_cast<std::uint32_t>(generation.size()); }
+    bool is_live(BodyHandle h) const noexcept {
+        return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation && h.generation != 0;
+    }
+    Vec3 origin(std::uint32_t i) const { return x[i] - q[i] * local_com[i]; }
+    Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
+    Mat3 inv_inertia_world(std::uint32_t i) const {
+        const Mat3 r = q[i].toRotationMatrix();
+        return r * inv_inertia_local[i] * r.transpose();
+    }
+};
+
+// One touching manifold with what the solver keeps between steps (impulses, for
+// warm starting, matched by feature id).
+struct ContactPoint {
+    ManifoldPoint geometry;
+    Real normal_impulse = 0;
+    Real tangent_impulse[2] = {0, 0};
+    Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
+    Real relative_velocity = 0;   // normal approach speed before solving (restitution)
+};
+
+struct ContactManifold {
+    Vec3 normal = Vec3::UnitY();
+    int point_count = 0;
+    ContactPoint points[kMaxManifoldPoints];
+};
+
+// A pair of bodies whose fat bounds overlap. Shape A has the lower shape type.
+struct Contact {
+    std::uint32_t body_a = 0, body_b = 0;  // slots
+    std::uint64_t key = 0;                 // (min slot << 32) | max slot
+    Real friction = 0, restitution = 0;
+    int manifold_count = 0;
+    ContactManifold manifold;              // the first (and for convex pairs only) manifold
+    std::vector<ContactManifold> extra;    // further manifolds (triangle meshes)
+    bool sleeping = false;
+
+    ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
+    const ContactManifold& manifold_at(int i) const {
+        return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)];
+    }
+};
+
+// Per-chunk effect counts, merged in chunk order after a parallel stage.
+struct EffectCounts {
+    std::uint64_t gravity = 0, damping = 0, gyro = 0;
+};
+
+// A sleeping island: its bodies and contacts, kept so one touch wakes them together.
+struct SleepingIsland {
+    std::vector<std::uint32_t> bodies;
+    std::vector<std::uint64_t> contacts;
+};
+
+struct World {
+    SpaceSettings settings;
+    JobSystem* jobs = nullptr;
+    std::unique_ptr<JobSystem> own_jobs;  // single-threaded, when none was given
+
+    Bodies bodies;
+    std::vector<std::uint32_t> awake;  // awake dynamic and kinematic bodies, ascending slot order
+
+    // Collision: contacts in a deterministic order (creation order from canonical
+    // pair lists; removal keeps the order of the rest).
+    std::unique_ptr<BroadphaseState> broadphase;
+    std::vector<Contact> contacts;
+    std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
+    std::unique_ptr<SolverScratch> solver;
+
+    // Buffering.
+    WriteBuffer writes;
+    std::vector<BufferedWrite> drained;  // reused by ApplyWrites
+    MotionStateManager motion_states;
+    std::vector<std::uint32_t> changed_now;   // slots whose published state changed outside a step
+    std::vector<std::uint32_t> changed_last;  // the same, one flip ago (the back buffer is two flips old)
+
+    // Time stepping.
+    Real accumulator = 0;
+    std::uint64_t steps = 0;
+
+    UpdateStats stats;
+    WorkCounters counters;
+    std::vector<EffectCounts> scratch_counts;
+    std::vector<std::uint32_t> scratch_lost;
+
+    // Islands.
+    std::vector<SleepingIsland> sleeping_islands;
+    std::vector<std::int32_t> free_islands;
+    std::vector<std::uint32_t> scratch_parent, scratch_sleepers;
+    std::vector<std::int32_t> scratch_island_of_root;
+    std::vector<Real> scratch_rest;
+
+    World();
+    ~World();
+};
+
+}  // namespace spindle
