@@ -265,6 +265,13 @@ void Space::update() {
     run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
 }
 
+void Space::flush() {
+    World& w = *m_world;
+    w.stats = UpdateStats{};
+    run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
+    run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
+}
+
 void step(World& w, Real dt) {
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });

@@ -53,6 +53,9 @@ public:
     void update(Real dt);
     // One step of TimeStepSettings::duration (after ApplyWrites, before the flip).
     void update();
+    // ApplyWrites and FlipReadBuffers without a step: makes every buffered write so
+    // far live and visible (AsyncRunner::stop uses it so no write is lost).
+    void flush();
 
     // ---- buffered accessors (any thread, concurrently with update) ----
     MotionState motion_state(BodyHandle body) const;  // interpolated where allowed
