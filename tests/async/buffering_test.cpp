@@ -1,4 +1,5 @@
 // Buffered and internal properties, motion states and their lock (the seed, section 2).
+#include <spindle/engine/body_object.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
@@ -221,4 +222,30 @@ TEST(MotionStates, HoldingTheLockKeepsThePhysicsThreadFromFlipping) {
     running.store(false);
     physics.join();
     EXPECT_TRUE(stable);
+}
+
+TEST(Buffering, ABodyOutsideASpaceReadsAndWritesItsOwnValues) {
+    Body body(body_at(Vec3(1, 0, 0)));
+    EXPECT_FALSE(body.in_space());
+    body.set_position(Vec3(2, 0, 0));  // direct: visible at once
+    EXPECT_EQ(body.position(), Vec3(2, 0, 0));
+    body.set_linear_velocity(Vec3(0, 0, 6));
+    EXPECT_EQ(body.linear_velocity(), Vec3(0, 0, 6));
+
+    Space space(weightless());
+    body.add_to(space);
+    ASSERT_TRUE(body.in_space());
+    EXPECT_EQ(body.position(), Vec3(2, 0, 0));
+    body.set_position(Vec3(3, 0, 0));  // buffered now: not before the next update
+    EXPECT_EQ(body.position(), Vec3(2, 0, 0));
+    space.update();
+    EXPECT_NEAR(body.position().z(), 0.1, 1e-12);  // 6 m/s for 1/60 s
+    EXPECT_EQ(body.position().x(), 3.0);
+
+    body.remove_from_space();  // keeps its live values
+    EXPECT_FALSE(body.in_space());
+    EXPECT_EQ(space.body_count(), 0u);
+    EXPECT_EQ(body.position().x(), 3.0);
+    body.set_position(Vec3(4, 0, 0));
+    EXPECT_EQ(body.position().x(), 4.0);
 }
