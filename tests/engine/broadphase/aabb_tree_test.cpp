@@ -14,9 +14,9 @@ namespace spindle {
 namespace {
 
 #ifdef NDEBUG
-constexpr int kScale = 4;  // Release: bigger trees
+constexpr int kScale = 8;  // Release: bigger trees
 #else
-constexpr int kScale = 1;  // Debug/ASan: every operation also walks the whole tree
+constexpr int kScale = 2;  // Debug/ASan: every operation also walks the whole tree
 #endif
 
 struct Rng {

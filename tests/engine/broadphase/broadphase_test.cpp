@@ -300,7 +300,7 @@ INSTANTIATE_TEST_SUITE_P(Sizes, BroadphaseScenes,
 #else
 // Debug and sanitizer builds validate both trees after every operation: smaller scenes.
 INSTANTIATE_TEST_SUITE_P(Sizes, BroadphaseScenes,
-                         ::testing::Values(SceneCase{10, 100}, SceneCase{200, 40}, SceneCase{600, 10}));
+                         ::testing::Values(SceneCase{10, 100}, SceneCase{200, 60}, SceneCase{1000, 20}));
 #endif
 
 // Two broadphases fed the same operations, one updated by SingleThreadedJobSystem with
@@ -311,8 +311,8 @@ TEST(Broadphase, UpdatePairs_SameResultForAnyJobSystemAndGrain) {
     const int bodies = 3000;
     const int steps = 30;
 #else
-    const int bodies = 300;
-    const int steps = 10;
+    const int bodies = 600;
+    const int steps = 15;
 #endif
     Scene single(bodies, 7);
     Scene threaded(bodies, 7, BroadphaseSettings{.grain = 3});

@@ -98,6 +98,12 @@ private:
     static_assert(sizeof(Node) == 64, "a node should fill one cache line");
     static constexpr std::int32_t kFreeHeight = -1;
 
+    // Same as Aabb::overlaps, but exits at the first separating axis: most nodes a
+    // query visits are rejected on x alone.
+    static bool overlaps(const Aabb& a, const Aabb& b) noexcept {
+        return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() && b.min.y() <= a.max.y() &&
+               a.min.z() <= b.max.z() && b.min.z() <= a.max.z();
+    }
     void check_proxy(std::int32_t id) const {
         SPINDLE_ASSERT(is_proxy(id), "DynamicAabbTree: not a live proxy id");
         (void)id;
@@ -110,7 +116,7 @@ private:
     void remove_leaf(std::int32_t leaf);
     void refit_upwards(std::int32_t id);
     void refit(std::int32_t id);
-    void rotate(std::int32_t id);
+    bool rotate(std::int32_t id);  // true when it swapped
     void validate_if_enabled() const {
         if (m_settings.validate_each_operation) validate();
     }
@@ -175,7 +181,7 @@ void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
     stack.push(m_root);
     while (!stack.empty()) {
         const Node& node = m_nodes[static_cast<std::size_t>(stack.pop())];
-        if (!node.box.overlaps(box)) continue;
+        if (!overlaps(node.box, box)) continue;
         if (node.height == 0) {
             const auto id = static_cast<std::int32_t>(&node - m_nodes.data());
             if (!callback(id)) return;
