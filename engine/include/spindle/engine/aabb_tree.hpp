@@ -108,6 +108,8 @@ private:
         SPINDLE_ASSERT(is_proxy(id), "DynamicAabbTree: not a live proxy id");
         (void)id;
     }
+    template <typename Enter, typename OnLeaf>
+    void traverse(Enter&& enter, OnLeaf&& on_leaf) const;
     std::int32_t allocate_node();
     void free_node(std::int32_t id);
     Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
@@ -174,17 +176,19 @@ private:
     };
 };
 
-template <typename Callback>
-void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
+// Depth first over the nodes whose box passes enter(box); on_leaf(id) -> bool is called
+// for each such leaf, false stops.
+template <typename Enter, typename OnLeaf>
+void DynamicAabbTree::traverse(Enter&& enter, OnLeaf&& on_leaf) const {
     if (m_root == kNull) return;
     TraversalStack stack;
     stack.push(m_root);
     while (!stack.empty()) {
-        const Node& node = m_nodes[static_cast<std::size_t>(stack.pop())];
-        if (!overlaps(node.box, box)) continue;
+        const std::int32_t id = stack.pop();
+        const Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (!enter(node.box)) continue;
         if (node.height == 0) {
-            const auto id = static_cast<std::int32_t>(&node - m_nodes.data());
-            if (!callback(id)) return;
+            if (!on_leaf(id)) return;
         } else {
             stack.push(node.payload.children.first);
             stack.push(node.payload.children.second);
@@ -193,15 +197,20 @@ void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
 }
 
 template <typename Callback>
+void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
+    traverse([&](const Aabb& node_box) { return overlaps(node_box, box); }, callback);
+}
+
+template <typename Callback>
 void DynamicAabbTree::ray_cast(const Vec3& origin, const Vec3& translation, Real max_fraction,
                                Callback&& callback) const {
-    if (m_root == kNull || !(max_fraction > 0)) return;
-    // Slab test of the segment [0, max_fraction] against a box. Division by a zero
-    // component gives +-inf, which the min/max below handle (origin inside the slab or not).
+    if (!(max_fraction > 0)) return;
+    // Slab test of the segment [0, max_fraction]. Axis-parallel components are tested
+    // apart: the division would give 0 * inf = NaN for an origin on a slab plane.
     const Vec3 inverse = translation.cwiseInverse();
-    auto hits = [&](const Aabb& b, Real limit) {
+    auto hits = [&](const Aabb& b) {
         Real t_enter = 0;
-        Real t_exit = limit;
+        Real t_exit = max_fraction;
         for (int k = 0; k < 3; ++k) {
             if (translation[k] == 0) {
                 if (origin[k] < b.min[k] || origin[k] > b.max[k]) return false;
@@ -216,21 +225,12 @@ void DynamicAabbTree::ray_cast(const Vec3& origin, const Vec3& translation, Real
         }
         return true;
     };
-    TraversalStack stack;
-    stack.push(m_root);
-    while (!stack.empty()) {
-        const Node& node = m_nodes[static_cast<std::size_t>(stack.pop())];
-        if (!hits(node.box, max_fraction)) continue;
-        if (node.height == 0) {
-            const auto id = static_cast<std::int32_t>(&node - m_nodes.data());
-            const Real result = callback(id, max_fraction);
-            if (result == 0) return;
-            if (result > 0 && result < max_fraction) max_fraction = result;
-        } else {
-            stack.push(node.payload.children.first);
-            stack.push(node.payload.children.second);
-        }
-    }
+    traverse(hits, [&](std::int32_t id) {
+        const Real result = callback(id, max_fraction);
+        if (result == 0) return false;
+        if (result > 0 && result < max_fraction) max_fraction = result;
+        return true;
+    });
 }
 
 }  // namespace spindle
