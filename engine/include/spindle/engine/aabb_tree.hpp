@@ -1,0 +1,236 @@
+// DynamicAabbTree: a bounding volume hierarchy over fattened AABBs, updated incrementally
+// (insert by cheapest SAH sibling, rebalance by tree rotations) or rebuilt in bulk.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <spindle/engine/math.hpp>
+#include <spindle/platform/assert.hpp>
+
+namespace spindle {
+
+struct AabbTreeSettings {
+    // Added on every side of a proxy's tight box, so small motions do not touch the tree.
+    Real margin = Real(0.1);
+    // The fat box is also stretched by this times the displacement passed to move_proxy,
+    // so a speculative contact finds its pair before the bodies get there.
+    Real displacement_multiplier = Real(2);
+    // Walk the whole tree after every change (O(n) each). On by default where
+    // SPINDLE_VALIDATE is on; big debug scenes may turn it off.
+    bool validate_each_operation = SPINDLE_VALIDATE_ENABLED != 0;
+};
+
+// Proxy ids are leaf node indices: stable for the proxy's life (moves and rebuild() keep
+// them) and reused after destroy_proxy. Not thread safe for writes; query(), ray_cast()
+// and the accessors are const and may run on many threads at once while nothing writes.
+class DynamicAabbTree {
+public:
+    static constexpr std::int32_t kNull = -1;
+
+    explicit DynamicAabbTree(AabbTreeSettings settings = {});
+
+    // Adds a proxy whose fat box is `tight` grown by the margin. Returns its id.
+    std::int32_t create_proxy(const Aabb& tight, std::uint64_t user);
+    void destroy_proxy(std::int32_t id);
+    // Returns true when the proxy was re-inserted with a new fat box: when `tight` left
+    // the fat box, or when the fat box is far bigger than needed (a fast body stopped).
+    // The new fat box is `tight` grown by the margin and stretched along the displacement.
+    bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement);
+
+    // Calls callback(id) -> bool for every proxy whose fat box overlaps `box`; false stops.
+    template <typename Callback>
+    void query(const Aabb& box, Callback&& callback) const;
+
+    // Casts the segment origin + t * translation, t in [0, max_fraction], against fat
+    // boxes. callback(id, max_fraction) -> Real returns: a negative value to ignore the
+    // proxy, 0 to stop, or a fraction in (0, max_fraction] that clips the segment.
+    template <typename Callback>
+    void ray_cast(const Vec3& origin, const Vec3& translation, Real max_fraction, Callback&& callback) const;
+
+    // Rebuilds every internal node top down with a binned surface area heuristic. Proxy
+    // ids, fat boxes and user values are unchanged. For trees built in bulk (static).
+    void rebuild();
+
+    const Aabb& fat_aabb(std::int32_t id) const {
+        check_proxy(id);
+        return m_nodes[static_cast<std::size_t>(id)].box;
+    }
+    std::uint64_t user(std::int32_t id) const {
+        check_proxy(id);
+        return m_nodes[static_cast<std::size_t>(id)].payload.user;
+    }
+    bool is_proxy(std::int32_t id) const noexcept {
+        return id >= 0 && static_cast<std::size_t>(id) < m_nodes.size() &&
+               m_nodes[static_cast<std::size_t>(id)].height == 0;
+    }
+    // Height of the root; 0 for one proxy or none.
+    int height() const noexcept { return m_root == kNull ? 0 : m_nodes[static_cast<std::size_t>(m_root)].height; }
+    std::int32_t proxy_count() const noexcept { return m_proxy_count; }
+    // Nodes allocated so far (used and free); constant in steady state.
+    std::size_t node_capacity() const noexcept { return m_nodes.size(); }
+    // Sum of the internal nodes' half areas: the SAH cost of a query, for tests and benches.
+    Real area_cost() const;
+    const AabbTreeSettings& settings() const noexcept { return m_settings; }
+
+    // Walks the whole tree and free list: parent links, boxes containing children, heights,
+    // proxy and free counts. A failure calls the assert handler, in every build type.
+    void validate() const;
+
+private:
+    struct Children {
+        std::int32_t first;
+        std::int32_t second;
+    };
+    // One cache line per node: a query reads a node's box and its children together, and
+    // a leaf's user value sits where an internal node keeps its children (a node is one
+    // or the other for its whole life), which keeps the node at 64 bytes.
+    struct alignas(64) Node {
+        Aabb box;
+        union Payload {
+            Children children;    // internal nodes (height > 0)
+            std::uint64_t user;   // leaves (height == 0)
+        } payload;
+        std::int32_t parent_or_next;  // parent while used, next free node while free
+        std::int32_t height;          // 0 leaf, > 0 internal, kFreeHeight on the free list
+    };
+    static_assert(sizeof(Node) == 64, "a node should fill one cache line");
+    static constexpr std::int32_t kFreeHeight = -1;
+
+    // Same as Aabb::overlaps, but exits at the first separating axis: most nodes a
+    // query visits are rejected on x alone.
+    static bool overlaps(const Aabb& a, const Aabb& b) noexcept {
+        return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() && b.min.y() <= a.max.y() &&
+               a.min.z() <= b.max.z() && b.min.z() <= a.max.z();
+    }
+    void check_proxy(std::int32_t id) const {
+        SPINDLE_ASSERT(is_proxy(id), "DynamicAabbTree: not a live proxy id");
+        (void)id;
+    }
+    template <typename Enter, typename OnLeaf>
+    void traverse(Enter&& enter, OnLeaf&& on_leaf) const;
+    std::int32_t allocate_node();
+    void free_node(std::int32_t id);
+    Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
+    std::int32_t find_best_sibling(const Aabb& box) const;
+    void insert_leaf(std::int32_t leaf);
+    void remove_leaf(std::int32_t leaf);
+    void refit_upwards(std::int32_t id);
+    void refit(std::int32_t id);
+    bool rotate(std::int32_t id);  // true when it swapped
+    void validate_if_enabled() const {
+        if (m_settings.validate_each_operation) validate();
+    }
+    // rebuild() helpers (aabb_tree_build.cpp).
+    std::uint32_t partition_sah(std::uint32_t begin, std::uint32_t end);
+
+    AabbTreeSettings m_settings;
+    std::vector<Node> m_nodes;
+    std::int32_t m_root = kNull;
+    std::int32_t m_free_list = kNull;
+    std::int32_t m_proxy_count = 0;
+    std::int32_t m_free_count = 0;
+
+    // Scratch for rebuild(), kept so that a rebuild in steady state does not allocate.
+    struct BuildLeaf {
+        std::int32_t id;
+        Vec3 center;
+    };
+    struct BuildTask {
+        std::int32_t parent;
+        int slot;
+        std::uint32_t begin;
+        std::uint32_t end;
+    };
+    std::vector<BuildLeaf> m_build_leaves;
+    std::vector<BuildTask> m_build_tasks;
+    std::vector<std::int32_t> m_build_order;
+
+    // A traversal stack that lives on the C++ stack and spills to the heap only for
+    // trees deeper than any balanced tree gets (a pathological rebuild()).
+    class TraversalStack {
+    public:
+        void push(std::int32_t id) {
+            if (m_size < kInline) {
+                m_inline[m_size++] = id;
+            } else {
+                m_spill.push_back(id);
+                ++m_size;
+            }
+        }
+        std::int32_t pop() {
+            --m_size;
+            if (m_size < kInline) return m_inline[m_size];
+            const std::int32_t id = m_spill.back();
+            m_spill.pop_back();
+            return id;
+        }
+        bool empty() const noexcept { return m_size == 0; }
+
+    private:
+        static constexpr std::size_t kInline = 128;
+        std::int32_t m_inline[kInline];
+        std::size_t m_size = 0;
+        std::vector<std::int32_t> m_spill;
+    };
+};
+
+// Depth first over the nodes whose box passes enter(box); on_leaf(id) -> bool is called
+// for each such leaf, false stops.
+template <typename Enter, typename OnLeaf>
+void DynamicAabbTree::traverse(Enter&& enter, OnLeaf&& on_leaf) const {
+    if (m_root == kNull) return;
+    TraversalStack stack;
+    stack.push(m_root);
+    while (!stack.empty()) {
+        const std::int32_t id = stack.pop();
+        const Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (!enter(node.box)) continue;
+        if (node.height == 0) {
+            if (!on_leaf(id)) return;
+        } else {
+            stack.push(node.payload.children.first);
+            stack.push(node.payload.children.second);
+        }
+    }
+}
+
+template <typename Callback>
+void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
+    traverse([&](const Aabb& node_box) { return overlaps(node_box, box); }, callback);
+}
+
+template <typename Callback>
+void DynamicAabbTree::ray_cast(const Vec3& origin, const Vec3& translation, Real max_fraction,
+                               Callback&& callback) const {
+    if (!(max_fraction > 0)) return;
+    // Slab test of the segment [0, max_fraction]. Axis-parallel components are tested
+    // apart: the division would give 0 * inf = NaN for an origin on a slab plane.
+    const Vec3 inverse = translation.cwiseInverse();
+    auto hits = [&](const Aabb& b) {
+        Real t_enter = 0;
+        Real t_exit = max_fraction;
+        for (int k = 0; k < 3; ++k) {
+            if (translation[k] == 0) {
+                if (origin[k] < b.min[k] || origin[k] > b.max[k]) return false;
+                continue;
+            }
+            Real t1 = (b.min[k] - origin[k]) * inverse[k];
+            Real t2 = (b.max[k] - origin[k]) * inverse[k];
+            if (t1 > t2) std::swap(t1, t2);
+            t_enter = t1 > t_enter ? t1 : t_enter;
+            t_exit = t2 < t_exit ? t2 : t_exit;
+            if (t_enter > t_exit) return false;
+        }
+        return true;
+    };
+    traverse(hits, [&](std::int32_t id) {
+        const Real result = callback(id, max_fraction);
+        if (result == 0) return false;
+        if (result > 0 && result < max_fraction) max_fraction = result;
+        return true;
+    });
+}
+
+}  // namespace spindle
