@@ -4,6 +4,7 @@
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "broadphase_stage.hpp"
 #include "stages.hpp"
 
 namespace spindle {
@@ -134,6 +135,7 @@ void Space::set_internal_motion_state(BodyHandle body, const MotionState& state)
         wake_body(*m_world, i);
     }
     b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+    refresh_proxy(*m_world, i);
     m_world->changed_now.push_back(i);
 }
 

@@ -1,6 +1,5 @@
-// Broadphase stage: bounds of awake bodies, new pairs -> contacts, contacts whose
-// fat bounds separated -> removed. (Brute force over the fat bounds for now; the
-// dynamic AABB tree replaces the pair search.)
+// Broadphase stage: bounds of awake bodies, proxies moved in the AABB tree, new pairs
+// -> contacts, contacts whose fat bounds separated -> removed.
 #include <algorithm>
 
 #include "broadphase_stage.hpp"
@@ -9,28 +8,30 @@
 namespace spindle {
 namespace {
 
-constexpr Real kAabbMargin = 0.1;  // m: fat bounds need not be refreshed for small moves
-
-Aabb fat_bounds(const World& world, std::uint32_t i, Real dt) {
-    const Bodies& b = world.bodies;
-    Aabb box = b.bounds[i].fattened(kAabbMargin);
-    // Enlarged along the motion so speculative contacts are found ahead of it.
-    const Vec3 d = b.v[i] * dt;
-    box.min += d.cwiseMin(Vec3::Zero());
-    box.max += d.cwiseMax(Vec3::Zero());
-    return box;
+bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
+    // Two bodies that cannot move each other make no contact.
+    return b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic;
 }
 
 }  // namespace
 
 void add_proxy(World& world, std::uint32_t slot) {
     BroadphaseState& bp = *world.broadphase;
-    if (bp.fat.size() <= slot) bp.fat.resize(slot + 1);
-    bp.fat[slot] = fat_bounds(world, slot, world.settings.time_step.duration);
-    world.bodies.proxy[slot] = static_cast<std::int32_t>(slot);
+    const Bodies& b = world.bodies;
+    if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
+    bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
 }
 
-void remove_proxy(World& world, std::uint32_t slot) { world.bodies.proxy[slot] = -1; }
+void remove_proxy(World& world, std::uint32_t slot) {
+    BroadphaseState& bp = *world.broadphase;
+    bp.tree.destroy_proxy(bp.proxy[slot]);
+    bp.proxy[slot] = ProxyId{};
+}
+
+void refresh_proxy(World& world, std::uint32_t slot) {
+    BroadphaseState& bp = *world.broadphase;
+    bp.tree.move_proxy(bp.proxy[slot], world.bodies.bounds[slot], Vec3::Zero());
+}
 
 void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
@@ -40,24 +41,19 @@ void update_broadphase(World& world, Real dt) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
-            bp.fat[i] = fat_bounds(world, i, dt);
         }
     });
-    // New pairs: every awake body against every other live body, in slot order.
-    bp.new_pairs.clear();
-    for (std::uint32_t i : world.awake) {
-        for (std::uint32_t j = 0; j < b.capacity(); ++j) {
-            if (j == i || !b.alive[j]) continue;
-            if (b.awake_index[j] >= 0 && j < i) continue;  // awake pairs once
-            if (b.type[i] != MotionType::Dynamic && b.type[j] != MotionType::Dynamic) continue;
-            if (!bp.fat[i].overlaps(bp.fat[j])) continue;
-            const std::uint64_t key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
-            if (!world.contact_index.count(key)) bp.new_pairs.push_back(key);
-        }
+    // The tree is single-writer; moves are cheap unless a body leaves its fat box.
+    for (std::uint32_t i : world.awake) bp.tree.move_proxy(bp.proxy[i], b.bounds[i], b.v[i] * dt);
+
+    bp.pairs.clear();
+    bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count
+    for (const Pair& pair : bp.pairs) {
+        const auto i = static_cast<std::uint32_t>(pair.user_a);
+        const auto j = static_cast<std::uint32_t>(pair.user_b);
+        if (!can_collide(b, i, j)) continue;
+        create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
     }
-    std::sort(bp.new_pairs.begin(), bp.new_pairs.end());
-    bp.new_pairs.erase(std::unique(bp.new_pairs.begin(), bp.new_pairs.end()), bp.new_pairs.end());
-    for (std::uint64_t key : bp.new_pairs) create_contact(world, key);
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
@@ -65,7 +61,7 @@ void update_broadphase(World& world, Real dt) {
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         const Contact& contact = world.contacts[c];
         if (contact.sleeping) continue;
-        if (!bp.fat[contact.body_a].overlaps(bp.fat[contact.body_b])) lost.push_back(c);
+        if (!bp.tree.test_overlap(bp.proxy[contact.body_a], bp.proxy[contact.body_b])) lost.push_back(c);
     }
     remove_contacts(world, lost);
 }

@@ -4,17 +4,22 @@
 #include <cstdint>
 #include <vector>
 
+#include <spindle/engine/broadphase.hpp>
+
 #include "world.hpp"
 
 namespace spindle {
 
 struct BroadphaseState {
-    std::vector<Aabb> fat;                   // per body slot: bounds grown by the margin and the motion
-    std::vector<std::uint64_t> new_pairs;    // scratch: keys of pairs found this step
+    Broadphase tree;               // moving and static AABB trees; proxy user value = body slot
+    std::vector<ProxyId> proxy;    // per body slot
+    std::vector<Pair> pairs;       // scratch: pairs found this step (kept: no allocation per step)
 };
 
 void add_proxy(World& world, std::uint32_t slot);
 void remove_proxy(World& world, std::uint32_t slot);
+// Re-fits a proxy to the body's current bounds (a teleport, or a static body moved).
+void refresh_proxy(World& world, std::uint32_t slot);
 // Removes every contact of a body (destroy_body).
 void remove_contacts_of(World& world, std::uint32_t slot);
 // Creates a contact for a pair key (min slot << 32 | max slot) if there is none.

@@ -2,6 +2,7 @@
 // (live state -> published buffer, swapped under the motion-state lock).
 #include <algorithm>
 
+#include "broadphase_stage.hpp"
 #include "stages.hpp"
 
 namespace spindle {
@@ -65,6 +66,7 @@ void apply_writes(World& world) {
         if (moves) wake_body(world, i);
         if (write.kind <= WriteKind::MotionState) {
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
         world.stats.writes_applied += 1;

@@ -149,7 +149,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         b.alive.push_back(0);
         grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
         grow(b.inv_inertia_local, n), grow(b.local_com, n), grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
-        grow(b.proxy, n), grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
+        grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
         grow(b.history_position[0], n), grow(b.history_position[1], n);
         grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
     }

@@ -45,7 +45,6 @@ struct Bodies {
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
     std::vector<Aabb> bounds;             // tight, world
-    std::vector<std::int32_t> proxy;      // broadphase proxy
     std::vector<std::int32_t> awake_index;  // position in World::awake, -1 if static or asleep
     std::vector<Real> sleep_time;
     std::vector<std::int32_t> island;     // sleeping island id, -1 when awake
