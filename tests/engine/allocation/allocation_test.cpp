@@ -1,0 +1,62 @@
+// A steady-state step allocates nothing: a counting global operator new proves it.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+    if (void* p = std::malloc(size ? size : 1)) return p;
+    throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, std::align_val_t align) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+    const auto a = static_cast<std::size_t>(align);
+    if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
+    throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t align) { return operator new(size, align); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+using namespace spindle;
+
+TEST(Allocation, SteadyStateStepAllocatesNothing) {
+    SpaceSettings settings;
+    settings.sleep.enabled = false;  // resting but awake: the full pipeline runs every step
+    settings.time_step.use_internal_time_stepping = true;
+    Space space(settings);
+    BodyDesc ground;
+    ground.type = MotionType::Static;
+    ground.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(ground);
+    for (int i = 0; i < 10; ++i) {
+        for (int k = 0; k < 10; ++k) {
+            BodyDesc d;
+            d.shape = (i + k) % 2 ? Shape::sphere(0.5) : Shape::box(Vec3(0.5, 0.5, 0.5));
+            d.position = Vec3(1.5 * i, 0.5, 1.5 * k);
+            space.create_body(d);
+        }
+    }
+    for (int i = 0; i < 120; ++i) space.update(1.0 / 60.0);  // settle: contacts made, buffers sized
+    const long before = g_allocations.load();
+    ASSERT_GT(before, 100) << "the counter must see the engine's allocations (setup makes many)";
+    for (int i = 0; i < 120; ++i) space.update(1.0 / 60.0);
+    const long during = g_allocations.load() - before;
+    EXPECT_EQ(space.last_update().contacts, 100u);
+    EXPECT_EQ(during, 0) << "allocations in 120 steady-state steps";
+}
