@@ -58,9 +58,8 @@ void update_broadphase(World& world, Real dt) {
     // Lost pairs: awake contacts whose fat bounds no longer overlap.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
-    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+    for (std::uint32_t c : awake_contacts(world)) {
         const Contact& contact = world.contacts[c];
-        if (contact.sleeping) continue;
         if (!bp.tree.test_overlap(bp.proxy[contact.body_a], bp.proxy[contact.body_b])) lost.push_back(c);
     }
     remove_contacts(world, lost);

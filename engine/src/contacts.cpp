@@ -21,6 +21,18 @@ void create_contact(World& world, std::uint64_t key) {
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contacts.push_back(std::move(contact));
+    world.awake_contacts_dirty = true;
+}
+
+const std::vector<std::uint32_t>& awake_contacts(World& world) {
+    if (world.awake_contacts_dirty) {
+        world.awake_contact_list.clear();
+        for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+            if (!world.contacts[c].sleeping) world.awake_contact_list.push_back(c);
+        }
+        world.awake_contacts_dirty = false;
+    }
+    return world.awake_contact_list;
 }
 
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
@@ -37,6 +49,7 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
         ++write;
     }
     world.contacts.resize(write);
+    world.awake_contacts_dirty = true;
 }
 
 void remove_contacts_of(World& world, std::uint32_t slot) {

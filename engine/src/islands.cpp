@@ -40,6 +40,7 @@ void wake_body(World& world, std::uint32_t slot) {
         auto it = world.contact_index.find(key);
         if (it != world.contact_index.end()) world.contacts[it->second].sleeping = false;
     }
+    world.awake_contacts_dirty = true;
     sleeping.bodies.clear();
     sleeping.contacts.clear();
     world.free_islands.push_back(island);
@@ -50,9 +51,9 @@ void update_islands(World& world, Real dt) {
     const SleepSettings& sleep = world.settings.sleep;
 
     // Contacts between an awake body and a sleeping one wake the sleeper's island.
-    for (std::size_t c = 0; c < world.contacts.size(); ++c) {
-        const Contact& contact = world.contacts[c];
-        if (contact.sleeping || !touching(contact)) continue;
+    for (std::size_t k = 0; k < awake_contacts(world).size(); ++k) {  // wake_body may rebuild the list
+        const Contact& contact = world.contacts[awake_contacts(world)[k]];
+        if (!touching(contact)) continue;
         const bool awake_a = b.awake_index[contact.body_a] >= 0, awake_b = b.awake_index[contact.body_b] >= 0;
         if (awake_a && !awake_b && b.type[contact.body_b] == MotionType::Dynamic) wake_body(world, contact.body_b);
         if (awake_b && !awake_a && b.type[contact.body_a] == MotionType::Dynamic) wake_body(world, contact.body_a);
@@ -72,8 +73,9 @@ void update_islands(World& world, Real dt) {
     std::vector<std::uint32_t>& parent = world.scratch_parent;
     parent.resize(n);
     std::iota(parent.begin(), parent.end(), 0u);
-    for (const Contact& contact : world.contacts) {
-        if (contact.sleeping || !touching(contact)) continue;
+    for (std::uint32_t c : awake_contacts(world)) {
+        const Contact& contact = world.contacts[c];
+        if (!touching(contact)) continue;
         if (b.type[contact.body_a] != MotionType::Dynamic || b.type[contact.body_b] != MotionType::Dynamic) continue;
         const std::int32_t ia = b.awake_index[contact.body_a], ib = b.awake_index[contact.body_b];
         if (ia < 0 || ib < 0) continue;
@@ -129,8 +131,8 @@ void update_islands(World& world, Real dt) {
         world.changed_now.push_back(slot);
     }
     // Contacts with no awake partner left sleep with their island.
-    for (Contact& contact : world.contacts) {
-        if (contact.sleeping) continue;
+    for (std::uint32_t c : awake_contacts(world)) {
+        Contact& contact = world.contacts[c];
         if (b.awake_index[contact.body_a] >= 0 || b.awake_index[contact.body_b] >= 0) continue;
         contact.sleeping = true;
         // Recorded in both islands when they differ, so waking either revives it.
@@ -138,6 +140,7 @@ void update_islands(World& world, Real dt) {
         if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].contacts.push_back(contact.key);
         if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].contacts.push_back(contact.key);
     }
+    world.awake_contacts_dirty = true;
 }
 
 }  // namespace spindle

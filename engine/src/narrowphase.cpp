@@ -32,12 +32,12 @@ void update_narrowphase(World& world) {
     const Bodies& b = world.bodies;
     const SolverSettings& settings = world.settings.solver;
     const Real dt = world.settings.time_step.duration;
-    const auto count = static_cast<std::uint32_t>(world.contacts.size());
+    const std::vector<std::uint32_t>& awake = awake_contacts(world);
+    const auto count = static_cast<std::uint32_t>(awake.size());
     world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         Manifold found[kMaxManifolds];
-        for (std::uint32_t c = lo; c < hi; ++c) {
-            Contact& contact = world.contacts[c];
-            if (contact.sleeping) continue;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            Contact& contact = world.contacts[awake[k]];
             const std::uint32_t a = contact.body_a, bb = contact.body_b;
             // Speculative contacts reach as far as the bodies can close in one step.
             const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
@@ -57,8 +57,9 @@ void update_narrowphase(World& world) {
         }
     });
     std::uint32_t touching = 0;
-    for (const Contact& contact : world.contacts) touching += contact.manifold_count > 0 ? 1u : 0u;
+    for (std::uint32_t c : awake) touching += world.contacts[c].manifold_count > 0 ? 1u : 0u;
     world.stats.contacts = touching;
+    world.counters.contacts_updated += count;
 }
 
 }  // namespace spindle

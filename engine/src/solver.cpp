@@ -96,9 +96,8 @@ void prepare(World& world, SolverScratch& scratch, Real h) {
 
     // Constraint list: one per touching manifold of an awake contact, in contact order.
     scratch.constraints.clear();
-    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+    for (std::uint32_t c : awake_contacts(world)) {
         const Contact& contact = world.contacts[c];
-        if (contact.sleeping) continue;
         for (int m = 0; m < contact.manifold_count; ++m) {
             if (contact.manifold_at(m).point_count == 0) continue;
             ContactConstraint& cc = scratch.constraints.emplace_back();

@@ -27,6 +27,8 @@ void record(World& world);
 
 // One step of dt: collide, islands, solve, record (space.cpp).
 void step(World& world, Real dt);
+// The positions of the awake contacts, ascending (contacts.cpp).
+const std::vector<std::uint32_t>& awake_contacts(World& world);
 // Body bookkeeping shared by stages (space.cpp).
 void set_awake(World& world, std::uint32_t slot, bool awake);
 // Wakes a body and, if it sleeps, its whole island (islands.cpp).

@@ -39,12 +39,12 @@ struct WorkCounters {
     std::uint64_t gravity_applied = 0;         // body-substeps with gravity
     std::uint64_t damping_applied = 0;         // body-substeps with damping
     std::uint64_t gyroscopic_applied = 0;      // body-substeps with gyroscopic torque
+    std::uint64_t contacts_updated = 0;        // contact-steps through the narrowphase
     std::uint64_t contact_points_solved = 0;   // point-iterations in the contact solver
     std::uint64_t restitution_applied = 0;     // points with restitution > 0 checked
     std::uint64_t friction_applied = 0;        // point-iterations with friction > 0
     std::uint64_t joints_solved = 0;           // joint-iterations
     std::uint64_t swept_tests = 0;             // continuous-collision sweeps
-    std::uint64_t sleeping_bodies_touched = 0; // must stay 0: a sleeping island costs nothing
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
 };
 

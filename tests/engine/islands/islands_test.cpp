@@ -1,0 +1,104 @@
+// Islands and sleeping: resting islands sleep as a whole, cost nothing while asleep,
+// and wake together when written to or touched by an awake body.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+using namespace spindle;
+
+namespace {
+
+struct Row {
+    Space space;
+    std::vector<BodyHandle> balls;  // touching each other: one island
+};
+
+// Five balls in a touching row on the ground, and one far away.
+void build(Row& row) {
+    BodyDesc ground;
+    ground.type = MotionType::Static;
+    ground.shape = Shape::plane(Vec3::UnitY(), 0);
+    row.space.create_body(ground);
+    for (int i = 0; i < 5; ++i) {
+        BodyDesc d;
+        d.shape = Shape::sphere(0.5);
+        d.position = Vec3(0.999 * i, 0.5, 0);
+        row.balls.push_back(row.space.create_body(d));
+    }
+}
+
+bool all_asleep(const Row& row) {
+    for (BodyHandle b : row.balls) {
+        if (row.space.internal_is_awake(b)) return false;
+    }
+    return true;
+}
+
+void settle(Row& row) {
+    for (int i = 0; i < 300 && !all_asleep(row); ++i) row.space.update();
+    ASSERT_TRUE(all_asleep(row));
+}
+
+}  // namespace
+
+TEST(Islands, RestingIslandSleepsAndCostsNothing) {
+    Row row;
+    build(row);
+    settle(row);
+    const WorkCounters before = row.space.counters();
+    for (int i = 0; i < 60; ++i) row.space.update();
+    const WorkCounters& after = row.space.counters();
+    EXPECT_EQ(after.bodies_integrated, before.bodies_integrated);
+    EXPECT_EQ(after.contacts_updated, before.contacts_updated);
+    EXPECT_EQ(after.contact_points_solved, before.contact_points_solved);
+    EXPECT_EQ(after.gravity_applied, before.gravity_applied);
+    EXPECT_EQ(row.space.last_update().awake_bodies, 0u);
+    for (BodyHandle b : row.balls) EXPECT_NEAR(row.space.position(b).y(), 0.5, 0.01);
+}
+
+TEST(Islands, AWriteWakesTheWholeIsland) {
+    Row row;
+    build(row);
+    settle(row);
+    row.space.set_linear_velocity(row.balls[4], Vec3(0, 0, 1));
+    row.space.update();
+    for (BodyHandle b : row.balls) EXPECT_TRUE(row.space.internal_is_awake(b));
+}
+
+TEST(Islands, AContactFromAnAwakeBodyWakesTheIsland) {
+    Row row;
+    build(row);
+    settle(row);
+    BodyDesc dropped;
+    dropped.shape = Shape::sphere(0.5);
+    dropped.position = Vec3(2, 3, 0);
+    row.space.create_body(dropped);
+    bool woke = false;
+    for (int i = 0; i < 90 && !woke; ++i) {
+        row.space.update();
+        woke = row.space.internal_is_awake(row.balls[0]);
+    }
+    EXPECT_TRUE(woke);
+}
+
+TEST(Islands, AnUnrelatedBodyDoesNotWakeTheIsland) {
+    Row row;
+    build(row);
+    settle(row);
+    BodyDesc far;
+    far.shape = Shape::sphere(0.5);
+    far.position = Vec3(50, 5, 0);
+    row.space.create_body(far);
+    for (int i = 0; i < 30; ++i) row.space.update();
+    EXPECT_TRUE(all_asleep(row));
+}
+
+TEST(Islands, SleepCanBeDisabled) {
+    Row row;
+    row.space.set_sleep(SleepSettings{.enabled = false});
+    build(row);
+    for (int i = 0; i < 300; ++i) row.space.update();
+    for (BodyHandle b : row.balls) EXPECT_TRUE(row.space.internal_is_awake(b));
+}
