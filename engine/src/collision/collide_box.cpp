@@ -1,0 +1,165 @@
+// Box-box: separating axis test over the 15 axes (3 + 3 face normals, 9 edge
+// cross products), then the incident face clipped against the reference face, or a
+// single point between the two closest edges.
+#include <cmath>
+
+#include "contact.hpp"
+#include "pair_functions.hpp"
+
+namespace spindle::detail {
+namespace {
+
+struct BoxAxis {
+    Real separation = -kHuge;
+    int index = -1;  // face axis 0..2, or edge pair 3 * i + j
+};
+
+// Reference box r (half extents hr) and incident box i (hi, rotation ri and centre ti in
+// r's frame). Writes the clipped points in r's frame; n is r's face normal pointing at i.
+int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3& ti, int axis, Real speculative,
+                     bool reference_is_b, Vec3& n, ContactCandidate* out) {
+    const Real sign = ti[axis] < 0 ? -1 : 1;
+    n = Vec3::Zero();
+    n[axis] = sign;
+    const auto reference_face = static_cast<std::uint32_t>(2 * axis + (sign < 0 ? 1 : 0));
+
+    // Incident face: the face of i whose normal is most against n.
+    const Vec3 along = ri.transpose() * n;
+    int j = 0;
+    for (int k = 1; k < 3; ++k) {
+        if (std::abs(along[k]) > std::abs(along[j])) j = k;
+    }
+    const auto incident_face = static_cast<std::uint32_t>(2 * j + (along[j] > 0 ? 1 : 0));
+    const BoxPoly incident_box(hi);
+    const PolyView view = incident_box.view();
+    const HullFace& face = view.faces[incident_face];
+    Vec3 quad[4];
+    for (std::uint32_t k = 0; k < 4; ++k) quad[k] = ri * view.face_vertex(face, k) + ti;
+
+    ClipVertex buffer_a[8], buffer_b[8];
+    int count = start_clip_polygon(quad, 4, buffer_a);
+    ClipVertex* in = buffer_a;
+    ClipVertex* next = buffer_b;
+    std::uint32_t side = 0;
+    for (int k = 1; k <= 2; ++k) {
+        const int u = (axis + k) % 3;
+        for (const Real s : {Real(1), Real(-1)}) {
+            Vec3 plane_normal = Vec3::Zero();
+            plane_normal[u] = s;
+            count = clip_polygon(in, count, {plane_normal, hr[u]}, side++, next);
+            std::swap(in, next);
+        }
+    }
+    int n_out = 0;
+    for (int k = 0; k < count; ++k) {
+        const Real separation = n.dot(in[k].p) - hr[axis];
+        if (separation > speculative) continue;
+        out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
+                        face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
+    }
+    if (n_out == 0 && count == 0) {
+        // Round-off clipped everything away although SAT says the faces meet: keep the
+        // deepest incident vertex so the pair still gets a contact.
+        int deepest = 0;
+        for (int k = 1; k < 4; ++k) {
+            if (n.dot(quad[k]) < n.dot(quad[deepest])) deepest = k;
+        }
+        const Real separation = n.dot(quad[deepest]) - hr[axis];
+        if (separation <= speculative) {
+            out[n_out++] = {quad[deepest] - n * (Real(0.5) * separation), separation,
+                            face_contact_id(reference_is_b, reference_face, incident_face,
+                                            clip_key(0, static_cast<std::uint32_t>(deepest), 0))};
+        }
+    }
+    return n_out;
+}
+
+}  // namespace
+
+int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                    Manifold* out, int) {
+    const Vec3& ha = a.half_extents;
+    const Vec3& hb = b.half_extents;
+    // Everything in A's frame: r's columns are B's axes, t is B's centre.
+    const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
+    const Vec3 t = xa.apply_inverse(xb.p);
+    const Mat3 abs_r = r.cwiseAbs();
+
+    BoxAxis face_a, face_b, edge;
+    for (int i = 0; i < 3; ++i) {
+        const Real s = std::abs(t[i]) - ha[i] - abs_r.row(i).dot(hb);
+        if (s > speculative) return 0;
+        if (s > face_a.separation) face_a = {s, i};
+    }
+    for (int j = 0; j < 3; ++j) {
+        const Real s = std::abs(r.col(j).dot(t)) - hb[j] - abs_r.col(j).dot(ha);
+        if (s > speculative) return 0;
+        if (s > face_b.separation) face_b = {s, j};
+    }
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            const Vec3 axis = Vec3::Unit(i).cross(r.col(j));
+            const Real length = axis.norm();
+            if (length < Real(1e-6)) continue;  // parallel edges: the face axes cover them
+            const Real ra = ha.dot(axis.cwiseAbs());
+            const Real rb = hb.dot((r.transpose() * axis).cwiseAbs());
+            const Real s = (std::abs(axis.dot(t)) - ra - rb) / length;
+            if (s > speculative) return 0;
+            if (s > edge.separation) edge = {s, 3 * i + j};
+        }
+    }
+
+    Manifold& m = out[0];
+    if (edge.index >= 0 && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
+        const int i = edge.index / 3, j = edge.index % 3;
+        Vec3 axis = Vec3::Unit(i).cross(r.col(j)).normalized();
+        if (axis.dot(t) < 0) axis = -axis;
+        // The edge of A farthest along the axis and the edge of B farthest against it.
+        Vec3 pa = Vec3::Zero(), qb = Vec3::Zero();
+        std::uint32_t edge_a = 4 * i, edge_b = 4 * j, bit = 1;
+        for (int k = 0; k < 3; ++k) {
+            if (k == i) continue;
+            pa[k] = axis[k] < 0 ? -ha[k] : ha[k];
+            edge_a |= axis[k] < 0 ? 0 : bit;
+            bit <<= 1;
+        }
+        const Vec3 axis_b = r.transpose() * axis;
+        bit = 1;
+        for (int k = 0; k < 3; ++k) {
+            if (k == j) continue;
+            qb[k] = axis_b[k] > 0 ? -hb[k] : hb[k];
+            edge_b |= axis_b[k] > 0 ? 0 : bit;
+            bit <<= 1;
+        }
+        const Vec3 a0 = pa - Vec3::Unit(i) * ha[i], da = Vec3::Unit(i) * (2 * ha[i]);
+        const Vec3 b0 = r * (qb - Vec3::Unit(j) * hb[j]) + t, db = r.col(j) * (2 * hb[j]);
+        Real s = 0, u = 0;
+        closest_segment_parameters(a0, da, b0, db, s, u);
+        const Vec3 on_a = a0 + s * da, on_b = b0 + u * db;
+        const Real separation = axis.dot(on_b - on_a);
+        m.normal = axis;
+        m.points[0] = {Real(0.5) * (on_a + on_b), separation, edge_contact_id(edge_a, edge_b)};
+        m.point_count = 1;
+        manifold_to_world(m, xa);
+        return 1;
+    }
+
+    ContactCandidate candidates[8];
+    int count = 0;
+    if (clearly_greater(face_b.separation, face_a.separation)) {
+        // Reference face on B: clip in B's frame, then bring the points back to A's.
+        const Mat3 rt = r.transpose();
+        Vec3 normal_b;
+        count = box_face_contact(hb, ha, rt, -(rt * t), face_b.index, speculative, true, normal_b, candidates);
+        for (int k = 0; k < count; ++k) candidates[k].point = r * candidates[k].point + t;
+        m.normal = -(r * normal_b);
+    } else {
+        count = box_face_contact(ha, hb, r, t, face_a.index, speculative, false, m.normal, candidates);
+    }
+    if (count == 0) return 0;
+    reduce_to_manifold(candidates, count, m);
+    manifold_to_world(m, xa);
+    return 1;
+}
+
+}  // namespace spindle::detail

@@ -1,0 +1,157 @@
+// Convex shape against a triangle mesh: the shape meets each triangle the mesh tree
+// finds under its bounds; contacts on inactive (flat interior) edges take the triangle's
+// face normal so shapes slide over seams without catching; manifolds whose normals
+// agree are merged, and the deepest come first.
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <spindle/engine/triangle_mesh.hpp>
+
+#include "contact.hpp"
+#include "pair_functions.hpp"
+
+namespace spindle::detail {
+namespace {
+
+constexpr int kMaxMeshManifolds = 32;    // distinct normals kept while walking triangles
+constexpr Real kSameNormal = 0.999;      // manifolds closer than this merge
+constexpr Real kFaceNormal = 1 - 1e-6;   // a contact this aligned with the face is a face contact
+constexpr Real kOnEdge = 1e-6;           // barycentric weight below which a point is on an edge
+
+// Triangle t in the mesh frame against convex a posed there by xa.
+bool collide_triangle(const Shape& a, const Transform& xa, const BoxPoly* box, const TrianglePoly& tri,
+                      Real speculative, Manifold& m) {
+    const Transform identity;
+    switch (a.type) {
+        case ShapeType::Sphere:
+        case ShapeType::Capsule: {
+            Vec3 p0, p1;
+            rounded_core(a, p0, p1);
+            return collide_rounded_polyhedron(p0, p1, a.radius, xa, tri.view(), identity, speculative, m);
+        }
+        case ShapeType::Box: return collide_polyhedra(box->view(), xa, tri.view(), identity, speculative, m);
+        case ShapeType::ConvexHull:
+            return collide_polyhedra(view_of(*a.hull), xa, tri.view(), identity, speculative, m);
+        default: return false;
+    }
+}
+
+// True when some contact point lies on an active edge of the triangle (a, b, c).
+bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t active_edges) {
+    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
+    const Real area2 = n.squaredNorm();
+    for (int i = 0; i < m.point_count; ++i) {
+        const Vec3 q = m.points[i].point + m.normal * (Real(0.5) * m.points[i].separation);
+        for (int k = 0; k < 3; ++k) {
+            // Weight of the vertex opposite edge k (v[k] -> v[k+1]); zero on that edge.
+            const Real w = (v[(k + 1) % 3] - v[k]).cross(q - v[k]).dot(n) / area2;
+            if (w <= kOnEdge && (active_edges >> k & 1)) return true;
+        }
+    }
+    return false;
+}
+
+// Replaces an edge or vertex normal by the face normal and re-measures the points
+// against the triangle's plane: a sphere or capsule from its deepest core point(s) along
+// the new normal, a polyhedron from its own points (they are its vertices or edge points).
+void use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const TrianglePoly& tri, const Vec3& on_plane,
+                     Real speculative) {
+    Real side = m.normal.dot(tri.normal());
+    if (side == 0) side = tri.normal().dot(on_plane - xa.p);
+    const Vec3 face = side < 0 ? Vec3(-tri.normal()) : tri.normal();
+    ContactCandidate c[kMaxManifoldPoints];
+    int n = 0;
+    if (a.type == ShapeType::Sphere || a.type == ShapeType::Capsule) {
+        Vec3 core[2];
+        rounded_core(a, core[0], core[1]);
+        const int ends = a.type == ShapeType::Sphere ? 1 : 2;
+        for (int i = 0; i < ends; ++i) {
+            const Vec3 on_a = xa.apply(core[i]) + face * a.radius;
+            c[n++] = {on_a, face.dot(on_plane - on_a), m.points[0].id + static_cast<std::uint32_t>(i)};
+        }
+    } else {
+        for (int i = 0; i < m.point_count; ++i) {
+            const Vec3 on_a = m.points[i].point - m.normal * (Real(0.5) * m.points[i].separation);
+            c[n++] = {on_a, face.dot(on_plane - on_a), m.points[i].id};
+        }
+    }
+    int kept = 0;
+    for (int i = 0; i < n; ++i) {
+        if (c[i].separation > speculative) continue;
+        m.points[kept++] = {c[i].point + face * (Real(0.5) * c[i].separation), c[i].separation, c[i].id};
+    }
+    m.normal = face;
+    m.point_count = kept;
+}
+
+Real deepest(const Manifold& m) {
+    Real d = kHuge;
+    for (int i = 0; i < m.point_count; ++i) d = std::min(d, m.points[i].separation);
+    return d;
+}
+
+// Adds m to the list, merging it into a manifold with nearly the same normal; when the
+// list is full a deeper manifold replaces the shallowest.
+void gather(Manifold* list, int& count, const Manifold& m) {
+    for (int i = 0; i < count; ++i) {
+        if (list[i].normal.dot(m.normal) < kSameNormal) continue;
+        ContactCandidate c[2 * kMaxManifoldPoints];
+        int n = 0;
+        for (const Manifold* src : {static_cast<const Manifold*>(&list[i]), &m}) {
+            for (int k = 0; k < src->point_count; ++k) {
+                c[n++] = {src->points[k].point, src->points[k].separation, src->points[k].id};
+            }
+        }
+        reduce_to_manifold(c, n, list[i], true);
+        return;
+    }
+    if (count < kMaxMeshManifolds) {
+        list[count++] = m;
+        return;
+    }
+    int shallowest = 0;
+    for (int i = 1; i < count; ++i) {
+        if (deepest(list[i]) > deepest(list[shallowest])) shallowest = i;
+    }
+    if (deepest(m) < deepest(list[shallowest])) list[shallowest] = m;
+}
+
+}  // namespace
+
+int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int capacity) {
+    const TriangleMesh& mesh = *b.mesh;
+    const Transform a_in_mesh = xb.inverse() * xa;
+    const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
+    BoxPoly box_storage(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
+    const BoxPoly* box = a.type == ShapeType::Box ? &box_storage : nullptr;
+
+    std::array<Manifold, kMaxMeshManifolds> found;
+    int found_count = 0;
+    mesh.query(query, [&](std::uint32_t t) {
+        const MeshTriangle& tri = mesh.triangles()[t];
+        const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
+        const TrianglePoly poly(v[0], v[1], v[2]);
+        Manifold m;
+        if (!collide_triangle(a, a_in_mesh, box, poly, speculative, m)) return;
+        if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
+            use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
+            if (m.point_count == 0) return;
+        }
+        // Ids from different triangles must differ inside a merged manifold.
+        for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
+        gather(found.data(), found_count, m);
+    });
+
+    std::sort(found.begin(), found.begin() + found_count,
+              [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
+    const int count = std::min(found_count, capacity);
+    for (int i = 0; i < count; ++i) {
+        out[i] = found[i];
+        manifold_to_world(out[i], xb);
+    }
+    return count;
+}
+
+}  // namespace spindle::detail

@@ -1,0 +1,64 @@
+// The narrowphase's pair functions, one per unordered pair of shape types, A being the
+// type that comes first in ShapeType. The dispatch table (narrowphase_dispatch.cpp)
+// calls them with swapped arguments for the other order and flips the normal.
+// Convex pairs write at most one manifold; all take capacity >= 1.
+#pragma once
+
+#include <spindle/engine/collision.hpp>
+
+#include "polyhedron.hpp"
+
+namespace spindle::detail {
+
+using PairFunction = int (*)(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                             Real speculative_distance, Manifold* out, int capacity);
+
+// collide_rounded.cpp: spheres and capsules among themselves, sphere-box.
+int collide_sphere_sphere(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_sphere_capsule(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_sphere_box(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_capsule_capsule(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
+// collide_box.cpp: box-box, SAT over 15 axes.
+int collide_box_box(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
+// collide_convex.cpp: sphere/capsule/box/hull against hulls, capsule against box.
+int collide_sphere_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_capsule_box(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_capsule_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_box_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_hull_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
+// collide_plane.cpp: every convex shape against a plane (B).
+int collide_convex_plane(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
+// collide_mesh.cpp: every convex shape against a triangle mesh (B).
+int collide_convex_mesh(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
+// ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) ---------------------------
+// Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and
+// Gauss-map-pruned edge pairs, then face clipping or a single edge-edge point.
+bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                       Real speculative_distance, Manifold& out);
+
+// A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
+// radius) against polyhedron b: GJK distance between the cores while they are apart, SAT
+// when they overlap; a capsule lying on a face gets two points.
+bool collide_rounded_polyhedron(const Vec3& p0, const Vec3& p1, Real radius, const Transform& xa, const PolyView& b,
+                                const Transform& xb, Real speculative_distance, Manifold& out);
+
+// The core segment of a sphere or capsule in its own frame.
+inline void rounded_core(const Shape& s, Vec3& p0, Vec3& p1) {
+    p0 = Vec3(0, -s.half_height, 0);
+    p1 = Vec3(0, s.half_height, 0);
+}
+
+// Tolerances that make SAT prefer a face over an edge, and A's face over B's, unless the
+// other is clearly better: this keeps the chosen features, and so the ids, from flickering.
+inline bool clearly_greater(Real candidate, Real current) {
+    constexpr Real kRelative = 0.02;
+    constexpr Real kAbsolute = 5e-4;
+    return candidate > current + kRelative * std::abs(current) + kAbsolute;
+}
+
+}  // namespace spindle::detail

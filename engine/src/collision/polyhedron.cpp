@@ -1,0 +1,134 @@
+// Polyhedron views of hulls, boxes and triangles, and edge extraction from face loops.
+#include "polyhedron.hpp"
+
+#include <algorithm>
+#include <vector>
+
+#include <spindle/platform/assert.hpp>
+
+namespace spindle::detail {
+namespace {
+
+// Face loops of the box, counter-clockwise seen from outside (see BoxPoly for numbering).
+constexpr std::uint32_t kBoxLoops[24] = {
+    1, 3, 7, 5,  // +x
+    0, 4, 6, 2,  // -x
+    2, 6, 7, 3,  // +y
+    0, 1, 5, 4,  // -y
+    4, 5, 7, 6,  // +z
+    0, 2, 3, 1,  // -z
+};
+
+struct BoxTopology {
+    std::array<HullEdge, 12> edges;
+    BoxTopology() {
+        std::array<HullFace, 6> faces;
+        for (std::uint32_t f = 0; f < 6; ++f) faces[f].first = 4 * f, faces[f].count = 4;
+        const std::uint32_t n = collect_edges(faces.data(), 6, kBoxLoops, edges.data(), 12);
+        SPINDLE_ASSERT(n == 12, "a box has 12 edges");
+    }
+};
+
+const BoxTopology& box_topology() {
+    static const BoxTopology topology;
+    return topology;
+}
+
+// Triangle edges i -> i+1 run counter-clockwise on the front face 0.
+constexpr std::uint32_t kTriangleLoops[6] = {0, 1, 2, 0, 2, 1};
+constexpr HullEdge kTriangleEdges[3] = {{0, 1, 0, 1}, {1, 2, 0, 1}, {2, 0, 0, 1}};
+
+}  // namespace
+
+PolyView view_of(const ConvexHull& hull) {
+    PolyView v;
+    v.vertices = hull.vertices().data();
+    v.vertex_count = static_cast<std::uint32_t>(hull.vertices().size());
+    v.faces = hull.faces().data();
+    v.face_count = static_cast<std::uint32_t>(hull.faces().size());
+    v.face_vertices = hull.face_vertices().data();
+    v.edges = hull.edges().data();
+    v.edge_count = static_cast<std::uint32_t>(hull.edges().size());
+    return v;
+}
+
+BoxPoly::BoxPoly(const Vec3& h) {
+    for (int i = 0; i < 8; ++i) {
+        m_vertices[i] = Vec3(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z());
+    }
+    for (int k = 0; k < 3; ++k) {
+        for (int s = 0; s < 2; ++s) {
+            HullFace& f = m_faces[2 * k + s];
+            f.normal = Vec3::Zero();
+            f.normal[k] = s == 0 ? 1 : -1;
+            f.offset = h[k];
+            f.first = static_cast<std::uint32_t>(4 * (2 * k + s));
+            f.count = 4;
+        }
+    }
+}
+
+PolyView BoxPoly::view() const {
+    PolyView v;
+    v.vertices = m_vertices.data();
+    v.vertex_count = 8;
+    v.faces = m_faces.data();
+    v.face_count = 6;
+    v.face_vertices = kBoxLoops;
+    v.edges = box_topology().edges.data();
+    v.edge_count = 12;
+    return v;
+}
+
+TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vertices{a, b, c} {
+    const Vec3 n = (b - a).cross(c - a).normalized();
+    m_faces[0] = {n, n.dot(a), 0, 3};
+    m_faces[1] = {-n, -n.dot(a), 3, 3};
+}
+
+PolyView TrianglePoly::view() const {
+    PolyView v;
+    v.vertices = m_vertices.data();
+    v.vertex_count = 3;
+    v.faces = m_faces.data();
+    v.face_count = 2;
+    v.face_vertices = kTriangleLoops;
+    v.edges = kTriangleEdges;
+    v.edge_count = 3;
+    return v;
+}
+
+std::uint32_t collect_edges(const HullFace* faces, std::uint32_t face_count, const std::uint32_t* face_vertices,
+                            HullEdge* out, std::uint32_t capacity) {
+    // Each edge of a closed surface appears once in each direction; sort the directed
+    // edges so the reverse of a -> b is found by binary search.
+    struct Directed {
+        std::uint64_t key;
+        std::uint32_t face;
+        bool operator<(const Directed& o) const { return key < o.key; }
+    };
+    std::vector<Directed> directed;
+    for (std::uint32_t f = 0; f < face_count; ++f) {
+        const HullFace& face = faces[f];
+        for (std::uint32_t k = 0; k < face.count; ++k) {
+            const std::uint64_t a = face_vertices[face.first + k];
+            const std::uint64_t b = face_vertices[face.first + (k + 1) % face.count];
+            directed.push_back({a << 32 | b, f});
+        }
+    }
+    std::sort(directed.begin(), directed.end());
+    std::uint32_t n = 0;
+    for (const Directed& d : directed) {
+        const auto a = static_cast<std::uint32_t>(d.key >> 32);
+        const auto b = static_cast<std::uint32_t>(d.key & 0xFFFFFFFFu);
+        if (a > b) continue;
+        const Directed probe{std::uint64_t(b) << 32 | a, 0};
+        const auto it = std::lower_bound(directed.begin(), directed.end(), probe);
+        SPINDLE_ASSERT(it != directed.end() && it->key == probe.key, "face loops must form a closed surface");
+        if (n < capacity) out[n] = {a, b, d.face, it->face};
+        ++n;
+    }
+    return n;
+}
+
+}  // namespace spindle::detail

@@ -1,0 +1,188 @@
+// Polyhedron-polyhedron contact (hull-hull, box-hull, box/hull-triangle): SAT over the
+// face normals of both and the edge pairs whose Gauss-map arcs cross (the only edge
+// pairs that can realise the minimum), then clipping of the incident face or one point
+// between the two edges. All work happens in A's frame.
+#include <cmath>
+
+#include "contact.hpp"
+#include "pair_functions.hpp"
+
+namespace spindle::detail {
+namespace {
+
+constexpr std::size_t kInlineVertices = 64;
+
+// A polyhedron placed in the common frame: its vertices already there, its normals
+// rotated by r and its plane offsets shifted by t on demand.
+struct Posed {
+    const PolyView& view;
+    const Vec3* vertices;  // in the common frame
+    Mat3 r;
+    Vec3 t;
+
+    Vec3 normal(std::uint32_t f) const { return r * view.faces[f].normal; }
+    Real offset(std::uint32_t f, const Vec3& n) const { return view.faces[f].offset + n.dot(t); }
+    std::uint32_t support(const Vec3& d) const {
+        std::uint32_t best = 0;
+        Real best_dot = vertices[0].dot(d);
+        for (std::uint32_t i = 1; i < view.vertex_count; ++i) {
+            const Real x = vertices[i].dot(d);
+            if (x > best_dot) best_dot = x, best = i;
+        }
+        return best;
+    }
+};
+
+struct FaceQuery {
+    Real separation = -kHuge;
+    std::uint32_t face = 0;
+};
+
+struct EdgeQuery {
+    Real separation = -kHuge;
+    std::uint32_t edge_a = 0;
+    std::uint32_t edge_b = 0;
+    Vec3 axis = Vec3::UnitY();
+    bool found = false;
+};
+
+// Largest separation of `other` from the face planes of p. Stops early past `limit`.
+FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
+    FaceQuery best;
+    for (std::uint32_t f = 0; f < p.view.face_count; ++f) {
+        const Vec3 n = p.normal(f);
+        const Real s = n.dot(other.vertices[other.support(-n)]) - p.offset(f, n);
+        if (s > best.separation) best = {s, f};
+        if (s > limit) break;
+    }
+    return best;
+}
+
+// Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
+// negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb).
+EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
+    EdgeQuery best;
+    for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
+        const HullEdge& edge_b = b.view.edges[jb];
+        const Vec3 nb0 = b.normal(edge_b.f0), nb1 = b.normal(edge_b.f1);
+        const Vec3& qb = b.vertices[edge_b.v0];
+        const Vec3 eb = b.vertices[edge_b.v1] - qb;
+        for (std::uint32_t ja = 0; ja < a.view.edge_count; ++ja) {
+            const HullEdge& edge_a = a.view.edges[ja];
+            const Vec3& pa = a.vertices[edge_a.v0];
+            const Vec3 ea = a.vertices[edge_a.v1] - pa;
+            const Vec3 cross = ea.cross(eb);
+            const Real length2 = cross.squaredNorm();
+            if (length2 <= Real(1e-12) * ea.squaredNorm() * eb.squaredNorm()) continue;  // parallel
+            const Vec3 na0 = a.normal(edge_a.f0), na1 = a.normal(edge_a.f1);
+            for (const Real sign : {Real(1), Real(-1)}) {
+                const Vec3 axis = sign * cross;
+                if (!on_edge_arc(axis, na0, na1, ea) || !on_edge_arc(-axis, nb0, nb1, eb)) continue;
+                const Vec3 unit = axis / std::sqrt(length2);
+                const Real s = unit.dot(qb - pa);
+                if (s > best.separation) best = {s, ja, jb, unit, true};
+                if (s > limit) return best;
+                break;
+            }
+        }
+    }
+    return best;
+}
+
+// Clips the incident face of `inc` against reference face `face` of `ref`.
+int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative,
+                 Vec3& n, ContactCandidate* out) {
+    n = ref.normal(face);
+    const Real d = ref.offset(face, n);
+    std::uint32_t incident = 0;
+    Real most_against = kHuge;
+    for (std::uint32_t f = 0; f < inc.view.face_count; ++f) {
+        const Real x = inc.normal(f).dot(n);
+        if (x < most_against) most_against = x, incident = f;
+    }
+    const HullFace& ref_face = ref.view.faces[face];
+    const HullFace& inc_face = inc.view.faces[incident];
+    const std::size_t capacity = inc_face.count + ref_face.count + 1;
+    ScratchBuffer<ClipVertex, 2 * kInlineVertices> buffer(2 * capacity);
+    ClipVertex* in = buffer.data();
+    ClipVertex* next = buffer.data() + capacity;
+    int count = static_cast<int>(inc_face.count);
+    for (std::uint32_t k = 0; k < inc_face.count; ++k) {
+        in[k] = {inc.vertices[inc.view.face_vertices[inc_face.first + k]], clip_key(0, k, 0),
+                 static_cast<std::uint16_t>(k)};
+    }
+    for (std::uint32_t k = 0; k < ref_face.count && count > 0; ++k) {
+        const Vec3& v0 = ref.vertices[ref.view.face_vertices[ref_face.first + k]];
+        const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1) % ref_face.count]];
+        const Vec3 side = (v1 - v0).cross(n).normalized();
+        count = clip_polygon(in, count, {side, side.dot(v0)}, k, next);
+        std::swap(in, next);
+    }
+    int n_out = 0;
+    for (int k = 0; k < count; ++k) {
+        const Real s = n.dot(in[k].p) - d;
+        if (s > speculative) continue;
+        out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
+    }
+    if (count == 0) {
+        // Clipping left nothing (the incident face lies beside the reference face, as
+        // when a corner pokes in): the support point still gives a contact.
+        const std::uint32_t v = inc.support(-n);
+        const Real s = n.dot(inc.vertices[v]) - d;
+        if (s <= speculative) {
+            out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
+                            face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
+        }
+    }
+    return n_out;
+}
+
+}  // namespace
+
+bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                       Real speculative, Manifold& m) {
+    const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
+    const Vec3 t = xa.apply_inverse(xb.p);
+    ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
+    for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
+    const Posed pa{a, a.vertices, Mat3::Identity(), Vec3::Zero()};
+    const Posed pb{b, b_vertices.data(), r, t};
+
+    const FaceQuery face_a = query_faces(pa, pb, speculative);
+    if (face_a.separation > speculative) return false;
+    const FaceQuery face_b = query_faces(pb, pa, speculative);
+    if (face_b.separation > speculative) return false;
+    const EdgeQuery edge = query_edges(pa, pb, speculative);
+    if (edge.separation > speculative) return false;
+
+    if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
+        const HullEdge& ea = a.edges[edge.edge_a];
+        const HullEdge& eb = b.edges[edge.edge_b];
+        const Vec3& a0 = a.vertices[ea.v0];
+        const Vec3& b0 = b_vertices[eb.v0];
+        const Vec3 da = a.vertices[ea.v1] - a0, db = b_vertices[eb.v1] - b0;
+        Real s = 0, u = 0;
+        closest_segment_parameters(a0, da, b0, db, s, u);
+        const Vec3 on_a = a0 + s * da, on_b = b0 + u * db;
+        m.normal = edge.axis;
+        m.points[0] = {Real(0.5) * (on_a + on_b), edge.axis.dot(on_b - on_a),
+                       edge_contact_id(edge.edge_a, edge.edge_b)};
+        m.point_count = 1;
+        manifold_to_world(m, xa);
+        return true;
+    }
+
+    const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
+    const std::size_t capacity = reference_is_b ? a.vertex_count + b.vertex_count : b.vertex_count + a.vertex_count;
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(capacity + 1);
+    Vec3 n;
+    const int count = reference_is_b ? face_contact(pb, face_b.face, pa, true, speculative, n, candidates.data())
+                                     : face_contact(pa, face_a.face, pb, false, speculative, n, candidates.data());
+    if (count == 0) return false;
+    m.normal = reference_is_b ? Vec3(-n) : n;
+    reduce_to_manifold(candidates.data(), count, m);
+    manifold_to_world(m, xa);
+    return true;
+}
+
+}  // namespace spindle::detail

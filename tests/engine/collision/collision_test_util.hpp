@@ -1,0 +1,65 @@
+// Helpers for the collision tests: poses, a collide() wrapper that returns the
+// manifolds, and checks that every manifold is well formed.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include <spindle/engine/collision.hpp>
+#include <spindle/engine/convex_hull.hpp>
+#include <spindle/engine/triangle_mesh.hpp>
+
+namespace spindle::test {
+
+inline Transform at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
+inline Quat about(const Vec3& axis, Real angle) { return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized())); }
+
+inline std::vector<Manifold> run(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                 Real speculative = 0, int capacity = 8) {
+    std::vector<Manifold> out(static_cast<std::size_t>(capacity));
+    const int n = collide(a, xa, b, xb, speculative, out.data(), capacity);
+    out.resize(static_cast<std::size_t>(n));
+    for (const Manifold& m : out) {
+        EXPECT_TRUE(m.normal.allFinite());
+        EXPECT_NEAR(m.normal.norm(), 1.0, 1e-9);
+        EXPECT_GE(m.point_count, 1);
+        EXPECT_LE(m.point_count, kMaxManifoldPoints);
+        for (int i = 0; i < m.point_count; ++i) {
+            EXPECT_TRUE(m.points[i].point.allFinite());
+            EXPECT_TRUE(std::isfinite(m.points[i].separation));
+            EXPECT_LE(m.points[i].separation, speculative + 1e-9);
+        }
+    }
+    return out;
+}
+
+inline Real min_separation(const Manifold& m) {
+    Real s = kHuge;
+    for (int i = 0; i < m.point_count; ++i) s = std::min(s, m.points[i].separation);
+    return s;
+}
+
+// Whether the manifold has a point within tol of p.
+inline bool has_point(const Manifold& m, const Vec3& p, Real tol = 1e-6) {
+    for (int i = 0; i < m.point_count; ++i) {
+        if ((m.points[i].point - p).norm() <= tol) return true;
+    }
+    return false;
+}
+
+inline std::vector<Vec3> box_corners(const Vec3& h) {
+    std::vector<Vec3> p;
+    for (int i = 0; i < 8; ++i) p.emplace_back(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z());
+    return p;
+}
+
+inline Shape hull_box(const Vec3& h) {
+    const std::vector<Vec3> p = box_corners(h);
+    return Shape::convex_hull(p);
+}
+
+}  // namespace spindle::test
+
+#define SPINDLE_EXPECT_VEC_NEAR(actual, expected, tol) \
+    EXPECT_LT(((actual) - (expected)).norm(), tol) << "actual " << (actual).transpose() << " expected " << (expected).transpose()

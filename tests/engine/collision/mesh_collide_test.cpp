@@ -1,0 +1,133 @@
+// Convex shapes against triangle meshes: one merged manifold on flat ground, no ghost
+// normals at the seams between triangles, edge normals on real ridges, several
+// manifolds in a valley (deepest first, capped by capacity).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "collision_test_util.hpp"
+
+namespace spindle {
+namespace {
+
+using test::about;
+using test::at;
+using test::run;
+
+// n x n unit quads in y = 0 from (0, 0) to (n, n), two triangles each, facing +y.
+Shape flat_grid(int n) {
+    std::vector<Vec3> v;
+    std::vector<std::uint32_t> idx;
+    for (int z = 0; z <= n; ++z) {
+        for (int x = 0; x <= n; ++x) v.emplace_back(x, 0, z);
+    }
+    const auto at_ = [n](int x, int z) { return static_cast<std::uint32_t>(z * (n + 1) + x); };
+    for (int z = 0; z < n; ++z) {
+        for (int x = 0; x < n; ++x) {
+            idx.insert(idx.end(), {at_(x, z), at_(x, z + 1), at_(x + 1, z + 1)});
+            idx.insert(idx.end(), {at_(x, z), at_(x + 1, z + 1), at_(x + 1, z)});
+        }
+    }
+    return Shape::triangle_mesh(v, idx);
+}
+
+// A V-shaped valley along z: two planes at 45 degrees meeting at x = 0, y = 0.
+Shape valley() {
+    const std::vector<Vec3> v{Vec3(-2, 2, -2), Vec3(-2, 2, 2), Vec3(0, 0, -2), Vec3(0, 0, 2), Vec3(2, 2, -2), Vec3(2, 2, 2)};
+    const std::vector<std::uint32_t> idx{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
+    return Shape::triangle_mesh(v, idx);
+}
+
+TEST(ConvexMesh, SphereOnASeamVertexGetsOneFaceNormal) {
+    const auto m = run(Shape::sphere(0.5), at(Vec3(2, 0.45, 2)), flat_grid(4), at(Vec3::Zero()));
+    ASSERT_EQ(m.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
+    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+}
+
+TEST(ConvexMesh, BoxOnGridMergesIntoOneFourPointManifold) {
+    const auto m = run(Shape::box(Vec3(0.7, 0.5, 0.6)), at(Vec3(2.1, 0.49, 1.9)), flat_grid(4), at(Vec3::Zero()));
+    ASSERT_EQ(m.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
+    ASSERT_EQ(m[0].point_count, 4);
+    for (const Real x : {1.4, 2.8}) {
+        for (const Real z : {1.3, 2.5}) EXPECT_TRUE(test::has_point(m[0], Vec3(x, -0.005, z), 1e-9));
+    }
+}
+
+TEST(ConvexMesh, SlidingBoxNeverCatchesOnInteriorEdges) {
+    const Shape ground = flat_grid(6);
+    const Shape box = Shape::box(Vec3(0.3, 0.3, 0.3));
+    for (int step = 0; step < 100; ++step) {
+        const Transform xb = at(Vec3(1.05 + 0.04 * step, 0.295, 3.0), about(Vec3::UnitY(), 0.3));
+        const auto m = run(box, xb, ground, at(Vec3::Zero()));
+        ASSERT_EQ(m.size(), 1u) << "step " << step;
+        SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
+        EXPECT_NEAR(test::min_separation(m[0]), -0.005, 1e-9) << "step " << step;
+    }
+}
+
+TEST(ConvexMesh, RollingCapsuleAndHullStayOnFaceNormals) {
+    const Shape ground = flat_grid(4);
+    const Shape capsule = Shape::capsule(0.6, 0.2);
+    const Shape hull = test::hull_box(Vec3(0.3, 0.2, 0.4));
+    for (int step = 0; step < 40; ++step) {
+        const Real x = 0.7 + 0.05 * step;
+        const auto mc = run(capsule, at(Vec3(x, 0.19, 2), about(Vec3::UnitX(), kPi / 2)), ground, at(Vec3::Zero()));
+        ASSERT_EQ(mc.size(), 1u);
+        SPINDLE_EXPECT_VEC_NEAR(mc[0].normal, Vec3(0, -1, 0), 1e-9);
+        EXPECT_EQ(mc[0].point_count, 2);
+        const auto mh = run(hull, at(Vec3(x, 0.19, 2)), ground, at(Vec3::Zero()));
+        ASSERT_EQ(mh.size(), 1u);
+        SPINDLE_EXPECT_VEC_NEAR(mh[0].normal, Vec3(0, -1, 0), 1e-9);
+        EXPECT_EQ(mh[0].point_count, 4);
+    }
+}
+
+TEST(ConvexMesh, SphereOnARidgeTakesTheEdgeNormal) {
+    // Roof ridge along x at y = 1: a sharp (active) edge.
+    const std::vector<Vec3> v{Vec3(-2, 1, 0), Vec3(2, 1, 0), Vec3(-2, 0, -1), Vec3(2, 0, -1), Vec3(-2, 0, 1), Vec3(2, 0, 1)};
+    const Shape roof = Shape::triangle_mesh(v, std::vector<std::uint32_t>{0, 1, 2, 1, 3, 2, 1, 0, 4, 1, 4, 5});
+    const auto m = run(Shape::sphere(0.5), at(Vec3(0, 1.45, 0)), roof, at(Vec3::Zero()));
+    ASSERT_EQ(m.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
+    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+}
+
+TEST(ConvexMesh, SphereInAValleyGetsTwoManifoldsDeepestFirst) {
+    const Shape v = valley();
+    // Closer to the right slope (x > 0) than to the left one.
+    const Vec3 c(0.1, 0.6, 0);
+    const auto m = run(Shape::sphere(0.5), at(c), v, at(Vec3::Zero()));
+    ASSERT_EQ(m.size(), 2u);
+    const Vec3 right = Vec3(1, -1, 0).normalized(), left = Vec3(-1, -1, 0).normalized();
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, right, 1e-9);
+    SPINDLE_EXPECT_VEC_NEAR(m[1].normal, left, 1e-9);
+    EXPECT_NEAR(test::min_separation(m[0]), (c.y() - c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
+    EXPECT_NEAR(test::min_separation(m[1]), (c.y() + c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
+    const auto capped = run(Shape::sphere(0.5), at(c), v, at(Vec3::Zero()), 0, 1);
+    ASSERT_EQ(capped.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(capped[0].normal, right, 1e-9);
+}
+
+TEST(ConvexMesh, SwappedOrderFlipsAndFarAwayGivesNothing) {
+    const Shape ground = flat_grid(2);
+    const auto m = run(ground, at(Vec3::Zero()), Shape::sphere(0.5), at(Vec3(1, 0.4, 1)));
+    ASSERT_EQ(m.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, 1, 0), 1e-9);
+    EXPECT_TRUE(run(Shape::sphere(0.5), at(Vec3(1, 0.6, 1)), ground, at(Vec3::Zero())).empty());
+    EXPECT_TRUE(run(Shape::sphere(0.5), at(Vec3(10, 0, 1)), ground, at(Vec3::Zero())).empty());
+}
+
+TEST(ConvexMesh, MovedAndRotatedMeshKeepsWorldResults) {
+    const Quat q = about(Vec3(1, 0, 1), 0.7);
+    const Transform xm = at(Vec3(3, -1, 2), q);
+    const Vec3 c = xm.apply(Vec3(1, 0.45, 1));
+    const auto m = run(Shape::sphere(0.5), at(c), flat_grid(2), xm);
+    ASSERT_EQ(m.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(q * Vec3(0, -1, 0)), 1e-9);
+    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+}
+
+}  // namespace
+}  // namespace spindle
