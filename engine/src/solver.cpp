@@ -340,7 +340,8 @@ void solve(World& world, Real dt) {
 
     SolveParams solve_params;
     // The contact spring may not be stiffer than a quarter of the substep rate.
-    const Real hertz = std::min(settings.contact_hertz, Real(0.25) / h);
+    const Real stiffest = Real(0.25) / h;
+    const Real hertz = settings.contact_hertz > 0 ? std::min(settings.contact_hertz, stiffest) : stiffest;
     solve_params.soft = make_softness(hertz, settings.damping_ratio, h);
     solve_params.inv_h = 1 / h;
     solve_params.push_out = settings.push_out_speed;

@@ -306,9 +306,9 @@ void Space::set_solver(const SolverSettings& s) {
     if (s.relax_iterations < 0) {
         throw Error("solver: relax_iterations must be >= 0, got " + std::to_string(s.relax_iterations));
     }
-    if (!(s.contact_hertz > 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) ||
+    if (!(s.contact_hertz >= 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) ||
         !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
-        throw Error("solver: contact_hertz must be positive; damping_ratio, push_out_speed, speculative_distance and "
+        throw Error("solver: contact_hertz, damping_ratio, push_out_speed, speculative_distance and "
                     "restitution_threshold must be >= 0");
     }
     m_world->settings.solver = s;
