@@ -1,6 +1,9 @@
 // SingleThreadedJobSystem: chunks in order on the caller.
 #include <spindle/scheduler/single_threaded.hpp>
 
+#include <utility>
+#include <vector>
+
 namespace spindle {
 
 void SingleThreadedJobSystem::parallel_for(const char*, std::uint32_t begin, std::uint32_t end,
@@ -11,6 +14,42 @@ void SingleThreadedJobSystem::parallel_for(const char*, std::uint32_t begin, std
         fn(lo, hi, 0);
         lo = hi;
     }
+}
+
+void SingleThreadedJobSystem::run_graph(StageGraph& graph) {
+    std::vector<std::uint32_t> waiting(graph.m_nodes.size());
+    std::vector<std::uint32_t> ready;
+    for (std::uint32_t i = 0; i < graph.m_nodes.size(); ++i) {
+        waiting[i] = graph.m_nodes[i].prerequisites;
+        if (waiting[i] == 0) ready.push_back(i);
+    }
+    std::exception_ptr error;
+    for (std::size_t k = 0; k < ready.size(); ++k) {  // ready grows as nodes finish
+        StageGraph::Node& node = graph.m_nodes[ready[k]];
+        try {
+            node.fn(0);
+        } catch (...) {
+            if (!error) error = std::current_exception();
+        }
+        for (std::uint32_t d : node.dependents) {
+            if (--waiting[d] == 0) ready.push_back(d);
+        }
+    }
+    if (error) std::rethrow_exception(error);
+}
+
+void SingleThreadedJobSystem::keep_error(JobGroup& group, std::exception_ptr error) {
+    std::scoped_lock guard(group.m_error_lock);
+    if (!group.m_error) group.m_error = std::move(error);
+}
+
+void SingleThreadedJobSystem::wait(JobGroup& group) {
+    std::exception_ptr error;
+    {
+        std::scoped_lock guard(group.m_error_lock);
+        error = std::exchange(group.m_error, nullptr);
+    }
+    if (error) std::rethrow_exception(error);
 }
 
 }  // namespace spindle

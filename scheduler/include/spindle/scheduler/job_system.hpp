@@ -4,15 +4,65 @@
 // workers = 1).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <exception>
+#include <mutex>
+#include <vector>
 
 #include <spindle/scheduler/function_ref.hpp>
 
 namespace spindle {
 
+struct GroupAccess;
+
 // Body of a range job: items [begin, end), and the index of the worker running it.
 // The worker index is for per-worker scratch buffers only, never for results.
 using RangeFn = FunctionRef<void(std::uint32_t begin, std::uint32_t end, unsigned worker)>;
+
+// A set of submitted jobs to wait for together. Lives on the waiter's stack; must not
+// be destroyed while jobs of it are pending (wait() first).
+class JobGroup {
+public:
+    JobGroup() = default;
+    JobGroup(const JobGroup&) = delete;
+    JobGroup& operator=(const JobGroup&) = delete;
+    bool done() const noexcept { return m_pending.load(std::memory_order_acquire) == 0; }
+
+private:
+    friend class WorkStealingJobSystem;
+    friend class SingleThreadedJobSystem;
+    friend struct GroupAccess;
+    std::atomic<std::int64_t> m_pending{0};
+    std::mutex m_error_lock;
+    std::exception_ptr m_error;
+};
+
+// A DAG of jobs: add nodes, then edges (a -> b: b runs after a), then run it.
+// Dependencies are data: each node keeps the count of nodes it still waits for.
+class StageGraph {
+public:
+    using Fn = FunctionRef<void(unsigned worker)>;
+    // The callable must outlive run_graph(). Returns the node's index.
+    std::uint32_t add(const char* name, Fn fn);
+    void depends_on(std::uint32_t node, std::uint32_t prerequisite);
+    std::size_t size() const noexcept { return m_nodes.size(); }
+
+private:
+    friend class WorkStealingJobSystem;
+    friend class SingleThreadedJobSystem;
+    struct Node {
+        const char* name;
+        Fn fn;
+        std::vector<std::uint32_t> dependents;
+        std::uint32_t prerequisites = 0;  // how many nodes must finish first
+        std::atomic<std::uint32_t> waiting{0};  // counts down while running
+        Node(const char* n, Fn f) : name(n), fn(f) {}
+        Node(Node&& o) noexcept
+            : name(o.name), fn(o.fn), dependents(std::move(o.dependents)), prerequisites(o.prerequisites) {}
+    };
+    std::vector<Node> m_nodes;
+};
 
 class JobSystem {
 public:
@@ -29,6 +79,11 @@ public:
     // Who may call: any thread. Deadlock: none, the caller never waits idle for work.
     virtual void parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
                               RangeFn fn) = 0;
+
+    // Runs a stage graph to completion: each node after its prerequisites, nodes in
+    // parallel where the graph allows; rethrows the first exception. Who may call: any
+    // thread; the caller runs nodes while it waits.
+    virtual void run_graph(StageGraph& graph) = 0;
 
     // Marks a named stage (e.g. "Broadphase") on the calling thread in the trace.
     // Near-free when tracing is off. Calls nest; each begin has one end.

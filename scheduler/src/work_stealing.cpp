@@ -1,0 +1,533 @@
+// WorkStealingJobSystem: Chase-Lev deques of small tasks, binary range splitting for
+// parallel_for (chunk boundaries fixed by the grain), pooled job records for submit,
+// per-worker mailboxes for pinned jobs, and sleeping with C++20 atomic wait.
+#include <spindle/platform/clock.hpp>
+#include <spindle/platform/error.hpp>
+#include <spindle/platform/spin.hpp>
+#include <spindle/platform/thread.hpp>
+#include <spindle/scheduler/single_threaded.hpp>
+#include <spindle/scheduler/work_stealing.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <ostream>
+
+namespace spindle {
+namespace detail {
+
+// Chase-Lev work-stealing deque (Le et al., "Correct and efficient work-stealing for
+// weak memory models", 2013) with sequentially consistent top/bottom operations in
+// place of fences, which ThreadSanitizer understands. Slots are atomics so a thief's
+// read racing with the owner is defined; a thief keeps what it read only if its CAS
+// on top succeeds. Fixed capacity: a full deque makes the pusher run the task itself.
+class Deque {
+public:
+    static constexpr std::int64_t kCapacity = 4096;
+
+    bool push(TaskHeader* task, std::uint64_t range) {
+        const std::int64_t b = m_bottom.load(std::memory_order_relaxed);
+        const std::int64_t t = m_top.load(std::memory_order_acquire);
+        if (b - t >= kCapacity) return false;
+        Slot& s = m_slots[b & (kCapacity - 1)];
+        s.task.store(task, std::memory_order_relaxed);
+        s.range.store(range, std::memory_order_relaxed);
+        m_bottom.store(b + 1, std::memory_order_seq_cst);
+        return true;
+    }
+
+    bool pop(TaskHeader*& task, std::uint64_t& range) {
+        const std::int64_t b = m_bottom.load(std::memory_order_relaxed) - 1;
+        m_bottom.store(b, std::memory_order_seq_cst);
+        std::int64_t t = m_top.load(std::memory_order_seq_cst);
+        if (t > b) {
+            m_bottom.store(b + 1, std::memory_order_relaxed);
+            return false;
+        }
+        const Slot& s = m_slots[b & (kCapacity - 1)];
+        task = s.task.load(std::memory_order_relaxed);
+        range = s.range.load(std::memory_order_relaxed);
+        if (t == b) {  // the last one: race thieves for it
+            const bool won = m_top.compare_exchange_strong(t, t + 1, std::memory_order_seq_cst);
+            m_bottom.store(b + 1, std::memory_order_relaxed);
+            return won;
+        }
+        return true;
+    }
+
+    bool steal(TaskHeader*& task, std::uint64_t& range) {
+        std::int64_t t = m_top.load(std::memory_order_seq_cst);
+        const std::int64_t b = m_bottom.load(std::memory_order_seq_cst);
+        if (t >= b) return false;
+        const Slot& s = m_slots[t & (kCapacity - 1)];
+        task = s.task.load(std::memory_order_relaxed);
+        range = s.range.load(std::memory_order_relaxed);
+        return m_top.compare_exchange_strong(t, t + 1, std::memory_order_seq_cst);
+    }
+
+    bool maybe_nonempty() const {
+        return m_top.load(std::memory_order_seq_cst) < m_bottom.load(std::memory_order_seq_cst);
+    }
+
+private:
+    struct Slot {
+        std::atomic<TaskHeader*> task{nullptr};
+        std::atomic<std::uint64_t> range{0};
+    };
+    alignas(cache_line_size) std::atomic<std::int64_t> m_top{0};
+    alignas(cache_line_size) std::atomic<std::int64_t> m_bottom{0};
+    Slot m_slots[kCapacity];
+};
+
+struct Worker {
+    WorkStealingJobSystem* system = nullptr;
+    unsigned index = 0;
+    int pu = -1;
+    std::uint64_t rng = 0;
+    Deque deque;
+    std::mutex mailbox_lock;  // pinned jobs for this worker only
+    std::vector<JobRecord*> mailbox;
+    std::atomic<bool> has_mail{false};
+    std::vector<TraceEvent> events;  // written only by the thread acting as this worker
+
+    // Pushes a task and wakes a sleeping worker to steal it.
+    bool push(TaskHeader* task, std::uint64_t range);
+    void record(const char* name, const char* stage, std::int64_t begin, std::int64_t end) {
+        events.push_back(TraceEvent{name, stage, begin, end, index, pu >= 0 ? pu : current_cpu()});
+    }
+
+    unsigned next_victim(unsigned n) {
+        rng ^= rng << 13;  // xorshift: cheap, per-worker, good enough to spread steals
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        return static_cast<unsigned>(rng % n);
+    }
+};
+
+// One parallel_for call, on the caller's stack.
+struct ForContext : TaskHeader {
+    RangeFn fn;
+    const char* name;
+    std::uint32_t begin, end, grain;
+    std::atomic<std::uint32_t> remaining;  // chunks not yet finished
+    std::atomic<bool> failed{false};
+    std::mutex error_lock;
+    std::exception_ptr error;
+    ForContext(RangeFn f, const char* n, std::uint32_t b, std::uint32_t e, std::uint32_t g, std::uint32_t chunks)
+        : fn(f), name(n), begin(b), end(e), grain(g), remaining(chunks) {}
+};
+
+thread_local Worker* tls_worker = nullptr;
+
+inline std::uint64_t pack(std::uint32_t first, std::uint32_t last) { return (std::uint64_t{first} << 32) | last; }
+
+}  // namespace detail
+
+using detail::ForContext;
+using detail::JobRecord;
+using detail::TaskHeader;
+using detail::Worker;
+
+
+namespace {
+
+// Runs chunks [first, last) of a parallel_for: keeps splitting off the upper half for
+// thieves (so a thief takes a big piece), and runs one chunk at a time.
+void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
+    auto* ctx = static_cast<ForContext*>(header);
+    auto first = static_cast<std::uint32_t>(range >> 32);
+    auto last = static_cast<std::uint32_t>(range & 0xffffffffu);
+    const bool tracing = self.system->trace_enabled();
+    while (first < last) {
+        if (last - first > 1) {
+            const std::uint32_t mid = first + (last - first) / 2;
+            if (self.push(ctx, detail::pack(mid, last))) last = mid;  // full deque: run it all here
+        }
+        const std::uint32_t lo = ctx->begin + first * ctx->grain;
+        const std::uint32_t hi = ctx->end - lo > ctx->grain ? lo + ctx->grain : ctx->end;
+        if (!ctx->failed.load(std::memory_order_relaxed)) {
+            const std::int64_t t0 = tracing ? now_nanoseconds() : 0;
+            try {
+                ctx->fn(lo, hi, self.index);
+            } catch (...) {
+                std::scoped_lock guard(ctx->error_lock);
+                if (!ctx->error) ctx->error = std::current_exception();
+                ctx->failed.store(true, std::memory_order_relaxed);
+            }
+            if (tracing) self.record(ctx->name, "parallel_for", t0, now_nanoseconds());
+        }
+        ++first;
+        ctx->remaining.fetch_sub(1, std::memory_order_acq_rel);
+    }
+}
+
+void finish_group(JobGroup& group);
+
+}  // namespace
+
+// Group bookkeeping needs JobGroup's private members.
+struct GroupAccess {
+    static void fail(JobGroup& g, std::exception_ptr e) {
+        std::scoped_lock guard(g.m_error_lock);
+        if (!g.m_error) g.m_error = std::move(e);
+    }
+    static void done(JobGroup& g) { g.m_pending.fetch_sub(1, std::memory_order_acq_rel); }
+    static void add(JobGroup& g) { g.m_pending.fetch_add(1, std::memory_order_relaxed); }
+    static std::exception_ptr take_error(JobGroup& g) {
+        std::scoped_lock guard(g.m_error_lock);
+        return std::exchange(g.m_error, nullptr);
+    }
+};
+
+namespace {
+
+void finish_group(JobGroup& group) { GroupAccess::done(group); }
+
+}  // namespace
+
+namespace detail {
+
+bool Worker::push(TaskHeader* task, std::uint64_t range) {
+    if (!deque.push(task, range)) return false;
+    system->wake_one_if_sleeping();
+    return true;
+}
+
+}  // namespace detail
+
+// ---- construction ----
+
+WorkStealingJobSystem::WorkStealingJobSystem(Options options) : m_options(std::move(options)) {
+    if (m_options.worker_pus.empty()) throw Error("WorkStealingJobSystem: at least one worker is needed");
+    for (unsigned i = 0; i < m_options.worker_pus.size(); ++i) {
+        auto w = std::make_unique<Worker>();
+        w->system = this;
+        w->index = i;
+        w->pu = i == 0 ? -1 : static_cast<int>(m_options.worker_pus[i]);  // worker 0 is whoever calls
+        w->rng = 0x9E3779B97F4A7C15ull * (i + 1);
+        m_workers.push_back(std::move(w));
+    }
+    for (unsigned i = 1; i < m_workers.size(); ++i) m_threads.emplace_back([this, i] { worker_main(i); });
+}
+
+WorkStealingJobSystem::~WorkStealingJobSystem() {
+    // Drain: queued and pinned jobs all run (worker 0's share on this thread) before
+    // the workers are told to stop.
+    bool entered = false;
+    Worker& self = enter(entered);
+    Backoff backoff;
+    while (m_outstanding.load(std::memory_order_acquire) > 0) {
+        if (run_one(self)) {
+            backoff.reset();
+        } else {
+            backoff.spin();
+        }
+    }
+    leave(entered);
+    m_stop.store(true, std::memory_order_seq_cst);
+    wake_all();
+    for (std::thread& t : m_threads) t.join();
+}
+
+// ---- worker 0: the calling thread ----
+
+Worker& WorkStealingJobSystem::enter(bool& entered) {
+    if (detail::tls_worker && detail::tls_worker->system == this) {
+        entered = false;
+        return *detail::tls_worker;
+    }
+    m_external.lock();  // one external thread acts as worker 0 at a time
+    entered = true;
+    detail::tls_worker = m_workers[0].get();
+    m_workers[0]->pu = current_cpu();
+    return *m_workers[0];
+}
+
+void WorkStealingJobSystem::leave(bool entered) {
+    if (!entered) return;
+    detail::tls_worker = nullptr;
+    m_external.unlock();
+}
+
+// ---- finding and running work ----
+
+bool WorkStealingJobSystem::run_one(Worker& self) {
+    TaskHeader* task = nullptr;
+    std::uint64_t range = 0;
+    if (self.has_mail.load(std::memory_order_acquire)) {
+        std::scoped_lock guard(self.mailbox_lock);
+        if (!self.mailbox.empty()) {
+            task = self.mailbox.back();
+            self.mailbox.pop_back();
+            self.has_mail.store(!self.mailbox.empty(), std::memory_order_release);
+        }
+    }
+    bool found = task != nullptr || self.deque.pop(task, range);
+    if (!found) {
+        const auto n = static_cast<unsigned>(m_workers.size());
+        const unsigned start = n > 1 ? self.next_victim(n) : 0;
+        for (unsigned k = 0; k < n && !found; ++k) {
+            const unsigned v = (start + k) % n;
+            if (v != self.index) found = m_workers[v]->deque.steal(task, range);
+        }
+    }
+    if (!found) return false;
+    task->run(task, range, self);
+    return true;
+}
+
+bool WorkStealingJobSystem::any_work() const {
+    for (const auto& w : m_workers) {
+        if (w->deque.maybe_nonempty() || w->has_mail.load(std::memory_order_acquire)) return true;
+    }
+    return false;
+}
+
+void WorkStealingJobSystem::wake_one_if_sleeping() {
+    if (m_sleeping.load(std::memory_order_seq_cst) > 0) {
+        m_wake.fetch_add(1, std::memory_order_seq_cst);
+        m_wake.notify_all();
+    }
+}
+
+void WorkStealingJobSystem::wake_all() {
+    m_wake.fetch_add(1, std::memory_order_seq_cst);
+    m_wake.notify_all();
+}
+
+void WorkStealingJobSystem::worker_main(unsigned index) {
+    Worker& self = *m_workers[index];
+    detail::tls_worker = &self;
+    set_current_thread_name(m_options.name_prefix + "-" + std::to_string(index));
+    if (m_options.pin) pin_current_thread(m_options.worker_pus[index]);
+    Backoff backoff;
+    for (;;) {
+        if (run_one(self)) {
+            backoff.reset();
+            continue;
+        }
+        if (m_stop.load(std::memory_order_acquire) && !any_work()) break;
+        if (!backoff.saturated()) {
+            backoff.spin();  // pause, briefly: work often arrives within microseconds
+            continue;
+        }
+        // Sleep until work arrives. Announcing the sleep before the last look for work
+        // pairs with push's check of m_sleeping, so no wake-up is missed.
+        const std::uint32_t epoch = m_wake.load(std::memory_order_seq_cst);
+        m_sleeping.fetch_add(1, std::memory_order_seq_cst);
+        if (!any_work() && !m_stop.load(std::memory_order_seq_cst)) m_wake.wait(epoch, std::memory_order_seq_cst);
+        m_sleeping.fetch_sub(1, std::memory_order_seq_cst);
+        backoff.reset();
+    }
+    detail::tls_worker = nullptr;
+}
+
+// ---- parallel_for ----
+
+void WorkStealingJobSystem::parallel_for(const char* name, std::uint32_t begin, std::uint32_t end,
+                                         std::uint32_t grain, RangeFn fn) {
+    if (end <= begin) return;  // zero items spawn nothing
+    if (grain == 0) grain = 1;
+    const std::uint32_t chunks = (end - begin - 1) / grain + 1;
+    bool entered = false;
+    Worker& self = enter(entered);
+    ForContext ctx(fn, name, begin, end, grain, chunks);
+    ctx.run = &run_for;
+    run_for(&ctx, detail::pack(0, chunks), self);
+    // Our share is done; help with anything (thieves hold the rest of ours) until every
+    // chunk finished. The context lives on this stack, so we must not return earlier.
+    Backoff backoff;
+    while (ctx.remaining.load(std::memory_order_acquire) > 0) {
+        if (run_one(self)) {
+            backoff.reset();
+        } else {
+            backoff.spin();
+        }
+    }
+    leave(entered);
+    if (ctx.error) std::rethrow_exception(ctx.error);
+}
+
+// ---- submit / wait ----
+
+JobRecord* WorkStealingJobSystem::make_record_raw() {
+    std::scoped_lock guard(m_pool_lock);
+    if (m_free_records.empty()) {
+        constexpr std::size_t kBlock = 1024;
+        m_record_blocks.push_back(std::make_unique<JobRecord[]>(kBlock));
+        for (std::size_t i = 0; i < kBlock; ++i) m_free_records.push_back(&m_record_blocks.back()[i]);
+    }
+    JobRecord* r = m_free_records.back();
+    m_free_records.pop_back();
+    return r;
+}
+
+void WorkStealingJobSystem::release_record(JobRecord* record) {
+    std::scoped_lock guard(m_pool_lock);
+    m_free_records.push_back(record);
+}
+
+void WorkStealingJobSystem::run_record(TaskHeader* header, std::uint64_t, Worker& self) {
+    auto* record = static_cast<JobRecord*>(header);
+    WorkStealingJobSystem& system = *self.system;
+    const bool tracing = system.trace_enabled();
+    const std::int64_t t0 = tracing ? now_nanoseconds() : 0;
+    try {
+        record->invoke(record->storage, self.index);
+    } catch (...) {
+        GroupAccess::fail(*record->group, std::current_exception());
+    }
+    if (tracing) self.record(record->name, "job", t0, now_nanoseconds());
+    record->destroy(record->storage);
+    JobGroup& group = *record->group;
+    system.release_record(record);
+    finish_group(group);
+    system.m_outstanding.fetch_sub(1, std::memory_order_acq_rel);
+}
+
+void WorkStealingJobSystem::submit_record(JobGroup& group, const char* name, JobRecord* record, int pinned) {
+    record->run = &WorkStealingJobSystem::run_record;
+    record->group = &group;
+    record->name = name;
+    record->pinned = pinned;
+    GroupAccess::add(group);
+    m_outstanding.fetch_add(1, std::memory_order_acq_rel);
+    if (pinned >= 0) {
+        if (static_cast<std::size_t>(pinned) >= m_workers.size()) {
+            throw Error("submit_pinned: worker " + std::to_string(pinned) + " does not exist (" +
+                        std::to_string(m_workers.size()) + " workers)");
+        }
+        Worker& target = *m_workers[static_cast<std::size_t>(pinned)];
+        {
+            std::scoped_lock guard(target.mailbox_lock);
+            target.mailbox.push_back(record);
+            target.has_mail.store(true, std::memory_order_seq_cst);
+        }
+        wake_all();  // the target may be asleep; a targeted wake would need per-worker waits
+        return;
+    }
+    bool entered = false;
+    Worker& self = enter(entered);
+    if (!self.push(record, 0)) run_record(record, 0, self);  // full deque: run it now
+    leave(entered);
+}
+
+void WorkStealingJobSystem::wait(JobGroup& group) {
+    bool entered = false;
+    Worker& self = enter(entered);
+    Backoff backoff;
+    while (!group.done()) {
+        if (run_one(self)) {
+            backoff.reset();
+        } else {
+            backoff.spin();
+        }
+    }
+    leave(entered);
+    if (std::exception_ptr e = GroupAccess::take_error(group)) std::rethrow_exception(e);
+}
+
+// ---- stage graph ----
+
+void WorkStealingJobSystem::run_graph(StageGraph& graph) {
+    JobGroup group;
+    struct Launch {
+        WorkStealingJobSystem* system;
+        StageGraph* graph;
+        JobGroup* group;
+        void start(std::uint32_t node) const {
+            StageGraph::Node& n = graph->m_nodes[node];
+            const Launch self = *this;
+            system->submit(*group, n.name, [self, node](unsigned worker) {
+                StageGraph::Node& me = self.graph->m_nodes[node];
+                me.fn(worker);
+                // Each dependent waits for `prerequisites` nodes; the last one to finish starts it.
+                for (std::uint32_t d : me.dependents) {
+                    if (self.graph->m_nodes[d].waiting.fetch_sub(1, std::memory_order_acq_rel) == 1) self.start(d);
+                }
+            });
+        }
+    };
+    const Launch launch{this, &graph, &group};
+    for (StageGraph::Node& n : graph.m_nodes) n.waiting.store(n.prerequisites, std::memory_order_relaxed);
+    for (std::uint32_t i = 0; i < graph.m_nodes.size(); ++i) {
+        if (graph.m_nodes[i].prerequisites == 0) launch.start(i);
+    }
+    wait(group);
+}
+
+std::uint32_t StageGraph::add(const char* name, Fn fn) {
+    m_nodes.emplace_back(name, fn);
+    return static_cast<std::uint32_t>(m_nodes.size() - 1);
+}
+
+void StageGraph::depends_on(std::uint32_t node, std::uint32_t prerequisite) {
+    if (node >= m_nodes.size() || prerequisite >= m_nodes.size() || node == prerequisite) {
+        throw Error("StageGraph::depends_on: bad node index");
+    }
+    m_nodes[prerequisite].dependents.push_back(node);
+    m_nodes[node].prerequisites += 1;
+}
+
+// ---- trace ----
+
+void WorkStealingJobSystem::trace_begin(const char* stage) noexcept {
+    if (!trace_enabled()) return;
+    std::scoped_lock guard(m_stage_lock);
+    m_open_stages.emplace_back(stage, now_nanoseconds());
+}
+
+void WorkStealingJobSystem::trace_end() noexcept {
+    if (!trace_enabled()) return;
+    std::scoped_lock guard(m_stage_lock);
+    if (m_open_stages.empty()) return;
+    const auto [stage, begin] = m_open_stages.back();
+    m_open_stages.pop_back();
+    m_stage_events.push_back(TraceEvent{stage, "stage", begin, now_nanoseconds(), 0, current_cpu()});
+}
+
+std::vector<TraceEvent> WorkStealingJobSystem::trace_events() const {
+    std::vector<TraceEvent> all;
+    {
+        std::scoped_lock guard(m_stage_lock);
+        all = m_stage_events;
+    }
+    for (const auto& w : m_workers) all.insert(all.end(), w->events.begin(), w->events.end());
+    std::sort(all.begin(), all.end(), [](const TraceEvent& a, const TraceEvent& b) { return a.begin_ns < b.begin_ns; });
+    return all;
+}
+
+void WorkStealingJobSystem::clear_trace() {
+    std::scoped_lock guard(m_stage_lock);
+    m_stage_events.clear();
+    for (auto& w : m_workers) w->events.clear();
+}
+
+void write_chrome_trace(std::ostream& out, const std::vector<TraceEvent>& events) {
+    out << "{\"traceEvents\":[";
+    const std::int64_t origin = events.empty() ? 0 : events.front().begin_ns;
+    for (std::size_t i = 0; i < events.size(); ++i) {
+        const TraceEvent& e = events[i];
+        // Stage spans on their own row (tid 1000) so they frame the job rows.
+        const unsigned tid = std::string_view(e.stage) == "stage" ? 1000u : e.worker;
+        out << (i ? ",\n" : "\n") << "{\"name\":\"" << e.name << "\",\"cat\":\"" << e.stage
+            << "\",\"ph\":\"X\",\"pid\":1,\"tid\":" << tid << ",\"ts\":" << static_cast<double>(e.begin_ns - origin) / 1e3
+            << ",\"dur\":" << static_cast<double>(e.end_ns - e.begin_ns) / 1e3 << ",\"args\":{\"worker\":" << e.worker
+            << ",\"pu\":" << e.pu << "}}";
+    }
+    out << "\n],\"displayTimeUnit\":\"ms\"}\n";
+}
+
+void WorkStealingJobSystem::write_trace(std::ostream& out) const { write_chrome_trace(out, trace_events()); }
+
+void WorkStealingJobSystem::write_trace(const std::string& path) const {
+    std::ofstream out(path);
+    if (!out) throw Error(path + ": cannot write the trace");
+    write_trace(out);
+}
+
+std::unique_ptr<JobSystem> make_job_system(const std::vector<unsigned>& worker_pus, bool pin) {
+    if (worker_pus.size() <= 1) return std::make_unique<SingleThreadedJobSystem>();
+    return std::make_unique<WorkStealingJobSystem>(WorkStealingJobSystem::Options{worker_pus, pin, "spindle-worker"});
+}
+
+}  // namespace spindle

@@ -1,0 +1,266 @@
+// The work-stealing job system: every job once, nesting, DAG order, pinned jobs,
+// the waiter helps, exceptions, shutdown, determinism of reductions, trace.
+#include <spindle/platform/thread.hpp>
+#include <spindle/platform/topology.hpp>
+#include <spindle/scheduler/single_threaded.hpp>
+#include <spindle/scheduler/work_stealing.hpp>
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+using namespace spindle;
+
+namespace {
+
+#ifdef SPINDLE_TSAN
+constexpr std::uint32_t kMillion = 100000;  // TSan is ~10x slower; the logic is the same
+#else
+constexpr std::uint32_t kMillion = 1000000;
+#endif
+
+// n workers on the machine's PUs (round robin), unpinned when there are more workers than PUs.
+std::unique_ptr<WorkStealingJobSystem> make(unsigned n) {
+    const Topology machine = Topology::from_system();
+    WorkStealingJobSystem::Options options;
+    for (unsigned i = 0; i < n; ++i) options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
+    options.pin = n <= machine.pus().size();
+    return std::make_unique<WorkStealingJobSystem>(options);
+}
+
+double reduce(JobSystem& jobs, const std::vector<double>& values) {
+    constexpr std::uint32_t kGrain = 1000;
+    const auto n = static_cast<std::uint32_t>(values.size());
+    std::vector<double> partial((n + kGrain - 1) / kGrain, 0.0);
+    jobs.parallel_for("reduce", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        double s = 0;
+        for (std::uint32_t i = lo; i < hi; ++i) s += values[i];
+        partial[lo / kGrain] = s;
+    });
+    double total = 0;
+    for (double p : partial) total += p;  // chunk order: independent of who ran what
+    return total;
+}
+
+}  // namespace
+
+TEST(WorkStealing, AMillionTinyChunksRunExactlyOnce) {
+    auto jobs = make(2);
+    std::vector<std::atomic<std::uint8_t>> hits(kMillion);
+    jobs->parallel_for("tiny", 0, kMillion, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t i = lo; i < hi; ++i) hits[i].fetch_add(1, std::memory_order_relaxed);
+    });
+    std::size_t wrong = 0;
+    for (auto& h : hits) wrong += h.load() != 1;
+    EXPECT_EQ(wrong, 0u);
+}
+
+TEST(WorkStealing, AMillionSubmittedJobsRunExactlyOnce) {
+    auto jobs = make(2);
+    std::vector<std::atomic<std::uint8_t>> hits(kMillion);
+    JobGroup group;
+    for (std::uint32_t i = 0; i < kMillion; ++i) {
+        jobs->submit(group, "job", [&hits, i] { hits[i].fetch_add(1, std::memory_order_relaxed); });
+    }
+    jobs->wait(group);
+    std::size_t wrong = 0;
+    for (auto& h : hits) wrong += h.load() != 1;
+    EXPECT_EQ(wrong, 0u);
+}
+
+TEST(WorkStealing, ChunkBoundariesDependOnlyOnRangeAndGrain) {
+    for (unsigned workers : {1u, 2u, 3u}) {
+        auto jobs = make(workers);
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> chunks(100);
+        jobs->parallel_for("chunks", 7, 1000, 10, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+            chunks[(lo - 7) / 10] = {lo, hi};
+        });
+        for (std::uint32_t c = 0; c < 100; ++c) {
+            EXPECT_EQ(chunks[c].first, 7 + 10 * c);
+            EXPECT_EQ(chunks[c].second, std::min<std::uint32_t>(1000, 17 + 10 * c));
+        }
+    }
+}
+
+TEST(WorkStealing, NestedParallelForCompletes) {
+    auto jobs = make(2);
+    std::atomic<std::uint32_t> sum{0};
+    jobs->parallel_for("outer", 0, 64, 1, [&](std::uint32_t lo, std::uint32_t, unsigned) {
+        jobs->parallel_for("inner", 0, 100, 7, [&](std::uint32_t a, std::uint32_t b, unsigned) {
+            sum.fetch_add(b - a, std::memory_order_relaxed);
+        });
+        (void)lo;
+    });
+    EXPECT_EQ(sum.load(), 6400u);
+}
+
+TEST(WorkStealing, RandomDagsRunInDependencyOrder) {
+    auto jobs = make(2);
+    std::mt19937 rng(7);
+    for (int round = 0; round < 20; ++round) {
+        constexpr std::uint32_t kNodes = 60;
+        StageGraph graph;
+        std::vector<std::atomic<std::int64_t>> finished(kNodes);
+        std::atomic<std::int64_t> clock{0};
+        std::vector<std::vector<std::uint32_t>> prereqs(kNodes);
+        std::atomic<int> violations{0};
+        std::vector<std::function<void(unsigned)>> bodies(kNodes);
+        for (std::uint32_t i = 0; i < kNodes; ++i) {
+            bodies[i] = [&, i](unsigned) {
+                for (std::uint32_t p : prereqs[i]) {
+                    if (finished[p].load() == 0) violations.fetch_add(1);
+                }
+                finished[i].store(clock.fetch_add(1) + 1);
+            };
+        }
+        for (std::uint32_t i = 0; i < kNodes; ++i) graph.add("node", bodies[i]);
+        for (std::uint32_t i = 1; i < kNodes; ++i) {
+            for (int e = 0; e < 3; ++e) {
+                const std::uint32_t p = rng() % i;  // edges point forward: a DAG
+                prereqs[i].push_back(p);
+                graph.depends_on(i, p);
+            }
+        }
+        jobs->run_graph(graph);
+        EXPECT_EQ(violations.load(), 0);
+        for (auto& f : finished) EXPECT_GT(f.load(), 0);
+    }
+}
+
+TEST(WorkStealing, PinnedJobRunsOnItsWorkersPu) {
+    const Topology machine = Topology::from_system();
+    if (machine.pus().size() < 2) GTEST_SKIP() << "needs two hardware threads";
+    auto jobs = make(2);
+    std::vector<unsigned> binding;
+    unsigned worker = 99;
+    JobGroup group;
+    jobs->submit_pinned(1, group, "pinned", [&](unsigned w) {
+        binding = current_binding();
+        worker = w;
+    });
+    jobs->wait(group);
+    EXPECT_EQ(worker, 1u);
+    EXPECT_EQ(binding, std::vector<unsigned>{machine.pus()[1].os_index});
+}
+
+TEST(WorkStealing, TheWaitingThreadRunsJobs) {
+    auto jobs = make(2);
+    std::atomic<int> by_caller{0};
+    jobs->parallel_for("slow", 0, 32, 1, [&](std::uint32_t, std::uint32_t, unsigned worker) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        if (worker == 0) by_caller.fetch_add(1);
+    });
+    EXPECT_GT(by_caller.load(), 0);
+    // A group waited on by a thread whose only other worker is busy still finishes.
+    JobGroup group;
+    std::atomic<bool> release{false};
+    jobs->submit_pinned(1, group, "block", [&] {
+        while (!release.load()) std::this_thread::yield();
+    });
+    JobGroup mine;
+    std::atomic<int> ran{0};
+    for (int i = 0; i < 10; ++i) jobs->submit(mine, "work", [&] { ran.fetch_add(1); });
+    jobs->wait(mine);
+    EXPECT_EQ(ran.load(), 10);
+    release.store(true);
+    jobs->wait(group);
+}
+
+TEST(WorkStealing, ExceptionsReachTheWaiter) {
+    auto jobs = make(2);
+    EXPECT_THROW(jobs->parallel_for("boom", 0, 100, 1,
+                                    [&](std::uint32_t lo, std::uint32_t, unsigned) {
+                                        if (lo == 57) throw std::runtime_error("chunk 57");
+                                    }),
+                 std::runtime_error);
+    JobGroup group;
+    for (int i = 0; i < 10; ++i) {
+        jobs->submit(group, "job", [i] {
+            if (i == 3) throw std::logic_error("job 3");
+        });
+    }
+    EXPECT_THROW(jobs->wait(group), std::logic_error);
+    // The system is still usable afterwards.
+    std::atomic<int> n{0};
+    jobs->parallel_for("after", 0, 10, 1, [&](std::uint32_t, std::uint32_t, unsigned) { n.fetch_add(1); });
+    EXPECT_EQ(n.load(), 10);
+}
+
+TEST(WorkStealing, ShutdownWithQueuedWorkRunsEverything) {
+    std::atomic<int> ran{0};
+    auto groups = std::make_unique<JobGroup[]>(2);
+    {
+        auto jobs = make(2);
+        for (int i = 0; i < 10000; ++i) jobs->submit(groups[0], "queued", [&] { ran.fetch_add(1); });
+        jobs->submit_pinned(1, groups[1], "pinned", [&] { ran.fetch_add(1); });
+        jobs->submit_pinned(0, groups[1], "pinned0", [&] { ran.fetch_add(1); });
+    }  // destroyed without waiting
+    EXPECT_EQ(ran.load(), 10002);
+}
+
+TEST(WorkStealing, FloatingPointReductionIsBitwiseTheSameForAnyWorkerCount) {
+    std::vector<double> values(kMillion / 2);
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> dist(-1e6, 1e6);
+    for (double& v : values) v = dist(rng) * std::exp(dist(rng) * 1e-5);
+    SingleThreadedJobSystem single;
+    const double expected = reduce(single, values);
+    for (unsigned workers : {1u, 2u, 3u, 4u}) {
+        auto jobs = make(workers);
+        for (int rep = 0; rep < 3; ++rep) {
+            const double got = reduce(*jobs, values);
+            EXPECT_EQ(std::memcmp(&got, &expected, sizeof got), 0) << workers << " workers";
+        }
+    }
+}
+
+TEST(WorkStealing, SingleThreadedRunsGraphsInOrderAndKeepsErrors) {
+    SingleThreadedJobSystem single;
+    StageGraph graph;
+    std::vector<int> order;
+    auto a = [&](unsigned) { order.push_back(0); };
+    auto b = [&](unsigned) { order.push_back(1); };
+    auto c = [&](unsigned) { order.push_back(2); };
+    const auto na = graph.add("a", a), nb = graph.add("b", b), nc = graph.add("c", c);
+    graph.depends_on(na, nc);  // a after c
+    graph.depends_on(nb, na);  // b after a
+    single.run_graph(graph);
+    EXPECT_EQ(order, (std::vector<int>{2, 0, 1}));
+    JobGroup group;
+    single.submit(group, "x", [] { throw std::runtime_error("x"); });
+    EXPECT_THROW(single.wait(group), std::runtime_error);
+}
+
+TEST(WorkStealing, TraceIsChromeJsonNamingJobsStagesWorkersAndPus) {
+    auto jobs = make(2);
+    jobs->parallel_for("untraced", 0, 10, 1, [](std::uint32_t, std::uint32_t, unsigned) {});
+    EXPECT_TRUE(jobs->trace_events().empty());  // off by default
+    jobs->enable_trace(true);
+    {
+        StageScope stage(*jobs, "Narrowphase");
+        jobs->parallel_for("pairs", 0, 64, 4, [](std::uint32_t, std::uint32_t, unsigned) {});
+    }
+    const std::vector<TraceEvent> events = jobs->trace_events();
+    ASSERT_EQ(events.size(), 17u);  // 16 chunks + 1 stage
+    std::ostringstream json;
+    jobs->write_trace(json);
+    const std::string text = json.str();
+    EXPECT_NE(text.find("\"name\":\"Narrowphase\""), std::string::npos);
+    EXPECT_NE(text.find("\"name\":\"pairs\""), std::string::npos);
+    EXPECT_NE(text.find("\"pu\":"), std::string::npos);
+    const std::string path = ::testing::TempDir() + "spindle_trace.json";
+    jobs->write_trace(path);
+    const std::string check = "python3 -c \"import json,sys; d=json.load(open('" + path +
+                              "')); sys.exit(0 if len(d['traceEvents'])==17 else 1)\"";
+    EXPECT_EQ(std::system(check.c_str()), 0);
+}
