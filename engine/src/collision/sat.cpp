@@ -11,6 +11,8 @@ namespace spindle::detail {
 namespace {
 
 constexpr std::size_t kInlineVertices = 64;
+// A clipped manifold shallower than the deepest vertex by more than this gets that vertex.
+constexpr Real kMissedDepth = 1e-6;
 
 // A polyhedron placed in the common frame: its vertices already there, its normals
 // rotated by r and its plane offsets shifted by t on demand.
@@ -124,15 +126,16 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
         if (s > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
     }
-    if (count == 0) {
-        // Clipping left nothing (the incident face lies beside the reference face, as
-        // when a corner pokes in): the support point still gives a contact.
-        const std::uint32_t v = inc.support(-n);
-        const Real s = n.dot(inc.vertices[v]) - d;
-        if (s <= speculative) {
-            out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
-                            face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
-        }
+    // The deepest vertex along the reference normal sets the SAT depth. When clipping
+    // dropped it (it pokes in beside a small reference face), it is kept anyway, so the
+    // reported depth never falls short of the real one.
+    Real shallowest_kept = kHuge;
+    for (int k = 0; k < n_out; ++k) shallowest_kept = std::min(shallowest_kept, out[k].separation);
+    const std::uint32_t v = inc.support(-n);
+    const Real s = n.dot(inc.vertices[v]) - d;
+    if (s <= speculative && s < shallowest_kept - kMissedDepth) {
+        out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
+                        face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
     }
     return n_out;
 }
