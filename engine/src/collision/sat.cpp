@@ -60,32 +60,56 @@ FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     return best;
 }
 
+// An edge in the common frame with what the Gauss-map test needs: the edge's arc
+// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
+struct ArcEdge {
+    Vec3 origin;
+    Vec3 direction;
+    Vec3 n0, n1;  // normals of the two faces
+    Vec3 t0, t1;  // direction x n0, n1 x direction
+};
+
+void prepare_edges(const Posed& p, ArcEdge* out) {
+    for (std::uint32_t j = 0; j < p.view.edge_count; ++j) {
+        const HullEdge& e = p.view.edges[j];
+        ArcEdge& a = out[j];
+        a.origin = p.vertices[e.v0];
+        a.direction = p.vertices[e.v1] - a.origin;
+        a.n0 = p.normal(e.f0);
+        a.n1 = p.normal(e.f1);
+        a.t0 = a.direction.cross(a.n0);
+        a.t1 = a.n1.cross(a.direction);
+    }
+}
+
 // Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
 // negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb).
 EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
+    ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_a(a.view.edge_count), edges_b(b.view.edge_count);
+    prepare_edges(a, edges_a.data());
+    prepare_edges(b, edges_b.data());
     EdgeQuery best;
     for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
-        const HullEdge& edge_b = b.view.edges[jb];
-        const Vec3 nb0 = b.normal(edge_b.f0), nb1 = b.normal(edge_b.f1);
-        const Vec3& qb = b.vertices[edge_b.v0];
-        const Vec3 eb = b.vertices[edge_b.v1] - qb;
+        const ArcEdge& eb = edges_b[jb];
         for (std::uint32_t ja = 0; ja < a.view.edge_count; ++ja) {
-            const HullEdge& edge_a = a.view.edges[ja];
-            const Vec3& pa = a.vertices[edge_a.v0];
-            const Vec3 ea = a.vertices[edge_a.v1] - pa;
-            const Vec3 cross = ea.cross(eb);
+            const ArcEdge& ea = edges_a[ja];
+            // Cheap rejections first: each arc must cross the other's great circle.
+            if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) continue;
+            if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) continue;
+            const Vec3 cross = ea.direction.cross(eb.direction);
             const Real length2 = cross.squaredNorm();
-            if (length2 <= Real(1e-12) * ea.squaredNorm() * eb.squaredNorm()) continue;  // parallel
-            const Vec3 na0 = a.normal(edge_a.f0), na1 = a.normal(edge_a.f1);
-            for (const Real sign : {Real(1), Real(-1)}) {
-                const Vec3 axis = sign * cross;
-                if (!on_edge_arc(axis, na0, na1, ea) || !on_edge_arc(-axis, nb0, nb1, eb)) continue;
-                const Vec3 unit = axis / std::sqrt(length2);
-                const Real s = unit.dot(qb - pa);
-                if (s > best.separation) best = {s, ja, jb, unit, true};
-                if (s > limit) return best;
-                break;
-            }
+            if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) continue;
+            // L = +cross or -cross must lie on A's arc while -L lies on B's arc.
+            const Real x0 = cross.dot(ea.t0), x1 = cross.dot(ea.t1);
+            const Real y0 = cross.dot(eb.t0), y1 = cross.dot(eb.t1);
+            Real sign = 0;
+            if (x0 >= 0 && x1 >= 0 && y0 <= 0 && y1 <= 0) sign = 1;
+            else if (x0 <= 0 && x1 <= 0 && y0 >= 0 && y1 >= 0) sign = -1;
+            if (sign == 0) continue;
+            const Vec3 unit = cross * (sign / std::sqrt(length2));
+            const Real s = unit.dot(eb.origin - ea.origin);
+            if (s > best.separation) best = {s, ja, jb, unit, true};
+            if (s > limit) return best;
         }
     }
     return best;
