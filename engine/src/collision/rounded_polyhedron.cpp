@@ -2,8 +2,11 @@
 // While the cores are apart GJK gives the exact closest points, so a capsule rolling
 // over a corner gets the true normal; once the core dips in, SAT over the face normals
 // and the edge-segment axes finds the way out. All work happens in B's frame.
+// Serves sphere-hull, capsule-box and capsule-hull, and spheres and capsules on mesh triangles.
 #include <algorithm>
 #include <cmath>
+
+#include <spindle/engine/convex_hull.hpp>
 
 #include "contact.hpp"
 #include "gjk.hpp"
@@ -163,6 +166,29 @@ bool collide_rounded_polyhedron(const Vec3& p0, const Vec3& p1, Real radius, con
                                                                : overlapping_cores(core, b, speculative, m);
     if (hit) manifold_to_world(m, xb);
     return hit;
+}
+
+int collide_sphere_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int) {
+    return collide_rounded_polyhedron(Vec3::Zero(), Vec3::Zero(), a.radius, xa, view_of(*b.hull), xb, speculative,
+                                      out[0])
+               ? 1
+               : 0;
+}
+
+int collide_capsule_box(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int) {
+    Vec3 p0, p1;
+    rounded_core(a, p0, p1);
+    const BoxPoly box(b.half_extents);
+    return collide_rounded_polyhedron(p0, p1, a.radius, xa, box.view(), xb, speculative, out[0]) ? 1 : 0;
+}
+
+int collide_capsule_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                         Manifold* out, int) {
+    Vec3 p0, p1;
+    rounded_core(a, p0, p1);
+    return collide_rounded_polyhedron(p0, p1, a.radius, xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
 }
 
 }  // namespace spindle::detail

@@ -4,6 +4,8 @@
 // between the two edges. All work happens in A's frame.
 #include <cmath>
 
+#include <spindle/engine/convex_hull.hpp>
+
 #include "contact.hpp"
 #include "pair_functions.hpp"
 
@@ -200,8 +202,8 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     }
 
     const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-    const std::size_t capacity = reference_is_b ? a.vertex_count + b.vertex_count : b.vertex_count + a.vertex_count;
-    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(capacity + 1);
+    // Clipping leaves at most (incident face + reference face) vertices, plus the deepest.
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(a.vertex_count + b.vertex_count + 1);
     Vec3 n;
     const int count = reference_is_b ? face_contact(pb, face_b.face, pa, true, speculative, n, candidates.data())
                                      : face_contact(pa, face_a.face, pb, false, speculative, n, candidates.data());
@@ -210,6 +212,17 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     reduce_to_manifold(candidates.data(), count, m);
     manifold_to_world(m, xa);
     return true;
+}
+
+int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                     Manifold* out, int) {
+    const BoxPoly box(a.half_extents);
+    return collide_polyhedra(box.view(), xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
+}
+
+int collide_hull_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                      Manifold* out, int) {
+    return collide_polyhedra(view_of(*a.hull), xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
 }
 
 }  // namespace spindle::detail
