@@ -130,5 +130,49 @@ TEST(ConvexConsistency, DepthMatchesBruteForcePenetration) {
     }
 }
 
+// Shapes that face each other along x with flat or round sides, each with its extent along x.
+struct Facing {
+    Shape shape;
+    Quat q;
+    Real extent;
+};
+
+std::vector<Facing> facing_shapes() {
+    const Quat lying = about(Vec3::UnitX(), kPi / 2);  // capsule axis along z
+    return {{Shape::sphere(0.4), Quat::Identity(), 0.4},
+            {Shape::capsule(0.5, 0.3), lying, 0.3},
+            {Shape::box(Vec3(0.5, 0.4, 0.3)), Quat::Identity(), 0.5},
+            {test::hull_box(Vec3(0.6, 0.3, 0.4)), Quat::Identity(), 0.6}};
+}
+
+TEST(ConvexPairs, SeparatedTouchingAndPenetratingAlongX) {
+    for (const Facing& a : facing_shapes()) {
+        for (const Facing& b : facing_shapes()) {
+            SCOPED_TRACE(std::string(to_string(a.shape.type)) + " vs " + to_string(b.shape.type));
+            const Real contact = a.extent + b.extent;
+            const auto pose_b = [&](Real gap) { return at(Vec3(contact + gap, 0, 0), b.q); };
+            const Transform xa = at(Vec3::Zero(), a.q);
+            // Apart by 0.1: nothing, or a speculative manifold at +0.1 when the margin allows.
+            EXPECT_TRUE(test::run(a.shape, xa, b.shape, pose_b(0.1)).empty());
+            auto m = test::run(a.shape, xa, b.shape, pose_b(0.1), 0.2);
+            ASSERT_EQ(m.size(), 1u);
+            SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(1, 0, 0), 1e-9);
+            EXPECT_NEAR(test::min_separation(m[0]), 0.1, 1e-9);
+            // Touching.
+            m = test::run(a.shape, xa, b.shape, pose_b(0), 1e-9);
+            ASSERT_EQ(m.size(), 1u);
+            EXPECT_NEAR(test::min_separation(m[0]), 0, 1e-9);
+            // Resting 0.02 deep: every point at that depth, midway between the surfaces.
+            m = test::run(a.shape, xa, b.shape, pose_b(-0.02));
+            ASSERT_EQ(m.size(), 1u);
+            SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(1, 0, 0), 1e-9);
+            for (int i = 0; i < m[0].point_count; ++i) {
+                EXPECT_NEAR(m[0].points[i].separation, -0.02, 1e-9);
+                EXPECT_NEAR(m[0].points[i].point.x(), a.extent - 0.01, 1e-9);
+            }
+        }
+    }
+}
+
 }  // namespace
 }  // namespace spindle
