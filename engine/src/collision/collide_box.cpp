@@ -1,6 +1,7 @@
 // Box-box: separating axis test over the 15 axes (3 + 3 face normals, 9 edge
 // cross products), then the incident face clipped against the reference face, or a
 // single point between the two closest edges.
+#include <algorithm>
 #include <cmath>
 
 #include "contact.hpp"
@@ -8,6 +9,9 @@
 
 namespace spindle::detail {
 namespace {
+
+// A clipped manifold shallower than the deepest corner by more than this gets that corner.
+constexpr Real kMissedDepth = 1e-6;
 
 struct BoxAxis {
     Real separation = -kHuge;
@@ -57,19 +61,22 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
         out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
                         face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
     }
-    if (n_out == 0 && count == 0) {
-        // Round-off clipped everything away although SAT says the faces meet: keep the
-        // deepest incident vertex so the pair still gets a contact.
-        int deepest = 0;
-        for (int k = 1; k < 4; ++k) {
-            if (n.dot(quad[k]) < n.dot(quad[deepest])) deepest = k;
-        }
-        const Real separation = n.dot(quad[deepest]) - hr[axis];
-        if (separation <= speculative) {
-            out[n_out++] = {quad[deepest] - n * (Real(0.5) * separation), separation,
-                            face_contact_id(reference_is_b, reference_face, incident_face,
-                                            clip_key(0, static_cast<std::uint32_t>(deepest), 0))};
-        }
+    // The deepest corner sets the SAT depth; when clipping dropped it (it pokes in beside
+    // the reference face) it is kept anyway, so the depth never falls short.
+    Real shallowest_kept = kHuge;
+    for (int k = 0; k < n_out; ++k) shallowest_kept = std::min(shallowest_kept, out[k].separation);
+    const Vec3 down = ri.transpose() * -n;
+    std::uint32_t corner = 0;
+    Vec3 local;
+    for (int k = 0; k < 3; ++k) {
+        local[k] = down[k] >= 0 ? hi[k] : -hi[k];
+        corner |= down[k] >= 0 ? 1u << k : 0u;
+    }
+    const Vec3 deepest = ri * local + ti;
+    const Real separation = n.dot(deepest) - hr[axis];
+    if (separation <= speculative && separation < shallowest_kept - kMissedDepth) {
+        out[n_out++] = {deepest - n * (Real(0.5) * separation), separation,
+                        face_contact_id(reference_is_b, reference_face, incident_face, clip_key(3, corner, 0))};
     }
     return n_out;
 }
@@ -144,7 +151,7 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         return 1;
     }
 
-    ContactCandidate candidates[8];
+    ContactCandidate candidates[9];
     int count = 0;
     if (clearly_greater(face_b.separation, face_a.separation)) {
         // Reference face on B: clip in B's frame, then bring the points back to A's.

@@ -17,13 +17,15 @@ constexpr std::uint32_t kCapsuleEndKey = 1;  // + 0..3: which segment end bounds
 constexpr Real kCoincident = 1e-12;
 
 // One contact between core points ca (on A) and cb (on B) swept by radii ra and rb.
-bool rounded_contact(const Vec3& ca, const Vec3& cb, Real ra, Real rb, const Vec3& fallback_normal, Real speculative,
+// `fallback()` gives the normal when the cores touch exactly (called only then).
+template <typename Fallback>
+bool rounded_contact(const Vec3& ca, const Vec3& cb, Real ra, Real rb, Fallback&& fallback, Real speculative,
                      Manifold& m) {
     const Vec3 d = cb - ca;
     const Real dist = d.norm();
     const Real separation = dist - ra - rb;
     if (separation > speculative) return false;
-    m.normal = dist > kCoincident ? Vec3(d / dist) : fallback_normal;
+    m.normal = dist > kCoincident ? Vec3(d / dist) : Vec3(fallback());
     m.points[0].point = ca + m.normal * (ra + Real(0.5) * separation);
     m.points[0].separation = separation;
     m.points[0].id = other_contact_id(kSingleKey);
@@ -77,7 +79,8 @@ bool parallel_capsules(const Vec3& a0, const Vec3& da, const Vec3& b0, const Vec
 
 int collide_sphere_sphere(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                           Manifold* out, int) {
-    return rounded_contact(xa.p, xb.p, a.radius, b.radius, Vec3::UnitY(), speculative, out[0]) ? 1 : 0;
+    const auto up = [] { return Vec3(Vec3::UnitY()); };
+    return rounded_contact(xa.p, xb.p, a.radius, b.radius, up, speculative, out[0]) ? 1 : 0;
 }
 
 int collide_sphere_capsule(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
@@ -86,7 +89,8 @@ int collide_sphere_capsule(const Shape& a, const Transform& xa, const Shape& b, 
     const Vec3 b0 = xb.p - axis;
     const Real t = closest_parameter_on_segment(xa.p, b0, xb.p + axis);
     const Vec3 cb = b0 + 2 * t * axis;
-    return rounded_contact(xa.p, cb, a.radius, b.radius, any_perpendicular(axis), speculative, out[0]) ? 1 : 0;
+    const auto across = [&axis] { return any_perpendicular(axis); };
+    return rounded_contact(xa.p, cb, a.radius, b.radius, across, speculative, out[0]) ? 1 : 0;
 }
 
 int collide_capsule_capsule(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
@@ -100,11 +104,13 @@ int collide_capsule_capsule(const Shape& a, const Transform& xa, const Shape& b,
     const Vec3 ca = a0 + s * da;
     const Vec3 cb = b0 + t * db;
     // Crossing axes: their common perpendicular; parallel ones: across, towards B.
-    const Vec3 across = da.cross(db);
-    Vec3 fallback = across.squaredNorm() > Real(1e-12) * da.squaredNorm() * db.squaredNorm()
-                        ? Vec3(across.normalized())
-                        : centre_direction(xa, xb, da.normalized());
-    if (fallback.dot(xb.p - xa.p) < 0) fallback = -fallback;
+    const auto fallback = [&] {
+        const Vec3 across = da.cross(db);
+        const Vec3 n = across.squaredNorm() > Real(1e-12) * da.squaredNorm() * db.squaredNorm()
+                           ? Vec3(across.normalized())
+                           : centre_direction(xa, xb, da.normalized());
+        return n.dot(xb.p - xa.p) < 0 ? Vec3(-n) : n;
+    };
     Manifold& m = out[0];
     if (!rounded_contact(ca, cb, a.radius, b.radius, fallback, speculative, m)) return 0;
     parallel_capsules(a0, da, b0, db, a.radius, b.radius, speculative, m);

@@ -22,7 +22,7 @@ int collide_capsule_capsule(const Shape&, const Transform&, const Shape&, const 
 // collide_box.cpp: box-box, SAT over 15 axes.
 int collide_box_box(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 
-// collide_convex.cpp: sphere/capsule/box/hull against hulls, capsule against box.
+// rounded_polyhedron.cpp (sphere/capsule vs hull, capsule vs box) and sat.cpp (box/hull vs hull).
 int collide_sphere_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 int collide_capsule_box(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 int collide_capsule_hull(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
@@ -35,7 +35,7 @@ int collide_convex_plane(const Shape&, const Transform&, const Shape&, const Tra
 // collide_mesh.cpp: every convex shape against a triangle mesh (B).
 int collide_convex_mesh(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 
-// ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) ---------------------------
+// ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and
 // Gauss-map-pruned edge pairs, then face clipping or a single edge-edge point.
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,

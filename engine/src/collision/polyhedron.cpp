@@ -38,18 +38,23 @@ const BoxTopology& box_topology() {
 constexpr std::uint32_t kTriangleLoops[6] = {0, 1, 2, 0, 2, 1};
 constexpr HullEdge kTriangleEdges[3] = {{0, 1, 0, 1}, {1, 2, 0, 1}, {2, 0, 0, 1}};
 
+PolyView make_view(std::span<const Vec3> vertices, std::span<const HullFace> faces, const std::uint32_t* face_vertices,
+                   std::span<const HullEdge> edges) {
+    PolyView v;
+    v.vertices = vertices.data();
+    v.vertex_count = static_cast<std::uint32_t>(vertices.size());
+    v.faces = faces.data();
+    v.face_count = static_cast<std::uint32_t>(faces.size());
+    v.face_vertices = face_vertices;
+    v.edges = edges.data();
+    v.edge_count = static_cast<std::uint32_t>(edges.size());
+    return v;
+}
+
 }  // namespace
 
 PolyView view_of(const ConvexHull& hull) {
-    PolyView v;
-    v.vertices = hull.vertices().data();
-    v.vertex_count = static_cast<std::uint32_t>(hull.vertices().size());
-    v.faces = hull.faces().data();
-    v.face_count = static_cast<std::uint32_t>(hull.faces().size());
-    v.face_vertices = hull.face_vertices().data();
-    v.edges = hull.edges().data();
-    v.edge_count = static_cast<std::uint32_t>(hull.edges().size());
-    return v;
+    return make_view(hull.vertices(), hull.faces(), hull.face_vertices().data(), hull.edges());
 }
 
 BoxPoly::BoxPoly(const Vec3& h) {
@@ -68,17 +73,7 @@ BoxPoly::BoxPoly(const Vec3& h) {
     }
 }
 
-PolyView BoxPoly::view() const {
-    PolyView v;
-    v.vertices = m_vertices.data();
-    v.vertex_count = 8;
-    v.faces = m_faces.data();
-    v.face_count = 6;
-    v.face_vertices = kBoxLoops;
-    v.edges = box_topology().edges.data();
-    v.edge_count = 12;
-    return v;
-}
+PolyView BoxPoly::view() const { return make_view(m_vertices, m_faces, kBoxLoops, box_topology().edges); }
 
 TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vertices{a, b, c} {
     const Vec3 n = (b - a).cross(c - a).normalized();
@@ -86,17 +81,7 @@ TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vert
     m_faces[1] = {-n, -n.dot(a), 3, 3};
 }
 
-PolyView TrianglePoly::view() const {
-    PolyView v;
-    v.vertices = m_vertices.data();
-    v.vertex_count = 3;
-    v.faces = m_faces.data();
-    v.face_count = 2;
-    v.face_vertices = kTriangleLoops;
-    v.edges = kTriangleEdges;
-    v.edge_count = 3;
-    return v;
-}
+PolyView TrianglePoly::view() const { return make_view(m_vertices, m_faces, kTriangleLoops, kTriangleEdges); }
 
 std::uint32_t collect_edges(const HullFace* faces, std::uint32_t face_count, const std::uint32_t* face_vertices,
                             HullEdge* out, std::uint32_t capacity) {

@@ -2,8 +2,11 @@
 // While the cores are apart GJK gives the exact closest points, so a capsule rolling
 // over a corner gets the true normal; once the core dips in, SAT over the face normals
 // and the edge-segment axes finds the way out. All work happens in B's frame.
+// Serves sphere-hull, capsule-box and capsule-hull, and spheres and capsules on mesh triangles.
 #include <algorithm>
 #include <cmath>
+
+#include <spindle/engine/convex_hull.hpp>
 
 #include "contact.hpp"
 #include "gjk.hpp"
@@ -15,7 +18,7 @@ namespace {
 // Cores closer than this are treated as overlapping: GJK's direction gets noisy there.
 constexpr Real kCoreTolerance = 1e-6;
 // A separated capsule whose closest-point normal is within ~2.5 degrees of a face normal
-// lies on that face: it gets two points so it does not rock.
+// lies on (or along) that face: it gets two points so it does not rock.
 constexpr Real kFaceAlignment = 0.999;
 
 struct Core {
@@ -24,9 +27,11 @@ struct Core {
     Real radius;
 };
 
-// Points of the core clipped to face f's prism, measured along the face normal. Returns
-// how many were written (0 when the core lies outside the prism).
-int face_points(const Core& core, const PolyView& b, std::uint32_t f, Real speculative, ManifoldPoint* out) {
+// Points of the core clipped to face f's prism. Each is measured from the face plane
+// along `out` (unit, from B towards A, within a few degrees of the face normal).
+// Returns how many were written (0 when the core lies outside the prism).
+int face_points(const Core& core, const PolyView& b, std::uint32_t f, const Vec3& out, Real speculative,
+                ManifoldPoint* points) {
     const HullFace& face = b.faces[f];
     Real t[2] = {0, 1};
     std::uint16_t key[2] = {clip_key(0, 0, 0), clip_key(0, 1, 0)};
@@ -48,13 +53,13 @@ int face_points(const Core& core, const PolyView& b, std::uint32_t f, Real specu
         if (t[0] > t[1]) return 0;
     }
     const int ends = core.is_point || t[1] - t[0] < Real(1e-9) ? 1 : 2;
+    const Real slant = face.normal.dot(out);
     int n = 0;
     for (int i = 0; i < ends; ++i) {
         const Vec3 s = core.s[0] + t[i] * d;
-        const Real separation = face.normal.dot(s) - face.offset - core.radius;
+        const Real separation = (face.normal.dot(s) - face.offset) / slant - core.radius;
         if (separation > speculative) continue;
-        out[n++] = {s - face.normal * (core.radius + Real(0.5) * separation), separation,
-                    face_contact_id(true, f, 0, key[i])};
+        points[n++] = {s - out * (core.radius + Real(0.5) * separation), separation, face_contact_id(true, f, 0, key[i])};
     }
     return n;
 }
@@ -78,9 +83,11 @@ bool separated_cores(const Core& core, const PolyView& b, const GjkResult& g, Re
             if (b.faces[f].normal.dot(out_normal) > b.faces[best].normal.dot(out_normal)) best = f;
         }
         if (b.faces[best].normal.dot(out_normal) > kFaceAlignment) {
-            const int n = face_points(core, b, best, speculative, m.points);
+            // Points from the face, but the exact closest-point normal: a capsule hanging
+            // over an edge still tips off it.
+            const int n = face_points(core, b, best, out_normal, speculative, m.points);
             if (n > 0) {
-                m.normal = -b.faces[best].normal;
+                m.normal = -out_normal;
                 m.point_count = n;
                 return true;
             }
@@ -130,7 +137,7 @@ bool overlapping_cores(const Core& core, const PolyView& b, Real speculative, Ma
         single_point(on_a, on_b, edge_axis, core.radius, edge_contact_id(0, edge), m);
         return edge_separation - core.radius <= speculative;
     }
-    const int n = face_points(core, b, face, speculative, m.points);
+    const int n = face_points(core, b, face, b.faces[face].normal, speculative, m.points);
     m.normal = -b.faces[face].normal;
     if (n > 0) {
         m.point_count = n;
@@ -159,6 +166,29 @@ bool collide_rounded_polyhedron(const Vec3& p0, const Vec3& p1, Real radius, con
                                                                : overlapping_cores(core, b, speculative, m);
     if (hit) manifold_to_world(m, xb);
     return hit;
+}
+
+int collide_sphere_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int) {
+    return collide_rounded_polyhedron(Vec3::Zero(), Vec3::Zero(), a.radius, xa, view_of(*b.hull), xb, speculative,
+                                      out[0])
+               ? 1
+               : 0;
+}
+
+int collide_capsule_box(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int) {
+    Vec3 p0, p1;
+    rounded_core(a, p0, p1);
+    const BoxPoly box(b.half_extents);
+    return collide_rounded_polyhedron(p0, p1, a.radius, xa, box.view(), xb, speculative, out[0]) ? 1 : 0;
+}
+
+int collide_capsule_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                         Manifold* out, int) {
+    Vec3 p0, p1;
+    rounded_core(a, p0, p1);
+    return collide_rounded_polyhedron(p0, p1, a.radius, xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
 }
 
 }  // namespace spindle::detail

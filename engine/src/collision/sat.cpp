@@ -4,6 +4,8 @@
 // between the two edges. All work happens in A's frame.
 #include <cmath>
 
+#include <spindle/engine/convex_hull.hpp>
+
 #include "contact.hpp"
 #include "pair_functions.hpp"
 
@@ -11,6 +13,8 @@ namespace spindle::detail {
 namespace {
 
 constexpr std::size_t kInlineVertices = 64;
+// A clipped manifold shallower than the deepest vertex by more than this gets that vertex.
+constexpr Real kMissedDepth = 1e-6;
 
 // A polyhedron placed in the common frame: its vertices already there, its normals
 // rotated by r and its plane offsets shifted by t on demand.
@@ -58,32 +62,56 @@ FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     return best;
 }
 
+// An edge in the common frame with what the Gauss-map test needs: the edge's arc
+// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
+struct ArcEdge {
+    Vec3 origin;
+    Vec3 direction;
+    Vec3 n0, n1;  // normals of the two faces
+    Vec3 t0, t1;  // direction x n0, n1 x direction
+};
+
+void prepare_edges(const Posed& p, ArcEdge* out) {
+    for (std::uint32_t j = 0; j < p.view.edge_count; ++j) {
+        const HullEdge& e = p.view.edges[j];
+        ArcEdge& a = out[j];
+        a.origin = p.vertices[e.v0];
+        a.direction = p.vertices[e.v1] - a.origin;
+        a.n0 = p.normal(e.f0);
+        a.n1 = p.normal(e.f1);
+        a.t0 = a.direction.cross(a.n0);
+        a.t1 = a.n1.cross(a.direction);
+    }
+}
+
 // Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
 // negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb).
 EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
+    ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_a(a.view.edge_count), edges_b(b.view.edge_count);
+    prepare_edges(a, edges_a.data());
+    prepare_edges(b, edges_b.data());
     EdgeQuery best;
     for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
-        const HullEdge& edge_b = b.view.edges[jb];
-        const Vec3 nb0 = b.normal(edge_b.f0), nb1 = b.normal(edge_b.f1);
-        const Vec3& qb = b.vertices[edge_b.v0];
-        const Vec3 eb = b.vertices[edge_b.v1] - qb;
+        const ArcEdge& eb = edges_b[jb];
         for (std::uint32_t ja = 0; ja < a.view.edge_count; ++ja) {
-            const HullEdge& edge_a = a.view.edges[ja];
-            const Vec3& pa = a.vertices[edge_a.v0];
-            const Vec3 ea = a.vertices[edge_a.v1] - pa;
-            const Vec3 cross = ea.cross(eb);
+            const ArcEdge& ea = edges_a[ja];
+            // Cheap rejections first: each arc must cross the other's great circle.
+            if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) continue;
+            if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) continue;
+            const Vec3 cross = ea.direction.cross(eb.direction);
             const Real length2 = cross.squaredNorm();
-            if (length2 <= Real(1e-12) * ea.squaredNorm() * eb.squaredNorm()) continue;  // parallel
-            const Vec3 na0 = a.normal(edge_a.f0), na1 = a.normal(edge_a.f1);
-            for (const Real sign : {Real(1), Real(-1)}) {
-                const Vec3 axis = sign * cross;
-                if (!on_edge_arc(axis, na0, na1, ea) || !on_edge_arc(-axis, nb0, nb1, eb)) continue;
-                const Vec3 unit = axis / std::sqrt(length2);
-                const Real s = unit.dot(qb - pa);
-                if (s > best.separation) best = {s, ja, jb, unit, true};
-                if (s > limit) return best;
-                break;
-            }
+            if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) continue;
+            // L = +cross or -cross must lie on A's arc while -L lies on B's arc.
+            const Real x0 = cross.dot(ea.t0), x1 = cross.dot(ea.t1);
+            const Real y0 = cross.dot(eb.t0), y1 = cross.dot(eb.t1);
+            Real sign = 0;
+            if (x0 >= 0 && x1 >= 0 && y0 <= 0 && y1 <= 0) sign = 1;
+            else if (x0 <= 0 && x1 <= 0 && y0 >= 0 && y1 >= 0) sign = -1;
+            if (sign == 0) continue;
+            const Vec3 unit = cross * (sign / std::sqrt(length2));
+            const Real s = unit.dot(eb.origin - ea.origin);
+            if (s > best.separation) best = {s, ja, jb, unit, true};
+            if (s > limit) return best;
         }
     }
     return best;
@@ -124,15 +152,16 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
         if (s > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
     }
-    if (count == 0) {
-        // Clipping left nothing (the incident face lies beside the reference face, as
-        // when a corner pokes in): the support point still gives a contact.
-        const std::uint32_t v = inc.support(-n);
-        const Real s = n.dot(inc.vertices[v]) - d;
-        if (s <= speculative) {
-            out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
-                            face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
-        }
+    // The deepest vertex along the reference normal sets the SAT depth. When clipping
+    // dropped it (it pokes in beside a small reference face), it is kept anyway, so the
+    // reported depth never falls short of the real one.
+    Real shallowest_kept = kHuge;
+    for (int k = 0; k < n_out; ++k) shallowest_kept = std::min(shallowest_kept, out[k].separation);
+    const std::uint32_t v = inc.support(-n);
+    const Real s = n.dot(inc.vertices[v]) - d;
+    if (s <= speculative && s < shallowest_kept - kMissedDepth) {
+        out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
+                        face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
     }
     return n_out;
 }
@@ -173,8 +202,8 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     }
 
     const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-    const std::size_t capacity = reference_is_b ? a.vertex_count + b.vertex_count : b.vertex_count + a.vertex_count;
-    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(capacity + 1);
+    // Clipping leaves at most (incident face + reference face) vertices, plus the deepest.
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(a.vertex_count + b.vertex_count + 1);
     Vec3 n;
     const int count = reference_is_b ? face_contact(pb, face_b.face, pa, true, speculative, n, candidates.data())
                                      : face_contact(pa, face_a.face, pb, false, speculative, n, candidates.data());
@@ -183,6 +212,17 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     reduce_to_manifold(candidates.data(), count, m);
     manifold_to_world(m, xa);
     return true;
+}
+
+int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                     Manifold* out, int) {
+    const BoxPoly box(a.half_extents);
+    return collide_polyhedra(box.view(), xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
+}
+
+int collide_hull_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                      Manifold* out, int) {
+    return collide_polyhedra(view_of(*a.hull), xa, view_of(*b.hull), xb, speculative, out[0]) ? 1 : 0;
 }
 
 }  // namespace spindle::detail

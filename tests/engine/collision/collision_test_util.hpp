@@ -59,6 +59,16 @@ inline Shape hull_box(const Vec3& h) {
     return Shape::convex_hull(p);
 }
 
+// A 0.5 cube resting 0.01 deep on a floor (half extents (2, 0.5, 2)) at (0.3, 0.99, -0.2):
+// four points at its corners, midway down the overlap.
+void expect_resting_cube_contact(const Shape& floor, const Shape& cube);
+
+// Two unit cubes rolled 45 degrees about z and x, edges crossed 0.1 deep: one edge point.
+void expect_crossed_edges_contact(const Shape& cube);
+
+// collide(b, a) gives the same points as collide(a, b) with the normal turned round.
+void expect_swapped_order_flips(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb);
+
 }  // namespace spindle::test
 
 #define SPINDLE_EXPECT_VEC_NEAR(actual, expected, tol) \
