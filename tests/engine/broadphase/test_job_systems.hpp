@@ -48,6 +48,7 @@ public:
     }
     void trace_begin(const char*) noexcept override {}
     void trace_end() noexcept override {}
+    void run_graph(StageGraph& graph) override { SingleThreadedJobSystem().run_graph(graph); }
 
 private:
     unsigned m_workers;
@@ -65,6 +66,7 @@ public:
     }
     void trace_begin(const char*) noexcept override {}
     void trace_end() noexcept override {}
+    void run_graph(StageGraph& graph) override { SingleThreadedJobSystem().run_graph(graph); }
     int chunks = 0;
 
 private:
