@@ -7,11 +7,24 @@
 
 namespace spindle::bench {
 
-BoxScene pyramid_scene() {
+namespace {
+
+// Coordinate of item `index` of `count` laid out `pitch` apart, centred on 0.
+Real centered(int index, int count, Real pitch) { return (index - (count - 1) / 2.0) * pitch; }
+
+// A scene with no boxes yet, over a 2 m thick floor box whose top face is y = 0.
+BoxScene on_floor(const char* name, Real half_x, Real half_z, Real friction) {
     BoxScene scene;
-    scene.name = "pyramid";
-    scene.floor = {Vec3(0, -1, 0), Vec3(50, 1, 50)};
-    scene.friction = 0.2;
+    scene.name = name;
+    scene.floor = {Vec3(0, -1, 0), Vec3(half_x, 1, half_z)};
+    scene.friction = friction;
+    return scene;
+}
+
+}  // namespace
+
+BoxScene pyramid_scene() {
+    BoxScene scene = on_floor("pyramid", 50, 50, 0.2);
     constexpr int kLayers = 15;
     for (int i = 0; i < kLayers; ++i) {
         const Real h = (i % 2 == 1) ? 1 : 0;  // odd layers sit in the hollows of the one below
@@ -30,18 +43,15 @@ BoxScene many_pyramids_scene() {
     constexpr Real kHalf = 0.5;
     constexpr Real kPitchX = kBase * 2 * kHalf + 2;  // 2 m between neighbouring bases
     constexpr Real kPitchZ = 2 * kHalf + 2;
-    BoxScene scene;
-    scene.name = "many_pyramids";
-    scene.floor = {Vec3(0, -1, 0), Vec3(kPerSide * kPitchX / 2 + 5, 1, kPerSide * kPitchZ / 2 + 5)};
-    scene.friction = 0.6;
+    BoxScene scene = on_floor("many_pyramids", kPerSide * kPitchX / 2 + 5, kPerSide * kPitchZ / 2 + 5, 0.6);
     for (int px = 0; px < kPerSide; ++px) {
         for (int pz = 0; pz < kPerSide; ++pz) {
-            const Real x0 = (px - (kPerSide - 1) / 2.0) * kPitchX;
-            const Real z0 = (pz - (kPerSide - 1) / 2.0) * kPitchZ;
+            const Vec3 base(centered(px, kPerSide, kPitchX), kHalf, centered(pz, kPerSide, kPitchZ));
             for (int layer = 0; layer < kBase; ++layer) {
+                // Layer `layer` holds kBase - layer boxes, centred over the base like the one below.
                 for (int j = 0; j < kBase - layer; ++j) {
-                    const Real x = x0 + 2 * kHalf * (j - (kBase - 1) / 2.0 + layer / 2.0);
-                    scene.boxes.push_back({Vec3(x, kHalf + 2 * kHalf * layer, z0), Vec3::Constant(kHalf)});
+                    const Vec3 offset(centered(j, kBase - layer, 2 * kHalf), 2 * kHalf * layer, 0);
+                    scene.boxes.push_back({base + offset, Vec3::Constant(kHalf)});
                 }
             }
         }
@@ -52,14 +62,11 @@ BoxScene many_pyramids_scene() {
 BoxScene box_grid_scene(int per_side) {
     constexpr Real kHalf = 0.5;
     constexpr Real kPitch = 1.5;  // 0.5 m gaps: every box is its own island
-    BoxScene scene;
-    scene.name = "box_grid";
-    scene.floor = {Vec3(0, -1, 0), Vec3(per_side * kPitch / 2 + 5, 1, per_side * kPitch / 2 + 5)};
-    scene.friction = 0.6;
+    const Real half_floor = per_side * kPitch / 2 + 5;
+    BoxScene scene = on_floor("box_grid", half_floor, half_floor, 0.6);
     for (int a = 0; a < per_side; ++a) {
         for (int b = 0; b < per_side; ++b) {
-            const Vec3 c((a - (per_side - 1) / 2.0) * kPitch, kHalf, (b - (per_side - 1) / 2.0) * kPitch);
-            scene.boxes.push_back({c, Vec3::Constant(kHalf)});
+            scene.boxes.push_back({Vec3(centered(a, per_side, kPitch), kHalf, centered(b, per_side, kPitch)), Vec3::Constant(kHalf)});
         }
     }
     return scene;
@@ -156,7 +163,7 @@ std::vector<BodyHandle> add_mixed_pile_on_mesh(Space& space, int count) {
         body.shape = shapes[n % 4];
         // Odd layers shifted by half a pitch, so the pile does not fall in columns.
         const Real shift = (layer % 2) * kPitch / 2;
-        body.position = Vec3((a - (kPerRow - 1) / 2.0) * kPitch + shift, 4 + 2 * layer, (b - (kPerRow - 1) / 2.0) * kPitch + shift);
+        body.position = Vec3(centered(a, kPerRow, kPitch) + shift, 4 + 2 * layer, centered(b, kPerRow, kPitch) + shift);
         body.orientation = Quat(Eigen::AngleAxis<Real>(0.7 * n, Vec3(1, 0.5 * (n % 3), 0.3).normalized()));
         handles.push_back(space.create_body(body));
     }

@@ -6,6 +6,7 @@
 //   --quick               --steps=60
 //   --floor=box|plane     Spindle's floor: the scene's box (default) or a plane at its top face
 #include "common/jobs.hpp"
+#include "common/run.hpp"
 #include "common/scenes.hpp"
 #include "common/timing.hpp"
 
@@ -127,12 +128,7 @@ void print_summary() {
 
 int main(int argc, char** argv) {
     using namespace spindle::bench;
-    std::vector<char*> rest{argv[0]};
-    for (int i = 1; i < argc; ++i) {
-        if (!take_flag(argv[i])) rest.push_back(argv[i]);
-    }
-    int rest_count = static_cast<int>(rest.size());
-    rest.push_back(nullptr);  // argv[argc] is null
+    std::vector<char*> rest = take_own_flags(argc, argv, take_flag);
 #ifdef SPINDLE_BENCH_HAVE_BULLET
     benchmark::RegisterBenchmark("pyramid/bullet", bm_bullet_pyramid)
         ->Iterations(g_options.steps)
@@ -143,10 +139,7 @@ int main(int argc, char** argv) {
         ->Iterations(g_options.steps)
         ->UseRealTime()
         ->Unit(benchmark::kMillisecond);
-    benchmark::Initialize(&rest_count, rest.data());
-    if (benchmark::ReportUnrecognizedArguments(rest_count, rest.data())) return 1;
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-    print_summary();
-    return 0;
+    const int code = run_registered_benchmarks(rest);
+    if (code == 0) print_summary();
+    return code;
 }
