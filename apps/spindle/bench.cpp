@@ -43,7 +43,7 @@ int bench_command(Args& args) {
     const std::int64_t steps = args.integer("steps", 1, 100'000'000).value_or(300);
     const std::optional<std::int64_t> substeps = args.integer("substeps", 1, 1000);
     const std::vector<std::string> names = args.positionals(1);
-    if (names.empty()) throw UsageError("missing the SCENE to run (see `spindle scenes`)");
+    if (names.empty()) throw UsageError("missing the SCENE to run");
     const SceneDesc scene = resolve_scene(names[0]);
 
     const std::unique_ptr<JobSystem> jobs = make_jobs(threads);

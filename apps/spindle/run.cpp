@@ -158,12 +158,6 @@ int run_command(Args& args) {
     std::optional<MotionRecorder> recorder;
     if (o.record_file) recorder.emplace(*o.record_file);
 
-    const std::size_t dynamic = scene.dynamic_body_count();
-    std::printf("scene %s (%s): %zu dynamic + %zu other bodies; %s\n", scene.name.c_str(), scene.source.c_str(),
-                dynamic, scene.bodies.size() - dynamic, scene.description.c_str());
-    std::printf("layout %s (%s):\n%s", layout.name.c_str(), layout.source.c_str(), mapping.describe().c_str());
-    std::fflush(stdout);
-
     set_current_thread_name("spindle-game");
     pin_current_thread(mapping.game.real_pu);
 
@@ -178,6 +172,11 @@ int run_command(Args& args) {
     for (std::uint32_t i = 0; i < scene.bodies.size(); ++i) {
         if (scene.bodies[i].desc.type != MotionType::Static) moving.push_back(i);
     }
+    const std::size_t dynamic = scene.dynamic_body_count();
+    std::printf("scene %s (%s): %zu dynamic + %zu other bodies; %s\n", scene.name.c_str(), scene.source.c_str(),
+                dynamic, scene.bodies.size() - dynamic, scene.description.c_str());
+    std::printf("layout %s (%s):\n%s", layout.name.c_str(), layout.source.c_str(), mapping.describe().c_str());
+    std::fflush(stdout);
 
     AsyncRunnerOptions runner_options;
     runner_options.physics_pu = mapping.physics.real_pu;
