@@ -2,15 +2,29 @@
 #include "physics_probe.hpp"
 
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/clock.hpp>
+
+#include <chrono>
+#include <thread>
 
 namespace spindle::app {
 
-void PhysicsProbe::attach(AsyncRunner& runner) {
+void PhysicsProbe::attach(AsyncRunner& runner, double min_interval) {
+    m_min_interval = min_interval;
+    post(runner);
+}
+
+void PhysicsProbe::post(AsyncRunner& runner) {
     // Re-posting from inside a posted function is safe: the loop runs posted functions
     // after taking them out of the runner's queue, without holding its lock.
     runner.post([this, &runner](Space& space) {
         sample(space.last_update());
-        attach(runner);
+        if (m_min_interval > 0 && runner.running()) {
+            const double wait = m_min_interval - static_cast<double>(now_nanoseconds() - m_last_ns) * 1e-9;
+            if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+            m_last_ns = now_nanoseconds();
+        }
+        post(runner);
     });
 }
 

@@ -1,9 +1,14 @@
-// PhysicsProbe: what each physics update did, read where it is safe to read.
+// PhysicsProbe: what each physics update did, read where it is safe to read, and
+// (optionally) the pace of the physics loop between steps.
 // Space::last_update() belongs to the physics loop thread, so the probe reads it there:
 // a function posted to the AsyncRunner runs before every update, reads the previous
 // update's stats, and posts itself again. The game thread sees a few live values
 // through atomics; the totals are read after AsyncRunner::stop() (which runs the last
 // posted function, so the final update is counted too, and joins the thread).
+// Pacing: a loop that never sleeps publishes hundreds of thousands of updates a second
+// and burns a hardware thread; the same function can hold the loop to one update per
+// `min_interval` (a few per frame are all interpolation needs). AsyncRunnerOptions has
+// no such knob, so it lives here.
 #pragma once
 
 #include <array>
@@ -24,8 +29,9 @@ struct ProbeTotals {
 
 class PhysicsProbe {
 public:
-    // Starts probing; call before runner.start(). The probe must outlive the runner's loop.
-    void attach(AsyncRunner& runner);
+    // Starts probing; call before runner.start(). The probe must outlive the runner's
+    // loop. min_interval > 0: no update starts sooner than that after the previous one.
+    void attach(AsyncRunner& runner, double min_interval = 0);
 
     // Any thread, while running.
     std::uint32_t awake_bodies() const noexcept { return m_awake.load(std::memory_order_relaxed); }
@@ -36,9 +42,12 @@ public:
     const ProbeTotals& totals() const noexcept { return m_totals; }
 
 private:
+    void post(AsyncRunner& runner);
     void sample(const UpdateStats& stats);
 
     ProbeTotals m_totals;  // physics loop thread only, until stop()
+    double m_min_interval = 0;
+    std::int64_t m_last_ns = 0;  // when the previous update was let go
     std::atomic<std::uint32_t> m_awake{0};
     std::atomic<std::uint32_t> m_contacts{0};
     std::atomic<double> m_update_ms{0};
