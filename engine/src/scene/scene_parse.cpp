@@ -23,51 +23,41 @@ SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
     SpaceSettings s;
     TimeStepSettings& ts = s.time_step;
     SolverSettings& solver = s.solver;
-    auto get = [&](const char* key) { return t.get(key); };
     auto name = [](const char* key) { return std::string("settings.") + key; };
-    constexpr std::int64_t kMaxCount = 1000;
-    if (auto* n = get("gravity")) s.gravity = r.vec3(*n, name("gravity"), "x, y, z in m/s^2");
-    if (auto* n = get("time_step")) ts.duration = r.positive(*n, name("time_step"));
-    if (auto* n = get("max_steps_per_frame")) {
-        ts.max_steps_per_frame = static_cast<int>(r.integer(*n, name("max_steps_per_frame"), 1, kMaxCount));
+    auto positive = [&](const char* key, Real& field) {
+        if (const toml::node* n = t.get(key)) field = r.positive(*n, name(key));
+    };
+    auto non_negative = [&](const char* key, Real& field) {
+        if (const toml::node* n = t.get(key)) field = r.non_negative(*n, name(key));
+    };
+    auto count = [&](const char* key, int& field, int min) {
+        constexpr std::int64_t kMaxCount = 1000;
+        if (const toml::node* n = t.get(key)) field = static_cast<int>(r.integer(*n, name(key), min, kMaxCount));
+    };
+    if (const toml::node* n = t.get("gravity")) s.gravity = r.vec3(*n, name("gravity"), "x, y, z in m/s^2");
+    positive("time_step", ts.duration);
+    count("max_steps_per_frame", ts.max_steps_per_frame, 1);
+    count("min_steps_per_frame", ts.min_steps_per_frame, 0);
+    if (ts.min_steps_per_frame > ts.max_steps_per_frame) {
+        r.fail(*t.get("min_steps_per_frame"), "settings.min_steps_per_frame: expected at most max_steps_per_frame (" +
+                                                  std::to_string(ts.max_steps_per_frame) + "), got " +
+                                                  std::to_string(ts.min_steps_per_frame));
     }
-    if (auto* n = get("min_steps_per_frame")) {
-        ts.min_steps_per_frame = static_cast<int>(r.integer(*n, name("min_steps_per_frame"), 0, kMaxCount));
-        if (ts.min_steps_per_frame > ts.max_steps_per_frame) {
-            r.fail(*n, "settings.min_steps_per_frame: expected at most max_steps_per_frame (" +
-                           std::to_string(ts.max_steps_per_frame) + "), got " +
-                           std::to_string(ts.min_steps_per_frame));
-        }
-    }
-    if (auto* n = get("substeps")) solver.substeps = static_cast<int>(r.integer(*n, name("substeps"), 1, kMaxCount));
-    if (auto* n = get("iterations")) {
-        solver.iterations = static_cast<int>(r.integer(*n, name("iterations"), 1, kMaxCount));
-    }
-    if (auto* n = get("relax_iterations")) {
-        solver.relax_iterations = static_cast<int>(r.integer(*n, name("relax_iterations"), 0, kMaxCount));
-    }
-    if (auto* n = get("contact_hertz")) solver.contact_hertz = r.positive(*n, name("contact_hertz"));
-    if (auto* n = get("contact_damping_ratio")) solver.damping_ratio = r.non_negative(*n, name("contact_damping_ratio"));
-    if (auto* n = get("joint_hertz")) solver.joint_hertz = r.non_negative(*n, name("joint_hertz"));
-    if (auto* n = get("joint_damping_ratio")) {
-        solver.joint_damping_ratio = r.non_negative(*n, name("joint_damping_ratio"));
-    }
-    if (auto* n = get("push_out_speed")) solver.push_out_speed = r.non_negative(*n, name("push_out_speed"));
-    if (auto* n = get("restitution_threshold")) {
-        solver.restitution_threshold = r.non_negative(*n, name("restitution_threshold"));
-    }
-    if (auto* n = get("speculative_distance")) {
-        solver.speculative_distance = r.non_negative(*n, name("speculative_distance"));
-    }
-    if (auto* n = get("linear_slop")) solver.linear_slop = r.non_negative(*n, name("linear_slop"));
-    if (auto* n = get("sleep")) s.sleep.enabled = r.boolean(*n, name("sleep"));
-    if (auto* n = get("time_to_sleep")) s.sleep.time_to_sleep = r.non_negative(*n, name("time_to_sleep"));
-    if (auto* n = get("sleep_linear_threshold")) {
-        s.sleep.linear_threshold = r.non_negative(*n, name("sleep_linear_threshold"));
-    }
-    if (auto* n = get("sleep_angular_threshold")) {
-        s.sleep.angular_threshold = r.non_negative(*n, name("sleep_angular_threshold"));
-    }
+    count("substeps", solver.substeps, 1);
+    count("iterations", solver.iterations, 1);
+    count("relax_iterations", solver.relax_iterations, 0);
+    positive("contact_hertz", solver.contact_hertz);
+    non_negative("contact_damping_ratio", solver.damping_ratio);
+    non_negative("joint_hertz", solver.joint_hertz);
+    non_negative("joint_damping_ratio", solver.joint_damping_ratio);
+    non_negative("push_out_speed", solver.push_out_speed);
+    non_negative("restitution_threshold", solver.restitution_threshold);
+    non_negative("speculative_distance", solver.speculative_distance);
+    non_negative("linear_slop", solver.linear_slop);
+    if (const toml::node* n = t.get("sleep")) s.sleep.enabled = r.boolean(*n, name("sleep"));
+    non_negative("time_to_sleep", s.sleep.time_to_sleep);
+    non_negative("sleep_linear_threshold", s.sleep.linear_threshold);
+    non_negative("sleep_angular_threshold", s.sleep.angular_threshold);
     return s;
 }
 
