@@ -49,7 +49,7 @@ int bench_command(Args& args) {
     const std::unique_ptr<JobSystem> jobs = make_jobs(threads);
     if (jobs->worker_count() != threads) {
         std::cerr << "spindle bench: note: " << threads << " threads asked for, the scheduler runs "
-                  << jobs->worker_count() << " (the work-stealing scheduler is not built in yet)\n";
+                  << jobs->worker_count() << '\n';
     }
     SpaceSettings settings = scene.settings;
     settings.time_step.duration = kBenchStep;

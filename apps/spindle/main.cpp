@@ -14,7 +14,7 @@ constexpr const char* kUsage =
     "usage: spindle <command> [options]     (spindle <command> --help for its options)\n"
     "commands:\n"
     "  run [SCENE] [--layout FILE] [--seconds S] [--render-hz HZ] [--idle MODE] [--trace FILE]\n"
-    "      [--record FILE]  play a scene asynchronously (default: the built-in pyramid, 5 s)\n"
+    "      [--record FILE]  play a scene asynchronously (default: the built-in pile, 5 s)\n"
     "  bench SCENE [--threads N] [--steps N] [--substeps N]\n"
     "                      step a scene as fast as possible; prints one line of results\n"
     "  scenes              list the built-in scenes\n"

@@ -1,7 +1,8 @@
 // `spindle run`: plays a scene like a game would (the seed, section 3). The main
 // thread is the game thread, pinned per the layout, "rendering" at --render-hz by
 // copying interpolated motion states; the physics loop runs in an AsyncRunner on its
-// own pinned thread with internal time stepping; the JobSystem comes from make_jobs().
+// own pinned thread with internal time stepping; the JobSystem comes from make_jobs()
+// (work stealing, workers pinned per the layout, the physics loop thread as worker 0).
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/scene.hpp>
@@ -37,7 +38,7 @@ namespace {
 
 constexpr const char* kRunUsage =
     "usage: spindle run [SCENE] [options]\n"
-    "Plays SCENE (a built-in scene name, see `spindle scenes`, or a .toml file; default: pyramid)\n"
+    "Plays SCENE (a built-in scene name, see `spindle scenes`, or a .toml file; default: pile)\n"
     "asynchronously: the game thread renders interpolated motion states while the physics loop\n"
     "thread steps the space with internal time stepping. Prints progress and a summary.\n"
     "options:\n"
@@ -93,6 +94,16 @@ struct GameStats {
     double frame_ms_max = 0;
     double frame_ms_sum = 0;
 };
+
+// Sleeps until `deadline` on the stopwatch, the last stretch with yields: a sleeping
+// thread wakes up to a scheduler tick late, and that lateness would show as jitter in
+// the interpolated poses (a display refreshes on time; a late read shows a later pose).
+void wait_until(const Stopwatch& wall, double deadline) {
+    constexpr double kSpinSeconds = 1e-3;
+    const double sleep = deadline - kSpinSeconds - wall.elapsed_seconds();
+    if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
+    while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
+}
 
 void print_smoothness(const char* name, const SmoothnessReport& r) {
     std::printf("    %-13s %10.3f mm %11.4f mm %9.3f %8llu of %llu\n", name, r.mean_step_m * 1e3, r.jerk_rms_m * 1e3,
@@ -171,11 +182,16 @@ int run_command(Args& args) {
     pin_current_thread(mapping.game.real_pu);
 
     std::unique_ptr<JobSystem> jobs = make_jobs(mapping);
-    std::optional<TracingJobSystem> tracer;
-    if (o.trace_file) tracer.emplace(*jobs);
+    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
+    std::vector<GameSpan> frames;  // the game thread's side of the trace
+    if (o.trace_file) {
+        if (!scheduler) throw Error("--trace: the trace comes from the work-stealing scheduler, which make_jobs did not choose");
+        scheduler->enable_trace(true);
+        frames.reserve(static_cast<std::size_t>(o.seconds * o.render_hz) + 16);
+    }
     SpaceSettings settings = scene.settings;
     settings.time_step.use_internal_time_stepping = true;
-    Space space(settings, tracer ? &*tracer : jobs.get());
+    Space space(settings, jobs.get());
     const std::vector<BodyHandle> handles = build(scene, space);
     std::vector<std::uint32_t> moving;
     for (std::uint32_t i = 0; i < scene.bodies.size(); ++i) {
@@ -209,8 +225,7 @@ int run_command(Args& args) {
     std::uint64_t last_print_steps = 0;
     ProgressSample sample;
     while (deadline < o.seconds) {
-        const double wait = deadline - wall.elapsed_seconds();
-        if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+        wait_until(wall, deadline);
         const std::int64_t frame_start = now_nanoseconds();
         const double now = wall.elapsed_seconds();
         // Two copies under the lock, not one: a flip may fall between them, which only
@@ -221,7 +236,7 @@ int run_command(Args& args) {
         smooth_raw.add_frame(raw);
         if (recorder) recorder->write_frame(game.frames, now, interpolated);
         const std::int64_t frame_end = now_nanoseconds();
-        if (tracer) tracer->add_span("Frame", frame_start, frame_end);
+        if (o.trace_file) frames.push_back({"Frame", frame_start, frame_end});
 
         const double frame_ms = static_cast<double>(frame_end - frame_start) * 1e-6;
         game.frames += 1;
@@ -258,12 +273,13 @@ int run_command(Args& args) {
         std::printf("  record         %s (%llu frames x %zu bodies)\n", o.record_file->c_str(),
                     static_cast<unsigned long long>(game.frames), handles.size());
     }
-    if (tracer) {
-        tracer->write(trace_out);
+    if (o.trace_file) {
+        const std::vector<TraceEvent> events = scheduler->trace_events();
+        const std::vector<unsigned> pus = scheduler_pus(mapping);
+        write_run_trace(trace_out, events, frames, mapping, pus);
         trace_out.close();
         if (!trace_out) throw Error(*o.trace_file + ": writing the trace file failed");
-        std::printf("  trace          %s (%zu spans%s)\n", o.trace_file->c_str(), tracer->event_count(),
-                    tracer->truncated() ? ", truncated: the span limit was reached" : "");
+        std::printf("  trace          %s (%zu spans)\n", o.trace_file->c_str(), events.size() + frames.size());
     }
     return 0;
 }

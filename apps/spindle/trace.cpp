@@ -1,21 +1,18 @@
-// TracingJobSystem: records spans with their thread and writes Chrome trace-event JSON.
+// The run's Chrome trace-event JSON: scheduler events and game-thread frames merged.
 #include "trace.hpp"
 
-#include <spindle/platform/clock.hpp>
-#include <spindle/platform/thread.hpp>
-
+#include <algorithm>
 #include <cstdio>
+#include <limits>
+#include <string>
+#include <string_view>
 
 namespace spindle::app {
 namespace {
 
-// Open stage spans of the calling thread. Spans nest per thread, so one stack per
-// thread serves every tracer.
-struct OpenSpan {
-    const char* name;
-    std::int64_t begin_ns;
-};
-thread_local std::vector<OpenSpan> t_open;
+// Rows of the trace (Chrome's "tid"): workers keep their index.
+constexpr unsigned kStageRow = 1000;
+constexpr unsigned kGameRow = 2000;
 
 void write_string(std::ostream& out, std::string_view text) {
     out << '"';
@@ -24,7 +21,7 @@ void write_string(std::ostream& out, std::string_view text) {
             out << '\\' << c;
         } else if (static_cast<unsigned char>(c) < 0x20) {
             char escaped[8];
-            std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+            std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
             out << escaped;
         } else {
             out << c;
@@ -33,100 +30,52 @@ void write_string(std::ostream& out, std::string_view text) {
     out << '"';
 }
 
+void write_row_name(std::ostream& out, unsigned row, const std::string& name, unsigned order) {
+    out << ",\n{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":" << row << ",\"args\":{\"name\":";
+    write_string(out, name);
+    out << "}},\n{\"name\":\"thread_sort_index\",\"ph\":\"M\",\"pid\":1,\"tid\":" << row
+        << ",\"args\":{\"sort_index\":" << order << "}}";
+}
+
+void write_span(std::ostream& out, const char* name, const char* category, unsigned row, std::int64_t begin_ns,
+                std::int64_t end_ns, std::int64_t origin_ns, int pu) {
+    char times[96];
+    std::snprintf(times, sizeof times, "\"ts\":%.3f,\"dur\":%.3f", static_cast<double>(begin_ns - origin_ns) * 1e-3,
+                  static_cast<double>(end_ns - begin_ns) * 1e-3);
+    out << ",\n{\"name\":";
+    write_string(out, name ? name : "?");
+    out << ",\"ph\":\"X\",\"cat\":";
+    write_string(out, category ? category : "");
+    out << ',' << times << ",\"pid\":1,\"tid\":" << row << ",\"args\":{\"pu\":" << pu << "}}";
+}
+
 }  // namespace
 
-TracingJobSystem::TracingJobSystem(JobSystem& inner, std::size_t max_events)
-    : m_inner(inner), m_max_events(max_events), m_origin_ns(now_nanoseconds()) {}
+void write_run_trace(std::ostream& out, std::span<const TraceEvent> scheduler, std::span<const GameSpan> game,
+                     const LayoutMapping& mapping, std::span<const unsigned> worker_pus) {
+    std::int64_t origin = std::numeric_limits<std::int64_t>::max();
+    for (const TraceEvent& e : scheduler) origin = std::min(origin, e.begin_ns);
+    for (const GameSpan& s : game) origin = std::min(origin, s.begin_ns);
+    if (origin == std::numeric_limits<std::int64_t>::max()) origin = 0;
 
-void TracingJobSystem::parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
-                                    RangeFn fn) {
-    const std::thread::id caller = std::this_thread::get_id();
-    const std::int64_t start = now_nanoseconds();
-    // Chunks the calling thread runs are inside the call's own span; only chunks run
-    // by other threads (workers) get spans of their own, which keeps a single-threaded
-    // trace small while a multi-threaded one still shows who ran what.
-    auto traced = [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
-        if (std::this_thread::get_id() == caller) {
-            fn(lo, hi, worker);
-            return;
-        }
-        const std::int64_t chunk_start = now_nanoseconds();
-        fn(lo, hi, worker);
-        add_span(name, chunk_start, now_nanoseconds());
-    };
-    m_inner.parallel_for(name, begin, end, grain, traced);
-    add_span(name, start, now_nanoseconds());
-}
-
-void TracingJobSystem::trace_begin(const char* stage) noexcept {
-    try {
-        t_open.push_back({stage, now_nanoseconds()});
-    } catch (...) {
-        // Out of memory for the stack: the span is lost, the program goes on.
-    }
-    m_inner.trace_begin(stage);
-}
-
-void TracingJobSystem::trace_end() noexcept {
-    m_inner.trace_end();
-    if (t_open.empty()) return;
-    const OpenSpan span = t_open.back();
-    t_open.pop_back();
-    add_span(span.name, span.begin_ns, now_nanoseconds());
-}
-
-std::uint32_t TracingJobSystem::thread_id_locked() {
-    const auto [it, inserted] = m_tids.try_emplace(std::this_thread::get_id(), static_cast<std::uint32_t>(m_tids.size()));
-    if (inserted) {
-        std::string name = current_thread_name();
-        m_thread_names.push_back(name.empty() ? "thread " + std::to_string(it->second) : std::move(name));
-    }
-    return it->second;
-}
-
-void TracingJobSystem::add_span(const char* name, std::int64_t begin_ns, std::int64_t end_ns) noexcept {
-    try {
-        std::scoped_lock guard(m_lock);
-        if (m_events.size() >= m_max_events) {
-            m_truncated = true;
-            return;
-        }
-        m_events.push_back({name, begin_ns, end_ns, thread_id_locked()});
-    } catch (...) {
-        m_truncated = true;  // out of memory: drop the event rather than stop the program
-    }
-}
-
-std::size_t TracingJobSystem::event_count() const {
-    std::scoped_lock guard(m_lock);
-    return m_events.size();
-}
-
-bool TracingJobSystem::truncated() const {
-    std::scoped_lock guard(m_lock);
-    return m_truncated;
-}
-
-void TracingJobSystem::write(std::ostream& out) const {
-    std::scoped_lock guard(m_lock);
     out << "{\"traceEvents\":[\n";
-    out << R"({"name":"process_name","ph":"M","pid":1,"tid":0,"args":{"name":"spindle"}})";
-    for (std::uint32_t tid = 0; tid < m_thread_names.size(); ++tid) {
-        out << ",\n{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":" << tid << ",\"args\":{\"name\":";
-        write_string(out, m_thread_names[tid]);
-        out << "}}";
+    out << R"({"name":"process_name","ph":"M","pid":1,"tid":0,"args":{"name":"spindle run"}})";
+    write_row_name(out, kGameRow, "game (PU " + std::to_string(mapping.game.real_pu) + ")", 0);
+    write_row_name(out, kStageRow, "physics loop: stages (PU " + std::to_string(mapping.physics.real_pu) + ")", 1);
+    for (unsigned w = 0; w < worker_pus.size(); ++w) {
+        write_row_name(out, w,
+                       "worker " + std::to_string(w) + (w == 0 ? " = physics loop" : "") + " (PU " +
+                           std::to_string(worker_pus[w]) + ")",
+                       2 + w);
     }
-    char number[64];
-    for (const Event& e : m_events) {
-        out << ",\n{\"name\":";
-        write_string(out, e.name ? e.name : "?");
-        std::snprintf(number, sizeof number, "%.3f", static_cast<double>(e.begin_ns - m_origin_ns) * 1e-3);
-        out << ",\"ph\":\"X\",\"ts\":" << number;
-        std::snprintf(number, sizeof number, "%.3f", static_cast<double>(e.end_ns - e.begin_ns) * 1e-3);
-        out << ",\"dur\":" << number << ",\"pid\":1,\"tid\":" << e.tid << '}';
+    for (const GameSpan& s : game) {
+        write_span(out, s.name, "game", kGameRow, s.begin_ns, s.end_ns, origin, static_cast<int>(mapping.game.real_pu));
     }
-    out << "\n],\"displayTimeUnit\":\"ms\",\"otherData\":{\"truncated\":" << (m_truncated ? "true" : "false")
-        << "}}\n";
+    for (const TraceEvent& e : scheduler) {
+        const bool stage = std::string_view(e.stage ? e.stage : "") == "stage";
+        write_span(out, e.name, e.stage, stage ? kStageRow : e.worker, e.begin_ns, e.end_ns, origin, e.pu);
+    }
+    out << "\n],\"displayTimeUnit\":\"ms\"}\n";
 }
 
 }  // namespace spindle::app

@@ -201,8 +201,8 @@ TEST(SpindleProgram, RunWithoutArguments_PlaysTheDefaultSceneFromAnyDirectory) {
     // binary (run from / where no configs/ exists).
     const Result r = spindle("run --seconds 1", false, "/");
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    expect_contains(r.output, "scene pyramid (configs/scenes/pyramid.toml): 1240 dynamic + 1 other bodies");
-    expect_contains(r.output, "summary: scene pyramid, layout native");
+    expect_contains(r.output, "scene pile (configs/scenes/pile.toml): 192 dynamic + 1 other bodies");
+    expect_contains(r.output, "summary: scene pile, layout native");
     expect_contains(r.output, "ApplyWrites");
     // Not a terminal: progress comes as plain lines, no carriage returns.
     EXPECT_EQ(r.output.find('\r'), std::string::npos);
@@ -245,6 +245,16 @@ TEST(SpindleProgram, BenchPyramid_PrintsOneLine) {
     const Result substeps = spindle("bench stack --steps 3 --substeps 2 --threads 1", true);
     ASSERT_EQ(substeps.exit_code, 0) << substeps.output;
     expect_contains(substeps.output, "scene=stack bodies=20 threads=1 steps=3 ");
+}
+
+TEST(SpindleProgram, BenchHash_IsTheSameForOneAndTwoThreads) {
+    const Result one = spindle("bench dominoes --steps 60 --threads 1", true);
+    const Result two = spindle("bench dominoes --steps 60 --threads 2", true);
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    ASSERT_EQ(two.exit_code, 0) << two.output;
+    expect_contains(two.output, " threads=2 ");
+    const auto hash = [](const std::string& s) { return s.substr(s.find("hash=")); };
+    EXPECT_EQ(hash(one.output), hash(two.output)) << one.output << two.output;
 }
 
 TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {

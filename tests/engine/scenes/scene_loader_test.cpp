@@ -1,6 +1,6 @@
-// Scene files: every file in configs/scenes parses (and builds, where the shapes it
-// uses exist on this branch), the built-in scenes are what they claim, broken files
-// are rejected at the right line and column, and build() is all or nothing.
+// Scene files: every file in configs/scenes parses and builds, the built-in scenes
+// are what they claim, broken files are rejected at the right line and column, and
+// build() is all or nothing.
 #include <spindle/engine/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
@@ -26,14 +26,6 @@ std::vector<std::filesystem::path> scene_files() {
 }
 
 SceneDesc load(const char* name) { return load_scene((kScenes / (std::string(name) + ".toml")).string()); }
-
-// Shapes the temporary collision stub on this branch can make.
-bool buildable_here(const SceneDesc& scene) {
-    for (const ShapeSpec& s : scene.shapes) {
-        if (s.type != ShapeType::Sphere && s.type != ShapeType::Box && s.type != ShapeType::Plane) return false;
-    }
-    return true;
-}
 
 // The message of the spindle::Error that parsing `text` (as "bad.toml") throws.
 std::string parse_error(const std::string& text) {
@@ -75,12 +67,10 @@ TEST(SceneFiles, EveryConfigScene_Parses) {
     }
 }
 
-TEST(SceneFiles, EverySphereBoxPlaneScene_BuildsAndSteps) {
-    int built = 0;
+TEST(SceneFiles, EveryConfigScene_BuildsAndSteps) {
     for (const auto& file : scene_files()) {
         SCOPED_TRACE(file.string());
         const SceneDesc scene = load_scene(file.string());
-        if (!buildable_here(scene)) continue;
         Space space;
         const std::vector<BodyHandle> handles = build(scene, space);
         ASSERT_EQ(handles.size(), scene.bodies.size());
@@ -88,12 +78,10 @@ TEST(SceneFiles, EverySphereBoxPlaneScene_BuildsAndSteps) {
         for (std::size_t i = 0; i < handles.size(); i += 97) {
             EXPECT_EQ(space.internal_position(handles[i]), scene.bodies[i].desc.position);
         }
-        if (scene.bodies.size() < 2000) {  // the brute-force broadphase makes 10k-body steps slow
+        if (scene.bodies.size() < 1000) {  // the big ones are stepped by the program's tests and bench
             for (int i = 0; i < 3; ++i) space.update();
         }
-        ++built;
     }
-    EXPECT_GE(built, 6);  // pyramid, stack, dominoes, mass_ratio, bullets, many_pyramids
 }
 
 TEST(SceneFiles, Pyramid_IsJoltsPerformanceTestPyramid) {
@@ -152,7 +140,7 @@ TEST(SceneFiles, OtherScenes_HaveWhatTheyPromise) {
             EXPECT_EQ(bullets.shapes[b.shape].type, ShapeType::Sphere);
         }
     }
-    const SceneDesc pile = load("pile");  // parsed only: capsule, hull and mesh wait for the narrowphase
+    const SceneDesc pile = load("pile");
     std::vector<bool> seen(static_cast<int>(ShapeType::Count), false);
     for (const SceneBody& b : pile.bodies) seen[static_cast<int>(pile.shapes[b.shape].type)] = true;
     for (ShapeType t : {ShapeType::Sphere, ShapeType::Box, ShapeType::Capsule, ShapeType::ConvexHull,
