@@ -228,8 +228,8 @@ int run_command(Args& args) {
         wait_until(wall, deadline);
         const std::int64_t frame_start = now_nanoseconds();
         const double now = wall.elapsed_seconds();
-        // Two copies under the lock, not one: a flip may fall between them, which only
-        // makes the raw side look (slightly) newer, never torn.
+        // Two calls, each a consistent copy under the motion-state lock; a flip may
+        // fall between them, which only makes the raw side (slightly) newer, never torn.
         states.get_motion_states(handles, interpolated);
         states.get_raw_motion_states(handles, raw);
         smooth_interpolated.add_frame(interpolated);
