@@ -238,15 +238,12 @@ TEST(SpindleProgram, BenchPyramid_PrintsOneLine) {
     EXPECT_EQ(w[6].size(), 7u + 16u) << w[6];
     EXPECT_TRUE(all_of_chars(w[6].substr(7), "0123456789abcdef")) << w[6];
 
-    // Same scene, same steps: the same state, bit for bit.
-    const Result again = spindle("bench pyramid --steps 5", true);
-    const auto hash = [](const std::string& s) { return s.substr(s.find("hash=")); };
-    EXPECT_EQ(hash(again.output), hash(r.output));
     const Result substeps = spindle("bench stack --steps 3 --substeps 2 --threads 1", true);
     ASSERT_EQ(substeps.exit_code, 0) << substeps.output;
     expect_contains(substeps.output, "scene=stack bodies=20 threads=1 steps=3 ");
 }
 
+// Same scene, same steps: the same state, bit for bit, whatever the worker count.
 TEST(SpindleProgram, BenchHash_IsTheSameForOneAndTwoThreads) {
     const Result one = spindle("bench dominoes --steps 60 --threads 1", true);
     const Result two = spindle("bench dominoes --steps 60 --threads 2", true);
