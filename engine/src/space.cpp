@@ -188,6 +188,7 @@ void Space::destroy_body(BodyHandle body) {
     World& w = *m_world;
     if (!w.bodies.is_live(body)) throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
     const std::uint32_t slot = body.index;
+    destroy_joints_of(w, slot);
     remove_contacts_of(w, slot);
     remove_proxy(w, slot);
     if (w.bodies.awake_index[slot] >= 0) set_awake(w, slot, false);
@@ -310,6 +311,9 @@ void Space::set_solver(const SolverSettings& s) {
         !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
         throw Error("solver: contact_hertz, damping_ratio, push_out_speed, speculative_distance and "
                     "restitution_threshold must be >= 0");
+    }
+    if (!(s.joint_hertz >= 0) || !std::isfinite(s.joint_hertz) || !(s.joint_damping_ratio >= 0)) {
+        throw Error("solver: joint_hertz and joint_damping_ratio must be finite and >= 0");
     }
     m_world->settings.solver = s;
 }

@@ -24,8 +24,11 @@ struct SolverSettings {
     // (6 substeps). More substeps buy stiffness.
     Real contact_hertz = 0;
     Real damping_ratio = 10;        // contact damping ratio
+    // Joint softness: position error is pulled back like a spring of joint_hertz for the
+    // joint's effective mass, so a load F stretches a joint by about F / (m_eff (2 pi hz)^2).
+    // 0 hertz = rigid: no softening and no position correction (drift is not pulled back).
     Real joint_hertz = 60;
-    Real joint_damping_ratio = 2;   // joint softness (0 hertz = rigid joints)
+    Real joint_damping_ratio = 2;
     Real push_out_speed = 3;        // m/s: most speed used to push overlapping bodies apart
     Real restitution_threshold = 1; // m/s: slower approaches do not bounce
     Real speculative_distance = 0.04;  // m: contacts are made this far before touching

@@ -1,0 +1,2 @@
+// Joint API: validation, handles.
+#include <gtest/gtest.h>
