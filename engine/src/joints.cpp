@@ -5,9 +5,9 @@
 #include <spindle/platform/error.hpp>
 
 #include <cmath>
-#include <sstream>
 
 #include "broadphase_stage.hpp"
+#include "describe.hpp"
 #include "stages.hpp"
 
 namespace spindle {
@@ -61,33 +61,29 @@ JointDesc JointDesc::distance_between(BodyHandle a, BodyHandle b, const Vec3& wo
 
 namespace {
 
-std::string number(Real value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
+// Throws "create_joint: <field> <rule>, got <value>" unless ok.
+void require(bool ok, const char* field, const char* rule, const std::string& got) {
+    if (!ok) throw Error(std::string("create_joint: ") + field + " " + rule + ", got " + got);
 }
 
-std::string vec(const Vec3& v) { return "(" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + ")"; }
+void require_finite(const Vec3& v, const char* field) { require(is_finite(v), field, "must be finite", vec(v)); }
 
-[[noreturn]] void reject(const std::string& what) { throw Error("create_joint: " + what); }
-
-void check_finite(const Vec3& v, const char* field) {
-    if (!is_finite(v)) reject(std::string(field) + " must be finite, got " + vec(v));
+void require_axis(const Vec3& v, const char* field) {
+    require(is_finite(v) && v.norm() >= 1e-9, field, "must be a finite, non-zero vector", vec(v));
 }
 
-void check_axis(const Vec3& v, const char* field) {
-    if (!is_finite(v) || v.norm() < 1e-9) reject(std::string(field) + " must be a finite, non-zero vector, got " + vec(v));
+void require_non_negative(Real value, const char* field) {
+    require(std::isfinite(value) && value >= 0, field, "must be finite and >= 0", number(value));
 }
 
-void check_non_negative(Real value, const char* field) {
-    if (!std::isfinite(value) || value < 0) reject(std::string(field) + " must be finite and >= 0, got " + number(value));
-}
-
-void check_ordered(Real lower, Real upper, const char* lower_field, const char* upper_field) {
+void require_ordered(Real lower, Real upper, const char* lower_field, const char* upper_field) {
     if (!(lower <= upper)) {
-        reject(std::string(lower_field) + " (" + number(lower) + ") must be <= " + upper_field + " (" + number(upper) + ")");
+        throw Error(std::string("create_joint: ") + lower_field + " (" + number(lower) + ") must be <= " + upper_field +
+                    " (" + number(upper) + ")");
     }
 }
+
+[[noreturn]] void reject(const std::string& what) { throw Error("create_joint: " + what); }
 
 void validate(const World& world, const JointDesc& d) {
     const Bodies& b = world.bodies;
@@ -104,31 +100,29 @@ void validate(const World& world, const JointDesc& d) {
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
         reject("anchors.frame is neither World nor Local");
     }
-    check_finite(d.anchors.a, "anchors.a");
-    check_finite(d.anchors.b, "anchors.b");
+    require_finite(d.anchors.a, "anchors.a");
+    require_finite(d.anchors.b, "anchors.b");
     if (d.type == JointType::Hinge) {
         const HingeParams& h = d.hinge;
-        check_axis(h.axis_a, "hinge.axis_a");
-        check_axis(h.axis_b, "hinge.axis_b");
+        require_axis(h.axis_a, "hinge.axis_a");
+        require_axis(h.axis_b, "hinge.axis_b");
         if (h.enable_limit) {
             for (auto [value, field] : {std::pair{h.lower_angle, "hinge.lower_angle"}, {h.upper_angle, "hinge.upper_angle"}}) {
-                if (!std::isfinite(value) || std::abs(value) > kPi) {
-                    reject(std::string(field) + " must be in [-pi, pi], got " + number(value));
-                }
+                require(std::isfinite(value) && std::abs(value) <= kPi, field, "must be in [-pi, pi]", number(value));
             }
-            check_ordered(h.lower_angle, h.upper_angle, "hinge.lower_angle", "hinge.upper_angle");
+            require_ordered(h.lower_angle, h.upper_angle, "hinge.lower_angle", "hinge.upper_angle");
         }
-        if (!std::isfinite(h.motor_speed)) reject("hinge.motor_speed must be finite, got " + number(h.motor_speed));
-        check_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
+        require(std::isfinite(h.motor_speed), "hinge.motor_speed", "must be finite", number(h.motor_speed));
+        require_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
     }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
-        if (!std::isfinite(p.rest_length)) reject("distance.rest_length must be finite, got " + number(p.rest_length));
-        check_non_negative(p.spring_hertz, "distance.spring_hertz");
-        check_non_negative(p.spring_damping_ratio, "distance.spring_damping_ratio");
-        check_non_negative(p.min_length, "distance.min_length");
-        if (std::isnan(p.max_length)) reject("distance.max_length must be a number");
-        check_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
+        require(std::isfinite(p.rest_length), "distance.rest_length", "must be finite", number(p.rest_length));
+        require_non_negative(p.spring_hertz, "distance.spring_hertz");
+        require_non_negative(p.spring_damping_ratio, "distance.spring_damping_ratio");
+        require_non_negative(p.min_length, "distance.min_length");
+        require(!std::isnan(p.max_length), "distance.max_length", "must be a number", number(p.max_length));
+        require_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
     }
 }
 

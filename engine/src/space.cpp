@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "broadphase_stage.hpp"
+#include "describe.hpp"
 #include "solver.hpp"
 #include "stages.hpp"
 
@@ -48,14 +49,6 @@ void run_stage(World& world, Stage stage, F&& body) {
     body();
     world.stats.stage_seconds[static_cast<int>(stage)] += static_cast<double>(now_nanoseconds() - start) * 1e-9;
 }
-
-std::string number(Real value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-}
-
-std::string vec(const Vec3& v) { return "(" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + ")"; }
 
 [[noreturn]] void reject(const std::string& what) { throw Error("create_body: " + what); }
 

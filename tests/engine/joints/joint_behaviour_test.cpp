@@ -20,14 +20,6 @@ using namespace spindle::test;
 
 namespace {
 
-BodyHandle add_box(Space& space, const Vec3& p, const Vec3& half_extents, Real mass) {
-    BodyDesc d;
-    d.shape = Shape::box(half_extents);
-    d.position = p;
-    d.mass = mass;
-    return space.create_body(d);
-}
-
 // A 1 m bar along +x from a hinge at the origin about z, under gravity.
 struct HingedBar {
     BodyHandle anchor, bar;

@@ -17,12 +17,20 @@ inline BodyHandle add_static(Space& space, const Vec3& p, Real radius = 0.05) {
     return space.create_body(d);
 }
 
-inline BodyHandle add_sphere(Space& space, const Vec3& p, Real radius, Real mass) {
+inline BodyHandle add_dynamic(Space& space, const Shape& shape, const Vec3& p, Real mass) {
     BodyDesc d;
-    d.shape = Shape::sphere(radius);
+    d.shape = shape;
     d.position = p;
     d.mass = mass;
     return space.create_body(d);
+}
+
+inline BodyHandle add_sphere(Space& space, const Vec3& p, Real radius, Real mass) {
+    return add_dynamic(space, Shape::sphere(radius), p, mass);
+}
+
+inline BodyHandle add_box(Space& space, const Vec3& p, const Vec3& half_extents, Real mass) {
+    return add_dynamic(space, Shape::box(half_extents), p, mass);
 }
 
 struct Chain {
