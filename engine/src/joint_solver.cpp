@@ -1,10 +1,6 @@
-// The joint solver, in the contact solver's soft step (solver.cpp): per step, prepare
-// the awake joints; per substep, from the colour loops, warm start, solve with soft
-// position correction from the bodies' dp/dq deltas, and relax without it; after the
-// step, keep the impulses for warm starting. Point constraints (ball-socket, and the
-// point part of hinge and fixed joints) are one 3x3 block; a hinge adds two angular
-// alignment rows, a limit and a motor about its axis; a fixed joint three angular rows;
-// a distance joint one row with a spring and limits.
+// The joint solver inside the soft step (solver.cpp): prepare, warm start, solve with
+// soft position correction from the dp/dq deltas, relax, and keep impulses, for the
+// ball-socket, hinge, fixed and distance joints.
 #include <algorithm>
 #include <cmath>
 
@@ -22,10 +18,11 @@ Mat3 skew(const Vec3& v) {
     return m;
 }
 
-// Inverse of an effective-mass matrix, or zero when nothing can move along it.
+// Inverse of an effective-mass matrix, or zero when nothing can move along it. With a
+// dynamic body in the joint K is positive definite (however heavy the body).
 template <typename M>
 M inverse_or_zero(const M& k) {
-    return std::abs(k.determinant()) > 1e-30 ? M(k.inverse()) : M(M::Zero());
+    return k.isZero(0) ? M(M::Zero()) : M(k.inverse());
 }
 
 Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
@@ -83,6 +80,8 @@ Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointS
     return applied;
 }
 
+// Point constraint (ball-socket, and the point part of hinge and fixed joints): the
+// anchors coincide, solved as one 3x3 block.
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
     const Vec3 ra = A.dq * jc.ra, rb = B.dq * jc.rb;
@@ -99,6 +98,7 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     apply(A, B, s, ra, rb, impulse);
 }
 
+// Hinge: motor and limit about the axis, two alignment rows, then the point.
 void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
     const AlignRows rows = align_rows(jc, A.dq, B.dq);
@@ -136,6 +136,7 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     solve_point(jc, A, B, s, p);
 }
 
+// Fixed: three angular rows that hold the relative rotation, then the point.
 void solve_fixed(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
     const Softness soft = pass_softness(p);
@@ -156,6 +157,7 @@ Vec3 distance_axis(const JointConstraint& jc, const SolverBody& A, const SolverB
     return length > 1e-9 ? Vec3(d / length) : jc.axis;
 }
 
+// Distance: one row along the anchors' line: rigid, or a spring with min/max limits.
 void solve_distance(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                     const JointSolveParams& p) {
     const Vec3 ra = A.dq * jc.ra, rb = B.dq * jc.rb;
