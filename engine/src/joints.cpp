@@ -187,13 +187,24 @@ void block_pair(World& world, const Joint& j, int delta) {
     }
 }
 
-void remove_joint(World& world, std::uint32_t slot) {
+// dying: a body about to be destroyed with the joint (its proxy goes anyway).
+void remove_joint(World& world, std::uint32_t slot, std::uint32_t dying = ~0u) {
     Joints& js = world.joints;
     const Joint& j = js.joint[slot];
     // The partners may have rested on this joint: let them move again.
     wake_body(world, j.body_a);
     wake_body(world, j.body_b);
     block_pair(world, j, -1);
+    if (!j.collide_connected) {
+        // The broadphase reports a pair only when a proxy is new or grew: re-adding one
+        // body's proxy finds the pair again if the two still overlap.
+        const bool b_first = world.bodies.type[j.body_b] != MotionType::Static && j.body_b != dying;
+        const std::uint32_t body = b_first ? j.body_b : j.body_a;
+        if (body != dying) {
+            remove_proxy(world, body);
+            add_proxy(world, body);
+        }
+    }
     js.alive[slot] = 0;
     js.live -= 1;
     js.free_slots.push_back(slot);
@@ -224,7 +235,7 @@ void destroy_joints_of(World& world, std::uint32_t body_slot) {
     if (js.live == 0) return;
     for (std::uint32_t slot = 0; slot < js.capacity(); ++slot) {
         if (js.alive[slot] && (js.joint[slot].body_a == body_slot || js.joint[slot].body_b == body_slot)) {
-            remove_joint(world, slot);
+            remove_joint(world, slot, body_slot);
         }
     }
 }
