@@ -259,10 +259,12 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
 }  // namespace
 
 Softness joint_softness(const SolverSettings& settings, Real h) {
-    // 0 hertz gives Box2D's rigid joint: full mass, no softening and no position
-    // correction. A bias of the whole error per substep (the stiff limit of a spring)
-    // would be unstable for coupled joints solved one at a time.
-    return make_softness(settings.joint_hertz, settings.joint_damping_ratio, h);
+    // As for contacts, no stiffer than a quarter of the substep rate: stiffer joints
+    // solved one at a time fight each other (a rigid bias of the whole error per
+    // substep makes a hanging chain under a heavy load blow up).
+    const Real stiffest = Real(0.25) / h;
+    const Real hertz = settings.joint_hertz > 0 ? std::min(settings.joint_hertz, stiffest) : stiffest;
+    return make_softness(hertz, settings.joint_damping_ratio, h);
 }
 
 void prepare_joints(World& world, SolverScratch& scratch, Real h) {

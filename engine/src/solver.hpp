@@ -122,7 +122,7 @@ struct SolverScratch {
 // joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are
 // none) and prepares them from the bodies of scratch; the others run per joint from
 // the colour loops, so a joint only touches its own two solver bodies.
-Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz 0: rigid
+Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz, capped; 0: the cap
 void prepare_joints(World& world, SolverScratch& scratch, Real h);
 void warm_start_joint(JointConstraint& jc, SolverBody* bodies);
 void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params);

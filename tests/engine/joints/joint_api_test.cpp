@@ -83,7 +83,7 @@ TEST(JointValidation, SolverRejectsNegativeJointSoftness) {
     SolverSettings s;
     s.joint_hertz = -1;
     EXPECT_THROW(space.set_solver(s), Error);
-    s.joint_hertz = 0;  // rigid
+    s.joint_hertz = 0;  // the stiffest stable
     EXPECT_NO_THROW(space.set_solver(s));
 }
 
