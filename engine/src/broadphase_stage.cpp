@@ -43,8 +43,17 @@ void update_broadphase(World& world, Real dt) {
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
         }
     });
-    // The tree is single-writer; moves are cheap unless a body leaves its fat box.
-    for (std::uint32_t i : world.awake) bp.tree.move_proxy(bp.proxy[i], b.bounds[i], b.v[i] * dt);
+    // The tree is single-writer; moves are cheap unless a body leaves its fat box. The
+    // box the fat box must hold is swept over this step's motion: a fast body near the
+    // edge of its fat box would otherwise cross a whole step into something before the
+    // pair is found.
+    for (std::uint32_t i : world.awake) {
+        const Vec3 d = b.v[i] * dt;
+        Aabb swept = b.bounds[i];
+        swept.min += d.cwiseMin(Vec3::Zero());
+        swept.max += d.cwiseMax(Vec3::Zero());
+        bp.tree.move_proxy(bp.proxy[i], swept, d);
+    }
 
     bp.pairs.clear();
     bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count

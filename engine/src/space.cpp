@@ -181,6 +181,9 @@ void Space::destroy_body(BodyHandle body) {
     World& w = *m_world;
     if (!w.bodies.is_live(body)) throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
     const std::uint32_t slot = body.index;
+    // A body leaving a sleeping island wakes it: what rested on the body may fall, and
+    // the island's member list must not keep a dead slot.
+    if (w.bodies.island[slot] >= 0) wake_body(w, slot);
     destroy_joints_of(w, slot);
     remove_contacts_of(w, slot);
     remove_proxy(w, slot);

@@ -102,3 +102,22 @@ TEST(Islands, SleepCanBeDisabled) {
     for (int i = 0; i < 300; ++i) row.space.update();
     for (BodyHandle b : row.balls) EXPECT_TRUE(row.space.internal_is_awake(b));
 }
+
+TEST(Islands, DestroyingASleepingBodyWakesItsIslandAndForgetsIt) {
+    Row row;
+    build(row);
+    settle(row);
+    row.space.destroy_body(row.balls[2]);
+    for (std::size_t i : {0u, 1u, 3u, 4u}) EXPECT_TRUE(row.space.internal_is_awake(row.balls[i]));
+    // Sleep and wake again: the island must not bring the dead slot back.
+    for (int i = 0; i < 300; ++i) row.space.update();
+    row.space.set_linear_velocity(row.balls[0], Vec3(0, 0, 1));
+    row.space.update();
+    EXPECT_FALSE(row.space.contains(row.balls[2]));
+    EXPECT_EQ(row.space.body_count(), 5u);  // ground and four balls
+    // Without ball 2 the row is two islands: waking ball 0 wakes {0, 1} and nothing else.
+    EXPECT_EQ(row.space.last_update().awake_bodies, 2u);
+    EXPECT_TRUE(row.space.internal_is_awake(row.balls[1]));
+    EXPECT_FALSE(row.space.internal_is_awake(row.balls[3]));
+    EXPECT_FALSE(row.space.internal_is_awake(row.balls[4]));
+}
