@@ -52,6 +52,7 @@ void update_broadphase(World& world, Real dt) {
         const auto i = static_cast<std::uint32_t>(pair.user_a);
         const auto j = static_cast<std::uint32_t>(pair.user_b);
         if (!can_collide(b, i, j)) continue;
+        if (joint_blocks_pair(world, i, j)) continue;  // jointed bodies do not collide unless asked
         create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
     }
 

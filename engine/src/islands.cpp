@@ -1,5 +1,5 @@
-// Islands and sleeping: bodies linked by touching contacts form islands (union-find
-// over the awake bodies each step); an island whose bodies all rested long enough
+// Islands and sleeping: bodies linked by touching contacts or joints form islands
+// (union-find over the awake bodies each step); an island whose bodies all rested long enough
 // goes to sleep as a whole and costs nothing until something wakes it.
 #include <algorithm>
 #include <numeric>
@@ -15,6 +15,13 @@ std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t i) {
         i = parent[i];
     }
     return i;
+}
+
+// Joins two sets; the lower root wins, so islands do not depend on the link order.
+void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t ra = find(parent, a);
+    const std::uint32_t rb = find(parent, b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
 }
 
 bool touching(const Contact& c) { return c.manifold_count > 0; }
@@ -41,8 +48,13 @@ void wake_body(World& world, std::uint32_t slot) {
         if (it != world.contact_index.end()) world.contacts[it->second].sleeping = false;
     }
     world.awake_contacts_dirty = true;
+    for (JointHandle joint : sleeping.joints) {
+        if (world.joints.is_live(joint)) world.joints.joint[joint.index].sleeping = false;
+    }
+    if (!sleeping.joints.empty()) world.joints.awake_dirty = true;
     sleeping.bodies.clear();
     sleeping.contacts.clear();
+    sleeping.joints.clear();
     world.free_islands.push_back(island);
 }
 
@@ -57,6 +69,15 @@ void update_islands(World& world, Real dt) {
         const bool awake_a = b.awake_index[contact.body_a] >= 0, awake_b = b.awake_index[contact.body_b] >= 0;
         if (awake_a && !awake_b && b.type[contact.body_b] == MotionType::Dynamic) wake_body(world, contact.body_b);
         if (awake_b && !awake_a && b.type[contact.body_a] == MotionType::Dynamic) wake_body(world, contact.body_a);
+    }
+    // So do joints: a joint cannot hold a body that does not move.
+    Joints& joints = world.joints;
+    for (std::size_t k = 0; k < awake_joints(world).size(); ++k) {  // wake_body may rebuild the list
+        const Joint& joint = joints.joint[awake_joints(world)[k]];
+        const std::uint32_t ja = joint.body_a, jb = joint.body_b;
+        const bool awake_a = b.awake_index[ja] >= 0, awake_b = b.awake_index[jb] >= 0;
+        if (awake_a && !awake_b && b.type[jb] == MotionType::Dynamic) wake_body(world, jb);
+        if (awake_b && !awake_a && b.type[ja] == MotionType::Dynamic) wake_body(world, ja);
     }
     if (!sleep.enabled) return;
 
@@ -79,9 +100,13 @@ void update_islands(World& world, Real dt) {
         if (b.type[contact.body_a] != MotionType::Dynamic || b.type[contact.body_b] != MotionType::Dynamic) continue;
         const std::int32_t ia = b.awake_index[contact.body_a], ib = b.awake_index[contact.body_b];
         if (ia < 0 || ib < 0) continue;
-        const std::uint32_t ra = find(parent, static_cast<std::uint32_t>(ia));
-        const std::uint32_t rb = find(parent, static_cast<std::uint32_t>(ib));
-        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+        unite(parent, static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+    }
+    for (std::uint32_t j : awake_joints(world)) {
+        const std::uint32_t ja = joints.joint[j].body_a, jb = joints.joint[j].body_b;
+        if (b.type[ja] != MotionType::Dynamic || b.type[jb] != MotionType::Dynamic) continue;
+        const std::int32_t ia = b.awake_index[ja], ib = b.awake_index[jb];
+        if (ia >= 0 && ib >= 0) unite(parent, static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
     }
     // An island sleeps when its least-rested body has rested long enough.
     std::vector<Real>& min_rest = world.scratch_rest;
@@ -141,6 +166,16 @@ void update_islands(World& world, Real dt) {
         if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].contacts.push_back(contact.key);
     }
     world.awake_contacts_dirty = true;
+    // Joints likewise, so a sleeping island's joints cost nothing until it wakes.
+    for (std::uint32_t j : awake_joints(world)) {
+        Joint& joint = joints.joint[j];
+        if (b.awake_index[joint.body_a] >= 0 || b.awake_index[joint.body_b] >= 0) continue;
+        joint.sleeping = true;
+        joints.awake_dirty = true;  // read on the next call: this loop's list stays as it is
+        const std::int32_t ia = b.island[joint.body_a], ib = b.island[joint.body_b];
+        if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].joints.push_back(joints.handle(j));
+        if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].joints.push_back(joints.handle(j));
+    }
 }
 
 }  // namespace spindle

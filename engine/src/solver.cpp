@@ -1,9 +1,9 @@
-// The contact solver (soft step, as Box2D v3 and Box3D): per step, prepare
-// constraints from the manifolds and colour them; per substep, integrate velocities,
-// warm start, solve with soft position bias, integrate positions, relax without bias;
-// then restitution and storing impulses for the next step's warm start. Each colour is
-// solved as parallel jobs: no two constraints of a colour share a dynamic body, so
-// the result is bitwise the same for any number of workers.
+// The constraint solver (soft step, as Box2D v3 and Box3D): per step, prepare the
+// contacts from the manifolds and the joints (joint_solver.cpp) and colour them; per
+// substep, integrate velocities, warm start, solve with soft position bias, integrate
+// positions, relax without bias; then restitution and storing impulses for the next
+// step's warm start. Each colour is solved as parallel jobs: no two constraints of a
+// colour share a dynamic body, so the result is bitwise the same for any number of workers.
 #include "solver.hpp"
 
 #include <algorithm>
@@ -46,29 +46,6 @@ Real make_row(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Ve
     row.ib = B.inv_inertia * row.rb_x;
     const Real k = A.inv_mass + B.inv_mass + row.ra_x.dot(row.ia) + row.rb_x.dot(row.ib);
     return k > 0 ? 1 / k : 0;
-}
-
-struct Velocities {
-    Vec3 va, wa, vb, wb;
-};
-
-inline Velocities load(const SolverBody& A, const SolverBody& B) { return {A.v, A.w, B.v, B.w}; }
-
-inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
-    // Only dynamic bodies are written: static and kinematic ones are shared by
-    // constraints of every colour.
-    if (A.dynamic) {
-        A.v = s.va;
-        A.w = s.wa;
-    }
-    if (B.dynamic) {
-        B.v = s.vb;
-        B.w = s.wb;
-    }
-}
-
-inline Vec3 relative_velocity(const Velocities& s, const Vec3& ra, const Vec3& rb) {
-    return s.vb + s.wb.cross(rb) - s.va - s.wa.cross(ra);
 }
 
 // Relative speed along a row's direction.
@@ -161,34 +138,42 @@ void prepare(World& world, SolverScratch& scratch, Real h) {
     (void)h;
 }
 
-// Greedy colouring in constraint order (deterministic): the first colour whose
-// bodies do not include either dynamic body of the constraint.
+// Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
+// neither dynamic body of the constraint; -1 when none is free. Static, kinematic and
+// sleeping partners are shared freely: constraints never write them.
+int assign_color(SolverScratch& scratch, std::uint32_t a, std::uint32_t b) {
+    const bool dyn_a = scratch.bodies[a].dynamic;
+    const bool dyn_b = scratch.bodies[b].dynamic;
+    for (int c = 0; c < kColorCount; ++c) {
+        std::vector<std::uint64_t>& bits = scratch.color_bits[c];
+        if (dyn_a && (bits[a / 64] >> (a % 64) & 1)) continue;
+        if (dyn_b && (bits[b / 64] >> (b % 64) & 1)) continue;
+        if (dyn_a) bits[a / 64] |= std::uint64_t{1} << (a % 64);
+        if (dyn_b) bits[b / 64] |= std::uint64_t{1} << (b % 64);
+        return c;
+    }
+    return -1;
+}
+
+// Joints first, then contacts, in list order (deterministic), sharing the colours'
+// body sets: a colour's joints and contacts together touch each dynamic body once.
 void color(World& world, SolverScratch& scratch) {
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     const std::size_t words = (n + 63) / 64;
     for (int c = 0; c < kColorCount; ++c) {
         scratch.colors[c].clear();
+        scratch.joint_colors[c].clear();
         scratch.color_bits[c].assign(words, 0);
     }
     scratch.overflow.clear();
+    scratch.joint_overflow.clear();
+    for (std::uint32_t k = 0; k < scratch.joints.size(); ++k) {
+        const int c = assign_color(scratch, scratch.joints[k].a, scratch.joints[k].b);
+        (c >= 0 ? scratch.joint_colors[c] : scratch.joint_overflow).push_back(k);
+    }
     for (std::uint32_t k = 0; k < scratch.constraints.size(); ++k) {
-        const ContactConstraint& cc = scratch.constraints[k];
-        const bool dyn_a = scratch.bodies[cc.a].dynamic;
-        const bool dyn_b = scratch.bodies[cc.b].dynamic;
-        int chosen = -1;
-        for (int c = 0; c < kColorCount && chosen < 0; ++c) {
-            std::vector<std::uint64_t>& bits = scratch.color_bits[c];
-            if (dyn_a && (bits[cc.a / 64] >> (cc.a % 64) & 1)) continue;
-            if (dyn_b && (bits[cc.b / 64] >> (cc.b % 64) & 1)) continue;
-            if (dyn_a) bits[cc.a / 64] |= std::uint64_t{1} << (cc.a % 64);
-            if (dyn_b) bits[cc.b / 64] |= std::uint64_t{1} << (cc.b % 64);
-            chosen = c;
-        }
-        if (chosen >= 0) {
-            scratch.colors[chosen].push_back(k);
-        } else {
-            scratch.overflow.push_back(k);
-        }
+        const int c = assign_color(scratch, scratch.constraints[k].a, scratch.constraints[k].b);
+        (c >= 0 ? scratch.colors[c] : scratch.overflow).push_back(k);
     }
 }
 
@@ -290,19 +275,33 @@ void apply_restitution(ContactConstraint& cc, SolverBody* bodies, Real threshold
     store(A, B, s);
 }
 
-// Runs fn over every constraint, colour by colour (each colour in parallel), then
-// the overflow serially.
-template <typename F>
-void for_each_colored(World& world, SolverScratch& scratch, const char* name, F&& fn) {
+// Runs joint_fn and contact_fn over every constraint, colour by colour: one parallel
+// range per colour, its joints then its contacts (they share no dynamic body); then
+// the overflow serially, joints first. Chunks depend only on the lists, so the result
+// does not depend on the worker count. kJoints = false walks the contacts only.
+template <bool kJoints = true, typename JointFn, typename ContactFn>
+void for_each_colored(World& world, SolverScratch& scratch, const char* name, JointFn&& joint_fn,
+                      ContactFn&& contact_fn) {
     for (int c = 0; c < kColorCount; ++c) {
-        const std::vector<std::uint32_t>& list = scratch.colors[c];
-        if (list.empty()) continue;
-        world.jobs->parallel_for(name, 0, static_cast<std::uint32_t>(list.size()), kConstraintGrain,
-                                 [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-                                     for (std::uint32_t k = lo; k < hi; ++k) fn(scratch.constraints[list[k]]);
-                                 });
+        const std::vector<std::uint32_t>& joints = scratch.joint_colors[c];
+        const std::vector<std::uint32_t>& contacts = scratch.colors[c];
+        const auto joint_count = kJoints ? static_cast<std::uint32_t>(joints.size()) : 0u;
+        const auto total = joint_count + static_cast<std::uint32_t>(contacts.size());
+        if (total == 0) continue;
+        world.jobs->parallel_for(name, 0, total, kConstraintGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+            for (std::uint32_t k = lo; k < hi; ++k) {
+                if (k < joint_count) {
+                    joint_fn(scratch.joints[joints[k]]);
+                } else {
+                    contact_fn(scratch.constraints[contacts[k - joint_count]]);
+                }
+            }
+        });
     }
-    for (std::uint32_t k : scratch.overflow) fn(scratch.constraints[k]);
+    if (kJoints) {
+        for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
+    }
+    for (std::uint32_t k : scratch.overflow) contact_fn(scratch.constraints[k]);
 }
 
 void finalize(World& world, SolverScratch& scratch) {
@@ -348,6 +347,7 @@ void solve(World& world, Real dt) {
     const Real h = dt / substeps;
 
     prepare(world, scratch, h);
+    prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
     color(world, scratch);
     SolverBody* bodies = scratch.bodies.data();
 
@@ -360,21 +360,31 @@ void solve(World& world, Real dt) {
     solve_params.push_out = settings.push_out_speed;
     SolveParams relax_params = solve_params;
     relax_params.use_bias = false;
+    const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
+    const JointSolveParams joint_relax{joint_solve.soft, joint_solve.inv_h, false};
 
     for (int sub = 0; sub < substeps; ++sub) {
         integrate_velocities(world, bodies, h);
-        for_each_colored(world, scratch, "WarmStart", [&](ContactConstraint& cc) { warm_start(cc, bodies); });
+        for_each_colored(
+            world, scratch, "WarmStart", [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+            [&](ContactConstraint& cc) { warm_start(cc, bodies); });
         for (int it = 0; it < settings.iterations; ++it) {
-            for_each_colored(world, scratch, "Solve", [&](ContactConstraint& cc) { solve_contact(cc, bodies, solve_params); });
+            for_each_colored(
+                world, scratch, "Solve", [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
+                [&](ContactConstraint& cc) { solve_contact(cc, bodies, solve_params); });
         }
         integrate_positions(world, bodies, h);
         for (int it = 0; it < settings.relax_iterations; ++it) {
-            for_each_colored(world, scratch, "Relax", [&](ContactConstraint& cc) { solve_contact(cc, bodies, relax_params); });
+            for_each_colored(
+                world, scratch, "Relax", [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
+                [&](ContactConstraint& cc) { solve_contact(cc, bodies, relax_params); });
         }
     }
-    for_each_colored(world, scratch, "Restitution",
-                     [&](ContactConstraint& cc) { apply_restitution(cc, bodies, settings.restitution_threshold, h); });
+    for_each_colored<false>(
+        world, scratch, "Restitution", [](JointConstraint&) {},
+        [&](ContactConstraint& cc) { apply_restitution(cc, bodies, settings.restitution_threshold, h); });
     store_impulses(world, scratch);
+    if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
     finalize(world, scratch);
 
     // Work counters, derived from the constraint set (no per-point counting in the hot loop).
@@ -388,6 +398,7 @@ void solve(World& world, Real dt) {
     world.counters.contact_points_solved += points * passes;
     world.counters.friction_applied += friction_points * passes;
     world.counters.restitution_applied += restitution_points;
+    world.counters.joints_solved += static_cast<std::uint64_t>(scratch.joints.size()) * passes;
     world.counters.bodies_integrated += world.awake.size();
 }
 

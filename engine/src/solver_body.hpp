@@ -18,4 +18,53 @@ struct SolverBody {
     bool dynamic = false;  // only dynamic bodies are written by constraints
 };
 
+// The velocities of a constraint's two bodies while it is solved: loaded once, changed
+// by each row, stored once.
+struct Velocities {
+    Vec3 va, wa, vb, wb;
+};
+
+inline Velocities load(const SolverBody& A, const SolverBody& B) { return {A.v, A.w, B.v, B.w}; }
+
+inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
+    // Only dynamic bodies are written: static and kinematic ones are shared by
+    // constraints of every colour.
+    if (A.dynamic) {
+        A.v = s.va;
+        A.w = s.wa;
+    }
+    if (B.dynamic) {
+        B.v = s.vb;
+        B.w = s.wb;
+    }
+}
+
+// An impulse at the anchors ra, rb (from each centre of mass): -impulse on A, +impulse on B.
+inline void apply(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& ra, const Vec3& rb,
+                  const Vec3& impulse) {
+    s.va -= A.inv_mass * impulse;
+    s.wa -= A.inv_inertia * ra.cross(impulse);
+    s.vb += B.inv_mass * impulse;
+    s.wb += B.inv_inertia * rb.cross(impulse);
+}
+
+// An angular impulse: -impulse on A, +impulse on B.
+inline void apply_angular(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& impulse) {
+    s.wa -= A.inv_inertia * impulse;
+    s.wb += B.inv_inertia * impulse;
+}
+
+// 1 / (J M^-1 J^T) of one linear row along dir at the anchors ra, rb (0 if nothing can move).
+inline Real effective_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir) {
+    const Vec3 rna = ra.cross(dir);
+    const Vec3 rnb = rb.cross(dir);
+    const Real k = A.inv_mass + B.inv_mass + rna.dot(A.inv_inertia * rna) + rnb.dot(B.inv_inertia * rnb);
+    return k > 0 ? 1 / k : 0;
+}
+
+// Velocity of B's anchor relative to A's.
+inline Vec3 relative_velocity(const Velocities& s, const Vec3& ra, const Vec3& rb) {
+    return s.vb + s.wb.cross(rb) - s.va - s.wa.cross(ra);
+}
+
 }  // namespace spindle

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "broadphase_stage.hpp"
+#include "describe.hpp"
 #include "solver.hpp"
 #include "stages.hpp"
 
@@ -48,14 +49,6 @@ void run_stage(World& world, Stage stage, F&& body) {
     body();
     world.stats.stage_seconds[static_cast<int>(stage)] += static_cast<double>(now_nanoseconds() - start) * 1e-9;
 }
-
-std::string number(Real value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
-}
-
-std::string vec(const Vec3& v) { return "(" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + ")"; }
 
 [[noreturn]] void reject(const std::string& what) { throw Error("create_body: " + what); }
 
@@ -188,6 +181,7 @@ void Space::destroy_body(BodyHandle body) {
     World& w = *m_world;
     if (!w.bodies.is_live(body)) throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
     const std::uint32_t slot = body.index;
+    destroy_joints_of(w, slot);
     remove_contacts_of(w, slot);
     remove_proxy(w, slot);
     if (w.bodies.awake_index[slot] >= 0) set_awake(w, slot, false);
@@ -310,6 +304,9 @@ void Space::set_solver(const SolverSettings& s) {
         !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
         throw Error("solver: contact_hertz, damping_ratio, push_out_speed, speculative_distance and "
                     "restitution_threshold must be >= 0");
+    }
+    if (!(s.joint_hertz >= 0) || !std::isfinite(s.joint_hertz) || !(s.joint_damping_ratio >= 0)) {
+        throw Error("solver: joint_hertz and joint_damping_ratio must be finite and >= 0");
     }
     m_world->settings.solver = s;
 }

@@ -16,6 +16,7 @@
 #include <spindle/engine/stats.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
+#include "joints.hpp"
 #include "write_buffer.hpp"
 
 namespace spindle {
@@ -106,10 +107,11 @@ struct EffectCounts {
     std::uint64_t gravity = 0, damping = 0, gyro = 0;
 };
 
-// A sleeping island: its bodies and contacts, kept so one touch wakes them together.
+// A sleeping island: its bodies, contacts and joints, kept so one touch wakes them together.
 struct SleepingIsland {
     std::vector<std::uint32_t> bodies;
     std::vector<std::uint64_t> contacts;
+    std::vector<JointHandle> joints;  // handles: a joint destroyed while asleep is skipped on waking
 };
 
 struct World {
@@ -130,6 +132,9 @@ struct World {
     std::vector<std::uint32_t> awake_contact_list;
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
+
+    // Joints (joints.cpp); solved with the contacts, coloured first.
+    Joints joints;
 
     // Buffering.
     WriteBuffer writes;

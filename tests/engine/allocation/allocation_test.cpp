@@ -60,3 +60,41 @@ TEST(Allocation, SteadyStateStepAllocatesNothing) {
     EXPECT_EQ(space.last_update().contacts, 100u);
     EXPECT_EQ(during, 0) << "allocations in 120 steady-state steps";
 }
+
+TEST(Allocation, SteadyStateJointedStepAllocatesNothing) {
+    SpaceSettings settings;
+    settings.sleep.enabled = false;  // hanging still but awake: the joints are solved every step
+    Space space(settings);
+    BodyDesc anchor;
+    anchor.type = MotionType::Static;
+    anchor.shape = Shape::sphere(0.1);
+    anchor.position = Vec3(0, 5, 0);
+    BodyHandle previous = space.create_body(anchor);
+    for (int i = 0; i < 8; ++i) {  // a hanging chain of ball-socket, hinge (with a motor), fixed and distance joints
+        BodyDesc d;
+        d.shape = Shape::box(Vec3(0.05, 0.25, 0.05));
+        d.position = Vec3(0, 5 - 0.5 * i - 0.25, 0);
+        const BodyHandle link = space.create_body(d);
+        const Vec3 pivot(0, 5 - 0.5 * i, 0);
+        JointDesc j = JointDesc::ball_socket_at(previous, link, pivot);
+        if (i % 4 == 1) {
+            j = JointDesc::hinge_at(previous, link, pivot, Vec3::UnitZ());
+            j.hinge.enable_motor = true;
+            j.hinge.max_motor_torque = 1;
+            j.hinge.enable_limit = true;
+            j.hinge.lower_angle = -0.5;
+            j.hinge.upper_angle = 0.5;
+        } else if (i % 4 == 2) {
+            j = JointDesc::fixed_at(previous, link, pivot);
+        } else if (i % 4 == 3) {
+            j = JointDesc::distance_between(previous, link, pivot, pivot - Vec3(0, 0.01, 0));
+        }
+        space.create_joint(j);
+        previous = link;
+    }
+    for (int i = 0; i < 60; ++i) space.update();
+    const long before = g_allocations.load();
+    for (int i = 0; i < 120; ++i) space.update();
+    EXPECT_GT(space.counters().joints_solved, 0u);
+    EXPECT_EQ(g_allocations.load() - before, 0) << "allocations in 120 steps of a jointed scene";
+}

@@ -66,6 +66,56 @@ std::uint64_t run_mixed_scene(JobSystem& jobs) {
     return space.state_hash();
 }
 
+// Chains of bars on ball-socket and fixed joints, a motor-driven hinged wheel, and
+// balls on spring ropes falling onto a floor: joints and contacts share the colours.
+std::uint64_t run_jointed_scene(JobSystem& jobs) {
+    Space space(SpaceSettings{}, &jobs);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(d);
+    d.shape = Shape::sphere(0.1);
+    d.position = Vec3(-3, 2, 0);
+    const BodyHandle hub = space.create_body(d);
+    for (int c = 0; c < 3; ++c) {
+        d.type = MotionType::Static;
+        d.shape = Shape::sphere(0.05);
+        d.position = Vec3(2.0 * c, 3, 0);
+        BodyHandle previous = space.create_body(d);
+        d.type = MotionType::Dynamic;
+        d.shape = Shape::box(Vec3(0.125, 0.02, 0.02));
+        for (int i = 0; i < 12; ++i) {
+            const Vec3 pivot(2.0 * c + 0.25 * i, 3, 0);
+            d.position = pivot + Vec3(0.125, 0, 0);
+            const BodyHandle link = space.create_body(d);
+            space.create_joint(i % 3 == 2 ? JointDesc::fixed_at(previous, link, pivot)
+                                          : JointDesc::ball_socket_at(previous, link, pivot));
+            previous = link;
+        }
+    }
+    d.shape = Shape::box(Vec3(0.5, 0.5, 0.1));
+    d.position = Vec3(-3, 2, 0);
+    JointDesc motor = JointDesc::hinge_at(hub, space.create_body(d), Vec3(-3, 2, 0), Vec3::UnitZ());
+    motor.hinge.enable_motor = true;
+    motor.hinge.motor_speed = 2;
+    motor.hinge.max_motor_torque = 50;
+    space.create_joint(motor);
+    d.shape = Shape::sphere(0.25);
+    for (int i = 0; i < 40; ++i) {
+        d.position = Vec3(0.3 * (i % 20) - 1, 0.5 + 1.1 * (i / 20), 0.4);
+        const BodyHandle ball = space.create_body(d);
+        if (i % 4 != 0) continue;
+        JointDesc rope = JointDesc::distance_between(hub, ball, Vec3(-3, 2, 0), d.position);
+        rope.distance.enable_spring = true;
+        rope.distance.spring_hertz = 2;
+        space.create_joint(rope);
+    }
+    for (int i = 0; i < kSteps; ++i) space.update();
+    EXPECT_GT(space.counters().joints_solved, 0u);
+    EXPECT_GT(space.counters().contact_points_solved, 0u);
+    return space.state_hash();
+}
+
 }  // namespace
 
 TEST(Determinism, MixedSceneHashIsTheSameForOneToFourWorkers) {
@@ -83,4 +133,15 @@ TEST(Determinism, RunToRunIsIdentical) {
     auto jobs = jobs_for(2);
     const std::uint64_t first = run_mixed_scene(*jobs);
     EXPECT_EQ(run_mixed_scene(*jobs), first);
+}
+
+TEST(Determinism, JointedSceneHashIsTheSameForOneToFourWorkers) {
+    const std::uint64_t reference = [] {
+        SingleThreadedJobSystem single;
+        return run_jointed_scene(single);
+    }();
+    for (unsigned workers : {2u, 3u, 4u}) {
+        auto jobs = jobs_for(workers);
+        EXPECT_EQ(run_jointed_scene(*jobs), reference) << workers << " workers";
+    }
 }

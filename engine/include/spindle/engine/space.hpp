@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <spindle/engine/body.hpp>
+#include <spindle/engine/joint.hpp>
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/stats.hpp>
 
@@ -44,6 +45,19 @@ public:
     void destroy_body(BodyHandle body);
     bool contains(BodyHandle body) const noexcept;
     std::size_t body_count() const noexcept;
+
+    // Joints (same thread rule as bodies). create_joint validates first (bodies live
+    // and different, at least one dynamic, finite anchors, non-zero axes, ordered
+    // limits); a rejected joint leaves the space unchanged and the spindle::Error names
+    // the field. Creating or destroying a joint wakes both bodies. Destroying a body
+    // destroys its joints.
+    JointHandle create_joint(const JointDesc& desc);
+    void destroy_joint(JointHandle joint);
+    bool contains(JointHandle joint) const noexcept;
+    std::size_t joint_count() const noexcept;
+    const JointDesc& joint_desc(JointHandle joint) const;  // as created
+    // Changes a hinge's motor (between updates); max_torque >= 0.
+    void set_hinge_motor(JointHandle joint, bool enable, Real speed, Real max_torque);
 
     // ---- update (one thread at a time) ----
     // With internal time stepping: adds dt to the accumulator and takes the steps it
@@ -85,6 +99,10 @@ public:
     void set_internal_motion_state(BodyHandle body, const MotionState& state);
     bool internal_is_awake(BodyHandle body) const;
     const BodyDesc& internal_desc(BodyHandle body) const;  // as created (shape, material, flags)
+    // How far a joint is from satisfied now, from the live poses.
+    JointError internal_joint_error(JointHandle joint) const;
+    // A hinge's angle (rad): B's rotation relative to A about the axis since creation.
+    Real internal_hinge_angle(JointHandle joint) const;
 
     MotionStateManager& motion_states() noexcept;
     const MotionStateManager& motion_states() const noexcept;
