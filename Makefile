@@ -36,5 +36,11 @@ test-tsan: setup
 bench: release
 	@for b in $(BUILD)/release/bench/*/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
 
+# Builds only bench_accuracy (not all of release) so a fresh clone finishes in minutes.
+accuracy: setup
+	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_COMMON) >/dev/null
+	@cmake --build $(BUILD)/release -j$(JOBS) --target bench_accuracy
+	bash scripts/accuracy.sh $(BUILD)/release
+
 clean:
 	rm -rf $(BUILD)

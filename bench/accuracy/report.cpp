@@ -1,0 +1,267 @@
+// Writes the sweep out: CSV for tools, markdown for people, a gnuplot script for the plot.
+// Every number and every sentence about the best trades is computed here from the rows,
+// so the report never disagrees with the data it was made from.
+#include "accuracy/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+
+namespace spindle::bench {
+namespace {
+
+// Errors at or below this are drawn at it: a log axis has no zero.
+constexpr double kPlotFloor = 1e-9;
+
+// The setting a user gets without asking (SolverSettings and TimeStepSettings defaults).
+constexpr Setting kDefault{4, 1, 60};
+
+std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* pattern, ...) {
+    char text[512];
+    va_list args;
+    va_start(args, pattern);
+    std::vsnprintf(text, sizeof text, pattern, args);
+    va_end(args);
+    return text;
+}
+
+std::ofstream open(const std::string& path) {
+    std::ofstream out(path);
+    if (!out) throw std::runtime_error("cannot write " + path);
+    return out;
+}
+
+bool same(const Setting& a, const Setting& b) {
+    return a.substeps == b.substeps && a.iterations == b.iterations && a.step_hz == b.step_hz;
+}
+
+std::vector<const Row*> rows_of(std::span<const Row> rows, int case_index) {
+    std::vector<const Row*> out;
+    for (const Row& r : rows) {
+        if (r.case_index == case_index) out.push_back(&r);
+    }
+    return out;
+}
+
+const Row* find(const std::vector<const Row*>& rows, const Setting& s) {
+    for (const Row* r : rows) {
+        if (same(r->setting, s)) return r;
+    }
+    return nullptr;
+}
+
+std::string point(const Row& r, const char* unit) {
+    return format("`%s` (%.3g ms, %.3g %s)", r.setting.label().c_str(), r.ms_per_second, r.error, unit);
+}
+
+// The best trades of one case in words: its front, its knee and where the default sits.
+std::string best_trades(const Case& c, const std::vector<const Row*>& rows) {
+    std::vector<const Row*> front;
+    for (const Row* r : rows) {
+        if (r->pareto) front.push_back(r);
+    }
+    std::sort(front.begin(), front.end(), [](const Row* a, const Row* b) { return a->ms_per_second < b->ms_per_second; });
+    std::string text = format("**%s** — Pareto front (%zu of %zu settings, cheapest first): ", c.name, front.size(), rows.size());
+    for (std::size_t i = 0; i < front.size(); ++i) text += (i ? ", " : "") + point(*front[i], c.unit);
+    text += ".";
+
+    const Row* best = front.back();  // the most accurate is the front's dearest point
+    const Row* knee = nullptr;
+    for (const Row* r : front) {
+        if (r->error <= 2 * best->error) {
+            knee = r;
+            break;
+        }
+    }
+    if (knee != best) {
+        text += format(" Within 2x of the best error, `%s` costs %.2gx less than the most accurate `%s`.",
+                       knee->setting.label().c_str(), best->ms_per_second / knee->ms_per_second, best->setting.label().c_str());
+    }
+
+    if (const Row* d = find(rows, kDefault)) {
+        if (d->pareto) {
+            text += format(" The default `%s` is on the front.", kDefault.label().c_str());
+        } else {
+            // The cheapest setting at least as good on both counts.
+            const Row* better = nullptr;
+            for (const Row* r : front) {
+                if (r->ms_per_second <= d->ms_per_second && r->error <= d->error) {
+                    better = r;
+                    break;
+                }
+            }
+            text += format(" The default %s is dominated", point(*d, c.unit).c_str());
+            text += better ? " by " + point(*better, c.unit) + "." : ".";
+        }
+    }
+    return text;
+}
+
+// From the default, doubling one knob: how the error and the time move.
+struct KnobStep {
+    const char* name;
+    Setting to;
+};
+constexpr KnobStep kKnobs[] = {
+    {"substeps 4 → 8", {8, 1, 60}},
+    {"dt 1/60 → 1/120", {4, 1, 120}},
+    {"iterations 1 → 2", {4, 2, 60}},
+};
+
+// log(error ratio) / log(time ratio): how many decades of error a decade of time buys
+// (more negative is better); empty when either ratio says nothing.
+std::optional<double> payoff(const Row& from, const Row& to) {
+    const double e = to.error / from.error, t = to.ms_per_second / from.ms_per_second;
+    if (!(e > 0) || !std::isfinite(e) || !(t > 1.05)) return std::nullopt;
+    return std::log(e) / std::log(t);
+}
+
+std::string knob_table(std::span<const Case> cases, std::span<const Row> rows) {
+    std::string text = "| case |";
+    for (const KnobStep& k : kKnobs) text += format(" %s: error ×, time × |", k.name);
+    text += "\n|---|";
+    for (std::size_t i = 0; i < std::size(kKnobs); ++i) text += "---|";
+    text += "\n";
+    int wins[std::size(kKnobs)] = {};
+    for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+        const auto mine = rows_of(rows, static_cast<int>(ci));
+        const Row* from = find(mine, kDefault);
+        if (!from) continue;
+        text += format("| %s |", cases[ci].name);
+        std::optional<double> best_payoff;
+        std::size_t best_knob = 0;
+        for (std::size_t k = 0; k < std::size(kKnobs); ++k) {
+            const Row* to = find(mine, kKnobs[k].to);
+            if (!to) {
+                text += " — |";
+                continue;
+            }
+            text += from->error > 0 ? format(" %.3g, %.2g |", to->error / from->error, to->ms_per_second / from->ms_per_second)
+                                    : format(" (error 0), %.2g |", to->ms_per_second / from->ms_per_second);
+            const auto p = payoff(*from, *to);
+            if (p && *p < 0 && (!best_payoff || *p < *best_payoff)) {
+                best_payoff = p;
+                best_knob = k;
+            }
+        }
+        if (best_payoff) ++wins[best_knob];
+        text += "\n";
+    }
+    text += "\nError bought per unit of time (log error ratio over log time ratio, from the table): ";
+    for (std::size_t k = 0; k < std::size(kKnobs); ++k) {
+        text += format("%s`%s` pays best in %d of %zu cases", k ? ", " : "", kKnobs[k].name, wins[k], cases.size());
+    }
+    text += " (a case where no knob lowered the error counts for none).\n";
+    return text;
+}
+
+// The sweep's dt as the users set it: "1/60".
+std::string dt_label(const Setting& s) { return format("1/%d", s.step_hz); }
+
+}  // namespace
+
+void mark_pareto(std::vector<Row>& rows) {
+    for (Row& r : rows) {
+        r.pareto = std::none_of(rows.begin(), rows.end(), [&](const Row& o) {
+            if (o.case_index != r.case_index || &o == &r) return false;
+            const bool no_worse = o.ms_per_second <= r.ms_per_second && o.error <= r.error;
+            const bool better = o.ms_per_second < r.ms_per_second || o.error < r.error;
+            return no_worse && better;
+        });
+    }
+}
+
+void write_csv(const std::string& path, std::span<const Case> cases, std::span<const Row> rows) {
+    std::ofstream out = open(path);
+    out << "case,substeps,iterations,dt,ms_per_simulated_second,error,unit,pareto\n";
+    for (const Row& r : rows) {
+        const Case& c = cases[static_cast<std::size_t>(r.case_index)];
+        out << format("%s,%d,%d,%.9g,%.6g,%.6g,%s,%d\n", c.name, r.setting.substeps, r.setting.iterations, r.setting.dt(),
+                      r.ms_per_second, r.error, c.unit, r.pareto ? 1 : 0);
+    }
+}
+
+void write_markdown(const std::string& path, std::span<const Case> cases, std::span<const Row> rows, const ReportInfo& info) {
+    std::ofstream out = open(path);
+    out << "# Accuracy and its cost\n\n"
+        << "<!-- Generated by `make accuracy` (bench/accuracy); edits are overwritten. -->\n\n"
+        << "Measured " << info.date << " on " << info.machine << ".\n\n"
+        << "Each hard case is run under every setting of the sweep: substeps {1, 2, 4, 8} × solve iterations {1, 2} "
+           "× step duration {1/30, 1/60, 1/120, 1/240} s. Other solver settings are the defaults (contact stiffness "
+           "automatic: a quarter of the substep rate; one relax iteration). **Time** is the wall time spent in "
+           "`Space::update()` per simulated second, single-threaded (no job system), the fastest of up to "
+        << info.runs
+        << " runs; building the scene and measuring are not timed. Sleeping is off, so a resting stack keeps costing "
+           "and keeps being judged. **Error** is against an analytic or ideal answer, in the unit given per case. "
+           "A setting is on the **Pareto front** when no other setting of its case is both cheaper and more accurate. "
+           "Single runs on a shared machine: times carry a few tens of percent of noise.\n\n"
+        << "![Time per simulated second against error, log-log, one series per case; Pareto points circled](accuracy.png)\n\n"
+        << "## Best trades\n\n";
+    for (std::size_t ci = 0; ci < cases.size(); ++ci) out << best_trades(cases[ci], rows_of(rows, static_cast<int>(ci))) << "\n\n";
+    out << "### Which knob to turn\n\nFrom the default `" << kDefault.label()
+        << "` (4 substeps, 1 iteration, 1/60 s), doubling one knob; ratios below 1 mean less error.\n\n"
+        << knob_table(cases, rows) << "\n";
+    out << "Joints are soft by default (`joint_hertz` 60, capped at a quarter of the substep rate), as they run here.\n\n";
+    out << "## Cases\n\n";
+    for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+        const Case& c = cases[ci];
+        out << "### " << c.name << "\n\n" << c.metric << ". Error in " << (std::string(c.unit) == "rel" ? "relative units (rel)" : c.unit)
+            << "; ★ marks the Pareto front.\n\n"
+            << "| substeps | iterations | dt (s) | time per simulated second (ms) | error | |\n"
+            << "|---:|---:|---:|---:|---:|:--:|\n";
+        for (const Row* r : rows_of(rows, static_cast<int>(ci))) {
+            out << format("| %d | %d | %s | %.3g | %.3g | %s |\n", r->setting.substeps, r->setting.iterations,
+                          dt_label(r->setting).c_str(), r->ms_per_second, r->error, r->pareto ? "★" : "");
+        }
+        out << "\n";
+    }
+}
+
+void write_gnuplot(const std::string& script_path, const std::string& data_path, const std::string& png_path,
+                   std::span<const Case> cases, std::span<const Row> rows, const ReportInfo& info) {
+    // Data: block 2i holds case i's points, block 2i+1 its front sorted by time (gnuplot `index`).
+    {
+        std::ofstream data = open(data_path);
+        for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+            auto mine = rows_of(rows, static_cast<int>(ci));
+            std::sort(mine.begin(), mine.end(), [](const Row* a, const Row* b) { return a->ms_per_second < b->ms_per_second; });
+            data << "# " << cases[ci].name << "\n";
+            for (const Row* r : mine) data << format("%.6g %.6g\n", r->ms_per_second, std::max(r->error, kPlotFloor));
+            data << "\n\n# " << cases[ci].name << " front\n";
+            for (const Row* r : mine) {
+                if (r->pareto) data << format("%.6g %.6g\n", r->ms_per_second, std::max(r->error, kPlotFloor));
+            }
+            data << "\n\n";
+        }
+    }
+    auto quoted = [](std::string s) {
+        std::erase(s, '"');
+        std::erase(s, '\\');
+        return '"' + s + '"';
+    };
+    std::ofstream gp = open(script_path);
+    gp << "set terminal pngcairo size 1200,760 font \",10\" noenhanced\n"
+       << "set output " << quoted(png_path) << "\n"
+       << "set title " << quoted("Spindle: accuracy against its cost (" + info.date + "; " + info.machine + ")") << "\n"
+       << "set logscale xy\nset format y \"%.0e\"\nset grid\nset key outside right top\n"
+       << "set xlabel \"time per simulated second (ms, one thread)\"\n"
+       << "set ylabel " << quoted(format("error (unit per case; below %.0e drawn at it)", kPlotFloor)) << "\n"
+       << "plot \\\n";
+    for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+        const Case& c = cases[ci];
+        const std::string title = format("%s (%s)", c.name, std::string(c.unit) == "rel" ? "relative" : c.unit);
+        gp << format("  %s index %zu using 1:2 with points pt 7 ps 0.7 lc %zu title %s, \\\n", quoted(data_path).c_str(), 2 * ci,
+                     ci + 1, quoted(title).c_str())
+           << format("  %s index %zu using 1:2 with linespoints pt 6 ps 2 lw 1.5 lc %zu notitle, \\\n", quoted(data_path).c_str(),
+                     2 * ci + 1, ci + 1);
+    }
+    gp << "  NaN with linespoints pt 6 ps 2 lc rgb \"black\" title \"Pareto front\"\n";
+}
+
+}  // namespace spindle::bench
