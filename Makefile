@@ -26,7 +26,7 @@ test-release: release
 test-asan: setup
 	@cmake -S . -B $(BUILD)/asan -DSPINDLE_SANITIZE=address $(SAN_FLAGS) $(CMAKE_COMMON) >/dev/null
 	@cmake --build $(BUILD)/asan -j$(JOBS)
-	cd $(BUILD)/asan && ctest --output-on-failure -j$(JOBS) -LE stability
+	cd $(BUILD)/asan && ctest --output-on-failure -j$(JOBS) -LE "stability|install"
 
 test-tsan: setup
 	@cmake -S . -B $(BUILD)/tsan -DSPINDLE_SANITIZE=thread $(SAN_FLAGS) -DSPINDLE_BUILD_APPS=OFF $(CMAKE_COMMON) >/dev/null
