@@ -54,6 +54,23 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
             fail_at(scene, body, "body", e);
         }
     }
+    for (const SceneJoint& joint : scene.joints) {
+        const BodyHandle a = handles[joint.body_a], b = handles[joint.body_b];
+        const JointDesc desc = joint.type == JointType::Hinge ? JointDesc::hinge_at(a, b, joint.anchor, joint.axis)
+                                                               : JointDesc::ball_socket_at(a, b, joint.anchor);
+        try {
+            space.create_joint(desc);
+        } catch (const Error& e) {
+            // Destroying the bodies destroys the joints made so far with them.
+            for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
+            space.set_time_step(before.time_step);
+            space.set_solver(before.solver);
+            space.set_sleep(before.sleep);
+            space.set_gravity(before.gravity);
+            throw Error(scene.source + ":" + std::to_string(joint.line) + ":" + std::to_string(joint.column) +
+                        ": joint: " + e.what());
+        }
+    }
     return handles;
 }
 

@@ -4,6 +4,7 @@
 #include <spindle/engine/scene.hpp>
 
 #include <array>
+#include <cmath>
 
 #include "scene_parts.hpp"
 
@@ -72,18 +73,93 @@ std::vector<Vec3> pyramid_2d(const Vec3& origin, std::int64_t base, Real sx, Rea
     return out;
 }
 
+// [[chain]]: `links` bodies made from the entry's body properties, centred along
+// `direction` from the anchor at `position`, each jointed to the one before; the first
+// hangs from a small static anchor body. `end_mass` makes the last link that heavy.
+struct Chain {
+    std::int64_t links = 0;
+    Real spacing = 0;                  // centre to centre, m
+    Vec3 direction = Vec3::UnitX();
+    JointType joint = JointType::BallSocket;
+    Vec3 axis = Vec3::UnitZ();
+    Real end_mass = 0;
+};
+
+Chain parse_chain(const TomlReader& r, const toml::table& entry, const std::string& where, const Vec3& half,
+                  const BodyDesc& body) {
+    auto key_name = [&](const char* key) { return where + "." + key; };
+    Chain c;
+    c.links = r.integer(r.require(entry, where, "links"), key_name("links"), 1, kMaxCount);
+    if (const toml::node* d = entry.get("direction")) {
+        c.direction = r.vec3(*d, key_name("direction"), "x, y, z");
+        if (!(c.direction.norm() > 1e-9)) r.fail(*d, key_name("direction") + ": expected a non-zero vector");
+        c.direction.normalize();
+    }
+    c.spacing = entry.get("spacing") ? r.positive(*entry.get("spacing"), key_name("spacing"))
+                                     : 2 * half.dot(c.direction.cwiseAbs());  // the shape's extent along it
+    if (!(c.spacing > 0)) {
+        r.fail(entry.source(), where + ": the shape has no size along direction; give " + key_name("spacing"));
+    }
+    if (const toml::node* j = entry.get("joint")) {
+        const std::string kind = r.string(*j, key_name("joint"));
+        if (kind == "hinge") {
+            c.joint = JointType::Hinge;
+        } else if (kind != "ball_socket") {
+            r.fail(*j, key_name("joint") + ": expected \"ball_socket\" or \"hinge\", got \"" + kind + "\"");
+        }
+    }
+    if (const toml::node* a = entry.get("axis")) {
+        c.axis = r.vec3(*a, key_name("axis"), "x, y, z");
+        if (!(c.axis.norm() > 1e-9)) r.fail(*a, key_name("axis") + ": expected a non-zero vector");
+        c.axis.normalize();
+    }
+    if (const toml::node* m = entry.get("end_mass")) c.end_mass = r.positive(*m, key_name("end_mass"));
+    if (body.type != MotionType::Dynamic) r.fail(entry.source(), where + ": chain links must be dynamic bodies");
+    return c;
+}
+
+// The anchor body and joints of one chain whose links start at scene.bodies[first].
+void add_chain_joints(SceneDesc& scene, const Chain& chain, const Vec3& origin, std::uint32_t first,
+                      const toml::source_position& at) {
+    if (chain.end_mass > 0) scene.bodies[first + static_cast<std::uint32_t>(chain.links) - 1].desc.mass = chain.end_mass;
+    ShapeSpec anchor_shape;
+    anchor_shape.type = ShapeType::Sphere;
+    anchor_shape.radius = 0.05;
+    scene.shapes.push_back(anchor_shape);
+    SceneBody anchor;
+    anchor.desc.type = MotionType::Static;
+    anchor.desc.position = origin;
+    anchor.shape = static_cast<std::uint32_t>(scene.shapes.size() - 1);
+    anchor.line = at.line;
+    anchor.column = at.column;
+    const auto anchor_index = static_cast<std::uint32_t>(scene.bodies.size());
+    scene.bodies.push_back(anchor);
+    for (std::int64_t i = 0; i < chain.links; ++i) {
+        SceneJoint joint;
+        joint.type = chain.joint;
+        joint.body_a = i == 0 ? anchor_index : first + static_cast<std::uint32_t>(i - 1);
+        joint.body_b = first + static_cast<std::uint32_t>(i);
+        joint.anchor = origin + chain.direction * (chain.spacing * static_cast<Real>(i));
+        joint.axis = chain.axis;
+        joint.line = at.line;
+        joint.column = at.column;
+        scene.joints.push_back(joint);
+    }
+}
+
 // What an entry kind accepts besides the body properties.
 std::vector<std::string_view> own_keys(std::string_view kind) {
     if (kind == "body") return {"position", "copies"};
     if (kind == "stack") return {"position", "copies", "count", "gap", "spacing"};
     if (kind == "pyramid") return {"position", "copies", "layers", "spacing"};
+    if (kind == "chain") return {"position", "copies", "links", "spacing", "direction", "joint", "axis", "end_mass"};
     return {"position", "copies", "base", "spacing"};  // pyramid_2d
 }
 
 }  // namespace
 
 const std::vector<std::string_view>& entry_kinds() {
-    static const std::vector<std::string_view> kinds = {"body", "stack", "pyramid", "pyramid_2d"};
+    static const std::vector<std::string_view> kinds = {"body", "stack", "pyramid", "pyramid_2d", "chain"};
     return kinds;
 }
 
@@ -109,7 +185,17 @@ void parse_entry(const TomlReader& r, std::string_view kind, const toml::table& 
 
     double count = 1;  // bodies before copies, checked against the limit before any is made
     std::vector<Vec3> positions;
-    if (kind == "body") {
+    Chain chain;
+    if (kind == "chain") {
+        chain = parse_chain(r, entry, where, half, body.desc);
+        count = static_cast<double>(chain.links + 1);  // links and the static anchor
+        const Real length = chain.spacing;
+        if (count <= static_cast<double>(kMaxSceneBodies)) {
+            for (std::int64_t i = 0; i < chain.links; ++i) {
+                positions.push_back(origin + chain.direction * (length * (static_cast<Real>(i) + 0.5)));
+            }
+        }
+    } else if (kind == "body") {
         positions.push_back(origin);
     } else if (kind == "stack") {
         const std::int64_t n = r.integer(r.require(entry, where, "count"), key_name("count"), 1, kMaxCount);
@@ -160,6 +246,7 @@ void parse_entry(const TomlReader& r, std::string_view kind, const toml::table& 
             for (std::int64_t cx = 0; cx < copies.count[0]; ++cx) {
                 const Vec3 offset(copies.step.x() * static_cast<Real>(cx), copies.step.y() * static_cast<Real>(cy),
                                   copies.step.z() * static_cast<Real>(cz));
+                const auto first = static_cast<std::uint32_t>(scene.bodies.size());
                 for (const Vec3& p : positions) {
                     SceneBody b;
                     b.desc = body.desc;
@@ -169,6 +256,7 @@ void parse_entry(const TomlReader& r, std::string_view kind, const toml::table& 
                     b.column = at.column;
                     scene.bodies.push_back(std::move(b));
                 }
+                if (kind == "chain") add_chain_joints(scene, chain, origin + offset, first, at);
             }
         }
     }

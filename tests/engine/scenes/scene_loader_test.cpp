@@ -478,3 +478,47 @@ TEST(SceneBuild, ARejectedShape_FailsBeforeAnyBodyIsCreated) {
 
 }  // namespace
 }  // namespace spindle
+
+namespace spindle {
+
+TEST(SceneParse, Chain_MakesLinksAnAnchorAndJoints) {
+    const SceneDesc scene = parse_scene(
+        "[[chain]]\nshape = { box = [0.25, 0.1, 0.1] }\nlinks = 3\nposition = [1, 5, 0]\nend_mass = 50\n"
+        "copies = { count = [1, 1, 2], step = [0, 0, 2] }\n",
+        "chain.toml");
+    ASSERT_EQ(scene.bodies.size(), 8u);  // (3 links + 1 anchor) x 2 copies
+    ASSERT_EQ(scene.joints.size(), 6u);
+    // First copy: links centred 0.25, 0.75, 1.25 m along x from the anchor at (1, 5, 0).
+    EXPECT_NEAR(scene.bodies[0].desc.position.x(), 1.25, 1e-12);
+    EXPECT_NEAR(scene.bodies[2].desc.position.x(), 2.25, 1e-12);
+    EXPECT_EQ(scene.bodies[2].desc.mass, 50.0);  // the heavy end
+    EXPECT_EQ(scene.bodies[3].desc.type, MotionType::Static);  // the anchor
+    EXPECT_EQ(scene.joints[0].body_a, 3u);  // anchor to first link
+    EXPECT_EQ(scene.joints[0].body_b, 0u);
+    EXPECT_EQ(scene.joints[2].body_a, 1u);
+    EXPECT_NEAR(scene.joints[2].anchor.x(), 2.0, 1e-12);
+    EXPECT_NEAR(scene.bodies[4].desc.position.z(), 2.0, 1e-12);  // second copy
+    EXPECT_EQ(scene.joints[3].body_a, 7u);
+}
+
+TEST(SceneBuild, ChainsScene_BuildsItsJoints) {
+    const SceneDesc scene = load("chains");
+    Space space;
+    build(scene, space);
+    EXPECT_EQ(space.joint_count(), scene.joints.size());
+    EXPECT_GT(space.joint_count(), 50u);
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_TRUE(std::isfinite(static_cast<double>(space.state_hash())));
+}
+
+TEST(SceneParse, BrokenChains_AreRejectedAtTheLine) {
+    EXPECT_REJECTED("[[chain]]\nshape = { sphere = 1 }\n", "1:1", "chain: missing key 'links'");
+    EXPECT_REJECTED("[[chain]]\nshape = { sphere = 1 }\nlinks = 2\njoint = \"rope\"\n", "4:9",
+                    "chain.joint: expected \"ball_socket\" or \"hinge\"");
+    EXPECT_REJECTED("[[chain]]\nshape = { sphere = 1 }\nlinks = 2\ndirection = [0, 0, 0]\n", "4:13",
+                    "chain.direction: expected a non-zero vector");
+    EXPECT_REJECTED("[[chain]]\ntype = \"static\"\nshape = { sphere = 1 }\nlinks = 2\n", "1:1",
+                    "chain links must be dynamic");
+}
+
+}  // namespace spindle

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <spindle/engine/body.hpp>
+#include <spindle/engine/joint.hpp>
 #include <spindle/engine/settings.hpp>
 
 namespace spindle {
@@ -43,6 +44,15 @@ struct SceneBody {
     std::uint32_t column = 0;
 };
 
+// A joint between two scene bodies (indices into SceneDesc::bodies), at a world point.
+struct SceneJoint {
+    JointType type = JointType::BallSocket;  // BallSocket or Hinge
+    std::uint32_t body_a = 0, body_b = 0;
+    Vec3 anchor = Vec3::Zero();  // world (m)
+    Vec3 axis = Vec3::UnitZ();   // hinge axis, world
+    std::uint32_t line = 0, column = 0;
+};
+
 struct SceneDesc {
     std::string name;         // the file's `name`, else its file name without .toml
     std::string description;
@@ -50,6 +60,7 @@ struct SceneDesc {
     SpaceSettings settings;   // time_step.use_internal_time_stepping is left to the program
     std::vector<ShapeSpec> shapes;
     std::vector<SceneBody> bodies;  // generators expanded, in file order
+    std::vector<SceneJoint> joints;  // made by [[chain]]; created after the bodies
 
     std::size_t dynamic_body_count() const noexcept;
 };
@@ -62,7 +73,7 @@ SceneDesc load_scene(const std::string& path);
 
 // Applies the scene's settings (gravity, time step duration and caps, solver, sleep;
 // the space's use_internal_time_stepping is kept) and creates its bodies, in scene
-// order. Returns their handles, one per SceneDesc::bodies entry. Every shape is made
+// order, then its joints. Returns the bodies' handles, one per SceneDesc::bodies entry. Every shape is made
 // before any body is created; if anything is rejected the bodies created so far are
 // destroyed again, the settings restored, and the spindle::Error names the entry's
 // file:line:column.
