@@ -1,76 +1,52 @@
-// The spindle console program: `spindle layout FILE`, `spindle run` (until the engine
-// exists, run prints the default layout's mapping onto this machine).
+// The spindle console program: dispatches to the commands (run, bench, scenes,
+// layout) and turns their errors into a message and an exit code.
 #include <spindle/platform/error.hpp>
-#include <spindle/platform/layout.hpp>
-#include <spindle/platform/topology.hpp>
 
-#include <cstdio>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "commands.hpp"
+
 namespace {
 
 constexpr const char* kUsage =
-    "usage: spindle <command> [options]\n"
+    "usage: spindle <command> [options]     (spindle <command> --help for its options)\n"
     "commands:\n"
-    "  run [SCENE] [--layout FILE]   run a scene (default: the embedded default scene)\n"
-    "  layout FILE                   print how a layout maps onto this machine\n"
-    "  --help                        this text\n";
-
-int print_layout(const spindle::Layout& layout) {
-    const spindle::Topology real = spindle::Topology::from_system();
-    const spindle::Topology model = layout.model_topology(real);
-    const spindle::LayoutMapping mapping = spindle::map_layout(layout, model, real);
-    std::cout << "layout " << layout.name << " (" << layout.source << ")\n"
-              << "model:   " << model.summary() << "machine: " << real.summary() << mapping.describe();
-    return 0;
-}
-
-int run(const std::vector<std::string>& args) {
-    std::string layout_file;
-    for (std::size_t i = 0; i < args.size(); ++i) {
-        if (args[i] == "--help") {
-            std::cout << "usage: spindle run [SCENE] [--layout FILE]\n";
-            return 0;
-        }
-        if (args[i] == "--layout" && i + 1 < args.size()) {
-            layout_file = args[++i];
-        } else {
-            std::cerr << "spindle run: unknown argument '" << args[i] << "'\n";
-            return 2;
-        }
-    }
-    const spindle::Topology real = spindle::Topology::from_system();
-    const spindle::Layout layout =
-        layout_file.empty() ? spindle::Layout::native(real) : spindle::Layout::load(layout_file, &real);
-    return print_layout(layout);
-}
+    "  run [SCENE] [--layout FILE] [--seconds S] [--render-hz HZ] [--idle MODE] [--trace FILE]\n"
+    "      [--record FILE]  play a scene asynchronously (default: the built-in pile, 5 s)\n"
+    "  bench SCENE [--threads N] [--steps N] [--substeps N]\n"
+    "                      step a scene as fast as possible; prints one line of results\n"
+    "  scenes              list the built-in scenes\n"
+    "  layout FILE         print how an affinity layout maps onto this machine\n"
+    "exit codes: 0 ok, 1 bad file or value, 2 bad command line\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::vector<std::string> args(argv + 1, argv + argc);
+    using namespace spindle::app;
+    const std::vector<std::string> all(argv + 1, argv + argc);
+    const std::string command = all.empty() ? "run" : all[0];
+    Args args(command, all.empty() ? std::vector<std::string>{} : std::vector<std::string>(all.begin() + 1, all.end()));
     try {
-        if (args.empty()) return run({});
-        const std::string& command = args[0];
-        const std::vector<std::string> rest(args.begin() + 1, args.end());
         if (command == "--help" || command == "-h" || command == "help") {
             std::cout << kUsage;
             return 0;
         }
-        if (command == "run") return run(rest);
-        if (command == "layout") {
-            if (rest.size() != 1 || rest[0] == "--help") {
-                std::cerr << "usage: spindle layout FILE\n";
-                return rest.size() == 1 ? 0 : 2;
-            }
-            return print_layout(spindle::Layout::load(rest[0]));
-        }
+        if (command == "run") return run_command(args);
+        if (command == "bench") return bench_command(args);
+        if (command == "scenes") return scenes_command(args);
+        if (command == "layout") return layout_command(args);
         std::cerr << "spindle: unknown command '" << command << "'\n" << kUsage;
         return 2;
+    } catch (const UsageError& e) {
+        std::cerr << "spindle " << command << ": " << e.what() << " (see spindle " << command << " --help)\n";
+        return 2;
     } catch (const spindle::Error& e) {
-        std::cerr << "spindle: " << e.what() << '\n';
+        std::cerr << "spindle " << command << ": " << e.what() << '\n';
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "spindle " << command << ": " << e.what() << '\n';
         return 1;
     }
 }

@@ -37,10 +37,14 @@ void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
     t2 = n.cross(t1);
 }
 
-Real effective_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir) {
-    const Vec3 rna = ra.cross(dir);
-    const Vec3 rnb = rb.cross(dir);
-    const Real k = A.inv_mass + B.inv_mass + rna.dot(A.inv_inertia * rna) + rnb.dot(B.inv_inertia * rnb);
+// Fills a row's angular terms and returns its effective mass.
+Real make_row(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir,
+              ContactRow& row) {
+    row.ra_x = ra.cross(dir);
+    row.rb_x = rb.cross(dir);
+    row.ia = A.inv_inertia * row.ra_x;
+    row.ib = B.inv_inertia * row.rb_x;
+    const Real k = A.inv_mass + B.inv_mass + row.ra_x.dot(row.ia) + row.rb_x.dot(row.ib);
     return k > 0 ? 1 / k : 0;
 }
 
@@ -63,16 +67,22 @@ inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
     }
 }
 
-inline void apply(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& ra, const Vec3& rb,
-                  const Vec3& impulse) {
-    s.va -= A.inv_mass * impulse;
-    s.wa -= A.inv_inertia * ra.cross(impulse);
-    s.vb += B.inv_mass * impulse;
-    s.wb += B.inv_inertia * rb.cross(impulse);
-}
-
 inline Vec3 relative_velocity(const Velocities& s, const Vec3& ra, const Vec3& rb) {
     return s.vb + s.wb.cross(rb) - s.va - s.wa.cross(ra);
+}
+
+// Relative speed along a row's direction.
+inline Real row_speed(const Velocities& s, const Vec3& dir, const ContactRow& row) {
+    return dir.dot(s.vb - s.va) + row.rb_x.dot(s.wb) - row.ra_x.dot(s.wa);
+}
+
+// Applies an impulse of size L along a row.
+inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& dir, const ContactRow& row,
+                      Real L) {
+    s.va -= (A.inv_mass * L) * dir;
+    s.wa -= L * row.ia;
+    s.vb += (B.inv_mass * L) * dir;
+    s.wb += L * row.ib;
 }
 
 void prepare(World& world, SolverScratch& scratch, Real h) {
@@ -137,9 +147,9 @@ void prepare(World& world, SolverScratch& scratch, Real h) {
                 p.ra = src.geometry.point - xa;
                 p.rb = src.geometry.point - xb;
                 p.adjusted_separation = src.geometry.separation - cc.normal.dot(p.rb - p.ra);
-                p.normal_mass = effective_mass(A, B, p.ra, p.rb, cc.normal);
-                p.tangent_mass[0] = effective_mass(A, B, p.ra, p.rb, cc.tangent[0]);
-                p.tangent_mass[1] = effective_mass(A, B, p.ra, p.rb, cc.tangent[1]);
+                p.normal_mass = make_row(A, B, p.ra, p.rb, cc.normal, p.normal_row);
+                p.tangent_mass[0] = make_row(A, B, p.ra, p.rb, cc.tangent[0], p.tangent_row[0]);
+                p.tangent_mass[1] = make_row(A, B, p.ra, p.rb, cc.tangent[1], p.tangent_row[1]);
                 p.normal_impulse = src.normal_impulse;
                 p.tangent_impulse[0] = src.tangent_impulse[0];
                 p.tangent_impulse[1] = src.tangent_impulse[1];
@@ -188,9 +198,9 @@ void warm_start(ContactConstraint& cc, SolverBody* bodies) {
     Velocities s = load(A, B);
     for (int j = 0; j < cc.point_count; ++j) {
         const ConstraintPoint& p = cc.points[j];
-        const Vec3 impulse =
-            p.normal_impulse * cc.normal + p.tangent_impulse[0] * cc.tangent[0] + p.tangent_impulse[1] * cc.tangent[1];
-        apply(A, B, s, p.ra, p.rb, impulse);
+        apply_row(A, B, s, cc.normal, p.normal_row, p.normal_impulse);
+        apply_row(A, B, s, cc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
+        apply_row(A, B, s, cc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
     }
     store(A, B, s);
 }
@@ -206,12 +216,15 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
     SolverBody& A = bodies[cc.a];
     SolverBody& B = bodies[cc.b];
     Velocities s = load(A, B);
-    const Vec3 dp = B.dp - A.dp;
+    // Current separation from the bodies' motion since the step began:
+    // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
+    // rotation is applied once per constraint rather than once per point.
+    const Real moved = cc.normal.dot(B.dp - A.dp);
+    const Vec3 na = A.dq.conjugate() * cc.normal;
+    const Vec3 nb = B.dq.conjugate() * cc.normal;
     for (int j = 0; j < cc.point_count; ++j) {
         ConstraintPoint& p = cc.points[j];
-        // Current separation from the bodies' motion since the step began.
-        const Vec3 d = dp + (B.dq * p.rb - A.dq * p.ra);
-        const Real separation = cc.normal.dot(d) + p.adjusted_separation;
+        const Real separation = moved + nb.dot(p.rb) - na.dot(p.ra) + p.adjusted_separation;
         Real bias = 0, mass_scale = 1, impulse_scale = 0;
         if (separation > 0) {
             bias = separation * params.inv_h;  // speculative: may close the gap, no more
@@ -220,7 +233,7 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
             mass_scale = params.soft.mass_scale;
             impulse_scale = params.soft.impulse_scale;
         }
-        const Real vn = cc.normal.dot(relative_velocity(s, p.ra, p.rb));
+        const Real vn = row_speed(s, cc.normal, p.normal_row);
         Real impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         const Real total = std::max(p.normal_impulse + impulse, Real(0));
         impulse = total - p.normal_impulse;
@@ -229,15 +242,14 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
         if (impulse > 0 && p.max_normal_impulse == 0) p.relative_velocity = std::min(p.relative_velocity, vn);
         p.normal_impulse = total;
         p.max_normal_impulse = std::max(p.max_normal_impulse, impulse);
-        apply(A, B, s, p.ra, p.rb, impulse * cc.normal);
+        apply_row(A, B, s, cc.normal, p.normal_row, impulse);
     }
     if (cc.friction > 0) {
         for (int j = 0; j < cc.point_count; ++j) {
             ConstraintPoint& p = cc.points[j];
-            const Vec3 dv = relative_velocity(s, p.ra, p.rb);
             const Real old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
-            Real new0 = old0 - p.tangent_mass[0] * cc.tangent[0].dot(dv);
-            Real new1 = old1 - p.tangent_mass[1] * cc.tangent[1].dot(dv);
+            Real new0 = old0 - p.tangent_mass[0] * row_speed(s, cc.tangent[0], p.tangent_row[0]);
+            Real new1 = old1 - p.tangent_mass[1] * row_speed(s, cc.tangent[1], p.tangent_row[1]);
             // Coulomb's cone: the friction impulse stays within friction x normal impulse.
             const Real limit = cc.friction * p.normal_impulse;
             const Real length_sq = new0 * new0 + new1 * new1;
@@ -248,7 +260,8 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
             }
             p.tangent_impulse[0] = new0;
             p.tangent_impulse[1] = new1;
-            apply(A, B, s, p.ra, p.rb, (new0 - old0) * cc.tangent[0] + (new1 - old1) * cc.tangent[1]);
+            apply_row(A, B, s, cc.tangent[0], p.tangent_row[0], new0 - old0);
+            apply_row(A, B, s, cc.tangent[1], p.tangent_row[1], new1 - old1);
         }
     }
     store(A, B, s);
@@ -263,7 +276,7 @@ void apply_restitution(ContactConstraint& cc, SolverBody* bodies, Real threshold
         ConstraintPoint& p = cc.points[j];
         // Only points that approached fast enough and actually pushed bounce.
         if (p.relative_velocity > -threshold || p.max_normal_impulse == 0) continue;
-        const Real vn = cc.normal.dot(relative_velocity(s, p.ra, p.rb));
+        const Real vn = row_speed(s, cc.normal, p.normal_row);
         // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
         const Real approach = p.relative_velocity + cc.gravity_normal * h;
@@ -272,7 +285,7 @@ void apply_restitution(ContactConstraint& cc, SolverBody* bodies, Real threshold
         impulse = total - p.normal_impulse;
         p.normal_impulse = total;
         p.max_normal_impulse = std::max(p.max_normal_impulse, impulse);
-        apply(A, B, s, p.ra, p.rb, impulse * cc.normal);
+        apply_row(A, B, s, cc.normal, p.normal_row, impulse);
     }
     store(A, B, s);
 }

@@ -19,7 +19,20 @@ struct Softness {
 };
 Softness make_softness(Real hertz, Real damping_ratio, Real h);
 
+// One velocity row (normal or tangent) of a contact point, with its angular terms
+// precomputed once per step: relative speed = dir.(vb - va) + rb_x.wb - ra_x.wa, and an
+// impulse L changes wa by -L ia, wb by +L ib. Saves the cross and 3x3 products that
+// every one of the substeps' passes would otherwise redo.
+struct ContactRow {
+    Vec3 ra_x = Vec3::Zero();  // ra x dir
+    Vec3 rb_x = Vec3::Zero();  // rb x dir
+    Vec3 ia = Vec3::Zero();    // Ia^-1 (ra x dir)
+    Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
+};
+
 struct ConstraintPoint {
+    ContactRow normal_row;
+    ContactRow tangent_row[2];
     Vec3 ra = Vec3::Zero();  // anchors from each centre of mass, world, fixed for the step
     Vec3 rb = Vec3::Zero();
     Real adjusted_separation = 0;  // separation minus n.(rb - ra): current separation = n.d + this

@@ -122,6 +122,9 @@ inline std::uint64_t pack(std::uint32_t first, std::uint32_t last) { return (std
 
 }  // namespace detail
 
+// How long an idle worker spins before it sleeps.
+constexpr std::int64_t kSpinBeforeSleepNs = 200'000;
+
 using detail::ForContext;
 using detail::JobRecord;
 using detail::TaskHeader;
@@ -300,14 +303,20 @@ void WorkStealingJobSystem::worker_main(unsigned index) {
     set_current_thread_name(m_options.name_prefix + "-" + std::to_string(index));
     if (m_options.pin) pin_current_thread(m_options.worker_pus[index]);
     Backoff backoff;
+    std::int64_t idle_since = 0;
     for (;;) {
         if (run_one(self)) {
             backoff.reset();
+            idle_since = 0;
             continue;
         }
         if (m_stop.load(std::memory_order_acquire) && !any_work()) break;
-        if (!backoff.saturated()) {
-            backoff.spin();  // pause, briefly: work often arrives within microseconds
+        // Spin (pause, then yield) for a while before sleeping: a step issues a
+        // parallel_for every few tens of microseconds, and a futex wake-up costs more.
+        const std::int64_t now = now_nanoseconds();
+        if (idle_since == 0) idle_since = now;
+        if (now - idle_since < kSpinBeforeSleepNs) {
+            backoff.spin();
             continue;
         }
         // Sleep until work arrives. Announcing the sleep before the last look for work
@@ -317,6 +326,7 @@ void WorkStealingJobSystem::worker_main(unsigned index) {
         if (!any_work() && !m_stop.load(std::memory_order_seq_cst)) m_wake.wait(epoch, std::memory_order_seq_cst);
         m_sleeping.fetch_sub(1, std::memory_order_seq_cst);
         backoff.reset();
+        idle_since = 0;
     }
     detail::tls_worker = nullptr;
 }

@@ -1,0 +1,287 @@
+// `spindle run`: plays a scene like a game would (the seed, section 3). The main
+// thread is the game thread, pinned per the layout, "rendering" at --render-hz by
+// copying interpolated motion states; the physics loop runs in an AsyncRunner on its
+// own pinned thread with internal time stepping; the JobSystem comes from make_jobs()
+// (work stealing, workers pinned per the layout, the physics loop thread as worker 0).
+#include <spindle/engine/async_runner.hpp>
+#include <spindle/engine/motion_state_manager.hpp>
+#include <spindle/engine/scene.hpp>
+#include <spindle/engine/space.hpp>
+#include <spindle/platform/clock.hpp>
+#include <spindle/platform/error.hpp>
+#include <spindle/platform/layout.hpp>
+#include <spindle/platform/thread.hpp>
+#include <spindle/platform/topology.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <thread>
+
+#include "commands.hpp"
+#include "jobs.hpp"
+#include "physics_probe.hpp"
+#include "progress.hpp"
+#include "recorder.hpp"
+#include "scenes.hpp"
+#include "smoothness.hpp"
+#include "trace.hpp"
+
+namespace spindle::app {
+namespace {
+
+constexpr const char* kRunUsage =
+    "usage: spindle run [SCENE] [options]\n"
+    "Plays SCENE (a built-in scene name, see `spindle scenes`, or a .toml file; default: pile)\n"
+    "asynchronously: the game thread renders interpolated motion states while the physics loop\n"
+    "thread steps the space with internal time stepping. Prints progress and a summary.\n"
+    "options:\n"
+    "  --layout FILE     affinity layout (configs/layouts/*.toml); default: this machine, all PUs\n"
+    "  --seconds S       how long to run, wall clock (default 5)\n"
+    "  --render-hz HZ    frames per second the game thread reads states at (default 60)\n"
+    "  --idle MODE       what the physics loop does between steps: poll (update every 0.5 ms, so\n"
+    "                    every frame gets a fresh interpolation; default), spin (update without\n"
+    "                    pause, the seed's loop; burns its hardware thread) or sleep (until the\n"
+    "                    next step is due: publishes only at steps, little to interpolate)\n"
+    "  --trace FILE      write a Chrome trace-event JSON of the run (open in Perfetto)\n"
+    "  --record FILE     write every rendered frame's motion states as CSV:\n"
+    "                    frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz\n";
+
+// --idle poll: the physics loop updates at most this often between steps. A frame at
+// 60 Hz then sees a publish at most 0.5 ms old (3% of the frame), for a few percent of
+// a hardware thread instead of all of it.
+constexpr double kPollInterval = 0.5e-3;
+
+struct RunOptions {
+    std::string scene;
+    std::optional<std::string> layout_file;
+    double seconds = 5;
+    double render_hz = 60;
+    std::string idle = "poll";
+    std::optional<std::string> trace_file;
+    std::optional<std::string> record_file;
+};
+
+RunOptions parse_options(Args& args) {
+    RunOptions o;
+    o.layout_file = args.option("layout");
+    o.seconds = args.number("seconds", 0.01, 1e6).value_or(o.seconds);
+    o.render_hz = args.number("render-hz", 1, 1000).value_or(o.render_hz);
+    if (const auto idle = args.option("idle")) {
+        if (*idle != "poll" && *idle != "spin" && *idle != "sleep") {
+            throw UsageError("--idle: expected poll, spin or sleep, got '" + *idle + "'");
+        }
+        o.idle = *idle;
+    }
+    o.trace_file = args.option("trace");
+    o.record_file = args.option("record");
+    const std::vector<std::string> scene = args.positionals(1);
+    o.scene = scene.empty() ? std::string(kDefaultScene) : scene[0];
+    return o;
+}
+
+// What the game thread measured.
+struct GameStats {
+    std::uint64_t frames = 0;
+    std::uint64_t late_frames = 0;  // frames that started more than a frame period late
+    double wall_seconds = 0;
+    double frame_ms_max = 0;
+    double frame_ms_sum = 0;
+};
+
+// Sleeps until `deadline` on the stopwatch, the last stretch with yields: a sleeping
+// thread wakes up to a scheduler tick late, and that lateness would show as jitter in
+// the interpolated poses (a display refreshes on time; a late read shows a later pose).
+void wait_until(const Stopwatch& wall, double deadline) {
+    constexpr double kSpinSeconds = 1e-3;
+    const double sleep = deadline - kSpinSeconds - wall.elapsed_seconds();
+    if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
+    while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
+}
+
+void print_smoothness(const char* name, const SmoothnessReport& r) {
+    std::printf("    %-13s %10.3f mm %11.4f mm %9.3f %8llu of %llu\n", name, r.mean_step_m * 1e3, r.jerk_rms_m * 1e3,
+                r.relative_jerk, static_cast<unsigned long long>(r.frozen_frames),
+                static_cast<unsigned long long>(r.frames));
+}
+
+void print_summary(const SceneDesc& scene, const Layout& layout, const RunOptions& o, const GameStats& game,
+                   const AsyncStats& physics, const ProbeTotals& probe, double step_seconds,
+                   const SmoothnessReport& interpolated, const SmoothnessReport& raw) {
+    std::printf("summary: scene %s, layout %s, %.2f s wall, idle %s\n", scene.name.c_str(), layout.name.c_str(),
+                game.wall_seconds, o.idle.c_str());
+    std::printf("  simulated      %.3f s in %llu steps (%.1f steps/s) over %llu updates\n",
+                static_cast<double>(probe.steps) * step_seconds, static_cast<unsigned long long>(probe.steps),
+                physics.steps_per_second, static_cast<unsigned long long>(probe.updates));
+    std::printf("  rendered       %llu frames at %.0f Hz (%llu late), frame work mean %.3f ms, max %.3f ms\n",
+                static_cast<unsigned long long>(game.frames), o.render_hz,
+                static_cast<unsigned long long>(game.late_frames),
+                game.frames ? game.frame_ms_sum / static_cast<double>(game.frames) : 0.0, game.frame_ms_max);
+    std::printf("  update         p50 %.3f ms, p99 %.3f ms, max %.3f ms (updates that took a step)\n",
+                physics.update_ms_p50, physics.update_ms_p99, physics.update_ms_max);
+    std::printf("  motion lock    held p50 %.2f us, p99 %.2f us, max %.2f us (FlipReadBuffers)\n", physics.lock_us_p50,
+                physics.lock_us_p99, physics.lock_us_max);
+    std::printf("  dropped        %llu steps (%.3f s of time beyond the %d-steps-per-update cap)\n",
+                static_cast<unsigned long long>(physics.steps_dropped), probe.dropped_seconds,
+                scene.settings.time_step.max_steps_per_frame);
+    double total = 0;
+    for (double s : probe.stage_seconds) total += s;
+    // ApplyWrites and FlipReadBuffers run on every update, stepping or not; with
+    // --idle poll or spin there are many updates per step, so their share is the price
+    // of publishing fresh interpolated states between steps.
+    std::printf("  stages         %-20s %10s %12s %7s   (%.0f updates per step)\n", "", "total s", "ms per step",
+                "share", probe.steps ? static_cast<double>(probe.updates) / static_cast<double>(probe.steps) : 0.0);
+    for (int i = 0; i < static_cast<int>(Stage::Count); ++i) {
+        const double s = probe.stage_seconds[static_cast<std::size_t>(i)];
+        if (s == 0) continue;  // stages folded into another (the solver integrates) take no time of their own
+        std::printf("                 %-20s %10.4f %12.4f %6.1f%%\n", to_string(static_cast<Stage>(i)), s,
+                    probe.steps ? s * 1e3 / static_cast<double>(probe.steps) : 0.0, total > 0 ? 100 * s / total : 0.0);
+    }
+    std::printf("  smoothness     motion per frame: mean, jerk (rms change frame to frame), jerk/mean, frozen frames\n");
+    print_smoothness("interpolated", interpolated);
+    print_smoothness("raw steps", raw);
+    if (interpolated.jerk_rms_m > 0 && raw.jerk_rms_m > 0) {
+        std::printf("  interpolated motion is %.1fx %s than the raw step states\n",
+                    raw.jerk_rms_m >= interpolated.jerk_rms_m ? raw.jerk_rms_m / interpolated.jerk_rms_m
+                                                              : interpolated.jerk_rms_m / raw.jerk_rms_m,
+                    raw.jerk_rms_m >= interpolated.jerk_rms_m ? "smoother" : "jerkier");
+    }
+}
+
+}  // namespace
+
+int run_command(Args& args) {
+    if (args.help()) {
+        std::cout << kRunUsage;
+        return 0;
+    }
+    const RunOptions o = parse_options(args);
+    const SceneDesc scene = resolve_scene(o.scene);
+
+    const Topology real = Topology::from_system();
+    const Layout layout = o.layout_file ? Layout::load(*o.layout_file, &real) : Layout::native(real);
+    const Topology model = layout.model_topology(real);
+    const LayoutMapping mapping = map_layout(layout, model, real);
+
+    // Outputs are opened before anything runs, so a bad path fails at once.
+    std::ofstream trace_out;
+    if (o.trace_file) {
+        trace_out.open(*o.trace_file);
+        if (!trace_out) throw Error(*o.trace_file + ": cannot write the trace file");
+    }
+    std::optional<MotionRecorder> recorder;
+    if (o.record_file) recorder.emplace(*o.record_file);
+
+    set_current_thread_name("spindle-game");
+    pin_current_thread(mapping.game.real_pu);
+
+    std::unique_ptr<JobSystem> jobs = make_jobs(mapping);
+    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
+    std::vector<GameSpan> frames;  // the game thread's side of the trace
+    if (o.trace_file) {
+        if (!scheduler) throw Error("--trace: the trace comes from the work-stealing scheduler, which make_jobs did not choose");
+        scheduler->enable_trace(true);
+        frames.reserve(static_cast<std::size_t>(o.seconds * o.render_hz) + 16);
+    }
+    SpaceSettings settings = scene.settings;
+    settings.time_step.use_internal_time_stepping = true;
+    Space space(settings, jobs.get());
+    const std::vector<BodyHandle> handles = build(scene, space);
+    std::vector<std::uint32_t> moving;
+    for (std::uint32_t i = 0; i < scene.bodies.size(); ++i) {
+        if (scene.bodies[i].desc.type != MotionType::Static) moving.push_back(i);
+    }
+    const std::size_t dynamic = scene.dynamic_body_count();
+    std::printf("scene %s (%s): %zu dynamic + %zu other bodies; %s\n", scene.name.c_str(), scene.source.c_str(),
+                dynamic, scene.bodies.size() - dynamic, scene.description.c_str());
+    std::printf("layout %s (%s):\n%s", layout.name.c_str(), layout.source.c_str(), mapping.describe().c_str());
+    std::fflush(stdout);
+
+    AsyncRunnerOptions runner_options;
+    runner_options.physics_pu = mapping.physics.real_pu;
+    runner_options.sleep_when_idle = o.idle == "sleep";
+    PhysicsProbe probe;  // before the runner: its posted function points at the probe
+    AsyncRunner runner(space, runner_options);
+    probe.attach(runner, o.idle == "poll" ? kPollInterval : 0.0);
+
+    std::vector<MotionState> interpolated(handles.size()), raw(handles.size());
+    SmoothnessMeter smooth_interpolated(moving), smooth_raw(moving);
+    Progress progress(stdout, isatty(fileno(stdout)) != 0);
+    const double step_seconds = settings.time_step.duration;
+    const MotionStateManager& states = space.motion_states();
+    GameStats game;
+
+    runner.start();
+    const Stopwatch wall;
+    const double period = 1.0 / o.render_hz;
+    double deadline = 0;
+    double last_print_time = 0;
+    std::uint64_t last_print_steps = 0;
+    ProgressSample sample;
+    while (deadline < o.seconds) {
+        wait_until(wall, deadline);
+        const std::int64_t frame_start = now_nanoseconds();
+        const double now = wall.elapsed_seconds();
+        // Two calls, each a consistent copy under the motion-state lock; a flip may
+        // fall between them, which only makes the raw side (slightly) newer, never torn.
+        states.get_motion_states(handles, interpolated);
+        states.get_raw_motion_states(handles, raw);
+        smooth_interpolated.add_frame(interpolated);
+        smooth_raw.add_frame(raw);
+        if (recorder) recorder->write_frame(game.frames, now, interpolated);
+        const std::int64_t frame_end = now_nanoseconds();
+        if (o.trace_file) frames.push_back({"Frame", frame_start, frame_end});
+
+        const double frame_ms = static_cast<double>(frame_end - frame_start) * 1e-6;
+        game.frames += 1;
+        game.frame_ms_sum += frame_ms;
+        game.frame_ms_max = std::max(game.frame_ms_max, frame_ms);
+        if (progress.due(now)) {
+            const std::uint64_t steps = states.published_steps();
+            sample.wall_seconds = now;
+            sample.simulated_seconds = static_cast<double>(steps) * step_seconds;
+            sample.steps_per_second =
+                now > last_print_time ? static_cast<double>(steps - last_print_steps) / (now - last_print_time) : 0;
+            sample.awake_bodies = probe.awake_bodies();
+            sample.contacts = probe.contacts();
+            sample.update_ms = probe.last_step_update_ms();
+            sample.frame_ms = frame_ms;
+            progress.print(sample);
+            last_print_time = now;
+            last_print_steps = steps;
+        }
+        deadline += period;
+        if (now - deadline > period) {  // more than a frame behind: start again from now
+            game.late_frames += 1;
+            deadline = now;
+        }
+    }
+    game.wall_seconds = wall.elapsed_seconds();
+    runner.stop();
+    progress.finish();
+
+    print_summary(scene, layout, o, game, runner.stats(), probe.totals(), step_seconds, smooth_interpolated.report(),
+                  smooth_raw.report());
+    if (recorder) {
+        recorder->close();
+        std::printf("  record         %s (%llu frames x %zu bodies)\n", o.record_file->c_str(),
+                    static_cast<unsigned long long>(game.frames), handles.size());
+    }
+    if (o.trace_file) {
+        const std::vector<TraceEvent> events = scheduler->trace_events();
+        const std::vector<unsigned> pus = scheduler_pus(mapping);
+        write_run_trace(trace_out, events, frames, mapping, pus);
+        trace_out.close();
+        if (!trace_out) throw Error(*o.trace_file + ": writing the trace file failed");
+        std::printf("  trace          %s (%zu spans)\n", o.trace_file->c_str(), events.size() + frames.size());
+    }
+    return 0;
+}
+
+}  // namespace spindle::app

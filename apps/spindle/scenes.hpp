@@ -1,0 +1,34 @@
+// Scenes the program knows: the built-in ones (configs/scenes/*.toml, embedded in the
+// binary at build time) and scene files named on the command line.
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+
+#include <spindle/engine/scene.hpp>
+
+#include "args.hpp"
+
+namespace spindle::app {
+
+struct BuiltinScene {
+    const char* name;    // file name without .toml
+    const char* source;  // "configs/scenes/<name>.toml", for error messages
+    std::string_view text;
+};
+
+// Every built-in scene, sorted by name (generated: builtin_scenes.cpp).
+std::span<const BuiltinScene> builtin_scenes() noexcept;
+
+// What `spindle run` runs without a scene argument: every shape falling on a mesh
+// terrain, lively and light enough to run in real time on one core (the 1240-box
+// pyramid is the benchmark, not the demo).
+inline constexpr std::string_view kDefaultScene = "pile";
+
+// A built-in scene's name, or the path of a scene file (anything with a '/' or
+// ending in .toml). Unknown names are a UsageError listing the built-in scenes; a
+// bad file is a spindle::Error naming file:line:column.
+SceneDesc resolve_scene(const std::string& name_or_path);
+
+}  // namespace spindle::app

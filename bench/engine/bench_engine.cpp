@@ -1,0 +1,165 @@
+// bench_engine: Spindle's throughput on named scenes (the table below), each at 1 and 2
+// threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
+//
+// Own flags (taken out before Google Benchmark sees the rest):
+//   --quick   a tenth of each scene's steps (at least 5)
+#include "common/jobs.hpp"
+#include "common/run.hpp"
+#include "common/scenes.hpp"
+#include "common/timing.hpp"
+#include "heap_counter.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <vector>
+
+#if __has_include(<spindle/engine/joint.hpp>)
+#define SPINDLE_BENCH_JOINT_HEADER 1
+#endif
+
+namespace spindle::bench {
+namespace {
+
+enum class SceneKind {
+    Pyramid,          // Jolt's pyramid (as bench_peers), from the drop
+    ManyPyramids,     // 196 small pyramids, from rest
+    MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
+    GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
+    GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
+};
+
+struct EngineScene {
+    const char* name;
+    SceneKind kind;
+    int steps;  // timed steps per run
+};
+
+// Step counts keep the whole default run (both thread counts) under about two minutes even
+// on a loaded machine. The pyramid takes 300 steps here (it stands after ~60); bench_peers
+// runs the full 500-step Jolt measure against Bullet.
+constexpr EngineScene kScenes[] = {
+    {"pyramid", SceneKind::Pyramid, 300},
+    {"many_pyramids", SceneKind::ManyPyramids, 40},
+    {"mixed_pile_on_mesh", SceneKind::MixedPileOnMesh, 200},
+    {"grid_10k_awake", SceneKind::GridAwake, 60},
+    {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
+};
+
+constexpr int kGridPerSide = 100;     // 10,000 boxes
+constexpr int kMixedPileBodies = 2048;
+constexpr int kGridSettleSteps = 30;  // awake grid: contacts made and warm before timing
+constexpr int kMaxStepsToSleep = 600;
+
+bool g_quick = false;
+
+struct Built {
+    std::unique_ptr<JobSystem> jobs;
+    std::unique_ptr<Space> space;
+    std::vector<BodyHandle> bodies;  // the dynamic ones
+    bool asleep = true;              // GridSleeping: did every body fall asleep before timing
+};
+
+// Builds the scene and takes the untimed steps it needs; bytes_per_body is the heap the
+// space holds by then (bodies, shapes, broadphase, contacts, solver scratch) per dynamic body.
+Built build(SceneKind kind, unsigned threads, double& bytes_per_body) {
+    Built built;
+    built.jobs = make_bench_jobs(threads);
+    SpaceSettings settings;
+    settings.sleep.enabled = kind == SceneKind::GridSleeping;
+    BoxScene boxes;
+    switch (kind) {
+        case SceneKind::Pyramid: boxes = pyramid_scene(); break;
+        case SceneKind::ManyPyramids: boxes = many_pyramids_scene(); break;
+        case SceneKind::GridAwake:
+        case SceneKind::GridSleeping: boxes = box_grid_scene(kGridPerSide); break;
+        case SceneKind::MixedPileOnMesh: break;
+    }
+    const std::int64_t heap_before = live_heap_bytes();
+    built.space = std::make_unique<Space>(settings, built.jobs.get());
+    Space& space = *built.space;
+    if (kind == SceneKind::MixedPileOnMesh) {
+        built.bodies = add_mixed_pile_on_mesh(space, kMixedPileBodies);
+    } else {
+        built.bodies = add_to_space(space, boxes, {.floor = FloorShape::Box, .allow_sleep = settings.sleep.enabled});
+    }
+    if (kind == SceneKind::GridAwake) {
+        for (int i = 0; i < kGridSettleSteps; ++i) space.update();
+    } else if (kind == SceneKind::GridSleeping) {
+        int steps = 0;
+        do {
+            space.update();
+        } while (space.last_update().awake_bodies > 0 && ++steps < kMaxStepsToSleep);
+        built.asleep = space.last_update().awake_bodies == 0;
+    }
+    const auto handle_bytes = static_cast<std::int64_t>(built.bodies.capacity() * sizeof(BodyHandle));
+    bytes_per_body = static_cast<double>(live_heap_bytes() - heap_before - handle_bytes) /
+                     static_cast<double>(built.bodies.size());
+    return built;
+}
+
+void bm_scene(benchmark::State& state, EngineScene scene) {
+    const auto threads = static_cast<unsigned>(state.range(0));
+    double bytes_per_body = 0;
+    Built built = build(scene.kind, threads, bytes_per_body);
+    if (!built.asleep) {
+        state.SkipWithError("the grid did not fall asleep within the step cap");
+        return;
+    }
+    Space& space = *built.space;
+    const StepClock clock;
+    for (auto _ : state) space.update();
+    const double wall = clock.wall_seconds();
+    const double cpu = clock.cpu_seconds();
+    const auto steps = static_cast<double>(state.iterations());
+    state.counters["steps_per_s"] = steps / wall;
+    state.counters["cpu_steps_per_s"] = steps / cpu;
+    state.counters["bodies"] = static_cast<double>(built.bodies.size());
+    state.counters["bytes_per_body"] = bytes_per_body;
+    state.counters["workers"] = built.jobs->worker_count();
+    state.counters["awake"] = space.last_update().awake_bodies;
+    state.counters["contacts"] = space.last_update().contacts;
+    if (scene.kind == SceneKind::Pyramid) state.counters["top_y"] = height_of(space, built.bodies.back());
+}
+
+void print_notes() {
+    std::printf("bench_engine notes:\n");
+    for (unsigned threads : {1u, 2u}) {
+        std::printf("  threads:%u runs %u worker(s) (bench/common/jobs.hpp make_bench_jobs)\n", threads,
+                    make_bench_jobs(threads)->worker_count());
+    }
+#ifdef SPINDLE_BENCH_JOINT_HEADER
+    std::printf("  chain/ragdoll scene: skipped; spindle/engine/joint.hpp exists now, the scene is still to be written\n");
+#else
+    std::printf("  chain/ragdoll scene: skipped (spindle/engine/joint.hpp is not on main)\n");
+#endif
+    std::fflush(stdout);
+}
+
+}  // namespace
+}  // namespace spindle::bench
+
+int main(int argc, char** argv) {
+    using namespace spindle::bench;
+    std::vector<char*> rest = take_own_flags(argc, argv, [](const char* arg) {
+        if (std::strcmp(arg, "--quick") != 0) return false;
+        g_quick = true;
+        return true;
+    });
+    for (const EngineScene& scene : kScenes) {
+        const int steps = g_quick ? std::max(5, scene.steps / 10) : scene.steps;
+        benchmark::RegisterBenchmark(scene.name, bm_scene, scene)
+            ->ArgName("threads")
+            ->Arg(1)
+            ->Arg(2)
+            ->Iterations(steps)
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+    }
+    print_notes();
+    return run_registered_benchmarks(rest);
+}

@@ -1,0 +1,93 @@
+// Each effect is paid for only where a scene uses it (design.md section 7): the work
+// counters stay at zero for an effect no body asks for, and count exactly the bodies
+// or contact points that do.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+using namespace spindle;
+
+namespace {
+
+BodyDesc ball(const Vec3& p) {
+    BodyDesc d;
+    d.shape = Shape::sphere(0.5);
+    d.position = p;
+    return d;
+}
+
+void add_ground(Space& space, Real friction = 0.6, Real restitution = 0) {
+    BodyDesc g;
+    g.type = MotionType::Static;
+    g.shape = Shape::plane(Vec3::UnitY(), 0);
+    g.friction = friction;
+    g.restitution = restitution;
+    space.create_body(g);
+}
+
+SpaceSettings awake() {
+    SpaceSettings s;
+    s.sleep.enabled = false;
+    return s;
+}
+
+}  // namespace
+
+TEST(Effects, GyroscopicTorqueOnlyForBodiesThatAsk) {
+    Space space(awake());
+    space.set_gravity(Vec3::Zero());
+    BodyDesc d;
+    d.shape = Shape::box(Vec3(0.5, 0.2, 0.1));
+    d.angular_velocity = Vec3(0.1, 5, 0.1);
+    space.create_body(d);
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(space.counters().gyroscopic_applied, 0u);
+    d.position = Vec3(5, 0, 0);
+    d.gyroscopic = true;
+    space.create_body(d);
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(space.counters().gyroscopic_applied, 10u * 4u);  // one body, 4 substeps
+}
+
+TEST(Effects, GravityScaleZeroSkipsGravity) {
+    Space space(awake());
+    BodyDesc d = ball(Vec3(0, 10, 0));
+    d.gravity_scale = 0;
+    const BodyHandle floating = space.create_body(d);
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(space.counters().gravity_applied, 0u);
+    EXPECT_EQ(space.internal_position(floating).y(), 10.0);
+    space.create_body(ball(Vec3(5, 10, 0)));
+    space.update();
+    EXPECT_EQ(space.counters().gravity_applied, 4u);
+}
+
+TEST(Effects, FrictionAndRestitutionOnlyWhereContactsHaveThem) {
+    Space space(awake());
+    add_ground(space, /*friction=*/0, /*restitution=*/0);
+    BodyDesc d = ball(Vec3(0, 0.5, 0));
+    d.friction = 0;
+    space.create_body(d);
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_GT(space.counters().contact_points_solved, 0u);
+    EXPECT_EQ(space.counters().friction_applied, 0u);
+    EXPECT_EQ(space.counters().restitution_applied, 0u);
+}
+
+TEST(Effects, FrictionCountsExactlyTheFrictionalPoints) {
+    Space space(awake());
+    add_ground(space);
+    space.create_body(ball(Vec3(0, 0.5, 0)));
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_GT(space.counters().friction_applied, 0u);
+    EXPECT_EQ(space.counters().friction_applied, space.counters().contact_points_solved);
+}
+
+TEST(Effects, NoContactsNoSolverWork) {
+    Space space(awake());
+    for (int i = 0; i < 5; ++i) space.create_body(ball(Vec3(3.0 * i, 10, 0)));
+    for (int i = 0; i < 20; ++i) space.update();
+    EXPECT_EQ(space.counters().contact_points_solved, 0u);
+    EXPECT_EQ(space.counters().contacts_updated, 0u);
+    EXPECT_EQ(space.counters().bodies_integrated, 5u * 20u);
+}
