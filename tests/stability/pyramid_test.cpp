@@ -76,10 +76,7 @@ TEST(OverlapRecovery, PyramidWithQuarterOverlapSeparatesAtThePushOutSpeed) {
             }
         }
     }
-    const OverlapRun run = run_overlap_recovery(*space, boxes, floor, 240);
-    std::printf("[ measure  ] overlapping pyramid (%zu boxes): worst end-of-step speed %.3f m/s, worst speed from "
-                "position change %.3f m/s, worst excess over push-out + g t %.3f m/s, final overlap %.4f m\n",
-                boxes.size(), run.worst_speed, run.worst_step_speed, run.worst_speed_excess, run.final_overlap);
+    const OverlapRun run = run_overlap_recovery("overlapping pyramid", *space, boxes, floor, 240);
     EXPECT_LE(run.worst_speed_excess, 0.0);
     EXPECT_LT(run.final_overlap, 0.01);
 }
@@ -91,10 +88,7 @@ TEST(OverlapRecovery, StackWithQuarterOverlapSeparatesAtThePushOutSpeed) {
     auto space = make_space();
     const BodyHandle floor = add_static_box(*space, Vec3(20, 1, 20), Vec3(0, -1, 0));
     const std::vector<BodyHandle> boxes = add_cube_stack(*space, 20, Vec3::Zero(), 0.75);
-    const OverlapRun run = run_overlap_recovery(*space, boxes, floor, 240);
-    std::printf("[ measure  ] overlapping stack (20 boxes): worst end-of-step speed %.3f m/s, worst speed from "
-                "position change %.3f m/s, worst excess over push-out + g t %.3f m/s, final overlap %.4f m\n",
-                run.worst_speed, run.worst_step_speed, run.worst_speed_excess, run.final_overlap);
+    const OverlapRun run = run_overlap_recovery("overlapping stack", *space, boxes, floor, 240);
     EXPECT_LE(run.worst_speed_excess, 0.0);
     EXPECT_LT(run.final_overlap, 0.01);
 }

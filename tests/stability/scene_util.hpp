@@ -6,6 +6,8 @@
 #include <spindle/engine/space.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
+#include <gtest/gtest.h>
+
 #include <memory>
 #include <vector>
 
@@ -71,6 +73,8 @@ struct OverlapRun {
 };
 // Steps a scene started overlapping; the speed allowed at time t is the push-out speed
 // plus the free-fall speed g t. bodies: the dynamic ones; floor: the static one under them.
-OverlapRun run_overlap_recovery(Space& space, const std::vector<BodyHandle>& bodies, BodyHandle floor, int steps);
+// Prints the measurements under the scene's name.
+OverlapRun run_overlap_recovery(const char* scene, Space& space, const std::vector<BodyHandle>& bodies,
+                                BodyHandle floor, int steps);
 
 }  // namespace spindle::stability

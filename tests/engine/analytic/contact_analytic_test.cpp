@@ -99,10 +99,7 @@ TEST(OverlapRecovery, SmallPyramidWithQuarterOverlapSeparatesAtThePushOutSpeed) 
             boxes.push_back(add_box(*space, Vec3::Constant(0.5), Vec3(-2 + 0.5 * row + i, 0.5 + 0.75 * row, 0)));
         }
     }
-    const OverlapRun run = run_overlap_recovery(*space, boxes, floor, 240);
-    std::printf("[ measure  ] small overlapping pyramid: worst end-of-step speed %.3f m/s, from position change %.3f "
-                "m/s, worst excess over push-out + g t %.3f m/s, final overlap %.4f m\n",
-                run.worst_speed, run.worst_step_speed, run.worst_speed_excess, run.final_overlap);
+    const OverlapRun run = run_overlap_recovery("small overlapping pyramid", *space, boxes, floor, 240);
     EXPECT_LE(run.worst_speed_excess, 0.0);
     EXPECT_LT(run.final_overlap, 0.01);
 }
