@@ -10,19 +10,38 @@ namespace {
 
 constexpr int kMaxManifolds = 4;
 
+// Within this distance an old point stands for a new one whose feature id changed.
+constexpr Real kCarryDistance = 0.02;
+
+// Each new point takes the impulses of the old point with the same feature id or, when
+// the id changed (two faces aligned exactly flip between reference features from step
+// to step), of the nearest old point within kCarryDistance: losing the warm start there
+// makes a tall stack jitter and walk.
 void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     for (int j = 0; j < fresh.point_count; ++j) {
         ContactPoint& p = fresh.points[j];
-        for (int m = 0; m < old_contact.manifold_count; ++m) {
+        const ContactPoint* match = nullptr;
+        Real nearest = kCarryDistance * kCarryDistance;
+        for (int m = 0; m < old_contact.manifold_count && !(match && match->geometry.id == p.geometry.id); ++m) {
             const ContactManifold& old = old_contact.manifold_at(m);
             if (old.normal.dot(fresh.normal) < 0.9) continue;  // a different face of a mesh
             for (int k = 0; k < old.point_count; ++k) {
-                if (old.points[k].geometry.id != p.geometry.id) continue;
-                p.normal_impulse = old.points[k].normal_impulse;
-                p.tangent_impulse[0] = old.points[k].tangent_impulse[0];
-                p.tangent_impulse[1] = old.points[k].tangent_impulse[1];
+                const ContactPoint& o = old.points[k];
+                if (o.geometry.id == p.geometry.id) {
+                    match = &o;
+                    break;
+                }
+                const Real d2 = (o.geometry.point - p.geometry.point).squaredNorm();
+                if (d2 < nearest) {
+                    nearest = d2;
+                    match = &o;
+                }
             }
         }
+        if (!match) continue;
+        p.normal_impulse = match->normal_impulse;
+        p.tangent_impulse[0] = match->tangent_impulse[0];
+        p.tangent_impulse[1] = match->tangent_impulse[1];
     }
 }
 

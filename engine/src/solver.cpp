@@ -194,6 +194,7 @@ struct SolveParams {
     Softness soft;
     Real inv_h = 0;
     Real push_out = 0;
+    Real slop = 0;  // gaps wider than this carry no friction
     bool use_bias = true;
 };
 
@@ -207,9 +208,11 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
     const Real moved = cc.normal.dot(B.dp - A.dp);
     const Vec3 na = A.dq.conjugate() * cc.normal;
     const Vec3 nb = B.dq.conjugate() * cc.normal;
+    Real gap[kMaxManifoldPoints];
     for (int j = 0; j < cc.point_count; ++j) {
         ConstraintPoint& p = cc.points[j];
         const Real separation = moved + nb.dot(p.rb) - na.dot(p.ra) + p.adjusted_separation;
+        gap[j] = separation;
         Real bias = 0, mass_scale = 1, impulse_scale = 0;
         if (separation > 0) {
             bias = separation * params.inv_h;  // speculative: may close the gap, no more
@@ -232,6 +235,9 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
     if (cc.friction > 0) {
         for (int j = 0; j < cc.point_count; ++j) {
             ConstraintPoint& p = cc.points[j];
+            // No friction across an open gap: a speculative point far from the body (a
+            // fast sphere's, metres ahead) would spin it up through the lever arm.
+            if (gap[j] > params.slop) continue;
             const Real old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
             Real new0 = old0 - p.tangent_mass[0] * row_speed(s, cc.tangent[0], p.tangent_row[0]);
             Real new1 = old1 - p.tangent_mass[1] * row_speed(s, cc.tangent[1], p.tangent_row[1]);
@@ -358,6 +364,7 @@ void solve(World& world, Real dt) {
     solve_params.soft = make_softness(hertz, settings.damping_ratio, h);
     solve_params.inv_h = 1 / h;
     solve_params.push_out = settings.push_out_speed;
+    solve_params.slop = settings.linear_slop;
     SolveParams relax_params = solve_params;
     relax_params.use_bias = false;
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};

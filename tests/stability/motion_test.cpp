@@ -152,11 +152,6 @@ TEST(Gyroscopic, IntermediateAxisSpinDoesNotGainEnergy) {
 // Sixteen 0.1 m spheres at 100 to 300 m/s, at angles from head-on to 80 degrees off
 // the normal, at a static wall 0.1 m thick; none may come out behind it.
 TEST(FastBodies, SpheresAtManyAnglesDoNotTunnelThroughAThinWall) {
-    SPINDLE_KNOWN_FAILURE("6 of the 16 spheres pass the wall (#3, 5, 6, 9, 11, 15; one ends 141 m beyond). Two "
-                          "causes: DynamicAabbTree::move_proxy keeps a fat box that holds the tight box but not its "
-                          "sweep, so no pair is made (#5, 6, 9); friction on a speculative contact acts at an anchor "
-                          "far from the sphere, spins it up (~150 rad/s) and the rotated anchor corrupts the tracked "
-                          "separation (#3, 11, 15, friction 0.6)");
     auto space = make_space();
     space->set_gravity(Vec3::Zero());
     add_static_box(*space, Vec3(0.05, 40, 40), Vec3::Zero());

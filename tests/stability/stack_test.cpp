@@ -61,9 +61,6 @@ StackRun run_stack(int count, int substeps, const Vec3& base) {
 // soft contacts compress in proportion to load, so the settled stack stands a little
 // lower than the ideal one; that offset is reported but is not drift.
 TEST(Stack, TwentyCubesAtDefaultSettingsStandFor1000Steps) {
-    SPINDLE_KNOWN_FAILURE("the top cube sways 0.19 m from its settled pose (any cube up to 0.13 m), never settling "
-                          "(speeds ~0.1 m/s at step 1000): box-box feature ids change on ~7% of contact-steps, so "
-                          "warm starting is lost; matching lost points by position brings the drift to 0.035 m");
     const StackRun run = run_stack(20, SolverSettings{}.substeps, Vec3::Zero());
     EXPECT_TRUE(run.finite);
     EXPECT_LT(run.top_drift_from_settled, 0.05);
