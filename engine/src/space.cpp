@@ -28,6 +28,7 @@ const char* to_string(Stage stage) noexcept {
         case Stage::Narrowphase: return "Narrowphase";
         case Stage::Islands: return "Islands";
         case Stage::Solver: return "Solver";
+        case Stage::Continuous: return "Continuous";
         case Stage::IntegratePositions: return "IntegratePositions";
         case Stage::Record: return "Record";
         case Stage::FlipReadBuffers: return "FlipReadBuffers";
@@ -273,7 +274,9 @@ void step(World& w, Real dt) {
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
+    record_fast_starts(w);
     run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
+    if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;
     w.counters.steps += 1;

@@ -114,6 +114,13 @@ struct SleepingIsland {
     std::vector<JointHandle> joints;  // handles: a joint destroyed while asleep is skipped on waking
 };
 
+// A fast body's pose when the step began, for the swept test after the solver.
+struct FastStart {
+    std::uint32_t slot = 0;
+    Vec3 x0 = Vec3::Zero();
+    Quat q0 = Quat::Identity();
+};
+
 struct World {
     SpaceSettings settings;
     JobSystem* jobs = nullptr;
@@ -151,6 +158,8 @@ struct World {
     WorkCounters counters;
     std::vector<EffectCounts> scratch_counts;
     std::vector<std::uint32_t> scratch_lost;
+    std::vector<FastStart> fast_starts;          // continuous.cpp
+    std::vector<std::uint32_t> scratch_candidates;
 
     // Islands.
     std::vector<SleepingIsland> sleeping_islands;

@@ -13,6 +13,7 @@ enum class Stage : std::uint8_t {
     Narrowphase,
     Islands,
     Solver,
+    Continuous,
     IntegratePositions,
     Record,
     FlipReadBuffers,
