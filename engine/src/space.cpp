@@ -117,6 +117,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     // Mass first: it may throw (e.g. a degenerate shape), and nothing has changed yet.
     Real inv_mass = 0;
     Mat3 inv_inertia = Mat3::Zero();
+    Mat3 inertia = Mat3::Zero();
     Vec3 local_com = Vec3::Zero();
     if (desc.type == MotionType::Dynamic) {
         MassProperties mp = desc.shape.mass_properties(desc.density);
@@ -127,6 +128,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         if (!(mp.mass > 0) || !mp.inertia.allFinite()) reject("the shape has no volume (mass " + number(mp.mass) + ")");
         inv_mass = 1 / mp.mass;
         inv_inertia = mp.inertia.inverse();
+        inertia = mp.inertia;
         local_com = mp.center_of_mass;
     } else if (desc.shape.type != ShapeType::Plane && desc.shape.type != ShapeType::TriangleMesh) {
         local_com = Vec3::Zero();
@@ -142,7 +144,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         b.generation.push_back(0);
         b.alive.push_back(0);
         grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
-        grow(b.inv_inertia_local, n), grow(b.local_com, n), grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
+        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
         grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
         grow(b.history_position[0], n), grow(b.history_position[1], n);
         grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
@@ -159,6 +161,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.w[slot] = desc.type == MotionType::Static ? Vec3::Zero() : desc.angular_velocity;
     b.inv_mass[slot] = inv_mass;
     b.inv_inertia_local[slot] = inv_inertia;
+    b.inertia_local[slot] = inertia;
     b.force[slot] = Vec3::Zero();
     b.torque[slot] = Vec3::Zero();
     b.awake_index[slot] = -1;

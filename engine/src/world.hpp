@@ -42,6 +42,7 @@ struct Bodies {
     std::vector<Vec3> w;   // angular velocity, world
     std::vector<Real> inv_mass;
     std::vector<Mat3> inv_inertia_local;  // about the centre of mass, body frame
+    std::vector<Mat3> inertia_local;      // the same, not inverted (gyroscopic bodies read it)
     std::vector<Vec3> local_com;          // centre of mass in the shape's frame
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
