@@ -1,6 +1,9 @@
 // Integration, once per substep over the awake bodies: velocities (gravity, user
 // forces, damping, gyroscopic torque -- each only for bodies that use it) and then
 // positions as deltas from the start of the step (semi-implicit Euler).
+#include <algorithm>
+#include <cmath>
+
 #include "solver_body.hpp"
 #include "stages.hpp"
 
@@ -70,11 +73,20 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h) {
 
 void integrate_positions(World& world, SolverBody* bodies, Real h) {
     const auto n = static_cast<std::uint32_t>(world.awake.size());
+    const Real push_out = world.settings.solver.push_out_speed;
     world.jobs->parallel_for("IntegratePositions", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             SolverBody& sb = bodies[k];
-            sb.dp += h * sb.v;
-            sb.dq = integrate_rotation(sb.dq, sb.w, h);
+            // The push-out velocity is capped per body, not only per contact: a chain of
+            // overlaps would otherwise add up each contact's push-out speed.
+            const Vec3 moving = sb.v + sb.push_v;
+            const Real limit_sq = std::max(sb.v.squaredNorm(), push_out * push_out);
+            const Real moving_sq = moving.squaredNorm();
+            if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
+            sb.dp += h * (sb.v + sb.push_v);
+            sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
+            sb.push_v = Vec3::Zero();
+            sb.push_w = Vec3::Zero();
         }
     });
 }

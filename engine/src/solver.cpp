@@ -72,6 +72,8 @@ void prepare(World& world, SolverScratch& scratch, Real h) {
             SolverBody& sb = scratch.bodies[k];
             sb.v = b.v[i];
             sb.w = b.w[i];
+            sb.push_v = Vec3::Zero();
+            sb.push_w = Vec3::Zero();
             sb.dp = Vec3::Zero();
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
@@ -188,6 +190,11 @@ void warm_start(ContactConstraint& cc, SolverBody* bodies) {
         apply_row(A, B, s, cc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
     }
     store(A, B, s);
+    if (cc.push_impulse > 0) {
+        Velocities push = load_push(A, B);
+        apply_row(A, B, push, cc.normal, cc.push_row, cc.push_impulse);
+        store_push(A, B, push);
+    }
 }
 
 struct SolveParams {
@@ -195,13 +202,35 @@ struct SolveParams {
     Real inv_h = 0;
     Real push_out = 0;
     Real slop = 0;  // gaps wider than this carry no friction
+    Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
     bool use_bias = true;
 };
+
+// Deep overlap is pushed out by a soft constraint on the push-out velocities (split
+// impulse), never by real speed, so a chain of deep overlaps separates without
+// launching anything. One row per manifold, through the overlap's depth-weighted centre,
+// so a face pushes straight and a tilted corner turns back.
+void push_out(ContactConstraint& cc, SolverBody& A, SolverBody& B, Real excess, const Vec3& ra, const Vec3& rb,
+              const SolveParams& params) {
+    const Real mass = make_row(A, B, ra, rb, cc.normal, cc.push_row);
+    Velocities push = load_push(A, B);
+    const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
+    const Real speed = row_speed(push, cc.normal, cc.push_row);
+    const Real total = std::max(
+        cc.push_impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * cc.push_impulse,
+        Real(0));
+    apply_row(A, B, push, cc.normal, cc.push_row, total - cc.push_impulse);
+    cc.push_impulse = total;
+    store_push(A, B, push);
+}
 
 void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams& params) {
     SolverBody& A = bodies[cc.a];
     SolverBody& B = bodies[cc.b];
     Velocities s = load(A, B);
+    // Overlap deeper than the recovery depth: its excess and where it is, weighted by depth.
+    Real excess_sum = 0, weight_sum = 0;
+    Vec3 push_ra = Vec3::Zero(), push_rb = Vec3::Zero();
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
     // rotation is applied once per constraint rather than once per point.
@@ -213,11 +242,20 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
         ConstraintPoint& p = cc.points[j];
         const Real separation = moved + nb.dot(p.rb) - na.dot(p.ra) + p.adjusted_separation;
         gap[j] = separation;
+        const Real excess = separation + params.recovery_depth;
+        if (excess < 0 && params.use_bias) {
+            excess_sum -= excess * excess;
+            weight_sum -= excess;
+            push_ra -= excess * p.ra;
+            push_rb -= excess * p.rb;
+        }
         Real bias = 0, mass_scale = 1, impulse_scale = 0;
         if (separation > 0) {
             bias = separation * params.inv_h;  // speculative: may close the gap, no more
         } else if (params.use_bias) {
-            bias = std::max(params.soft.bias_rate * separation, -params.push_out);
+            // Resting overlap is corrected by the contact's own soft bias (soft step);
+            // deeper overlap is left to push_out.
+            bias = std::max(params.soft.bias_rate * std::max(separation, -params.recovery_depth), -params.push_out);
             mass_scale = params.soft.mass_scale;
             impulse_scale = params.soft.impulse_scale;
         }
@@ -232,6 +270,7 @@ void solve_contact(ContactConstraint& cc, SolverBody* bodies, const SolveParams&
         p.max_normal_impulse = std::max(p.max_normal_impulse, impulse);
         apply_row(A, B, s, cc.normal, p.normal_row, impulse);
     }
+    if (weight_sum > 0) push_out(cc, A, B, excess_sum / weight_sum, push_ra / weight_sum, push_rb / weight_sum, params);
     if (cc.friction > 0) {
         for (int j = 0; j < cc.point_count; ++j) {
             ConstraintPoint& p = cc.points[j];
@@ -365,6 +404,7 @@ void solve(World& world, Real dt) {
     solve_params.inv_h = 1 / h;
     solve_params.push_out = settings.push_out_speed;
     solve_params.slop = settings.linear_slop;
+    solve_params.recovery_depth = settings.recovery_depth;
     SolveParams relax_params = solve_params;
     relax_params.use_bias = false;
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};

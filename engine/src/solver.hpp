@@ -56,6 +56,10 @@ struct ContactConstraint {
     Real gravity_normal = 0;  // relative acceleration of B from A along the normal, from gravity
     int point_count = 0;
     ConstraintPoint points[kMaxManifoldPoints];
+    // Push-out of deep overlap (split impulse): one row through the overlap's centre,
+    // on the push-out velocities; the impulse is kept over the step's substeps.
+    ContactRow push_row;
+    Real push_impulse = 0;
 };
 
 using Vec2 = Eigen::Matrix<Real, 2, 1>;

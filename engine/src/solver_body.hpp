@@ -11,6 +11,11 @@ namespace spindle {
 struct SolverBody {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
+    // Push-out velocities of the current substep (split impulse): they move the body out
+    // of overlaps in integrate_positions and are then dropped, so pushing apart never
+    // becomes real speed. Capped per body at the push-out speed.
+    Vec3 push_v = Vec3::Zero();
+    Vec3 push_w = Vec3::Zero();
     Vec3 dp = Vec3::Zero();        // position change since the step began
     Quat dq = Quat::Identity();    // rotation change since the step began
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step
@@ -25,6 +30,9 @@ struct Velocities {
 };
 
 inline Velocities load(const SolverBody& A, const SolverBody& B) { return {A.v, A.w, B.v, B.w}; }
+inline Velocities load_push(const SolverBody& A, const SolverBody& B) {
+    return {A.push_v, A.push_w, B.push_v, B.push_w};
+}
 
 inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
     // Only dynamic bodies are written: static and kinematic ones are shared by
@@ -36,6 +44,17 @@ inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
     if (B.dynamic) {
         B.v = s.vb;
         B.w = s.wb;
+    }
+}
+
+inline void store_push(SolverBody& A, SolverBody& B, const Velocities& s) {
+    if (A.dynamic) {
+        A.push_v = s.va;
+        A.push_w = s.wa;
+    }
+    if (B.dynamic) {
+        B.push_v = s.vb;
+        B.push_w = s.wb;
     }
 }
 

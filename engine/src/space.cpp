@@ -310,8 +310,8 @@ void Space::set_solver(const SolverSettings& s) {
         throw Error("solver: relax_iterations must be >= 0, got " + std::to_string(s.relax_iterations));
     }
     if (!(s.contact_hertz >= 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) ||
-        !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
-        throw Error("solver: contact_hertz, damping_ratio, push_out_speed, speculative_distance and "
+        !(s.recovery_depth >= 0) || !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
+        throw Error("solver: contact_hertz, damping_ratio, push_out_speed, recovery_depth, speculative_distance and "
                     "restitution_threshold must be >= 0");
     }
     if (!(s.joint_hertz >= 0) || !std::isfinite(s.joint_hertz) || !(s.joint_damping_ratio >= 0)) {

@@ -24,7 +24,6 @@ MassProperties mass_of(const BodyDesc& d) {
 
 }  // namespace
 
-bool run_known_failures() { return std::getenv("SPINDLE_RUN_KNOWN_FAILURES") != nullptr; }
 
 std::unique_ptr<Space> make_space(const SpaceSettings& settings, JobSystem* jobs) {
     SpaceSettings s = settings;
@@ -149,7 +148,8 @@ OverlapRun run_overlap_recovery(const char* scene, Space& space, const std::vect
     const double push_out = space.settings().solver.push_out_speed;
     const double dt = space.settings().time_step.duration;
     OverlapRun run;
-    std::vector<Vec3> before = positions(space, bodies);
+    const std::vector<Vec3> start = positions(space, bodies);
+    std::vector<Vec3> before = start;
     for (int step = 1; step <= steps; ++step) {
         space.update();
         const double allowed = push_out + kGravity * step * dt;
@@ -166,9 +166,14 @@ OverlapRun run_overlap_recovery(const char* scene, Space& space, const std::vect
     std::vector<BodyHandle> all = bodies;
     all.push_back(floor);
     run.final_overlap = deepest_penetration(space, all);
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const Vec3 d = space.internal_position(bodies[i]) - start[i];
+        run.final_sideways = std::max(run.final_sideways, std::hypot(d.x(), d.z()));
+    }
     std::printf("[ measure  ] %s (%zu boxes): worst end-of-step speed %.3f m/s, from position change %.3f m/s, worst "
-                "excess over push-out + g t %.3f m/s; deepest overlap at the end %.4f m\n",
-                scene, bodies.size(), run.worst_speed, run.worst_step_speed, run.worst_speed_excess, run.final_overlap);
+                "excess over push-out + g t %.3f m/s; deepest overlap at the end %.4f m; most moved sideways %.4f m\n",
+                scene, bodies.size(), run.worst_speed, run.worst_step_speed, run.worst_speed_excess, run.final_overlap,
+                run.final_sideways);
     return run;
 }
 

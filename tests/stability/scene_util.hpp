@@ -11,16 +11,7 @@
 #include <memory>
 #include <vector>
 
-// A case the engine fails today: skipped, with what fails, unless the environment
-// variable SPINDLE_RUN_KNOWN_FAILURES is set (then it runs and reports its numbers).
-#define SPINDLE_KNOWN_FAILURE(what)                                                   \
-    do {                                                                              \
-        if (!::spindle::stability::run_known_failures()) GTEST_SKIP() << "known failure: " << what; \
-    } while (0)
-
 namespace spindle::stability {
-
-bool run_known_failures();
 
 inline constexpr double kGravity = 9.81;
 inline constexpr double kStep = 1.0 / 60.0;
@@ -70,6 +61,7 @@ struct OverlapRun {
     double worst_step_speed = 0;         // max over steps and bodies of |position change| / dt, m/s
     double worst_speed_excess = -kHuge;  // max over steps and bodies of either speed - allowed, m/s
     double final_overlap = 0;            // deepest penetration left at the end, m
+    double final_sideways = 0;           // most any body ended up moved sideways (x, z) from its start, m
 };
 // Steps a scene started overlapping; the speed allowed at time t is the push-out speed
 // plus the free-fall speed g t. bodies: the dynamic ones; floor: the static one under them.

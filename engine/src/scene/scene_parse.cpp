@@ -18,7 +18,7 @@ SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
     r.check_keys(t, "[settings]",
                  {"gravity", "time_step", "max_steps_per_frame", "min_steps_per_frame", "substeps", "iterations",
                   "relax_iterations", "contact_hertz", "contact_damping_ratio", "joint_hertz",
-                  "joint_damping_ratio", "push_out_speed", "restitution_threshold", "speculative_distance",
+                  "joint_damping_ratio", "push_out_speed", "recovery_depth", "restitution_threshold", "speculative_distance",
                   "linear_slop", "sleep", "time_to_sleep", "sleep_linear_threshold", "sleep_angular_threshold"});
     SpaceSettings s;
     TimeStepSettings& ts = s.time_step;
@@ -51,6 +51,7 @@ SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
     non_negative("joint_hertz", solver.joint_hertz);
     non_negative("joint_damping_ratio", solver.joint_damping_ratio);
     non_negative("push_out_speed", solver.push_out_speed);
+    non_negative("recovery_depth", solver.recovery_depth);
     non_negative("restitution_threshold", solver.restitution_threshold);
     non_negative("speculative_distance", solver.speculative_distance);
     non_negative("linear_slop", solver.linear_slop);

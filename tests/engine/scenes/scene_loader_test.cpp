@@ -283,6 +283,7 @@ contact_damping_ratio = 5
 joint_hertz = 0
 joint_damping_ratio = 1
 push_out_speed = 1.5
+recovery_depth = 0.05
 restitution_threshold = 0.5
 speculative_distance = 0.02
 linear_slop = 0.001
@@ -307,6 +308,7 @@ sleep_angular_threshold = 0.02
     EXPECT_EQ(s.solver.joint_hertz, 0);
     EXPECT_EQ(s.solver.joint_damping_ratio, 1);
     EXPECT_EQ(s.solver.push_out_speed, 1.5);
+    EXPECT_EQ(s.solver.recovery_depth, 0.05);
     EXPECT_EQ(s.solver.restitution_threshold, 0.5);
     EXPECT_EQ(s.solver.speculative_distance, 0.02);
     EXPECT_EQ(s.solver.linear_slop, 0.001);
