@@ -34,28 +34,24 @@ inline Velocities load_push(const SolverBody& A, const SolverBody& B) {
     return {A.push_v, A.push_w, B.push_v, B.push_w};
 }
 
-inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
-    // Only dynamic bodies are written: static and kinematic ones are shared by
-    // constraints of every colour.
+// Stores into the members v and w (the real or the push-out velocities). Only dynamic
+// bodies are written: static and kinematic ones are shared by constraints of every colour.
+template <Vec3 SolverBody::*V, Vec3 SolverBody::*W>
+inline void store_into(SolverBody& A, SolverBody& B, const Velocities& s) {
     if (A.dynamic) {
-        A.v = s.va;
-        A.w = s.wa;
+        A.*V = s.va;
+        A.*W = s.wa;
     }
     if (B.dynamic) {
-        B.v = s.vb;
-        B.w = s.wb;
+        B.*V = s.vb;
+        B.*W = s.wb;
     }
 }
-
+inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
+    store_into<&SolverBody::v, &SolverBody::w>(A, B, s);
+}
 inline void store_push(SolverBody& A, SolverBody& B, const Velocities& s) {
-    if (A.dynamic) {
-        A.push_v = s.va;
-        A.push_w = s.wa;
-    }
-    if (B.dynamic) {
-        B.push_v = s.vb;
-        B.push_w = s.wb;
-    }
+    store_into<&SolverBody::push_v, &SolverBody::push_w>(A, B, s);
 }
 
 // An impulse at the anchors ra, rb (from each centre of mass): -impulse on A, +impulse on B.
