@@ -6,6 +6,9 @@ function(spindle_target_defaults target)
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
     # GCC 12 reports false -Wrestrict positives inside std::string concatenation (GCC bug 105329).
     target_compile_options(${target} PRIVATE -Wno-restrict)
+    # wide.hpp's vector types are passed between inline functions of one build only;
+    # the note that their ABI depends on AVX being enabled does not concern us.
+    target_compile_options(${target} PRIVATE -Wno-psabi)
   endif()
 endfunction()
 
@@ -31,6 +34,11 @@ function(spindle_add_layer name)
     $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(spindle_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  if(SPINDLE_ARCH)
+    # Public: Eigen's alignment of fixed-size types in our headers follows the target
+    # CPU, so everything that includes them, installed users too, must agree.
+    target_compile_options(spindle_${name} PUBLIC -march=${SPINDLE_ARCH})
+  endif()
   spindle_target_defaults(spindle_${name})
   install(TARGETS spindle_${name} EXPORT SpindleTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "solver_body.hpp"
+#include "wide.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -30,36 +31,46 @@ struct ContactRow {
     Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
 };
 
-struct ConstraintPoint {
-    ContactRow normal_row;
-    ContactRow tangent_row[2];
-    Vec3 ra = Vec3::Zero();  // anchors from each centre of mass, world, fixed for the step
-    Vec3 rb = Vec3::Zero();
-    Real adjusted_separation = 0;  // separation minus n.(rb - ra): current separation = n.d + this
-    Real normal_mass = 0;
-    Real tangent_mass[2] = {0, 0};
-    Real normal_impulse = 0;
-    Real tangent_impulse[2] = {0, 0};
-    Real max_normal_impulse = 0;
-    Real relative_velocity = 0;
+// The same row for the four lanes of a WideContact.
+struct WideRow {
+    Wide3 ra_x, rb_x, ia, ib;
 };
 
-// One manifold as the solver sees it. a and b index the step's solver bodies; static
-// and sleeping partners share one immovable body at the end of that array.
-struct ContactConstraint {
-    std::uint32_t a = 0, b = 0;
+// One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
+// fill has no mass and lies far apart, so it never pushes and never rubs.
+struct WidePoint {
+    Wide3 ra, rb;                 // anchors from each centre of mass, world, fixed for the step
+    Wide adjusted_separation{};   // separation minus n.(rb - ra): current separation = n.d + this
+    WideRow normal_row, tangent_row[2];
+    Wide normal_mass{}, tangent_mass[2]{};
+    Wide normal_impulse{}, tangent_impulse[2]{};
+    Wide max_normal_impulse{};
+    Wide relative_velocity{};     // approach speed at impact (restitution)
+};
+
+// A touching manifold of an awake contact, as listed and coloured for the step.
+struct ManifoldRef {
     std::uint32_t contact = 0;
     int manifold = 0;
-    Vec3 normal = Vec3::UnitY();
-    Vec3 tangent[2] = {Vec3::UnitX(), Vec3::UnitZ()};
-    Real friction = 0, restitution = 0;
-    Real gravity_normal = 0;  // relative acceleration of B from A along the normal, from gravity
-    int point_count = 0;
-    ConstraintPoint points[kMaxManifoldPoints];
-    // Push-out of deep overlap (split impulse): one row through the overlap's centre,
-    // on the push-out velocities; the impulse is kept over the step's substeps.
-    ContactRow push_row;
-    Real push_impulse = 0;
+    std::uint32_t a = 0, b = 0;  // solver bodies
+};
+
+// Four manifolds of one colour solved together, one per lane (structure of arrays).
+// They share no dynamic body, so the lanes never write the same body. Lanes past the
+// colour's end hold no manifold: both bodies are the immovable one and nothing is written.
+struct WideContact {
+    std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
+    std::uint32_t ref[kLanes] = {};                  // manifold ref per lane
+    int lanes = 0;                                   // lanes holding a manifold
+    Wide3 normal, tangent[2];
+    Wide inv_mass_a{}, inv_mass_b{};
+    Wide friction{}, restitution{};
+    Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
+    WidePoint points[kMaxManifoldPoints];
+    // Push-out of deep overlap (split impulse), per lane: one row through the overlap's
+    // centre on the push-out velocities; the impulse is kept over the step's substeps.
+    ContactRow push_row[kLanes];
+    Real push_impulse[kLanes] = {};
 };
 
 using Vec2 = Eigen::Matrix<Real, 2, 1>;
@@ -114,14 +125,35 @@ inline constexpr int kColorCount = 24;
 
 struct SolverScratch {
     std::vector<SolverBody> bodies;                 // awake bodies, then the static body
-    std::vector<ContactConstraint> constraints;
-    std::vector<std::uint32_t> colors[kColorCount];  // constraint indices per colour
-    std::vector<std::uint32_t> overflow;             // constraints that fit no colour, solved serially
+    std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
+    std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
+    std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
+    std::vector<WideContact> wide;                   // the colours' manifolds four by four, then the overflow one by one
+    std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
     std::vector<std::uint32_t> joint_overflow;
     std::vector<std::uint64_t> color_bits[kColorCount];  // per colour: which dynamic bodies it uses
 };
+
+// How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,
+// none (relax) without.
+struct ContactSolveParams {
+    Softness soft;
+    Real inv_h = 0;
+    Real push_out = 0;        // push-out speed
+    Real slop = 0;            // gaps wider than this carry no friction
+    Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
+    bool use_bias = true;
+};
+
+// contact_solver.cpp. prepare_contacts fills scratch.wide from scratch.manifolds and
+// the colours; the others run per wide contact from the colour loops.
+void prepare_contacts(World& world, SolverScratch& scratch);
+void warm_start_contact(WideContact& wc, SolverBody* bodies);
+void solve_contact(WideContact& wc, SolverBody* bodies, const ContactSolveParams& params);
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h);
+void store_contact_impulses(World& world, SolverScratch& scratch);
 
 // joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are
 // none) and prepares them from the bodies of scratch; the others run per joint from

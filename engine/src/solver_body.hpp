@@ -11,13 +11,13 @@ namespace spindle {
 struct SolverBody {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
+    Vec3 dp = Vec3::Zero();        // position change since the step began
+    Quat dq = Quat::Identity();    // rotation change since the step began
     // Push-out velocities of the current substep (split impulse): they move the body out
     // of overlaps in integrate_positions and are then dropped, so pushing apart never
     // becomes real speed. Capped per body at the push-out speed.
     Vec3 push_v = Vec3::Zero();
     Vec3 push_w = Vec3::Zero();
-    Vec3 dp = Vec3::Zero();        // position change since the step began
-    Quat dq = Quat::Identity();    // rotation change since the step began
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step
     Real inv_mass = 0;
     bool dynamic = false;  // only dynamic bodies are written by constraints
