@@ -45,6 +45,22 @@ inline Wide3 cross(const Wide3& a, const Wide3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
+// A 3x3 matrix per lane, row-major.
+struct WideMat3 {
+    Wide m[3][3]{};
+
+    void set_lane(int i, const Mat3& a) {
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c) m[r][c][i] = a(r, c);
+        }
+    }
+};
+
+inline Wide3 operator*(const WideMat3& a, const Wide3& v) {
+    return {a.m[0][0] * v.x + a.m[0][1] * v.y + a.m[0][2] * v.z, a.m[1][0] * v.x + a.m[1][1] * v.y + a.m[1][2] * v.z,
+            a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z};
+}
+
 // A unit quaternion per lane.
 struct WideQuat {
     Wide3 v;      // x, y, z

@@ -86,5 +86,7 @@ TEST(OverlapRecovery, StackWithQuarterOverlapSeparatesAtThePushOutSpeed) {
     const OverlapRun run = run_overlap_recovery("overlapping stack", *space, boxes, floor, 240);
     EXPECT_LE(run.worst_speed_excess, 0.0);
     EXPECT_LT(run.final_overlap, 0.01);
-    EXPECT_LT(run.final_sideways, 0.25) << "the column should end standing, not toppled";
+    // Standing: no cube ends more than half its width from where it started (the
+    // column toppled, several metres, before overlap was pushed out by split impulse).
+    EXPECT_LT(run.final_sideways, 0.5) << "the column should end standing, not toppled";
 }
