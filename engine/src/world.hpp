@@ -75,6 +75,10 @@ struct Bodies {
 // warm starting, matched by feature id).
 struct ContactPoint {
     ManifoldPoint geometry;
+    // The point on each surface in its body's frame (shape origin), kept from the last
+    // collide so a manifold can follow its bodies while they barely move (narrowphase.cpp).
+    Vec3 local_a = Vec3::Zero();
+    Vec3 local_b = Vec3::Zero();
     Real normal_impulse = 0;
     Real tangent_impulse[2] = {0, 0};
     Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
@@ -83,6 +87,7 @@ struct ContactPoint {
 
 struct ContactManifold {
     Vec3 normal = Vec3::UnitY();
+    Vec3 local_normal = Vec3::UnitY();  // in A's frame, from the last collide
     int point_count = 0;
     ContactPoint points[kMaxManifoldPoints];
 };
@@ -96,6 +101,12 @@ struct Contact {
     ContactManifold manifold;              // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;    // further manifolds (triangle meshes)
     bool sleeping = false;
+    // B's pose in A's frame when the manifolds were last computed; while the bodies stay
+    // within 0.2 mm and half a degree of it, the manifolds are moved, not recomputed.
+    bool cached = false;
+    bool reused = false;  // this step's manifolds were moved from the cache
+    Vec3 cached_position = Vec3::Zero();
+    Quat cached_rotation = Quat::Identity();
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
     const ContactManifold& manifold_at(int i) const {

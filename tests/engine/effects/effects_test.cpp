@@ -91,3 +91,37 @@ TEST(Effects, NoContactsNoSolverWork) {
     EXPECT_EQ(space.counters().contacts_updated, 0u);
     EXPECT_EQ(space.counters().bodies_integrated, 5u * 20u);
 }
+
+// Collision tests only for pairs that moved: a resting box keeps its manifold (moved
+// with the bodies), a sliding one has it recomputed every step.
+TEST(Effects, RestingContactsKeepTheirManifolds) {
+    Space space(awake());
+    add_ground(space);
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.5));
+    d.position = Vec3(0, 0.5, 0);
+    const BodyHandle box = space.create_body(d);
+    for (int i = 0; i < 60; ++i) space.update();
+    const WorkCounters before = space.counters();
+    for (int i = 0; i < 60; ++i) space.update();
+    const WorkCounters after = space.counters();
+    EXPECT_EQ(after.contacts_updated - before.contacts_updated, 60u);
+    EXPECT_GE(after.manifolds_reused - before.manifolds_reused, 55u);
+    EXPECT_NEAR(space.internal_position(box).y(), 0.5, 0.01);
+}
+
+TEST(Effects, SlidingContactsAreRecomputed) {
+    Space space(awake());
+    add_ground(space, 0);
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.5));
+    d.position = Vec3(0, 0.5, 0);
+    d.friction = 0;
+    d.linear_velocity = Vec3(2, 0, 0);
+    const BodyHandle box = space.create_body(d);
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_EQ(space.counters().contacts_updated, 30u);
+    EXPECT_EQ(space.counters().manifolds_reused, 0u);
+    EXPECT_NEAR(space.internal_position(box).y(), 0.5, 0.01);
+    EXPECT_NEAR(space.internal_linear_velocity(box).x(), 2, 1e-6);
+}

@@ -41,6 +41,7 @@ struct WorkCounters {
     std::uint64_t damping_applied = 0;         // body-substeps with damping
     std::uint64_t gyroscopic_applied = 0;      // body-substeps with gyroscopic torque
     std::uint64_t contacts_updated = 0;        // contact-steps through the narrowphase
+    std::uint64_t manifolds_reused = 0;        // of those, moved with the bodies instead of recomputed
     std::uint64_t contact_points_solved = 0;   // point-iterations in the contact solver
     std::uint64_t restitution_applied = 0;     // points with restitution > 0 checked
     std::uint64_t friction_applied = 0;        // point-iterations with friction > 0
