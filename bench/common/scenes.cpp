@@ -1,5 +1,6 @@
 // Benchmark scenes: the box scenes both engines build, and the Spindle-only mixed pile on
-// a mesh. Positions are computed, never random, so every run builds the same scene.
+// a mesh and chain pile. Positions are computed, never random, so every run builds the
+// same scene.
 #include "common/scenes.hpp"
 
 #include <cmath>
@@ -166,6 +167,51 @@ std::vector<BodyHandle> add_mixed_pile_on_mesh(Space& space, int count) {
         body.position = Vec3(centered(a, kPerRow, kPitch) + shift, 4 + 2 * layer, centered(b, kPerRow, kPitch) + shift);
         body.orientation = Quat(Eigen::AngleAxis<Real>(0.7 * n, Vec3(1, 0.5 * (n % 3), 0.3).normalized()));
         handles.push_back(space.create_body(body));
+    }
+    return handles;
+}
+
+std::vector<BodyHandle> add_chain_pile(Space& space, int chains, int links) {
+    constexpr Real kHalfHeight = 0.25;  // capsule links 0.7 m tip to tip, 0.2 m thick
+    constexpr Real kRadius = 0.1;
+    constexpr Real kLinkLength = 2 * (kHalfHeight + kRadius);  // centre to centre: tips touch
+    constexpr int kChainsPerLayer = 10;
+    constexpr Real kChainPitch = 0.7;    // side by side in a layer: 0.5 m gaps to fall through
+    constexpr Real kLayerPitch = 0.5;    // vertical: 0.3 m gaps, so no body starts in contact
+    constexpr Real kBottomHeight = 1.0;  // the bottom layer falls too
+    // Each layer turned ~63 degrees from the one below: links cross at varied angles and
+    // slide off each other, rather than stacking into a square woodpile that stays ordered.
+    constexpr Real kLayerTurn = 1.1;  // rad
+
+    BodyDesc floor;
+    floor.type = MotionType::Static;
+    floor.shape = Shape::box(Vec3(20, 1, 20));  // top face at y = 0, well beyond the pile
+    floor.position = Vec3(0, -1, 0);
+    space.create_body(floor);
+
+    BodyDesc link;
+    link.shape = Shape::capsule(kHalfHeight, kRadius);
+    link.allow_interpolation = false;
+    std::vector<BodyHandle> handles;
+    handles.reserve(static_cast<std::size_t>(chains * links));
+    for (int c = 0; c < chains; ++c) {
+        const int layer = c / kChainsPerLayer;
+        const Real angle = kLayerTurn * layer;
+        const Vec3 along(std::cos(angle), 0, std::sin(angle));  // the chain's direction
+        const Vec3 across(-along.z(), 0, along.x());
+        const Vec3 center = across * centered(c % kChainsPerLayer, kChainsPerLayer, kChainPitch) +
+                            Vec3(0, kBottomHeight + kLayerPitch * layer, 0);
+        const Vec3 first_tip = center - along * (kLinkLength * links / 2);
+        link.orientation = Quat::FromTwoVectors(Vec3::UnitY(), along);  // capsules are built along y
+        for (int i = 0; i < links; ++i) {
+            link.position = first_tip + along * (kLinkLength * (i + 0.5));
+            const BodyHandle body = space.create_body(link);
+            if (i > 0) {
+                const Vec3 touching_tips = first_tip + along * (kLinkLength * i);
+                space.create_joint(JointDesc::ball_socket_at(handles.back(), body, touching_tips));
+            }
+            handles.push_back(body);
+        }
     }
     return handles;
 }

@@ -53,6 +53,12 @@ std::vector<BodyHandle> add_to_space(Space& space, const BoxScene& scene, const 
 // dropped from a grid onto a static rolling-terrain triangle mesh; returns their handles.
 std::vector<BodyHandle> add_mixed_pile_on_mesh(Space& space, int count);
 
+// `chains` free chains of `links` capsule links each, ball-socket jointed where neighbouring
+// links touch, dropped in layers of 10 parallel chains (each layer turned against the one
+// below) onto a static floor box, to fall and tangle into a pile; returns the links' handles,
+// chain by chain.
+std::vector<BodyHandle> add_chain_pile(Space& space, int chains, int links);
+
 // Height of a body's position (internal state: the update thread, between updates).
 Real height_of(const Space& space, BodyHandle body);
 

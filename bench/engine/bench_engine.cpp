@@ -1,5 +1,7 @@
 // bench_engine: Spindle's throughput on named scenes (the table below), each at 1 and 2
 // threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
+// Scenes: Jolt's pyramid, 196 small pyramids, a mixed pile on a terrain mesh, a pile of 100
+// jointed capsule chains, and a 10k box grid awake and asleep.
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
@@ -18,10 +20,6 @@
 #include <string>
 #include <vector>
 
-#if __has_include(<spindle/engine/joint.hpp>)
-#define SPINDLE_BENCH_JOINT_HEADER 1
-#endif
-
 namespace spindle::bench {
 namespace {
 
@@ -29,6 +27,7 @@ enum class SceneKind {
     Pyramid,          // Jolt's pyramid (as bench_peers), from the drop
     ManyPyramids,     // 196 small pyramids, from rest
     MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
+    ChainPile,        // 100 ball-socket chains of 10 capsules landing in a tangle (ragdoll-pile load)
     GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
     GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
 };
@@ -46,12 +45,17 @@ constexpr EngineScene kScenes[] = {
     {"pyramid", SceneKind::Pyramid, 300},
     {"many_pyramids", SceneKind::ManyPyramids, 40},
     {"mixed_pile_on_mesh", SceneKind::MixedPileOnMesh, 200},
+    {"chain_pile", SceneKind::ChainPile, 100},
     {"grid_10k_awake", SceneKind::GridAwake, 60},
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
 };
 
 constexpr int kGridPerSide = 100;     // 10,000 boxes
 constexpr int kMixedPileBodies = 2048;
+constexpr int kChains = 100;
+constexpr int kLinksPerChain = 10;
+// The top layer lands after about 60 steps: timing starts on a pile, not on free fall.
+constexpr int kChainSettleSteps = 60;
 constexpr int kGridSettleSteps = 30;  // awake grid: contacts made and warm before timing
 constexpr int kMaxStepsToSleep = 600;
 
@@ -77,18 +81,23 @@ Built build(SceneKind kind, unsigned threads, double& bytes_per_body) {
         case SceneKind::ManyPyramids: boxes = many_pyramids_scene(); break;
         case SceneKind::GridAwake:
         case SceneKind::GridSleeping: boxes = box_grid_scene(kGridPerSide); break;
-        case SceneKind::MixedPileOnMesh: break;
+        case SceneKind::MixedPileOnMesh:
+        case SceneKind::ChainPile: break;
     }
     const std::int64_t heap_before = live_heap_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
     Space& space = *built.space;
     if (kind == SceneKind::MixedPileOnMesh) {
         built.bodies = add_mixed_pile_on_mesh(space, kMixedPileBodies);
+    } else if (kind == SceneKind::ChainPile) {
+        built.bodies = add_chain_pile(space, kChains, kLinksPerChain);
     } else {
         built.bodies = add_to_space(space, boxes, {.floor = FloorShape::Box, .allow_sleep = settings.sleep.enabled});
     }
     if (kind == SceneKind::GridAwake) {
         for (int i = 0; i < kGridSettleSteps; ++i) space.update();
+    } else if (kind == SceneKind::ChainPile) {
+        for (int i = 0; i < kChainSettleSteps; ++i) space.update();
     } else if (kind == SceneKind::GridSleeping) {
         int steps = 0;
         do {
@@ -132,11 +141,6 @@ void print_notes() {
         std::printf("  threads:%u runs %u worker(s) (bench/common/jobs.hpp make_bench_jobs)\n", threads,
                     make_bench_jobs(threads)->worker_count());
     }
-#ifdef SPINDLE_BENCH_JOINT_HEADER
-    std::printf("  chain/ragdoll scene: skipped; spindle/engine/joint.hpp exists now, the scene is still to be written\n");
-#else
-    std::printf("  chain/ragdoll scene: skipped (spindle/engine/joint.hpp is not on main)\n");
-#endif
     std::fflush(stdout);
 }
 
