@@ -176,6 +176,23 @@ TEST(WorkStealing, TheWaitingThreadRunsJobs) {
     jobs->wait(group);
 }
 
+TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {
+    // Worker 1 runs `quick` (group first), then `blocker` (group second), which waits
+    // until the main thread saw `first` done: a worker must not hold back the count of
+    // a finished job while it runs a job of another group.
+    auto jobs = make(2);
+    JobGroup first;
+    JobGroup second;
+    std::atomic<bool> first_seen_done{false};
+    jobs->submit_pinned(1, second, "blocker", [&] {
+        while (!first_seen_done.load()) std::this_thread::yield();
+    });
+    jobs->submit_pinned(1, first, "quick", [] {});  // the mailbox runs the newest first
+    jobs->wait(first);
+    first_seen_done.store(true);
+    jobs->wait(second);
+}
+
 TEST(WorkStealing, ExceptionsReachTheWaiter) {
     auto jobs = make(2);
     EXPECT_THROW(jobs->parallel_for("boom", 0, 100, 1,
