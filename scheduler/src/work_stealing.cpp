@@ -1,6 +1,7 @@
 // WorkStealingJobSystem: Chase-Lev deques of small tasks, binary range splitting for
-// parallel_for (chunk boundaries fixed by the grain), per-worker pools of job records
-// for submit, per-worker mailboxes for pinned jobs, and sleeping with C++20 atomic wait.
+// parallel_for on demand (chunk boundaries fixed by the grain), per-worker pools of job
+// records for submit, per-worker mailboxes for pinned jobs, and sleeping with C++20
+// atomic wait.
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/spin.hpp>
@@ -68,6 +69,11 @@ public:
         return m_top.compare_exchange_strong(t, t + 1, std::memory_order_seq_cst);
     }
 
+    // The owner's cheap look: a hint, exact only when no thief is stealing.
+    bool looks_empty() const {
+        return m_top.load(std::memory_order_relaxed) >= m_bottom.load(std::memory_order_relaxed);
+    }
+
     bool maybe_nonempty() const {
         return m_top.load(std::memory_order_seq_cst) < m_bottom.load(std::memory_order_seq_cst);
     }
@@ -99,6 +105,7 @@ struct Worker {
     std::atomic<bool> has_mail{false};
     std::vector<TraceEvent> events;  // written only by the thread acting as this worker
     std::vector<JobRecord*> free_records;  // this worker's record pool (see m_free_records)
+    bool idle = false;                     // counted in the system's m_idle
 
     // Finished jobs of `finished_group` not yet taken off its pending count. Jobs of
     // one group run back to back are counted down in one atomic operation: while this
@@ -115,6 +122,7 @@ struct Worker {
     // Pushes a task and wakes a sleeping worker to steal it.
     bool push(TaskHeader* task, std::uint64_t range);
     void flush_finished();
+    void set_idle(bool now_idle);
     void record(const char* name, const char* stage, std::int64_t begin, std::int64_t end) {
         events.push_back(TraceEvent{name, stage, begin, end, index, pu >= 0 ? pu : current_cpu()});
     }
@@ -159,15 +167,20 @@ using detail::Worker;
 
 namespace {
 
-// Runs chunks [first, last) of a parallel_for: keeps splitting off the upper half for
-// thieves (so a thief takes a big piece), and runs one chunk at a time.
+// Runs chunks [first, last) of a parallel_for one at a time. While some worker is
+// idle and nothing is left in our deque for it, it splits off the upper half for it to
+// steal (so a thief takes a big piece); otherwise it just runs on, without touching the
+// deque: the split is only on demand, like TBB's auto partitioner, yet each chunk is
+// still [begin + i*grain, ...), so which worker runs it never changes what it computes.
+// The empty-deque condition leaves at most one piece (and one wake-up) waiting.
 void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
     auto* ctx = static_cast<ForContext*>(header);
     auto first = static_cast<std::uint32_t>(range >> 32);
     auto last = static_cast<std::uint32_t>(range & 0xffffffffu);
     const bool tracing = self.system->trace_enabled();
+    std::uint32_t ran = 0;
     while (first < last) {
-        if (last - first > 1) {
+        if (last - first > 1 && self.system->has_idle_worker() && self.deque.looks_empty()) {
             const std::uint32_t mid = first + (last - first) / 2;
             if (self.push(ctx, detail::pack(mid, last))) last = mid;  // full deque: run it all here
         }
@@ -185,8 +198,11 @@ void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
             if (tracing) self.record(ctx->name, "parallel_for", t0, now_nanoseconds());
         }
         ++first;
-        ctx->remaining.fetch_sub(1, std::memory_order_acq_rel);
+        ++ran;
     }
+    // One decrement for the chunks run here (those split off count themselves); after
+    // it the context may be gone, as the caller returns once `remaining` is zero.
+    ctx->remaining.fetch_sub(ran, std::memory_order_acq_rel);
 }
 
 }  // namespace
@@ -217,6 +233,12 @@ void Worker::flush_finished() {
     // After the decrement the group may be gone (its waiter returns): forget it first.
     JobGroup* const group = std::exchange(finished_group, nullptr);
     if (finished_count > 0) GroupAccess::done(*group, std::exchange(finished_count, 0));
+}
+
+void Worker::set_idle(bool now_idle) {
+    if (idle == now_idle) return;  // the shared counter changes only on a transition
+    idle = now_idle;
+    system->m_idle.value.fetch_add(now_idle ? 1 : -1, std::memory_order_relaxed);
 }
 
 }  // namespace detail
@@ -297,15 +319,18 @@ bool WorkStealingJobSystem::run_one(Worker& self) {
     }
     if (!found) {
         self.flush_finished();
+        self.set_idle(true);
         return false;
     }
+    self.set_idle(false);
     if (task->group != self.finished_group) self.flush_finished();
     task->run(task, range, self);
     return true;
 }
 
-// Runs jobs as `self` until done() holds, spinning while it finds none. Returns holding
-// no finished jobs back: the caller may go on with long work of its own.
+// Runs jobs as `self` until done() holds, idle (spinning, counted in m_idle so that busy
+// workers split their ranges for it) while it finds none. Returns no longer idle and
+// holding no finished jobs back: the caller may go on with long work of its own.
 template <typename Done>
 void WorkStealingJobSystem::run_until(Worker& self, Done done) {
     Backoff backoff;
@@ -316,6 +341,7 @@ void WorkStealingJobSystem::run_until(Worker& self, Done done) {
             backoff.spin();
         }
     }
+    self.set_idle(false);
     self.flush_finished();
 }
 
@@ -370,8 +396,9 @@ void WorkStealingJobSystem::worker_main(unsigned index) {
             backoff.spin();
             continue;
         }
-        // Sleep until work arrives. Announcing the sleep before the last look for work
-        // pairs with push's check of m_sleeping, so no wake-up is missed.
+        // Sleep until work arrives. A sleeper stays idle, so a worker with a range splits
+        // it and the push wakes the sleeper. Announcing the sleep before the last look
+        // for work pairs with push's check of m_sleeping, so no wake-up is missed.
         const std::uint32_t epoch = m_wake.value.load(std::memory_order_seq_cst);
         m_sleeping.value.fetch_add(1, std::memory_order_seq_cst);
         if (!any_work() && !m_stop.load(std::memory_order_seq_cst)) {
@@ -381,6 +408,7 @@ void WorkStealingJobSystem::worker_main(unsigned index) {
         backoff.reset();
         idle_since = 0;
     }
+    self.set_idle(false);
     detail::tls_worker = nullptr;
 }
 
@@ -395,7 +423,12 @@ void WorkStealingJobSystem::parallel_for(const char* name, std::uint32_t begin, 
     Worker& self = scope.worker;
     ForContext ctx(fn, name, begin, end, grain, chunks);
     ctx.run = &run_for;
-    run_for(&ctx, detail::pack(0, chunks), self);
+    // Offer the upper half at once, whether or not a worker is idle yet: the push wakes
+    // sleeping workers, and one spinning between two calls steals it without waiting for
+    // the caller to notice it. Splitting after that is on demand (run_for).
+    std::uint32_t mine = chunks;
+    if (chunks > 1 && worker_count() > 1 && self.push(&ctx, detail::pack(chunks / 2, chunks))) mine = chunks / 2;
+    run_for(&ctx, detail::pack(0, mine), self);
     // Our share is done; help with anything (thieves hold the rest of ours) until every
     // chunk finished. The context lives on this stack, so we must not return earlier.
     run_until(self, [&ctx] { return ctx.remaining.load(std::memory_order_acquire) == 0; });

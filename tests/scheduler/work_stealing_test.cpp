@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -174,6 +176,19 @@ TEST(WorkStealing, TheWaitingThreadRunsJobs) {
     EXPECT_EQ(ran.load(), 10);
     release.store(true);
     jobs->wait(group);
+}
+
+TEST(WorkStealing, AnIdleWorkerGetsPartOfABusyWorkersRange) {
+    // The lower half is free, the upper half slow: the worker done with its half must be
+    // handed part of the other's (ranges are split on demand, not up front).
+    auto jobs = make(2);
+    std::vector<unsigned> ran_by(16, 99);
+    jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
+        if (lo >= 8) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        ran_by[lo] = worker;
+    });
+    EXPECT_NE(std::count(ran_by.begin() + 8, ran_by.end(), 0u), 0) << "worker 0 ran none of the slow half";
+    EXPECT_NE(std::count(ran_by.begin() + 8, ran_by.end(), 1u), 0) << "worker 1 ran none of the slow half";
 }
 
 TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {

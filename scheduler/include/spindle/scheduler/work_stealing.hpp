@@ -114,6 +114,11 @@ public:
 
     static constexpr std::size_t kInlineBytes = sizeof(detail::JobRecord::storage);
 
+    // True while some worker looks for work and finds none, or sleeps for want of it:
+    // a worker running a parallel_for range then splits it so the idle one can steal
+    // half (the push wakes a sleeper). Any thread.
+    bool has_idle_worker() const noexcept { return m_idle.value.load(std::memory_order_relaxed) > 0; }
+
 private:
     friend struct detail::Worker;
 
@@ -153,10 +158,12 @@ private:
     std::vector<std::unique_ptr<detail::Worker>> m_workers;
     std::vector<std::thread> m_threads;
     std::atomic<bool> m_stop{false};
-    // Each hot counter on its own cache line: m_sleeping is read per push while the
-    // others change; sharing a line would make every read a miss.
+    // Each hot counter on its own cache line: m_idle is read per parallel_for chunk and
+    // m_sleeping per push, while the others change; sharing a line would make every
+    // read a miss.
     CacheLinePadded<std::atomic<std::uint32_t>> m_wake;      // bumped when work arrives (sleepers wait on it)
     CacheLinePadded<std::atomic<std::int32_t>> m_sleeping;
+    CacheLinePadded<std::atomic<std::int32_t>> m_idle;       // workers looking for work or asleep
     std::atomic<std::uint64_t> m_foreign_submitted{0};        // pinned jobs submitted by non-worker threads
     // Own cache lines: the external thread locks m_external once per submit, and every
     // job reads m_trace_on; on one line each lock would take the line from the workers.
