@@ -180,15 +180,21 @@ TEST(WorkStealing, TheWaitingThreadRunsJobs) {
 
 TEST(WorkStealing, AnIdleWorkerGetsPartOfABusyWorkersRange) {
     // The lower half is free, the upper half slow: the worker done with its half must be
-    // handed part of the other's (ranges are split on demand, not up front).
+    // handed part of the other's (ranges are split on demand, not up front). Without that
+    // split one worker runs the whole slow half every time; with it, both share it unless
+    // the OS kept a worker off its CPU throughout, so a few attempts are allowed.
     auto jobs = make(2);
-    std::vector<unsigned> ran_by(16, 99);
-    jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
-        if (lo >= 8) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        ran_by[lo] = worker;
-    });
-    EXPECT_NE(std::count(ran_by.begin() + 8, ran_by.end(), 0u), 0) << "worker 0 ran none of the slow half";
-    EXPECT_NE(std::count(ran_by.begin() + 8, ran_by.end(), 1u), 0) << "worker 1 ran none of the slow half";
+    bool shared = false;
+    for (int attempt = 0; attempt < 20 && !shared; ++attempt) {
+        std::vector<unsigned> ran_by(16, 99);
+        jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
+            if (lo >= 8) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            ran_by[lo] = worker;
+        });
+        shared = std::count(ran_by.begin() + 8, ran_by.end(), 0u) > 0 &&
+                 std::count(ran_by.begin() + 8, ran_by.end(), 1u) > 0;
+    }
+    EXPECT_TRUE(shared) << "one worker ran the whole slow half in every attempt";
 }
 
 TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {
