@@ -1,7 +1,9 @@
 // Scheduler benchmarks, Spindle and oneTBB side by side, 1 and 2 workers:
 //   EmptyJobs          submit + run + wait of empty jobs (ns per job)
 //   ParallelForTrivial parallel_for over 1e6 trivial items (grain 1024)
-//   ParallelForWork    parallel_for over ~1 ms of real work (1000 items of ~1 us, grain 1)
+//   ParallelForWork    parallel_for over ~1 ms of real work (items:1000, ~1 us each, grain 1)
+//                      and over ~20 us (items:24): the size of a physics stage, where
+//                      starting and joining the other worker dominate
 // Results and the targets they are held to: docs/benchmarks.md.
 #include <cmath>
 #include <cstdint>
@@ -28,6 +30,7 @@ constexpr int empty_batch = 1000;          // jobs per submit-and-wait round
 constexpr std::uint32_t trivial_items = 1'000'000;
 constexpr std::uint32_t trivial_grain = 1024;
 constexpr std::uint32_t work_items = 1000;
+constexpr std::uint32_t short_items = 24;
 constexpr int work_iterations = 220;        // ~1 us per item on the reference machine
 
 // ~1 us of dependent floating-point work per item (a sqrt chain: no vectorising it away).
@@ -72,21 +75,32 @@ void Spindle_ParallelForTrivial(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * trivial_items);
 }
 
+// parallel_for over `items` of ~1 us each, grain 1; state.range(1) is the item count.
 void Spindle_ParallelForWork(benchmark::State& state) {
     auto jobs = spindle_system(static_cast<int>(state.range(0)));
-    std::vector<float> out(work_items);
+    const auto items = static_cast<std::uint32_t>(state.range(1));
+    std::vector<float> out(items);
     for (auto _ : state) {
-        jobs->parallel_for("work", 0, work_items, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        jobs->parallel_for("work", 0, items, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
             for (std::uint32_t i = lo; i < hi; ++i) out[i] = work_item(i);
         });
         benchmark::DoNotOptimize(out.data());
     }
-    state.SetItemsProcessed(state.iterations() * work_items);
+    state.SetItemsProcessed(state.iterations() * items);
+}
+
+// Work cases: ~1 ms and ~20 us of work, 1 and 2 workers.
+void work_cases(benchmark::internal::Benchmark* b) {
+    b->ArgNames({"workers", "items"});
+    for (const std::int64_t items : {std::int64_t{work_items}, std::int64_t{short_items}}) {
+        for (const std::int64_t workers : {1, 2}) b->Args({workers, items});
+    }
+    b->UseRealTime();
 }
 
 BENCHMARK(Spindle_EmptyJobs)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
 BENCHMARK(Spindle_ParallelForTrivial)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
-BENCHMARK(Spindle_ParallelForWork)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
+BENCHMARK(Spindle_ParallelForWork)->Apply(work_cases);
 
 #ifdef SPINDLE_BENCH_HAVE_TBB
 
@@ -133,12 +147,13 @@ void TBB_ParallelForTrivial(benchmark::State& state) {
 template <typename Partitioner>
 void TBB_ParallelForWork(benchmark::State& state) {
     tbb::task_arena& arena = tbb_arena(static_cast<int>(state.range(0)));
-    std::vector<float> out(work_items);
+    const auto items = static_cast<std::uint32_t>(state.range(1));
+    std::vector<float> out(items);
     arena.execute([&] {
         for (auto _ : state) {
             Partitioner partitioner;
             tbb::parallel_for(
-                tbb::blocked_range<std::uint32_t>(0, work_items, 1),
+                tbb::blocked_range<std::uint32_t>(0, items, 1),
                 [&](const tbb::blocked_range<std::uint32_t>& r) {
                     for (std::uint32_t i = r.begin(); i < r.end(); ++i) out[i] = work_item(i);
                 },
@@ -146,15 +161,15 @@ void TBB_ParallelForWork(benchmark::State& state) {
             benchmark::DoNotOptimize(out.data());
         }
     });
-    state.SetItemsProcessed(state.iterations() * work_items);
+    state.SetItemsProcessed(state.iterations() * items);
 }
 
 BENCHMARK(TBB_EmptyJobs)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
 // simple_partitioner: the same chunks as Spindle's; auto_partitioner: TBB's default.
 BENCHMARK_TEMPLATE(TBB_ParallelForTrivial, tbb::simple_partitioner)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
 BENCHMARK_TEMPLATE(TBB_ParallelForTrivial, tbb::auto_partitioner)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
-BENCHMARK_TEMPLATE(TBB_ParallelForWork, tbb::simple_partitioner)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
-BENCHMARK_TEMPLATE(TBB_ParallelForWork, tbb::auto_partitioner)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
+BENCHMARK_TEMPLATE(TBB_ParallelForWork, tbb::simple_partitioner)->Apply(work_cases);
+BENCHMARK_TEMPLATE(TBB_ParallelForWork, tbb::auto_partitioner)->Apply(work_cases);
 
 #endif
 

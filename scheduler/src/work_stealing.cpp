@@ -1,6 +1,7 @@
 // WorkStealingJobSystem: Chase-Lev deques of small tasks, binary range splitting for
-// parallel_for (chunk boundaries fixed by the grain), pooled job records for submit,
-// per-worker mailboxes for pinned jobs, and sleeping with C++20 atomic wait.
+// parallel_for on demand (chunk boundaries fixed by the grain), per-worker pools of job
+// records for submit, per-worker mailboxes for pinned jobs, and sleeping with C++20
+// atomic wait.
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/spin.hpp>
@@ -26,8 +27,12 @@ public:
 
     bool push(TaskHeader* task, std::uint64_t range) {
         const std::int64_t b = m_bottom.load(std::memory_order_relaxed);
-        const std::int64_t t = m_top.load(std::memory_order_acquire);
-        if (b - t >= kCapacity) return false;
+        // Top only grows, so a stale copy can only under-report the free room: read the
+        // thieves' cache line only when the copy says the deque may be full.
+        if (b - m_top_seen >= kCapacity) {
+            m_top_seen = m_top.load(std::memory_order_acquire);
+            if (b - m_top_seen >= kCapacity) return false;
+        }
         Slot& s = m_slots[b & (kCapacity - 1)];
         s.task.store(task, std::memory_order_relaxed);
         s.range.store(range, std::memory_order_relaxed);
@@ -64,6 +69,11 @@ public:
         return m_top.compare_exchange_strong(t, t + 1, std::memory_order_seq_cst);
     }
 
+    // The owner's cheap look: a hint, exact only when no thief is stealing.
+    bool looks_empty() const {
+        return m_top.load(std::memory_order_relaxed) >= m_bottom.load(std::memory_order_relaxed);
+    }
+
     bool maybe_nonempty() const {
         return m_top.load(std::memory_order_seq_cst) < m_bottom.load(std::memory_order_seq_cst);
     }
@@ -75,8 +85,14 @@ private:
     };
     alignas(cache_line_size) std::atomic<std::int64_t> m_top{0};
     alignas(cache_line_size) std::atomic<std::int64_t> m_bottom{0};
+    std::int64_t m_top_seen = 0;  // the owner's last look at m_top
     Slot m_slots[kCapacity];
 };
+
+// Adds one to a counter only its worker writes: a plain store, no locked instruction.
+inline void bump(std::atomic<std::uint64_t>& counter) {
+    counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+}
 
 struct Worker {
     WorkStealingJobSystem* system = nullptr;
@@ -88,9 +104,25 @@ struct Worker {
     std::vector<JobRecord*> mailbox;
     std::atomic<bool> has_mail{false};
     std::vector<TraceEvent> events;  // written only by the thread acting as this worker
+    std::vector<JobRecord*> free_records;  // this worker's record pool (see m_free_records)
+    bool idle = false;                     // counted in the system's m_idle
+
+    // Finished jobs of `finished_group` not yet taken off its pending count. Jobs of
+    // one group run back to back are counted down in one atomic operation: while this
+    // worker runs another job of the same group the group cannot be done anyway, so
+    // the delay never holds up a waiter. Flushed before anything else runs or idles.
+    JobGroup* finished_group = nullptr;
+    std::int64_t finished_count = 0;
+
+    // Submitted and finished jobs, each written only by this worker (no shared
+    // counter bounces between cores per job); the destructor compares the sums.
+    std::atomic<std::uint64_t> jobs_submitted{0};
+    std::atomic<std::uint64_t> jobs_finished{0};
 
     // Pushes a task and wakes a sleeping worker to steal it.
     bool push(TaskHeader* task, std::uint64_t range);
+    void flush_finished();
+    void set_idle(bool now_idle);
     void record(const char* name, const char* stage, std::int64_t begin, std::int64_t end) {
         events.push_back(TraceEvent{name, stage, begin, end, index, pu >= 0 ? pu : current_cpu()});
     }
@@ -124,6 +156,8 @@ inline std::uint64_t pack(std::uint32_t first, std::uint32_t last) { return (std
 
 // How long an idle worker spins before it sleeps.
 constexpr std::int64_t kSpinBeforeSleepNs = 200'000;
+// Job records a worker trades with the shared pool at once.
+constexpr std::size_t kRecordBatch = 64;
 
 using detail::ForContext;
 using detail::JobRecord;
@@ -133,15 +167,20 @@ using detail::Worker;
 
 namespace {
 
-// Runs chunks [first, last) of a parallel_for: keeps splitting off the upper half for
-// thieves (so a thief takes a big piece), and runs one chunk at a time.
+// Runs chunks [first, last) of a parallel_for one at a time. While some worker is
+// idle and nothing is left in our deque for it, it splits off the upper half for it to
+// steal (so a thief takes a big piece); otherwise it just runs on, without touching the
+// deque: the split is only on demand, like TBB's auto partitioner, yet each chunk is
+// still [begin + i*grain, ...), so which worker runs it never changes what it computes.
+// The empty-deque condition leaves at most one piece (and one wake-up) waiting.
 void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
     auto* ctx = static_cast<ForContext*>(header);
     auto first = static_cast<std::uint32_t>(range >> 32);
     auto last = static_cast<std::uint32_t>(range & 0xffffffffu);
     const bool tracing = self.system->trace_enabled();
+    std::uint32_t ran = 0;
     while (first < last) {
-        if (last - first > 1) {
+        if (last - first > 1 && self.system->has_idle_worker() && self.deque.looks_empty()) {
             const std::uint32_t mid = first + (last - first) / 2;
             if (self.push(ctx, detail::pack(mid, last))) last = mid;  // full deque: run it all here
         }
@@ -159,11 +198,12 @@ void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
             if (tracing) self.record(ctx->name, "parallel_for", t0, now_nanoseconds());
         }
         ++first;
-        ctx->remaining.fetch_sub(1, std::memory_order_acq_rel);
+        ++ran;
     }
+    // One decrement for the chunks run here (those split off count themselves); after
+    // it the context may be gone, as the caller returns once `remaining` is zero.
+    ctx->remaining.fetch_sub(ran, std::memory_order_acq_rel);
 }
-
-void finish_group(JobGroup& group);
 
 }  // namespace
 
@@ -173,7 +213,7 @@ struct GroupAccess {
         std::scoped_lock guard(g.m_error_lock);
         if (!g.m_error) g.m_error = std::move(e);
     }
-    static void done(JobGroup& g) { g.m_pending.fetch_sub(1, std::memory_order_acq_rel); }
+    static void done(JobGroup& g, std::int64_t jobs) { g.m_pending.fetch_sub(jobs, std::memory_order_acq_rel); }
     static void add(JobGroup& g) { g.m_pending.fetch_add(1, std::memory_order_relaxed); }
     static std::exception_ptr take_error(JobGroup& g) {
         std::scoped_lock guard(g.m_error_lock);
@@ -181,18 +221,24 @@ struct GroupAccess {
     }
 };
 
-namespace {
-
-void finish_group(JobGroup& group) { GroupAccess::done(group); }
-
-}  // namespace
-
 namespace detail {
 
 bool Worker::push(TaskHeader* task, std::uint64_t range) {
     if (!deque.push(task, range)) return false;
     system->wake_one_if_sleeping();
     return true;
+}
+
+void Worker::flush_finished() {
+    // After the decrement the group may be gone (its waiter returns): forget it first.
+    JobGroup* const group = std::exchange(finished_group, nullptr);
+    if (finished_count > 0) GroupAccess::done(*group, std::exchange(finished_count, 0));
+}
+
+void Worker::set_idle(bool now_idle) {
+    if (idle == now_idle) return;  // the shared counter changes only on a transition
+    idle = now_idle;
+    system->m_idle.value.fetch_add(now_idle ? 1 : -1, std::memory_order_relaxed);
 }
 
 }  // namespace detail
@@ -207,6 +253,7 @@ WorkStealingJobSystem::WorkStealingJobSystem(Options options) : m_options(std::m
         w->index = i;
         w->pu = i == 0 ? -1 : static_cast<int>(m_options.worker_pus[i]);  // worker 0 is whoever calls
         w->rng = 0x9E3779B97F4A7C15ull * (i + 1);
+        w->free_records.reserve(2 * kRecordBatch + 1);  // release_record never grows it further
         m_workers.push_back(std::move(w));
     }
     for (unsigned i = 1; i < m_workers.size(); ++i) m_threads.emplace_back([this, i] { worker_main(i); });
@@ -215,17 +262,10 @@ WorkStealingJobSystem::WorkStealingJobSystem(Options options) : m_options(std::m
 WorkStealingJobSystem::~WorkStealingJobSystem() {
     // Drain: queued and pinned jobs all run (worker 0's share on this thread) before
     // the workers are told to stop.
-    bool entered = false;
-    Worker& self = enter(entered);
-    Backoff backoff;
-    while (m_outstanding.load(std::memory_order_acquire) > 0) {
-        if (run_one(self)) {
-            backoff.reset();
-        } else {
-            backoff.spin();
-        }
+    {
+        const WorkerScope scope(*this);
+        run_until(scope.worker, [this] { return !any_job_unfinished(); });
     }
-    leave(entered);
     m_stop.store(true, std::memory_order_seq_cst);
     wake_all();
     for (std::thread& t : m_threads) t.join();
@@ -233,10 +273,14 @@ WorkStealingJobSystem::~WorkStealingJobSystem() {
 
 // ---- worker 0: the calling thread ----
 
+Worker* WorkStealingJobSystem::current_worker() const noexcept {
+    return detail::tls_worker && detail::tls_worker->system == this ? detail::tls_worker : nullptr;
+}
+
 Worker& WorkStealingJobSystem::enter(bool& entered) {
-    if (detail::tls_worker && detail::tls_worker->system == this) {
+    if (Worker* self = current_worker()) {
         entered = false;
-        return *detail::tls_worker;
+        return *self;
     }
     m_external.lock();  // one external thread acts as worker 0 at a time
     entered = true;
@@ -273,9 +317,32 @@ bool WorkStealingJobSystem::run_one(Worker& self) {
             if (v != self.index) found = m_workers[v]->deque.steal(task, range);
         }
     }
-    if (!found) return false;
+    if (!found) {
+        self.flush_finished();
+        self.set_idle(true);
+        return false;
+    }
+    self.set_idle(false);
+    if (task->group != self.finished_group) self.flush_finished();
     task->run(task, range, self);
     return true;
+}
+
+// Runs jobs as `self` until done() holds, idle (spinning, counted in m_idle so that busy
+// workers split their ranges for it) while it finds none. Returns no longer idle and
+// holding no finished jobs back: the caller may go on with long work of its own.
+template <typename Done>
+void WorkStealingJobSystem::run_until(Worker& self, Done done) {
+    Backoff backoff;
+    while (!done()) {
+        if (run_one(self)) {
+            backoff.reset();
+        } else {
+            backoff.spin();
+        }
+    }
+    self.set_idle(false);
+    self.flush_finished();
 }
 
 bool WorkStealingJobSystem::any_work() const {
@@ -285,16 +352,26 @@ bool WorkStealingJobSystem::any_work() const {
     return false;
 }
 
+bool WorkStealingJobSystem::any_job_unfinished() const {
+    // Finished counts first: a job seen finished was submitted before, so its submit is
+    // then seen too, and the difference never under-counts.
+    std::uint64_t finished = 0;
+    for (const auto& w : m_workers) finished += w->jobs_finished.load(std::memory_order_acquire);
+    std::uint64_t submitted = m_foreign_submitted.load(std::memory_order_acquire);
+    for (const auto& w : m_workers) submitted += w->jobs_submitted.load(std::memory_order_acquire);
+    return submitted > finished;
+}
+
 void WorkStealingJobSystem::wake_one_if_sleeping() {
-    if (m_sleeping.load(std::memory_order_seq_cst) > 0) {
-        m_wake.fetch_add(1, std::memory_order_seq_cst);
-        m_wake.notify_all();
+    if (m_sleeping.value.load(std::memory_order_seq_cst) > 0) {
+        m_wake.value.fetch_add(1, std::memory_order_seq_cst);
+        m_wake.value.notify_all();
     }
 }
 
 void WorkStealingJobSystem::wake_all() {
-    m_wake.fetch_add(1, std::memory_order_seq_cst);
-    m_wake.notify_all();
+    m_wake.value.fetch_add(1, std::memory_order_seq_cst);
+    m_wake.value.notify_all();
 }
 
 void WorkStealingJobSystem::worker_main(unsigned index) {
@@ -319,15 +396,19 @@ void WorkStealingJobSystem::worker_main(unsigned index) {
             backoff.spin();
             continue;
         }
-        // Sleep until work arrives. Announcing the sleep before the last look for work
-        // pairs with push's check of m_sleeping, so no wake-up is missed.
-        const std::uint32_t epoch = m_wake.load(std::memory_order_seq_cst);
-        m_sleeping.fetch_add(1, std::memory_order_seq_cst);
-        if (!any_work() && !m_stop.load(std::memory_order_seq_cst)) m_wake.wait(epoch, std::memory_order_seq_cst);
-        m_sleeping.fetch_sub(1, std::memory_order_seq_cst);
+        // Sleep until work arrives. A sleeper stays idle, so a worker with a range splits
+        // it and the push wakes the sleeper. Announcing the sleep before the last look
+        // for work pairs with push's check of m_sleeping, so no wake-up is missed.
+        const std::uint32_t epoch = m_wake.value.load(std::memory_order_seq_cst);
+        m_sleeping.value.fetch_add(1, std::memory_order_seq_cst);
+        if (!any_work() && !m_stop.load(std::memory_order_seq_cst)) {
+            m_wake.value.wait(epoch, std::memory_order_seq_cst);
+        }
+        m_sleeping.value.fetch_sub(1, std::memory_order_seq_cst);
         backoff.reset();
         idle_since = 0;
     }
+    self.set_idle(false);
     detail::tls_worker = nullptr;
 }
 
@@ -338,42 +419,62 @@ void WorkStealingJobSystem::parallel_for(const char* name, std::uint32_t begin, 
     if (end <= begin) return;  // zero items spawn nothing
     if (grain == 0) grain = 1;
     const std::uint32_t chunks = (end - begin - 1) / grain + 1;
-    bool entered = false;
-    Worker& self = enter(entered);
+    const WorkerScope scope(*this);
+    Worker& self = scope.worker;
     ForContext ctx(fn, name, begin, end, grain, chunks);
     ctx.run = &run_for;
-    run_for(&ctx, detail::pack(0, chunks), self);
+    // Offer the upper half at once, whether or not a worker is idle yet: the push wakes
+    // sleeping workers, and one spinning between two calls steals it without waiting for
+    // the caller to notice it. Splitting after that is on demand (run_for).
+    std::uint32_t mine = chunks;
+    if (chunks > 1 && worker_count() > 1 && self.push(&ctx, detail::pack(chunks / 2, chunks))) mine = chunks / 2;
+    run_for(&ctx, detail::pack(0, mine), self);
     // Our share is done; help with anything (thieves hold the rest of ours) until every
     // chunk finished. The context lives on this stack, so we must not return earlier.
-    Backoff backoff;
-    while (ctx.remaining.load(std::memory_order_acquire) > 0) {
-        if (run_one(self)) {
-            backoff.reset();
-        } else {
-            backoff.spin();
-        }
-    }
-    leave(entered);
+    run_until(self, [&ctx] { return ctx.remaining.load(std::memory_order_acquire) == 0; });
     if (ctx.error) std::rethrow_exception(ctx.error);
 }
 
 // ---- submit / wait ----
 
-JobRecord* WorkStealingJobSystem::make_record_raw() {
-    std::scoped_lock guard(m_pool_lock);
-    if (m_free_records.empty()) {
-        constexpr std::size_t kBlock = 1024;
-        m_record_blocks.push_back(std::make_unique<JobRecord[]>(kBlock));
-        for (std::size_t i = 0; i < kBlock; ++i) m_free_records.push_back(&m_record_blocks.back()[i]);
+void WorkStealingJobSystem::check_worker_exists(unsigned worker) const {
+    if (worker >= m_workers.size()) {
+        throw Error("submit_pinned: worker " + std::to_string(worker) + " does not exist (" +
+                    std::to_string(m_workers.size()) + " workers)");
     }
-    JobRecord* r = m_free_records.back();
-    m_free_records.pop_back();
+}
+
+JobRecord* WorkStealingJobSystem::acquire_record(Worker* self) {
+    // A worker refills its own list a batch at a time; a non-worker thread (pinned
+    // submits only) takes one record from the shared list.
+    std::vector<JobRecord*>& from = self ? self->free_records : m_free_records;
+    std::unique_lock guard(m_pool_lock, std::defer_lock);
+    if (!self || from.empty()) {
+        guard.lock();
+        if (m_free_records.size() < kRecordBatch) {
+            constexpr std::size_t kBlock = 1024;
+            m_record_blocks.push_back(std::make_unique<JobRecord[]>(kBlock));
+            for (std::size_t i = 0; i < kBlock; ++i) m_free_records.push_back(&m_record_blocks.back()[i]);
+        }
+        if (self) {
+            from.insert(from.end(), m_free_records.end() - kRecordBatch, m_free_records.end());
+            m_free_records.resize(m_free_records.size() - kRecordBatch);
+        }
+    }
+    JobRecord* r = from.back();
+    from.pop_back();
     return r;
 }
 
-void WorkStealingJobSystem::release_record(JobRecord* record) {
-    std::scoped_lock guard(m_pool_lock);
-    m_free_records.push_back(record);
+void WorkStealingJobSystem::release_record(Worker& self, JobRecord* record) {
+    self.free_records.push_back(record);
+    // A thief frees records another worker took: hand a batch back once it holds too
+    // many, so they do not pile up here while the submitter allocates new ones.
+    if (self.free_records.size() > 2 * kRecordBatch) {
+        std::scoped_lock guard(m_pool_lock);
+        m_free_records.insert(m_free_records.end(), self.free_records.end() - kRecordBatch, self.free_records.end());
+        self.free_records.resize(self.free_records.size() - kRecordBatch);
+    }
 }
 
 void WorkStealingJobSystem::run_record(TaskHeader* header, std::uint64_t, Worker& self) {
@@ -388,51 +489,52 @@ void WorkStealingJobSystem::run_record(TaskHeader* header, std::uint64_t, Worker
     }
     if (tracing) self.record(record->name, "job", t0, now_nanoseconds());
     record->destroy(record->storage);
-    JobGroup& group = *record->group;
-    system.release_record(record);
-    finish_group(group);
-    system.m_outstanding.fetch_sub(1, std::memory_order_acq_rel);
+    // Counted down with the group's next jobs on this worker (see finished_group). A
+    // job of another group may have run meanwhile inside this one (a nested wait).
+    if (self.finished_group != record->group) self.flush_finished();
+    self.finished_group = record->group;
+    self.finished_count += 1;
+    system.release_record(self, record);
+    detail::bump(self.jobs_finished);
 }
 
-void WorkStealingJobSystem::submit_record(JobGroup& group, const char* name, JobRecord* record, int pinned) {
+void WorkStealingJobSystem::submit_record(Worker& self, JobGroup& group, const char* name, JobRecord* record) {
     record->run = &WorkStealingJobSystem::run_record;
     record->group = &group;
     record->name = name;
-    record->pinned = pinned;
     GroupAccess::add(group);
-    m_outstanding.fetch_add(1, std::memory_order_acq_rel);
-    if (pinned >= 0) {
-        if (static_cast<std::size_t>(pinned) >= m_workers.size()) {
-            throw Error("submit_pinned: worker " + std::to_string(pinned) + " does not exist (" +
-                        std::to_string(m_workers.size()) + " workers)");
-        }
-        Worker& target = *m_workers[static_cast<std::size_t>(pinned)];
-        {
-            std::scoped_lock guard(target.mailbox_lock);
-            target.mailbox.push_back(record);
-            target.has_mail.store(true, std::memory_order_seq_cst);
-        }
-        wake_all();  // the target may be asleep; a targeted wake would need per-worker waits
-        return;
+    detail::bump(self.jobs_submitted);
+    if (!self.push(record, 0)) {  // full deque: run it now
+        run_record(record, 0, self);
+        self.flush_finished();  // the submitter may be a job that goes on for long
     }
-    bool entered = false;
-    Worker& self = enter(entered);
-    if (!self.push(record, 0)) run_record(record, 0, self);  // full deque: run it now
-    leave(entered);
+}
+
+void WorkStealingJobSystem::submit_pinned_record(unsigned worker, JobGroup& group, const char* name,
+                                                 JobRecord* record) {
+    record->run = &WorkStealingJobSystem::run_record;
+    record->group = &group;
+    record->name = name;
+    GroupAccess::add(group);
+    if (Worker* self = current_worker()) {
+        detail::bump(self->jobs_submitted);
+    } else {
+        m_foreign_submitted.fetch_add(1, std::memory_order_acq_rel);
+    }
+    Worker& target = *m_workers[worker];
+    {
+        std::scoped_lock guard(target.mailbox_lock);
+        target.mailbox.push_back(record);
+        target.has_mail.store(true, std::memory_order_seq_cst);
+    }
+    wake_all();  // the target may be asleep; a targeted wake would need per-worker waits
 }
 
 void WorkStealingJobSystem::wait(JobGroup& group) {
-    bool entered = false;
-    Worker& self = enter(entered);
-    Backoff backoff;
-    while (!group.done()) {
-        if (run_one(self)) {
-            backoff.reset();
-        } else {
-            backoff.spin();
-        }
+    {
+        const WorkerScope scope(*this);
+        run_until(scope.worker, [&group] { return group.done(); });
     }
-    leave(entered);
     if (std::exception_ptr e = GroupAccess::take_error(group)) std::rethrow_exception(e);
 }
 

@@ -7,7 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -174,6 +176,42 @@ TEST(WorkStealing, TheWaitingThreadRunsJobs) {
     EXPECT_EQ(ran.load(), 10);
     release.store(true);
     jobs->wait(group);
+}
+
+TEST(WorkStealing, AnIdleWorkerGetsPartOfABusyWorkersRange) {
+    // The lower half is free, the upper half slow: the worker done with its half must be
+    // handed part of the other's (ranges are split on demand, not up front). Without that
+    // split one worker runs the whole slow half every time; with it, both share it unless
+    // the OS kept a worker off its CPU throughout, so a few attempts are allowed.
+    auto jobs = make(2);
+    bool shared = false;
+    for (int attempt = 0; attempt < 20 && !shared; ++attempt) {
+        std::vector<unsigned> ran_by(16, 99);
+        jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
+            if (lo >= 8) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            ran_by[lo] = worker;
+        });
+        shared = std::count(ran_by.begin() + 8, ran_by.end(), 0u) > 0 &&
+                 std::count(ran_by.begin() + 8, ran_by.end(), 1u) > 0;
+    }
+    EXPECT_TRUE(shared) << "one worker ran the whole slow half in every attempt";
+}
+
+TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {
+    // Worker 1 runs `quick` (group first), then `blocker` (group second), which waits
+    // until the main thread saw `first` done: a worker must not hold back the count of
+    // a finished job while it runs a job of another group.
+    auto jobs = make(2);
+    JobGroup first;
+    JobGroup second;
+    std::atomic<bool> first_seen_done{false};
+    jobs->submit_pinned(1, second, "blocker", [&] {
+        while (!first_seen_done.load()) std::this_thread::yield();
+    });
+    jobs->submit_pinned(1, first, "quick", [] {});  // the mailbox runs the newest first
+    jobs->wait(first);
+    first_seen_done.store(true);
+    jobs->wait(second);
 }
 
 TEST(WorkStealing, ExceptionsReachTheWaiter) {

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <vector>
 
+#include <spindle/platform/spin.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
 namespace spindle {
@@ -31,6 +32,7 @@ struct Worker;
 // `range` packs the chunks [first, last) for a parallel_for (unused by jobs).
 struct TaskHeader {
     void (*run)(TaskHeader* self, std::uint64_t range, Worker& worker) = nullptr;
+    JobGroup* group = nullptr;  // the job's group; null for a parallel_for
 };
 
 // A submitted job: the callable lives inline (no heap allocation per job).
@@ -38,9 +40,7 @@ struct JobRecord : TaskHeader {
     alignas(std::max_align_t) unsigned char storage[48];
     void (*invoke)(void* storage, unsigned worker) = nullptr;
     void (*destroy)(void* storage) = nullptr;
-    JobGroup* group = nullptr;
     const char* name = "";
-    int pinned = -1;
 };
 }  // namespace detail
 
@@ -78,15 +78,19 @@ public:
 
     // Submits fn into group. The callable is copied into a pooled job record (at most
     // kInlineBytes; no heap allocation). Any thread.
+    // A non-worker thread acts as worker 0 for the call (see parallel_for).
     template <typename F>
     void submit(JobGroup& group, const char* name, F&& fn) {
-        submit_record(group, name, make_record(std::forward<F>(fn)), -1);
+        const WorkerScope scope(*this);
+        submit_record(scope.worker, group, name, make_record(&scope.worker, std::forward<F>(fn)));
     }
-    // As submit, but the job runs only on `worker` (its PU). Any thread. Deadlock: a
+    // As submit, but the job runs only on `worker` (its PU). Any thread; a non-worker
+    // thread does not become worker 0 (it never blocks on the one that is). Deadlock: a
     // pinned job for worker 0 runs only while some thread waits as worker 0.
     template <typename F>
     void submit_pinned(unsigned worker, JobGroup& group, const char* name, F&& fn) {
-        submit_record(group, name, make_record(std::forward<F>(fn)), static_cast<int>(worker));
+        check_worker_exists(worker);
+        submit_pinned_record(worker, group, name, make_record(current_worker(), std::forward<F>(fn)));
     }
     // Runs jobs until every job of the group finished; rethrows the first exception.
     // Who may call: any thread (a non-worker becomes worker 0 meanwhile); from inside a
@@ -110,16 +114,40 @@ public:
 
     static constexpr std::size_t kInlineBytes = sizeof(detail::JobRecord::storage);
 
+    // True while some worker looks for work and finds none, or sleeps for want of it:
+    // a worker running a parallel_for range then splits it so the idle one can steal
+    // half (the push wakes a sleeper). Any thread.
+    bool has_idle_worker() const noexcept { return m_idle.value.load(std::memory_order_relaxed) > 0; }
+
 private:
     friend struct detail::Worker;
-    detail::JobRecord* make_record_raw();
+
+    // The calling thread's worker for the scope: its own if it is one of ours, else
+    // worker 0 (taking the external lock, see parallel_for).
+    struct WorkerScope {
+        explicit WorkerScope(WorkStealingJobSystem& owner) : system(owner), worker(owner.enter(entered)) {}
+        ~WorkerScope() { system.leave(entered); }
+        WorkerScope(const WorkerScope&) = delete;
+        WorkerScope& operator=(const WorkerScope&) = delete;
+        WorkStealingJobSystem& system;
+        bool entered = false;
+        detail::Worker& worker;
+    };
+
+    detail::Worker* current_worker() const noexcept;
+    void check_worker_exists(unsigned worker) const;
+    detail::JobRecord* acquire_record(detail::Worker* self);
     template <typename F>
-    detail::JobRecord* make_record(F&& fn);
-    void submit_record(JobGroup& group, const char* name, detail::JobRecord* record, int pinned);
-    void release_record(detail::JobRecord* record);
+    detail::JobRecord* make_record(detail::Worker* self, F&& fn);
+    void submit_record(detail::Worker& self, JobGroup& group, const char* name, detail::JobRecord* record);
+    void submit_pinned_record(unsigned worker, JobGroup& group, const char* name, detail::JobRecord* record);
+    void release_record(detail::Worker& self, detail::JobRecord* record);
     static void run_record(detail::TaskHeader* header, std::uint64_t range, detail::Worker& self);
     bool run_one(detail::Worker& self);
+    template <typename Done>
+    void run_until(detail::Worker& self, Done done);
     bool any_work() const;
+    bool any_job_unfinished() const;
     void worker_main(unsigned index);
     void wake_one_if_sleeping();
     void wake_all();
@@ -130,27 +158,35 @@ private:
     std::vector<std::unique_ptr<detail::Worker>> m_workers;
     std::vector<std::thread> m_threads;
     std::atomic<bool> m_stop{false};
-    std::atomic<std::uint32_t> m_wake{0};        // bumped when work arrives (sleepers wait on it)
-    std::atomic<std::int32_t> m_sleeping{0};
-    std::atomic<std::int64_t> m_outstanding{0};  // submitted jobs not yet finished
-    std::mutex m_external;                        // one external thread acts as worker 0 at a time
-    std::atomic<bool> m_trace_on{false};
+    // Each hot counter on its own cache line: m_idle is read per parallel_for chunk and
+    // m_sleeping per push, while the others change; sharing a line would make every
+    // read a miss.
+    CacheLinePadded<std::atomic<std::uint32_t>> m_wake;      // bumped when work arrives (sleepers wait on it)
+    CacheLinePadded<std::atomic<std::int32_t>> m_sleeping;
+    CacheLinePadded<std::atomic<std::int32_t>> m_idle;       // workers looking for work or asleep
+    std::atomic<std::uint64_t> m_foreign_submitted{0};        // pinned jobs submitted by non-worker threads
+    // Own cache lines: the external thread locks m_external once per submit, and every
+    // job reads m_trace_on; on one line each lock would take the line from the workers.
+    alignas(cache_line_size) std::mutex m_external;  // one external thread acts as worker 0 at a time
+    alignas(cache_line_size) std::atomic<bool> m_trace_on{false};
     mutable std::mutex m_stage_lock;              // stage spans (a few per step) from the owner thread
     std::vector<TraceEvent> m_stage_events;
     std::vector<std::pair<const char*, std::int64_t>> m_open_stages;
 
-    // Pool of job records for submit(): a free list under a small lock.
+    // Job records for submit(): each worker keeps its own free list and trades batches
+    // with this shared one under the lock, so the lock is taken once per batch, not
+    // per job (a job stolen by another worker is freed into the thief's list).
     std::mutex m_pool_lock;
     std::vector<detail::JobRecord*> m_free_records;
     std::vector<std::unique_ptr<detail::JobRecord[]>> m_record_blocks;
 };
 
 template <typename F>
-detail::JobRecord* WorkStealingJobSystem::make_record(F&& fn) {
+detail::JobRecord* WorkStealingJobSystem::make_record(detail::Worker* self, F&& fn) {
     using Callable = std::decay_t<F>;
     static_assert(sizeof(Callable) <= kInlineBytes, "job callable too large: capture less or capture a pointer");
     static_assert(alignof(Callable) <= alignof(std::max_align_t), "job callable over-aligned");
-    detail::JobRecord* record = make_record_raw();
+    detail::JobRecord* record = acquire_record(self);
     new (record->storage) Callable(std::forward<F>(fn));
     record->invoke = [](void* storage, unsigned worker) {
         Callable& c = *static_cast<Callable*>(storage);
