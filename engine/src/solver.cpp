@@ -8,6 +8,7 @@
 #include "solver.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "stages.hpp"
@@ -50,51 +51,61 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
 }
 
-// One ref per touching manifold of an awake contact, in contact order.
-void list_manifolds(World& world, SolverScratch& scratch) {
+// Contact points of the step's manifolds, for the work counters.
+struct PointCounts {
+    std::uint64_t points = 0, friction = 0, restitution = 0;
+};
+
+// One ref per touching manifold of an awake contact, in contact order; counts their points.
+PointCounts list_manifolds(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     auto solver_index = [&](std::uint32_t slot) {
         const std::int32_t k = b.awake_index[slot];
         return k >= 0 ? static_cast<std::uint32_t>(k) : n;
     };
+    PointCounts counts;
     scratch.manifolds.clear();
     for (std::uint32_t c : awake_contacts(world)) {
         const Contact& contact = world.contacts[c];
         for (int m = 0; m < contact.manifold_count; ++m) {
-            if (contact.manifold_at(m).point_count == 0) continue;
+            const auto points = static_cast<std::uint64_t>(contact.manifold_at(m).point_count);
+            if (points == 0) continue;
             scratch.manifolds.push_back({c, m, solver_index(contact.body_a), solver_index(contact.body_b)});
+            counts.points += points;
+            if (contact.friction > 0) counts.friction += points;
+            if (contact.restitution > 0) counts.restitution += points;
         }
     }
+    return counts;
 }
 
 // Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
 // neither dynamic body of the constraint; -1 when none is free. Static, kinematic and
-// sleeping partners are shared freely: constraints never write them.
+// sleeping partners are shared freely: constraints never write them. Each body keeps a
+// mask of the colours it is in, so the first free colour is one bit scan.
 int assign_color(SolverScratch& scratch, std::uint32_t a, std::uint32_t b) {
+    static_assert(kColorCount <= 32, "one bit per colour in a 32-bit mask");
+    constexpr std::uint32_t kAllColors = kColorCount == 32 ? ~0u : (1u << kColorCount) - 1;
     const bool dyn_a = scratch.bodies[a].dynamic;
     const bool dyn_b = scratch.bodies[b].dynamic;
-    for (int c = 0; c < kColorCount; ++c) {
-        std::vector<std::uint64_t>& bits = scratch.color_bits[c];
-        if (dyn_a && (bits[a / 64] >> (a % 64) & 1)) continue;
-        if (dyn_b && (bits[b / 64] >> (b % 64) & 1)) continue;
-        if (dyn_a) bits[a / 64] |= std::uint64_t{1} << (a % 64);
-        if (dyn_b) bits[b / 64] |= std::uint64_t{1} << (b % 64);
-        return c;
-    }
-    return -1;
+    std::uint32_t* used = scratch.body_colors.data();
+    const std::uint32_t free = kAllColors & ~((dyn_a ? used[a] : 0u) | (dyn_b ? used[b] : 0u));
+    if (free == 0) return -1;
+    const int c = std::countr_zero(free);
+    if (dyn_a) used[a] |= 1u << c;
+    if (dyn_b) used[b] |= 1u << c;
+    return c;
 }
 
 // Joints first, then contacts, in list order (deterministic), sharing the colours'
 // body sets: a colour's joints and contacts together touch each dynamic body once.
-void color(World& world, SolverScratch& scratch) {
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
-    const std::size_t words = (n + 63) / 64;
+void color(SolverScratch& scratch) {
     for (int c = 0; c < kColorCount; ++c) {
         scratch.colors[c].clear();
         scratch.joint_colors[c].clear();
-        scratch.color_bits[c].assign(words, 0);
     }
+    scratch.body_colors.assign(scratch.bodies.size(), 0);
     scratch.overflow.clear();
     scratch.joint_overflow.clear();
     for (std::uint32_t k = 0; k < scratch.joints.size(); ++k) {
@@ -162,9 +173,9 @@ void solve(World& world, Real dt) {
     const Real h = dt / substeps;
 
     prepare_bodies(world, scratch);
-    list_manifolds(world, scratch);
+    const PointCounts points = list_manifolds(world, scratch);
     prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
-    color(world, scratch);
+    color(scratch);
     prepare_contacts(world, scratch);
     SolverBody* bodies = scratch.bodies.data();
 
@@ -207,18 +218,10 @@ void solve(World& world, Real dt) {
     finalize(world, scratch);
 
     // Work counters, derived from the constraint set (no per-point counting in the hot loop).
-    std::uint64_t points = 0, friction_points = 0, restitution_points = 0;
-    for (const ManifoldRef& ref : scratch.manifolds) {
-        const Contact& contact = world.contacts[ref.contact];
-        const auto count = static_cast<std::uint64_t>(contact.manifold_at(ref.manifold).point_count);
-        points += count;
-        if (contact.friction > 0) friction_points += count;
-        if (contact.restitution > 0) restitution_points += count;
-    }
     const auto passes = static_cast<std::uint64_t>(substeps * (settings.iterations + settings.relax_iterations));
-    world.counters.contact_points_solved += points * passes;
-    world.counters.friction_applied += friction_points * passes;
-    world.counters.restitution_applied += restitution_points;
+    world.counters.contact_points_solved += points.points * passes;
+    world.counters.friction_applied += points.friction * passes;
+    world.counters.restitution_applied += points.restitution;
     world.counters.joints_solved += static_cast<std::uint64_t>(scratch.joints.size()) * passes;
     world.counters.bodies_integrated += world.awake.size();
 }

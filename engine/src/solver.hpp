@@ -133,7 +133,7 @@ struct SolverScratch {
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
     std::vector<std::uint32_t> joint_overflow;
-    std::vector<std::uint64_t> color_bits[kColorCount];  // per colour: which dynamic bodies it uses
+    std::vector<std::uint32_t> body_colors;          // per solver body: a bit for each colour it is in
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,
