@@ -88,25 +88,26 @@ void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s)
 }
 
 inline Wide row_speed(const WideVelocities& s, const Wide3& dir, const WideRow& row) {
-    return dot(dir, s.vb - s.va) + dot(row.rb_x, s.wb) - dot(row.ra_x, s.wa);
+    return dot(dir, s.vb - s.va) + dot(widen(row.rb_x), s.wb) - dot(widen(row.ra_x), s.wa);
 }
 
 inline void apply_row(const WideContact& wc, WideVelocities& s, const Wide3& dir, const WideRow& row, Wide L) {
     s.va -= (wc.inv_mass_a * L) * dir;
-    s.wa -= L * row.ia;
+    s.wa -= L * widen(row.ia);
     s.vb += (wc.inv_mass_b * L) * dir;
-    s.wb += L * row.ib;
+    s.wb += L * widen(row.ib);
 }
 
 // A row's angular terms for four lanes; returns the effective masses (0 where nothing moves).
-Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
-              const Wide3& rb, const Wide3& dir, WideRow& row) {
-    row.ra_x = cross(ra, dir);
-    row.rb_x = cross(rb, dir);
-    row.ia = inv_inertia_a * row.ra_x;
-    row.ib = inv_inertia_b * row.rb_x;
-    const Wide k = inv_mass_sum + dot(row.ra_x, row.ia) + dot(row.rb_x, row.ib);
-    return select(k > splat(0), splat(1) / k, splat(0));
+WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
+               const Wide3& rb, const Wide3& dir, WideRow& row) {
+    const Wide3 ra_x = cross(ra, dir);
+    const Wide3 rb_x = cross(rb, dir);
+    const Wide3 ia = inv_inertia_a * ra_x;
+    const Wide3 ib = inv_inertia_b * rb_x;
+    row = {narrow(ra_x), narrow(rb_x), narrow(ia), narrow(ib)};
+    const Wide k = inv_mass_sum + dot(ra_x, ia) + dot(rb_x, ib);
+    return narrow(select(k > splat(0), splat(1) / k, splat(0)));
 }
 
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
@@ -276,9 +277,9 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
             const Wide bias = select(speculative, separation * inv_h, soft_bias);
             const Wide mass_scale = select(speculative, one, splat(params.soft.mass_scale));
             const Wide impulse_scale = select(speculative, zero, splat(params.soft.impulse_scale));
-            impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+            impulse = -widen(p.normal_mass) * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         } else {
-            impulse = -p.normal_mass * (vn + select(speculative, separation * inv_h, zero));
+            impulse = -widen(p.normal_mass) * (vn + select(speculative, separation * inv_h, zero));
         }
         const Wide total = wide_max(p.normal_impulse + impulse, zero);
         impulse = total - p.normal_impulse;
@@ -302,8 +303,8 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
         if (!any(touching)) continue;
         WidePoint& p = wc.points[j];
         const Wide old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
-        Wide new0 = old0 - p.tangent_mass[0] * row_speed(s, wc.tangent[0], p.tangent_row[0]);
-        Wide new1 = old1 - p.tangent_mass[1] * row_speed(s, wc.tangent[1], p.tangent_row[1]);
+        Wide new0 = old0 - widen(p.tangent_mass[0]) * row_speed(s, wc.tangent[0], p.tangent_row[0]);
+        Wide new1 = old1 - widen(p.tangent_mass[1]) * row_speed(s, wc.tangent[1], p.tangent_row[1]);
         // Coulomb's cone: the friction impulse stays within friction x normal impulse.
         const Wide limit = wc.friction * p.normal_impulse;
         const Wide length_sq = new0 * new0 + new1 * new1;
@@ -377,7 +378,7 @@ void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real
         // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
         const Wide approach = p.relative_velocity + wc.gravity_normal * splat(h);
-        const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
+        const Wide impulse = -widen(p.normal_mass) * (vn + wc.restitution * wide_min(approach, zero));
         const Wide total = wide_max(p.normal_impulse + impulse, zero);
         const Wide applied = select(bounce, total - p.normal_impulse, zero);
         p.normal_impulse += applied;

@@ -31,9 +31,10 @@ struct ContactRow {
     Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
 };
 
-// The same row for the four lanes of a WideContact.
+// The same row for the four lanes of a WideContact, in single precision: the solver's
+// passes are bound by the memory they stream, and a row only scales an impulse.
 struct WideRow {
-    Wide3 ra_x, rb_x, ia, ib;
+    Wide3F ra_x, rb_x, ia, ib;
 };
 
 // One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
@@ -42,7 +43,7 @@ struct WidePoint {
     Wide3 ra, rb;                 // anchors from each centre of mass, world, fixed for the step
     Wide adjusted_separation{};   // separation minus n.(rb - ra): current separation = n.d + this
     WideRow normal_row, tangent_row[2];
-    Wide normal_mass{}, tangent_mass[2]{};
+    WideF normal_mass{}, tangent_mass[2]{};
     Wide normal_impulse{}, tangent_impulse[2]{};
     Wide max_normal_impulse{};
     Wide relative_velocity{};     // approach speed at impact (restitution)

@@ -16,6 +16,12 @@ inline constexpr int kLanes = 4;
 using Wide = double __attribute__((vector_size(kLanes * sizeof(double))));
 using WideMask = std::int64_t __attribute__((vector_size(kLanes * sizeof(std::int64_t))));  // lanes: 0 or -1
 
+// Four floats, for data that is only read back (a contact's rows): half the memory a
+// pass streams through. Widened to doubles before any arithmetic.
+using WideF = float __attribute__((vector_size(kLanes * sizeof(float))));
+inline Wide widen(WideF f) { return __builtin_convertvector(f, Wide); }
+inline WideF narrow(Wide d) { return __builtin_convertvector(d, WideF); }
+
 inline Wide splat(Real x) { return Wide{x, x, x, x}; }
 inline Wide wide_max(Wide a, Wide b) { return a > b ? a : b; }
 inline Wide wide_min(Wide a, Wide b) { return a < b ? a : b; }
@@ -34,6 +40,13 @@ struct Wide3 {
         z[i] = v.z();
     }
 };
+
+// A Wide3 stored as floats.
+struct Wide3F {
+    WideF x{}, y{}, z{};
+};
+inline Wide3 widen(const Wide3F& v) { return {widen(v.x), widen(v.y), widen(v.z)}; }
+inline Wide3F narrow(const Wide3& v) { return {narrow(v.x), narrow(v.y), narrow(v.z)}; }
 
 inline Wide3 operator+(const Wide3& a, const Wide3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline Wide3 operator-(const Wide3& a, const Wide3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
