@@ -13,13 +13,24 @@ bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
     return b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic;
 }
 
+// Moves a body's proxy, noting when its fat box changed at all (grown or shrunk: either
+// can end an overlap).
+void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
+    const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
+    bp.tree.move_proxy(bp.proxy[slot], box, displacement);
+    const Aabb& after = bp.tree.fat_aabb(bp.proxy[slot]);
+    if (after.min != before.min || after.max != before.max) bp.refit[slot] = 1;
+}
+
 }  // namespace
 
 void add_proxy(World& world, std::uint32_t slot) {
     BroadphaseState& bp = *world.broadphase;
     const Bodies& b = world.bodies;
     if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
+    if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
     bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
+    bp.refit[slot] = 1;
 }
 
 void remove_proxy(World& world, std::uint32_t slot) {
@@ -29,8 +40,7 @@ void remove_proxy(World& world, std::uint32_t slot) {
 }
 
 void refresh_proxy(World& world, std::uint32_t slot) {
-    BroadphaseState& bp = *world.broadphase;
-    bp.tree.move_proxy(bp.proxy[slot], world.bodies.bounds[slot], Vec3::Zero());
+    move_proxy(*world.broadphase, slot, world.bodies.bounds[slot], Vec3::Zero());
 }
 
 void update_broadphase(World& world, Real dt) {
@@ -52,7 +62,7 @@ void update_broadphase(World& world, Real dt) {
         Aabb swept = b.bounds[i];
         swept.min += d.cwiseMin(Vec3::Zero());
         swept.max += d.cwiseMax(Vec3::Zero());
-        bp.tree.move_proxy(bp.proxy[i], swept, d);
+        move_proxy(bp, i, swept, d);
     }
 
     bp.pairs.clear();
@@ -65,14 +75,17 @@ void update_broadphase(World& world, Real dt) {
         create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
     }
 
-    // Lost pairs: awake contacts whose fat bounds no longer overlap.
+    // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
+    // can have stopped overlapping.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
     for (std::uint32_t c : awake_contacts(world)) {
         const Contact& contact = world.contacts[c];
+        if (!bp.refit[contact.body_a] && !bp.refit[contact.body_b]) continue;
         if (!bp.tree.test_overlap(bp.proxy[contact.body_a], bp.proxy[contact.body_b])) lost.push_back(c);
     }
     remove_contacts(world, lost);
+    std::fill(bp.refit.begin(), bp.refit.end(), std::uint8_t{0});
 }
 
 }  // namespace spindle
