@@ -292,7 +292,10 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
         apply_row(wc, s, wc.normal, p.normal_row, impulse);
     }
     const Wide slop = splat(params.slop);
-    for (int k = 0; k < kMaxManifoldPoints; ++k) {
+    // A lane without friction has an empty cone (its rows come out zero); when no lane
+    // has friction, the rows are skipped outright.
+    const int friction_points = any(wc.friction > zero) ? kMaxManifoldPoints : 0;
+    for (int k = 0; k < friction_points; ++k) {
         // Friction points in one order when biased and the other when relaxing: Gauss-
         // Seidel favours the point solved last, and in a resting pyramid a fixed order
         // creeps the upper layers sideways (0.10 m over 1000 steps, 0.07 alternating).
@@ -341,8 +344,10 @@ void prepare_contacts(World& world, SolverScratch& scratch) {
 
 void warm_start_contact(WideContact& wc, SolverBody* bodies) {
     WideVelocities s = gather(wc, bodies);
+    const bool friction = any(wc.friction > splat(0));  // else the tangent impulses are all zero
     for (const WidePoint& p : wc.points) {
         apply_row(wc, s, wc.normal, p.normal_row, p.normal_impulse);
+        if (!friction) continue;
         apply_row(wc, s, wc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
         apply_row(wc, s, wc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
     }
