@@ -62,8 +62,10 @@ void update_islands(World& world, Real dt) {
     Bodies& b = world.bodies;
     const SleepSettings& sleep = world.settings.sleep;
 
-    // Contacts between an awake body and a sleeping one wake the sleeper's island.
-    for (std::size_t k = 0; k < awake_contacts(world).size(); ++k) {  // wake_body may rebuild the list
+    // Contacts between an awake body and a sleeping one wake the sleeper's island (none
+    // to wake while no island sleeps).
+    const bool any_asleep = world.sleeping_islands.size() > world.free_islands.size();
+    for (std::size_t k = 0; any_asleep && k < awake_contacts(world).size(); ++k) {  // wake_body may rebuild the list
         const Contact& contact = world.contacts[awake_contacts(world)[k]];
         if (!touching(contact)) continue;
         const bool awake_a = b.awake_index[contact.body_a] >= 0, awake_b = b.awake_index[contact.body_b] >= 0;
@@ -72,7 +74,7 @@ void update_islands(World& world, Real dt) {
     }
     // So do joints: a joint cannot hold a body that does not move.
     Joints& joints = world.joints;
-    for (std::size_t k = 0; k < awake_joints(world).size(); ++k) {  // wake_body may rebuild the list
+    for (std::size_t k = 0; any_asleep && k < awake_joints(world).size(); ++k) {  // wake_body may rebuild the list
         const Joint& joint = joints.joint[awake_joints(world)[k]];
         const std::uint32_t ja = joint.body_a, jb = joint.body_b;
         const bool awake_a = b.awake_index[ja] >= 0, awake_b = b.awake_index[jb] >= 0;
@@ -84,10 +86,15 @@ void update_islands(World& world, Real dt) {
     // Rest timers.
     const Real lin2 = sleep.linear_threshold * sleep.linear_threshold;
     const Real ang2 = sleep.angular_threshold * sleep.angular_threshold;
+    Real longest_rest = 0;
     for (std::uint32_t i : world.awake) {
         const bool resting = b.desc[i].allow_sleep && b.v[i].squaredNorm() < lin2 && b.w[i].squaredNorm() < ang2;
         b.sleep_time[i] = resting ? b.sleep_time[i] + dt : 0;
+        longest_rest = std::max(longest_rest, b.sleep_time[i]);
     }
+    // An island sleeps only when all its bodies rested long enough: while no body has,
+    // there is no island to find.
+    if (longest_rest < sleep.time_to_sleep) return;
 
     // Islands over the awake bodies (positions in world.awake).
     const auto n = static_cast<std::uint32_t>(world.awake.size());
