@@ -66,11 +66,18 @@ struct Built {
     std::unique_ptr<Space> space;
     std::vector<BodyHandle> bodies;  // the dynamic ones
     bool asleep = true;              // GridSleeping: did every body fall asleep before timing
+    std::int64_t heap_before = 0;    // live heap before the space was made
+
+    // The heap the space holds now (bodies, shapes, broadphase, contacts, solver scratch)
+    // per dynamic body; taken after the timed steps, so every scene counts the same things.
+    double bytes_per_body() const {
+        const auto handle_bytes = static_cast<std::int64_t>(bodies.capacity() * sizeof(BodyHandle));
+        return static_cast<double>(live_heap_bytes() - heap_before - handle_bytes) / static_cast<double>(bodies.size());
+    }
 };
 
-// Builds the scene and takes the untimed steps it needs; bytes_per_body is the heap the
-// space holds by then (bodies, shapes, broadphase, contacts, solver scratch) per dynamic body.
-Built build(SceneKind kind, unsigned threads, double& bytes_per_body) {
+// Builds the scene and takes the untimed steps it needs.
+Built build(SceneKind kind, unsigned threads) {
     Built built;
     built.jobs = make_bench_jobs(threads);
     SpaceSettings settings;
@@ -84,7 +91,7 @@ Built build(SceneKind kind, unsigned threads, double& bytes_per_body) {
         case SceneKind::MixedPileOnMesh:
         case SceneKind::ChainPile: break;
     }
-    const std::int64_t heap_before = live_heap_bytes();
+    built.heap_before = live_heap_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
     Space& space = *built.space;
     if (kind == SceneKind::MixedPileOnMesh) {
@@ -105,16 +112,12 @@ Built build(SceneKind kind, unsigned threads, double& bytes_per_body) {
         } while (space.last_update().awake_bodies > 0 && ++steps < kMaxStepsToSleep);
         built.asleep = space.last_update().awake_bodies == 0;
     }
-    const auto handle_bytes = static_cast<std::int64_t>(built.bodies.capacity() * sizeof(BodyHandle));
-    bytes_per_body = static_cast<double>(live_heap_bytes() - heap_before - handle_bytes) /
-                     static_cast<double>(built.bodies.size());
     return built;
 }
 
 void bm_scene(benchmark::State& state, EngineScene scene) {
     const auto threads = static_cast<unsigned>(state.range(0));
-    double bytes_per_body = 0;
-    Built built = build(scene.kind, threads, bytes_per_body);
+    Built built = build(scene.kind, threads);
     if (!built.asleep) {
         state.SkipWithError("the grid did not fall asleep within the step cap");
         return;
@@ -128,7 +131,7 @@ void bm_scene(benchmark::State& state, EngineScene scene) {
     state.counters["steps_per_s"] = steps / wall;
     state.counters["cpu_steps_per_s"] = steps / cpu;
     state.counters["bodies"] = static_cast<double>(built.bodies.size());
-    state.counters["bytes_per_body"] = bytes_per_body;
+    state.counters["bytes_per_body"] = built.bytes_per_body();
     state.counters["workers"] = built.jobs->worker_count();
     state.counters["awake"] = space.last_update().awake_bodies;
     state.counters["contacts"] = space.last_update().contacts;
