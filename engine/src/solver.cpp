@@ -210,9 +210,11 @@ void solve(World& world, Real dt) {
                 [&](WideContact& wc) { solve_contact(wc, bodies, relax_params); });
         }
     }
-    for_each_colored<false>(
-        world, scratch, "Restitution", [](JointConstraint&) {},
-        [&](WideContact& wc) { apply_restitution(wc, bodies, settings.restitution_threshold, h); });
+    if (points.restitution > 0) {  // no pass at all over a scene without bouncy contacts
+        for_each_colored<false>(
+            world, scratch, "Restitution", [](JointConstraint&) {},
+            [&](WideContact& wc) { apply_restitution(wc, bodies, settings.restitution_threshold, h); });
+    }
     store_contact_impulses(world, scratch);
     if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
     finalize(world, scratch);
