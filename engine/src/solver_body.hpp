@@ -15,7 +15,8 @@ struct SolverBody {
     Quat dq = Quat::Identity();    // rotation change since the step began
     // Push-out velocities of the current substep (split impulse): they move the body out
     // of overlaps in integrate_positions and are then dropped, so pushing apart never
-    // becomes real speed. Capped per body at the push-out speed.
+    // becomes real speed. Capped per body in integrate_positions: pushing never makes a
+    // body move faster than the push-out speed or its own speed, whichever is larger.
     Vec3 push_v = Vec3::Zero();
     Vec3 push_w = Vec3::Zero();
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step
