@@ -27,7 +27,7 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 namespace {
 
 constexpr std::uint32_t kBodyGrain = 128;
-constexpr std::uint32_t kConstraintGrain = 8;  // joints or wide contacts (4 manifolds) per job
+constexpr std::uint32_t kConstraintGrain = 2;  // joints or wide contacts (4 manifolds) per chunk: small, so a colour's tail splits evenly
 
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
