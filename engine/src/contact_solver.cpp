@@ -87,8 +87,9 @@ void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s)
     }
 }
 
-inline Wide row_speed(const WideVelocities& s, const Wide3& dir, const WideRow& row) {
-    return dot(dir, s.vb - s.va) + dot(widen(row.rb_x), s.wb) - dot(widen(row.ra_x), s.wa);
+// Velocity of B's anchor relative to A's, per lane.
+inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide3& rb) {
+    return s.vb + cross(s.wb, rb) - s.va - cross(s.wa, ra);
 }
 
 inline void apply_row(const WideContact& wc, WideVelocities& s, const Wide3& dir, const WideRow& row, Wide L) {
@@ -105,7 +106,7 @@ WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wid
     const Wide3 rb_x = cross(rb, dir);
     const Wide3 ia = inv_inertia_a * ra_x;
     const Wide3 ib = inv_inertia_b * rb_x;
-    row = {narrow(ra_x), narrow(rb_x), narrow(ia), narrow(ib)};
+    row = {narrow(ia), narrow(ib)};
     const Wide k = inv_mass_sum + dot(ra_x, ia) + dot(rb_x, ib);
     return narrow(select(k > splat(0), splat(1) / k, splat(0)));
 }
@@ -262,7 +263,7 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
         const Wide separation = moved + dot(nb, p.rb) - dot(na, p.ra) + p.adjusted_separation;
         gap[j] = separation;
         const WideMask speculative = separation > zero;  // may close the gap, no more
-        const Wide vn = row_speed(s, wc.normal, p.normal_row);
+        const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
         if constexpr (kBias) {
             const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
@@ -306,8 +307,9 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
         if (!any(touching)) continue;
         WidePoint& p = wc.points[j];
         const Wide old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
-        Wide new0 = old0 - widen(p.tangent_mass[0]) * row_speed(s, wc.tangent[0], p.tangent_row[0]);
-        Wide new1 = old1 - widen(p.tangent_mass[1]) * row_speed(s, wc.tangent[1], p.tangent_row[1]);
+        const Wide3 dv = point_velocity(s, p.ra, p.rb);
+        Wide new0 = old0 - widen(p.tangent_mass[0]) * dot(wc.tangent[0], dv);
+        Wide new1 = old1 - widen(p.tangent_mass[1]) * dot(wc.tangent[1], dv);
         // Coulomb's cone: the friction impulse stays within friction x normal impulse.
         const Wide limit = wc.friction * p.normal_impulse;
         const Wide length_sq = new0 * new0 + new1 * new1;
@@ -379,7 +381,7 @@ void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real
         // Only points that approached fast enough and actually pushed bounce.
         const WideMask bounce = bouncy & (p.relative_velocity <= splat(-threshold)) & (p.max_normal_impulse > zero);
         if (!any(bounce)) continue;
-        const Wide vn = row_speed(s, wc.normal, p.normal_row);
+        const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
         const Wide approach = p.relative_velocity + wc.gravity_normal * splat(h);

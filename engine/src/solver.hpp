@@ -31,10 +31,12 @@ struct ContactRow {
     Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
 };
 
-// The same row for the four lanes of a WideContact, in single precision: the solver's
-// passes are bound by the memory they stream, and a row only scales an impulse.
+// What a WideContact keeps of a row for its four lanes: the inertia-weighted angular
+// terms, in single precision (the passes are bound by the memory they stream, and these
+// only scale an impulse). The row's speed is taken from the point's relative velocity
+// instead, so ra x dir and rb x dir need not be stored.
 struct WideRow {
-    Wide3F ra_x, rb_x, ia, ib;
+    Wide3F ia, ib;
 };
 
 // One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
