@@ -13,13 +13,19 @@ bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
     return b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic;
 }
 
+void mark_refit(BroadphaseState& bp, std::uint32_t slot) {
+    if (bp.refit[slot]) return;
+    bp.refit[slot] = 1;
+    bp.refit_slots.push_back(slot);
+}
+
 // Moves a body's proxy, noting when its fat box changed at all (grown or shrunk: either
 // can end an overlap).
 void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
     const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
     bp.tree.move_proxy(bp.proxy[slot], box, displacement);
     const Aabb& after = bp.tree.fat_aabb(bp.proxy[slot]);
-    if (after.min != before.min || after.max != before.max) bp.refit[slot] = 1;
+    if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
 }
 
 }  // namespace
@@ -30,7 +36,7 @@ void add_proxy(World& world, std::uint32_t slot) {
     if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
     if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
     bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
-    bp.refit[slot] = 1;
+    mark_refit(bp, slot);
 }
 
 void remove_proxy(World& world, std::uint32_t slot) {
@@ -85,7 +91,9 @@ void update_broadphase(World& world, Real dt) {
         if (!bp.tree.test_overlap(bp.proxy[contact.body_a], bp.proxy[contact.body_b])) lost.push_back(c);
     }
     remove_contacts(world, lost);
-    std::fill(bp.refit.begin(), bp.refit.end(), std::uint8_t{0});
+    // Only the marked slots are cleared: a sleeping pile's slots are not touched.
+    for (std::uint32_t slot : bp.refit_slots) bp.refit[slot] = 0;
+    bp.refit_slots.clear();
 }
 
 }  // namespace spindle

@@ -17,6 +17,7 @@ struct BroadphaseState {
     // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;
+    std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
 };
 
 void add_proxy(World& world, std::uint32_t slot);
