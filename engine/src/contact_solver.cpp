@@ -119,7 +119,6 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
     // far apart.
     WideMat3 inv_inertia_a, inv_inertia_b;
-    Wide3 va, wa, vb, wb;
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
     Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
     Wide tangent_impulse[kMaxManifoldPoints][2]{};
@@ -141,10 +140,6 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         wc.inv_mass_b[l] = B.inv_mass;
         inv_inertia_a.set_lane(l, A.inv_inertia);
         inv_inertia_b.set_lane(l, B.inv_inertia);
-        va.set_lane(l, A.v);
-        wa.set_lane(l, A.w);
-        vb.set_lane(l, B.v);
-        wb.set_lane(l, B.w);
         wc.friction[l] = contact.friction;
         wc.restitution[l] = contact.restitution;
         wc.gravity_normal[l] = m.normal.dot((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g -
@@ -162,6 +157,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         }
     }
     const Wide inv_mass_sum = wc.inv_mass_a + wc.inv_mass_b;
+    const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
         p.ra = ra[j];
@@ -177,7 +173,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         }
         p.normal_impulse = normal_impulse[j];
         p.max_normal_impulse = Wide{};
-        p.relative_velocity = dot(wc.normal, vb + cross(wb, rb[j]) - va - cross(wa, ra[j]));
+        p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
     }
     for (Real& impulse : wc.push_impulse) impulse = 0;
 }

@@ -1,9 +1,8 @@
 // The constraint solver (soft step, as Box2D v3 and Box3D): per step, list the
 // touching manifolds and the joints, colour them, and prepare them (contact_solver.cpp,
-// joint_solver.cpp); per
-// substep, integrate velocities, warm start, solve with soft position bias, integrate
-// positions, relax without bias; then restitution and storing impulses for the next
-// step's warm start. Each colour is solved as parallel jobs: no two constraints of a
+// joint_solver.cpp); per substep, integrate velocities, warm start, solve with soft
+// position bias, integrate positions, relax without bias; then restitution and storing
+// impulses for the next step's warm start. Each colour is solved as parallel jobs: no two constraints of a
 // colour share a dynamic body, so the result is bitwise the same for any number of workers.
 #include "solver.hpp"
 
@@ -27,7 +26,9 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 namespace {
 
 constexpr std::uint32_t kBodyGrain = 128;
-constexpr std::uint32_t kConstraintGrain = 2;  // joints or wide contacts (4 manifolds) per chunk: small, so a colour's tail splits evenly
+// Joints or wide contacts (4 manifolds each) per chunk: small, so the end of a colour
+// splits evenly between the workers.
+constexpr std::uint32_t kConstraintGrain = 2;
 
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;

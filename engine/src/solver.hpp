@@ -20,10 +20,8 @@ struct Softness {
 };
 Softness make_softness(Real hertz, Real damping_ratio, Real h);
 
-// One velocity row (normal or tangent) of a contact point, with its angular terms
-// precomputed once per step: relative speed = dir.(vb - va) + rb_x.wb - ra_x.wa, and an
-// impulse L changes wa by -L ia, wb by +L ib. Saves the cross and 3x3 products that
-// every one of the substeps' passes would otherwise redo.
+// One velocity row of a single lane, for a push-out row (contact_solver.cpp): relative
+// speed = dir.(vb - va) + rb_x.wb - ra_x.wa, and an impulse L changes wa by -L ia, wb by +L ib.
 struct ContactRow {
     Vec3 ra_x = Vec3::Zero();  // ra x dir
     Vec3 rb_x = Vec3::Zero();  // rb x dir
