@@ -16,6 +16,12 @@ void SingleThreadedJobSystem::parallel_for(const char*, std::uint32_t begin, std
     }
 }
 
+void SingleThreadedJobSystem::run_phases(const char*, std::span<const Phase> phases, PhaseFn fn) {
+    for (std::uint32_t p = 0; p < phases.size(); ++p) {
+        if (phases[p].count > 0) fn(p, 0, phases[p].count, 0);
+    }
+}
+
 void SingleThreadedJobSystem::run_graph(StageGraph& graph) {
     std::vector<std::uint32_t> waiting(graph.m_nodes.size());
     std::vector<std::uint32_t> ready;

@@ -302,3 +302,128 @@ TEST(WorkStealing, TraceIsChromeJsonNamingJobsStagesWorkersAndPus) {
                               "')); sys.exit(0 if len(d['traceEvents'])==17 else 1)\"";
     EXPECT_EQ(std::system(check.c_str()), 0);
 }
+
+namespace {
+
+// Phases whose items read the previous non-empty phase at scattered places: a phase
+// that began before the one it reads had finished would read zeros (and race, for TSan).
+struct PhaseChain {
+    std::vector<Phase> phases;
+    std::vector<std::vector<std::uint64_t>> values;
+    std::vector<std::vector<int>> runs;
+
+    PhaseChain() {
+        const std::uint32_t counts[] = {1, 0, 7, 1000, 3, 0, 0, 257, 64, 1, 5000, 2, 999};
+        for (int round = 0; round < 4; ++round) {
+            for (std::uint32_t c : counts) phases.push_back(Phase{"chain", c, 1 + c % 5});
+        }
+        values.resize(phases.size());
+        runs.resize(phases.size());
+        for (std::size_t p = 0; p < phases.size(); ++p) {
+            values[p].assign(phases[p].count, 0);
+            runs[p].assign(phases[p].count, 0);
+        }
+    }
+    const std::vector<std::uint64_t>* source(std::uint32_t p) const {
+        while (p-- > 0) {
+            if (!values[p].empty()) return &values[p];
+        }
+        return nullptr;
+    }
+    void item(std::uint32_t p, std::uint32_t i) {
+        std::uint64_t v = p * 1000003ull + i;
+        if (const std::vector<std::uint64_t>* in = source(p)) {
+            v += (*in)[(i * 7919ull) % in->size()] + 3 * (*in)[in->size() - 1 - i % in->size()];
+        }
+        values[p][i] = v;
+        ++runs[p][i];
+    }
+    void run(JobSystem& jobs) {
+        jobs.run_phases("chain", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
+            for (std::uint32_t i = lo; i < hi; ++i) item(p, i);
+        });
+    }
+};
+
+}  // namespace
+
+TEST(WorkStealing, PhasesRunInOrderEveryItemOnce) {
+    PhaseChain expected;
+    for (std::uint32_t p = 0; p < expected.phases.size(); ++p) {
+        for (std::uint32_t i = 0; i < expected.phases[p].count; ++i) expected.item(p, i);
+    }
+    SingleThreadedJobSystem serial;
+    PhaseChain one;
+    one.run(serial);
+    EXPECT_EQ(one.values, expected.values);
+    for (unsigned workers : {1u, 2u, 3u, 4u}) {
+        auto jobs = make(workers);
+        for (int repeat = 0; repeat < 5; ++repeat) {
+            PhaseChain chain;
+            chain.run(*jobs);
+            EXPECT_EQ(chain.values, expected.values) << workers << " workers";
+            for (const std::vector<int>& r : chain.runs) {
+                EXPECT_EQ(std::count(r.begin(), r.end(), 1), static_cast<std::ptrdiff_t>(r.size()));
+            }
+        }
+    }
+}
+
+TEST(WorkStealing, AnIdleWorkerTakesPartInPhases) {
+    // Two items in two blocks of one phase: each waits (up to a second) for the other to
+    // have started, which happens only if two workers run the phase at once.
+    auto jobs = make(2);
+    bool together = false;
+    for (int attempt = 0; attempt < 10 && !together; ++attempt) {
+        std::atomic<int> started{0};
+        std::atomic<int> met{0};
+        const Phase phase{"pair", 2, 1};
+        jobs->run_phases("pair", std::span(&phase, 1), [&](std::uint32_t, std::uint32_t lo, std::uint32_t hi, unsigned) {
+            for (std::uint32_t i = lo; i < hi; ++i) {
+                started.fetch_add(1);
+                const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+                while (started.load() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+                if (started.load() == 2) met.fetch_add(1);
+            }
+        });
+        together = met.load() == 2;
+    }
+    EXPECT_TRUE(together) << "one worker ran both blocks of the phase in every attempt";
+}
+
+TEST(WorkStealing, PhasesFinishWhenAWorkerNeverJoins) {
+    // Worker 1 is held by a pinned job for the whole call: worker 0 runs every block
+    // itself, then the participant meant for worker 1 walks past the finished phases.
+    auto jobs = make(2);
+    JobGroup group;
+    std::atomic<bool> release{false};
+    std::atomic<bool> holding{false};
+    jobs->submit_pinned(1, group, "hold", [&] {
+        holding.store(true);
+        while (!release.load()) std::this_thread::yield();
+    });
+    while (!holding.load()) std::this_thread::yield();
+    PhaseChain chain;
+    chain.run(*jobs);
+    release.store(true);
+    jobs->wait(group);
+    PhaseChain expected;
+    for (std::uint32_t p = 0; p < expected.phases.size(); ++p) {
+        for (std::uint32_t i = 0; i < expected.phases[p].count; ++i) expected.item(p, i);
+    }
+    EXPECT_EQ(chain.values, expected.values);
+}
+
+TEST(WorkStealing, PhaseBlocksAreTracedByPhaseName) {
+    auto jobs = make(2);
+    jobs->enable_trace(true);
+    const Phase phases[] = {{"alpha", 10, 1}, {"beta", 0, 1}, {"gamma", 3, 1}};
+    jobs->run_phases("Greek", phases, [](std::uint32_t, std::uint32_t, std::uint32_t, unsigned) {});
+    const std::vector<TraceEvent> events = jobs->trace_events();
+    auto count = [&](const char* name) {
+        return std::count_if(events.begin(), events.end(), [&](const TraceEvent& e) { return std::strcmp(e.name, name) == 0; });
+    };
+    EXPECT_EQ(count("alpha"), 8);  // two shares of 5 items, each in blocks of 2, 1, 1, 1 (halving)
+    EXPECT_EQ(count("beta"), 0);
+    EXPECT_EQ(count("gamma"), 3);
+}

@@ -49,6 +49,13 @@ public:
     void trace_begin(const char*) noexcept override {}
     void trace_end() noexcept override {}
     void run_graph(StageGraph& graph) override { SingleThreadedJobSystem().run_graph(graph); }
+    // Each phase as one reversed parallel_for, in phase order.
+    void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override {
+        for (std::uint32_t p = 0; p < phases.size(); ++p) {
+            parallel_for(name, 0, phases[p].count, phases[p].grain,
+                         [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) { fn(p, lo, hi, worker); });
+        }
+    }
 
 private:
     unsigned m_workers;
@@ -67,6 +74,9 @@ public:
     void trace_begin(const char*) noexcept override {}
     void trace_end() noexcept override {}
     void run_graph(StageGraph& graph) override { SingleThreadedJobSystem().run_graph(graph); }
+    void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override {
+        m_inner.run_phases(name, phases, fn);
+    }
     int chunks = 0;
 
 private:

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <exception>
 #include <mutex>
+#include <span>
 #include <vector>
 
 #include <spindle/scheduler/function_ref.hpp>
@@ -19,6 +20,16 @@ struct GroupAccess;
 // Body of a range job: items [begin, end), and the index of the worker running it.
 // The worker index is for per-worker scratch buffers only, never for results.
 using RangeFn = FunctionRef<void(std::uint32_t begin, std::uint32_t end, unsigned worker)>;
+
+// One phase of run_phases: `count` items, run in blocks of at least `grain` items.
+struct Phase {
+    const char* name = "";
+    std::uint32_t count = 0;
+    std::uint32_t grain = 1;
+};
+
+// Body of a block of run_phases: items [begin, end) of phase `phase`.
+using PhaseFn = FunctionRef<void(std::uint32_t phase, std::uint32_t begin, std::uint32_t end, unsigned worker)>;
 
 // A set of submitted jobs to wait for together. Lives on the waiter's stack; must not
 // be destroyed while jobs of it are pending (wait() first).
@@ -79,6 +90,20 @@ public:
     // Who may call: any thread. Deadlock: none, the caller never waits idle for work.
     virtual void parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
                               RangeFn fn) = 0;
+
+    // Runs phases in order: every item of a phase finishes before any item of the next
+    // starts; within a phase, blocks of items run in parallel. Unlike parallel_for's
+    // chunks, block boundaries may depend on the worker count: use it only where the
+    // result does not depend on how a phase is split (constraints of one colour, one
+    // body each). Made for many short phases (the solver's colour passes): one job per
+    // worker walks the whole list, claiming blocks and meeting the others at a spin
+    // barrier after each phase, so a phase costs a few cache-line transfers instead of a
+    // fork and a join. fn must not throw (std::terminate) nor wait for other jobs (no
+    // parallel_for or wait inside it: the waiting thread could pick up a participant
+    // that then waits at a barrier for the block below it). Who may call: any thread,
+    // not from inside a phase. Deadlock: none otherwise; a worker that never joins
+    // leaves its blocks to the others.
+    virtual void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) = 0;
 
     // Runs a stage graph to completion: each node after its prerequisites, nodes in
     // parallel where the graph allows; rethrows the first exception. Who may call: any

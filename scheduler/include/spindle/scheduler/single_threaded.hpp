@@ -13,6 +13,8 @@ public:
     unsigned worker_count() const noexcept override { return 1; }
     void parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
                       RangeFn fn) override;
+    // Each phase in one block, in order.
+    void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override;
     // Nodes in index order among those ready (a deterministic topological order).
     void run_graph(StageGraph& graph) override;
     // Runs fn at once; an exception is kept for wait(), as the threaded system does.

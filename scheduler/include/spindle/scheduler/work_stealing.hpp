@@ -96,6 +96,9 @@ public:
     // Who may call: any thread (a non-worker becomes worker 0 meanwhile); from inside a
     // job too (it keeps running other jobs, never idles while work is queued).
     void wait(JobGroup& group);
+    // See JobSystem: one job per worker (at most kMaxPhaseWorkers) runs every phase.
+    void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override;
+    static constexpr unsigned kMaxPhaseWorkers = 16;
     // Runs a stage graph to completion (nodes in dependency order, in parallel where
     // allowed); rethrows the first exception after every runnable node finished.
     void run_graph(StageGraph& graph) override;
