@@ -27,68 +27,52 @@ Vec3 solve_gyroscopic(const Quat& q, const Mat3& inertia_local, const Vec3& w_wo
     return q * corrected;
 }
 
-constexpr std::uint32_t kGrain = 256;
-
 }  // namespace
 
-void integrate_velocities(World& world, SolverBody* bodies, Real h) {
+void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
+                          EffectCounts& c) {
     const Bodies& b = world.bodies;
     const Vec3 gravity = world.settings.gravity;
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
-    // Per-chunk counts merged afterwards: counters never depend on the worker count.
-    std::vector<EffectCounts>& chunk_counts = world.scratch_counts;
-    chunk_counts.assign((n + kGrain - 1) / kGrain, EffectCounts{});
-    world.jobs->parallel_for("IntegrateVelocities", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        EffectCounts& c = chunk_counts[lo / kGrain];
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            SolverBody& sb = bodies[k];
-            if (!sb.dynamic) continue;
-            const std::uint32_t i = world.awake[k];
-            const BodyDesc& d = b.desc[i];
-            if (d.gravity_scale != 0) {
-                sb.v += h * d.gravity_scale * gravity;
-                ++c.gravity;
-            }
-            sb.v += h * sb.inv_mass * b.force[i];
-            sb.w += h * (sb.inv_inertia * b.torque[i]);
-            if (d.gyroscopic) {
-                const Quat q = (sb.dq * b.q[i]).normalized();
-                sb.w = solve_gyroscopic(q, b.inertia_local[i], sb.w, h);
-                ++c.gyro;
-            }
-            if (d.linear_damping > 0 || d.angular_damping > 0) {
-                // Implicit (Pade) damping: stable for any h.
-                sb.v *= 1 / (1 + h * d.linear_damping);
-                sb.w *= 1 / (1 + h * d.angular_damping);
-                ++c.damping;
-            }
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        SolverBody& sb = bodies[k];
+        if (!sb.dynamic) continue;
+        const std::uint32_t i = world.awake[k];
+        const BodyDesc& d = b.desc[i];
+        if (d.gravity_scale != 0) {
+            sb.v += h * d.gravity_scale * gravity;
+            ++c.gravity;
         }
-    });
-    for (const EffectCounts& c : chunk_counts) {
-        world.counters.gravity_applied += c.gravity;
-        world.counters.damping_applied += c.damping;
-        world.counters.gyroscopic_applied += c.gyro;
+        sb.v += h * sb.inv_mass * b.force[i];
+        sb.w += h * (sb.inv_inertia * b.torque[i]);
+        if (d.gyroscopic) {
+            const Quat q = (sb.dq * b.q[i]).normalized();
+            sb.w = solve_gyroscopic(q, b.inertia_local[i], sb.w, h);
+            ++c.gyro;
+        }
+        if (d.linear_damping > 0 || d.angular_damping > 0) {
+            // Implicit (Pade) damping: stable for any h.
+            sb.v *= 1 / (1 + h * d.linear_damping);
+            sb.w *= 1 / (1 + h * d.angular_damping);
+            ++c.damping;
+        }
     }
 }
 
-void integrate_positions(World& world, SolverBody* bodies, Real h) {
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
+void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi) {
     const Real push_out = world.settings.solver.push_out_speed;
-    world.jobs->parallel_for("IntegratePositions", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            SolverBody& sb = bodies[k];
-            // The push-out velocity is capped per body, not only per contact: a chain of
-            // overlaps would otherwise add up each contact's push-out speed.
-            const Vec3 moving = sb.v + sb.push_v;
-            const Real limit_sq = std::max(sb.v.squaredNorm(), push_out * push_out);
-            const Real moving_sq = moving.squaredNorm();
-            if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
-            sb.dp += h * (sb.v + sb.push_v);
-            sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
-            sb.push_v = Vec3::Zero();
-            sb.push_w = Vec3::Zero();
-        }
-    });
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        SolverBody& sb = bodies[k];
+        // The push-out velocity is capped per body, not only per contact: a chain of
+        // overlaps would otherwise add up each contact's push-out speed.
+        const Vec3 moving = sb.v + sb.push_v;
+        const Real limit_sq = std::max(sb.v.squaredNorm(), push_out * push_out);
+        const Real moving_sq = moving.squaredNorm();
+        if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
+        sb.dp += h * (sb.v + sb.push_v);
+        sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
+        sb.push_v = Vec3::Zero();
+        sb.push_w = Vec3::Zero();
+    }
 }
 
 }  // namespace spindle

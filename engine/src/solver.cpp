@@ -2,8 +2,10 @@
 // touching manifolds and the joints, colour them, and prepare them (contact_solver.cpp,
 // joint_solver.cpp); per substep, integrate velocities, warm start, solve with soft
 // position bias, integrate positions, relax without bias; then restitution and storing
-// impulses for the next step's warm start. Each colour is solved as parallel jobs: no two constraints of a
-// colour share a dynamic body, so the result is bitwise the same for any number of workers.
+// impulses for the next step's warm start. The substeps run as one list of phases
+// (JobSystem::run_phases), a phase per pass over the bodies or over one colour: no two
+// constraints of a colour share a dynamic body, so however a phase is split between
+// workers the result is bitwise the same.
 #include "solver.hpp"
 
 #include <algorithm>
@@ -119,33 +121,68 @@ void color(SolverScratch& scratch) {
     }
 }
 
-// Runs joint_fn and contact_fn over every constraint, colour by colour: one parallel
-// range per colour, its joints then its wide contacts (they share no dynamic body); then
-// the overflow serially, joints first. Chunks depend only on the lists, so the result
-// does not depend on the worker count. kJoints = false walks the contacts only.
-template <bool kJoints = true, typename JointFn, typename ContactFn>
-void for_each_colored(World& world, SolverScratch& scratch, const char* name, JointFn&& joint_fn,
-                      ContactFn&& contact_fn) {
+// Runs joint_fn and contact_fn over constraints [lo, hi) of colour `color`: its joints
+// (if kJoints), then its wide contacts. The overflow (color == kColorCount) is one
+// block, run serially, joints first.
+template <bool kJoints, typename JointFn, typename ContactFn>
+void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, JointFn&& joint_fn,
+                 ContactFn&& contact_fn) {
+    if (color == kColorCount) {
+        if (kJoints) {
+            for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
+        }
+        for (std::size_t k = scratch.wide_begin[kColorCount]; k < scratch.wide.size(); ++k) contact_fn(scratch.wide[k]);
+        return;
+    }
+    const std::vector<std::uint32_t>& joints = scratch.joint_colors[color];
+    const auto joint_count = kJoints ? static_cast<std::uint32_t>(joints.size()) : 0u;
+    WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        if (k < joint_count) {
+            joint_fn(scratch.joints[joints[k]]);
+        } else {
+            contact_fn(contacts[k - joint_count]);
+        }
+    }
+}
+
+// Adds the phases of one pass over the constraints: one per colour that has any (its
+// joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
+void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints) {
     for (int c = 0; c < kColorCount; ++c) {
-        const std::vector<std::uint32_t>& joints = scratch.joint_colors[c];
-        WideContact* contacts = scratch.wide.data() + scratch.wide_begin[c];
-        const auto joint_count = kJoints ? static_cast<std::uint32_t>(joints.size()) : 0u;
-        const auto total = joint_count + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
-        if (total == 0) continue;
-        world.jobs->parallel_for(name, 0, total, kConstraintGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-            for (std::uint32_t k = lo; k < hi; ++k) {
-                if (k < joint_count) {
-                    joint_fn(scratch.joints[joints[k]]);
-                } else {
-                    contact_fn(contacts[k - joint_count]);
-                }
-            }
-        });
+        const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) : 0u;
+        const std::uint32_t count = joints + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
+        if (count == 0) continue;
+        scratch.phases.push_back(Phase{name, count, kConstraintGrain});
+        scratch.plan.push_back(SolverPhase{pass, c});
     }
-    if (kJoints) {
-        for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
+    const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||
+                          scratch.wide.size() > scratch.wide_begin[kColorCount];
+    if (overflow) {
+        scratch.phases.push_back(Phase{name, 1, 1});
+        scratch.plan.push_back(SolverPhase{pass, kColorCount});
     }
-    for (std::size_t k = scratch.wide_begin[kColorCount]; k < scratch.wide.size(); ++k) contact_fn(scratch.wide[k]);
+}
+
+void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
+    scratch.phases.push_back(Phase{name, bodies, kBodyGrain});
+    scratch.plan.push_back(SolverPhase{pass, 0});
+}
+
+// The step's solver loop as a list of phases, each over the bodies or one colour.
+void plan_step(World& world, SolverScratch& scratch, bool restitution) {
+    const SolverSettings& settings = world.settings.solver;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    scratch.phases.clear();
+    scratch.plan.clear();
+    for (int sub = 0; sub < settings.substeps; ++sub) {
+        plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
+        plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
+        for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
+        plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
+        for (int it = 0; it < settings.relax_iterations; ++it) plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
+    }
+    if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
 }
 
 void finalize(World& world, SolverScratch& scratch) {
@@ -194,27 +231,48 @@ void solve(World& world, Real dt) {
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
     const JointSolveParams joint_relax{joint_solve.soft, joint_solve.inv_h, false};
 
-    for (int sub = 0; sub < substeps; ++sub) {
-        integrate_velocities(world, bodies, h);
-        for_each_colored(
-            world, scratch, "WarmStart", [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-            [&](WideContact& wc) { warm_start_contact(wc, bodies); });
-        for (int it = 0; it < settings.iterations; ++it) {
-            for_each_colored(
-                world, scratch, "Solve", [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
+    // Every substep's passes in one run_phases: the workers meet at a barrier after each
+    // colour instead of forking and joining about a hundred times per step. Effects are
+    // counted per worker and summed (the sum does not depend on who counted what).
+    plan_step(world, scratch, points.restitution > 0);  // no pass at all over a scene without bouncy contacts
+    world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
+    const Real restitution_threshold = settings.restitution_threshold;
+    world.jobs->run_phases("Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi,
+                                                         unsigned worker) {
+        const SolverPhase phase = scratch.plan[p];
+        switch (phase.pass) {
+        case Pass::IntegrateVelocities:
+            integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
+            break;
+        case Pass::IntegratePositions:
+            integrate_positions(world, bodies, h, lo, hi);
+            break;
+        case Pass::WarmStart:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+                [&](WideContact& wc) { warm_start_contact(wc, bodies); });
+            break;
+        case Pass::Solve:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
                 [&](WideContact& wc) { solve_contact(wc, bodies, solve_params); });
-        }
-        integrate_positions(world, bodies, h);
-        for (int it = 0; it < settings.relax_iterations; ++it) {
-            for_each_colored(
-                world, scratch, "Relax", [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
+            break;
+        case Pass::Relax:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
                 [&](WideContact& wc) { solve_contact(wc, bodies, relax_params); });
+            break;
+        case Pass::Restitution:
+            for_colored<false>(
+                scratch, phase.color, lo, hi, [](JointConstraint&) {},
+                [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h); });
+            break;
         }
-    }
-    if (points.restitution > 0) {  // no pass at all over a scene without bouncy contacts
-        for_each_colored<false>(
-            world, scratch, "Restitution", [](JointConstraint&) {},
-            [&](WideContact& wc) { apply_restitution(wc, bodies, settings.restitution_threshold, h); });
+    });
+    for (const EffectCounts& c : world.scratch_counts) {
+        world.counters.gravity_applied += c.gravity;
+        world.counters.damping_applied += c.damping;
+        world.counters.gyroscopic_applied += c.gyro;
     }
     store_contact_impulses(world, scratch);
     if (!scratch.joints.empty()) store_joint_impulses(world, scratch);

@@ -124,6 +124,14 @@ struct JointSolveParams {
 
 inline constexpr int kColorCount = 24;
 
+// What one phase of the step's solver loop does (solver.cpp): a pass over the bodies,
+// or over one colour's constraints (color == kColorCount: the overflow, one block).
+enum class Pass : std::uint8_t { IntegrateVelocities, WarmStart, Solve, IntegratePositions, Relax, Restitution };
+struct SolverPhase {
+    Pass pass = Pass::Solve;
+    int color = 0;
+};
+
 struct SolverScratch {
     std::vector<SolverBody> bodies;                 // awake bodies, then the static body
     std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
@@ -135,6 +143,8 @@ struct SolverScratch {
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
     std::vector<std::uint32_t> joint_overflow;
     std::vector<std::uint32_t> body_colors;          // per solver body: a bit for each colour it is in
+    std::vector<Phase> phases;                       // the step's solver loop, run by run_phases
+    std::vector<SolverPhase> plan;                   // what each phase does
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,

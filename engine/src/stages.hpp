@@ -21,10 +21,12 @@ void solve(World& world, Real dt);
 // continuous.cpp: fast bodies swept against static geometry (poses recorded before the solver).
 void record_fast_starts(World& world);
 void sweep_fast_bodies(World& world);
-// integrator.cpp (called by the solver once per substep, over the awake bodies).
+// integrator.cpp (called by the solver once per substep, in blocks of the awake
+// bodies [lo, hi); effects used are counted into `counts`).
 struct SolverBody;
-void integrate_velocities(World& world, SolverBody* bodies, Real h);
-void integrate_positions(World& world, SolverBody* bodies, Real h);
+void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
+                          EffectCounts& counts);
+void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi);
 // record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
 void record(World& world);
 

@@ -114,8 +114,10 @@ struct Contact {
     }
 };
 
-// Per-chunk effect counts, merged in chunk order after a parallel stage.
-struct EffectCounts {
+// Effect counts of one worker in the solver's integration, summed after the step (a
+// sum of counts, so the total does not depend on who counted what). A cache line
+// each: the workers bump theirs per body.
+struct alignas(64) EffectCounts {
     std::uint64_t gravity = 0, damping = 0, gyro = 0;
 };
 
@@ -168,7 +170,7 @@ struct World {
 
     UpdateStats stats;
     WorkCounters counters;
-    std::vector<EffectCounts> scratch_counts;
+    std::vector<EffectCounts> scratch_counts;  // per worker
     std::vector<std::uint32_t> scratch_lost;
     std::vector<FastStart> fast_starts;          // continuous.cpp
     std::vector<std::uint32_t> scratch_candidates;
