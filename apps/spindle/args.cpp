@@ -56,6 +56,22 @@ std::optional<std::string> Args::option(std::string_view name) {
     return value;
 }
 
+bool Args::flag(std::string_view name) {
+    const std::string flag = "--" + std::string(name);
+    bool found = false;
+    for (std::size_t i = 0; i < m_args.size(); ++i) {
+        if (m_used[i]) continue;
+        const std::string& a = m_args[i];
+        if (a == flag) {
+            m_used[i] = true;
+            found = true;
+        } else if (a.rfind(flag + "=", 0) == 0) {
+            throw UsageError(flag + ": takes no value");
+        }
+    }
+    return found;
+}
+
 std::optional<double> Args::number(std::string_view name, double min, double max) {
     const std::optional<std::string> text = option(name);
     if (!text) return std::nullopt;

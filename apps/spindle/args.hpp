@@ -30,6 +30,8 @@ public:
     std::optional<std::string> option(std::string_view name);
     std::optional<double> number(std::string_view name, double min, double max);
     std::optional<std::int64_t> integer(std::string_view name, std::int64_t min, std::int64_t max);
+    // True when --name is given (a flag takes no value: --name=VALUE is a usage error).
+    bool flag(std::string_view name);
 
     // What is left, after every option was taken: unknown options and more than
     // `max` positionals are usage errors.

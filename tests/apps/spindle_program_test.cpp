@@ -243,6 +243,28 @@ TEST(SpindleProgram, BenchPyramid_PrintsOneLine) {
     expect_contains(substeps.output, "scene=stack bodies=20 threads=1 steps=3 ");
 }
 
+TEST(SpindleProgram, BenchStages_PrintsMillisecondsPerStage) {
+    const Result r = spindle("bench stack --steps 20 --stages", true);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 2) << r.output;
+    const std::string second = r.output.substr(r.output.find('\n') + 1);
+    const std::vector<std::string> w = words(second);
+    ASSERT_GE(w.size(), 4u) << second;
+    EXPECT_EQ(w[0], "stages_ms");
+    bool solver = false;
+    for (std::size_t i = 1; i < w.size(); ++i) {
+        const std::size_t eq = w[i].find('=');
+        ASSERT_NE(eq, std::string::npos) << w[i];
+        const double ms = std::stod(w[i].substr(eq + 1));
+        EXPECT_GT(ms, 0.0) << w[i];  // only stages that took time are listed
+        if (w[i].rfind("Solver=", 0) == 0) solver = true;
+    }
+    EXPECT_TRUE(solver) << second;
+    const Result bad = spindle("bench stack --stages=yes");
+    EXPECT_EQ(bad.exit_code, 2);
+    expect_contains(bad.output, "--stages: takes no value");
+}
+
 // Same scene, same steps: the same state, bit for bit, whatever the worker count.
 TEST(SpindleProgram, BenchHash_IsTheSameForOneAndTwoThreads) {
     const Result one = spindle("bench dominoes --steps 60 --threads 1", true);
