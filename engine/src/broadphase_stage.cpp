@@ -28,6 +28,16 @@ void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const 
     if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
 }
 
+// The box a body's fat box must hold: its bounds swept over this step's motion (a
+// fast body near the edge of its fat box would otherwise cross a whole step into
+// something before the pair is found).
+Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
+    Aabb swept = b.bounds[i];
+    swept.min += displacement.cwiseMin(Vec3::Zero());
+    swept.max += displacement.cwiseMax(Vec3::Zero());
+    return swept;
+}
+
 }  // namespace
 
 void add_proxy(World& world, std::uint32_t slot) {
@@ -53,22 +63,22 @@ void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
+    // Bounds, and whether each proxy must move, in parallel; the tree is single-writer,
+    // so the few proxies that left their fat boxes are moved after, in awake order.
+    bp.moving.resize(n);
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            const Vec3 d = b.v[i] * dt;
+            bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
         }
     });
-    // The tree is single-writer; moves are cheap unless a body leaves its fat box. The
-    // box the fat box must hold is swept over this step's motion: a fast body near the
-    // edge of its fat box would otherwise cross a whole step into something before the
-    // pair is found.
-    for (std::uint32_t i : world.awake) {
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (!bp.moving[k]) continue;
+        const std::uint32_t i = world.awake[k];
         const Vec3 d = b.v[i] * dt;
-        Aabb swept = b.bounds[i];
-        swept.min += d.cwiseMin(Vec3::Zero());
-        swept.max += d.cwiseMax(Vec3::Zero());
-        move_proxy(bp, i, swept, d);
+        move_proxy(bp, i, swept_bounds(b, i, d), d);
     }
 
     bp.pairs.clear();
@@ -85,10 +95,14 @@ void update_broadphase(World& world, Real dt) {
     // can have stopped overlapping.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
-    for (std::uint32_t c : awake_contacts(world)) {
-        const Contact& contact = world.contacts[c];
-        if (!bp.refit[contact.body_a] && !bp.refit[contact.body_b]) continue;
-        if (!bp.tree.test_overlap(bp.proxy[contact.body_a], bp.proxy[contact.body_b])) lost.push_back(c);
+    if (!bp.refit_slots.empty()) {
+        for (std::uint32_t c : awake_contacts(world)) {
+            const std::uint64_t key = world.contact_keys[c];  // packed: no Contact is read
+            const auto i = static_cast<std::uint32_t>(key >> 32);
+            const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
+            if (!bp.refit[i] && !bp.refit[j]) continue;
+            if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) lost.push_back(c);
+        }
     }
     remove_contacts(world, lost);
     // Only the marked slots are cleared: a sleeping pile's slots are not touched.

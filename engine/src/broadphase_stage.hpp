@@ -18,6 +18,7 @@ struct BroadphaseState {
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;
     std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
+    std::vector<std::uint8_t> moving;        // scratch, per awake body: its proxy must move this step
 };
 
 void add_proxy(World& world, std::uint32_t slot);

@@ -21,6 +21,7 @@ void create_contact(World& world, std::uint64_t key) {
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contacts.push_back(std::move(contact));
+    world.contact_keys.push_back(key);
     world.awake_contacts_dirty = true;
 }
 
@@ -44,11 +45,15 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
             ++next;
             continue;
         }
-        if (write != read) world.contacts[write] = std::move(world.contacts[read]);
-        world.contact_index[world.contacts[write].key] = static_cast<std::uint32_t>(write);
+        if (write != read) {
+            world.contacts[write] = std::move(world.contacts[read]);
+            world.contact_keys[write] = world.contact_keys[read];
+        }
+        world.contact_index[world.contact_keys[write]] = static_cast<std::uint32_t>(write);
         ++write;
     }
     world.contacts.resize(write);
+    world.contact_keys.resize(write);
     world.awake_contacts_dirty = true;
 }
 

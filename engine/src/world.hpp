@@ -148,6 +148,7 @@ struct World {
     std::unique_ptr<BroadphaseState> broadphase;
     std::vector<Contact> contacts;
     std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
+    std::vector<std::uint64_t> contact_keys;  // contacts[i].key, packed: a scan of pairs reads 8 bytes per contact
     // Positions of the contacts that are not asleep, ascending; rebuilt only after a
     // contact is made, removed, or changes sleep, so sleeping contacts cost nothing per step.
     std::vector<std::uint32_t> awake_contact_list;

@@ -88,21 +88,24 @@ void DynamicAabbTree::destroy_proxy(std::int32_t id) {
     validate_if_enabled();
 }
 
+bool DynamicAabbTree::needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const {
+    check_proxy(id);
+    const Aabb& box = m_nodes[static_cast<std::size_t>(id)].box;
+    if (!box.contains(tight)) return true;
+    // Keep the old fat box unless it is far bigger than wanted (a fast body slowed
+    // down): the slack scales with the motion so a steadily moving body re-inserts
+    // only when it leaves its box, not every step.
+    const Real slack = 4 * m_settings.margin + m_settings.displacement_multiplier * displacement.cwiseAbs().maxCoeff();
+    return !fatten(tight, displacement).fattened(slack).contains(box);
+}
+
 bool DynamicAabbTree::move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement) {
     check_proxy(id);
     SPINDLE_ASSERT(is_finite_box(tight) && is_finite(displacement),
                    "DynamicAabbTree::move_proxy: box and displacement must be finite");
-    Node& node = m_nodes[static_cast<std::size_t>(id)];
-    const Aabb wanted = fatten(tight, displacement);
-    if (node.box.contains(tight)) {
-        // Keep the old fat box unless it is far bigger than wanted (a fast body slowed
-        // down): the slack scales with the motion so a steadily moving body re-inserts
-        // only when it leaves its box, not every step.
-        const Real slack = 4 * m_settings.margin + m_settings.displacement_multiplier * displacement.cwiseAbs().maxCoeff();
-        if (wanted.fattened(slack).contains(node.box)) return false;
-    }
+    if (!needs_move(id, tight, displacement)) return false;
     remove_leaf(id);
-    m_nodes[static_cast<std::size_t>(id)].box = wanted;
+    m_nodes[static_cast<std::size_t>(id)].box = fatten(tight, displacement);
     insert_leaf(id);
     validate_if_enabled();
     return true;

@@ -104,6 +104,8 @@ TEST(AabbTree, MoveProxy_KeepsFatBoxWhileTightBoxInside) {
     const std::int32_t id = tree.create_proxy(tight, 7);
     const Aabb fat = tree.fat_aabb(id);
     const Vec3 small(0.05, -0.05, 0.02);
+    EXPECT_FALSE(tree.needs_move(id, {tight.min + small, tight.max + small}, small));
+    EXPECT_TRUE(tree.needs_move(id, {tight.min + 3 * small, tight.max + 3 * small}, 3 * small));
     EXPECT_FALSE(tree.move_proxy(id, {tight.min + small, tight.max + small}, small));
     EXPECT_TRUE(tree.fat_aabb(id).min == fat.min && tree.fat_aabb(id).max == fat.max);
 }
@@ -138,8 +140,12 @@ TEST(AabbTree, MoveProxy_SteadyMotionReinsertsOnlyWhenLeavingAndShrinksAfterStop
     }
     // Stretched two displacements ahead, the box lasts two steps.
     EXPECT_LE(reinserts, 11);
-    // The body stops: the long box is shrunk back to tight + margin.
+    // The body stops: the long box is shrunk back to tight + margin (needs_move says so
+    // first, and asking twice changes nothing).
+    EXPECT_TRUE(tree.needs_move(id, tight, Vec3::Zero()));
+    EXPECT_TRUE(tree.needs_move(id, tight, Vec3::Zero()));
     EXPECT_TRUE(tree.move_proxy(id, tight, Vec3::Zero()));
+    EXPECT_FALSE(tree.needs_move(id, tight, Vec3::Zero()));
     EXPECT_TRUE(tree.fat_aabb(id).max.isApprox(tight.max + Vec3::Constant(0.1)));
     EXPECT_FALSE(tree.move_proxy(id, tight, Vec3::Zero()));
 }

@@ -38,6 +38,9 @@ public:
     // the fat box, or when the fat box is far bigger than needed (a fast body stopped).
     // The new fat box is `tight` grown by the margin and stretched along the displacement.
     bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement);
+    // Whether move_proxy(id, tight, displacement) would re-insert the proxy. Const: may
+    // run on many threads at once while nothing writes.
+    bool needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const;
 
     // Calls callback(id) -> bool for every proxy whose fat box overlaps `box`; false stops.
     template <typename Callback>

@@ -66,6 +66,11 @@ public:
     // Updates the proxy's tight box; `displacement` is its motion this step (stretches the
     // fat box ahead). Returns true and marks the proxy enlarged when the fat box grew.
     bool move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement);
+    // Whether move_proxy would change the proxy's fat box (const: any number of threads
+    // while nothing writes), so callers can test many proxies in parallel and move few.
+    bool needs_move(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
+        return tree_of(id).needs_move(id.tree_id(), tight_aabb, displacement);
+    }
 
     // Replaces new_pairs with every pair of proxies whose fat boxes overlap and of which at
     // least one was enlarged (created or grown) since the last call; never static with
