@@ -184,6 +184,7 @@ void pack(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
     scratch.wide.resize(count);  // kept from step to step: prepare_wide writes every field
+    scratch.push_rows.resize(count * kLanes);  // a row is written by push_out before it is read
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     std::size_t next = 0;
     auto add = [&](const std::uint32_t* refs, int lanes) {
@@ -210,12 +211,11 @@ void pack(SolverScratch& scratch) {
 // impulse), never by real speed, so a chain of deep overlaps separates without
 // launching anything. One row per manifold, through the overlap's depth-weighted centre,
 // so a face pushes straight and a tilted corner turns back.
-void push_out(WideContact& wc, int lane, SolverBody* bodies, Real excess, const Vec3& ra, const Vec3& rb,
-              const ContactSolveParams& params) {
+void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
+              const Vec3& rb, const ContactSolveParams& params) {
     SolverBody& A = bodies[wc.a[lane]];
     SolverBody& B = bodies[wc.b[lane]];
     const Vec3 normal = wc.normal.lane(lane);
-    ContactRow& row = wc.push_row[lane];
     Real& impulse = wc.push_impulse[lane];
     const Real mass = make_row(A, B, ra, rb, normal, row);
     Velocities push = load_push(A, B);
@@ -229,7 +229,7 @@ void push_out(WideContact& wc, int lane, SolverBody* bodies, Real excess, const 
 }
 
 template <bool kBias>
-void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& params) {
+void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
     WideVelocities s = gather(wc, bodies);
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
@@ -323,7 +323,8 @@ void solve_wide(WideContact& wc, SolverBody* bodies, const ContactSolveParams& p
         for (int l = 0; l < kLanes; ++l) {
             if (deep_weight[l] <= 0) continue;
             const Real w = deep_weight[l];
-            push_out(wc, l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w, params);
+            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
+                     params);
         }
     }
 }
@@ -340,7 +341,7 @@ void prepare_contacts(World& world, SolverScratch& scratch) {
     });
 }
 
-void warm_start_contact(WideContact& wc, SolverBody* bodies) {
+void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
     WideVelocities s = gather(wc, bodies);
     const bool friction = any(wc.friction > splat(0));  // else the tangent impulses are all zero
     for (const WidePoint& p : wc.points) {
@@ -355,16 +356,16 @@ void warm_start_contact(WideContact& wc, SolverBody* bodies) {
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
         Velocities push = load_push(A, B);
-        apply_row(A, B, push, wc.normal.lane(l), wc.push_row[l], wc.push_impulse[l]);
+        apply_row(A, B, push, wc.normal.lane(l), push_rows[l], wc.push_impulse[l]);
         store_push(A, B, push);
     }
 }
 
-void solve_contact(WideContact& wc, SolverBody* bodies, const ContactSolveParams& params) {
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
     if (params.use_bias) {
-        solve_wide<true>(wc, bodies, params);
+        solve_wide<true>(wc, push_rows, bodies, params);
     } else {
-        solve_wide<false>(wc, bodies, params);
+        solve_wide<false>(wc, push_rows, bodies, params);
     }
 }
 

@@ -237,6 +237,9 @@ void solve(World& world, Real dt) {
     plan_step(world, scratch, points.restitution > 0);  // no pass at all over a scene without bouncy contacts
     world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
     const Real restitution_threshold = settings.restitution_threshold;
+    auto push_rows = [&](const WideContact& wc) {
+        return scratch.push_rows.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
+    };
     world.jobs->run_phases("Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi,
                                                          unsigned worker) {
         const SolverPhase phase = scratch.plan[p];
@@ -250,17 +253,17 @@ void solve(World& world, Real dt) {
         case Pass::WarmStart:
             for_colored<true>(
                 scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-                [&](WideContact& wc) { warm_start_contact(wc, bodies); });
+                [&](WideContact& wc) { warm_start_contact(wc, push_rows(wc), bodies); });
             break;
         case Pass::Solve:
             for_colored<true>(
                 scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
-                [&](WideContact& wc) { solve_contact(wc, bodies, solve_params); });
+                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params); });
             break;
         case Pass::Relax:
             for_colored<true>(
                 scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
-                [&](WideContact& wc) { solve_contact(wc, bodies, relax_params); });
+                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params); });
             break;
         case Pass::Restitution:
             for_colored<false>(

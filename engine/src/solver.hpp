@@ -68,9 +68,10 @@ struct WideContact {
     Wide friction{}, restitution{};
     Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
     WidePoint points[kMaxManifoldPoints];
-    // Push-out of deep overlap (split impulse), per lane: one row through the overlap's
-    // centre on the push-out velocities; the impulse is kept over the step's substeps.
-    ContactRow push_row[kLanes];
+    // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
+    // the overlap's centre on the push-out velocities, kept over the step's substeps. The
+    // rows themselves live apart (SolverScratch::push_rows): they are rarely used, and
+    // every pass streams the wide contacts.
     Real push_impulse[kLanes] = {};
 };
 
@@ -138,6 +139,7 @@ struct SolverScratch {
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
     std::vector<WideContact> wide;                   // the colours' manifolds four by four, then the overflow one by one
+    std::vector<ContactRow> push_rows;               // kLanes per wide contact: its push-out rows (written before read)
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
@@ -161,8 +163,9 @@ struct ContactSolveParams {
 // contact_solver.cpp. prepare_contacts fills scratch.wide from scratch.manifolds and
 // the colours; the others run per wide contact from the colour loops.
 void prepare_contacts(World& world, SolverScratch& scratch);
-void warm_start_contact(WideContact& wc, SolverBody* bodies);
-void solve_contact(WideContact& wc, SolverBody* bodies, const ContactSolveParams& params);
+// push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
+void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params);
 void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h);
 void store_contact_impulses(World& world, SolverScratch& scratch);
 
