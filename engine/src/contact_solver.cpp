@@ -178,9 +178,11 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     for (Real& impulse : wc.push_impulse) impulse = 0;
 }
 
+}  // namespace
+
 // Lays the colours' manifold refs out four by four, then the overflow one per
 // WideContact (its manifolds may share bodies, so they are solved one at a time).
-void pack(SolverScratch& scratch) {
+void pack_contacts(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
     scratch.wide.resize(count);  // kept from step to step: prepare_wide writes every field
@@ -206,6 +208,8 @@ void pack(SolverScratch& scratch) {
     scratch.wide_begin[kColorCount] = static_cast<std::uint32_t>(next);
     for (const std::uint32_t& ref : scratch.overflow) add(&ref, 1);
 }
+
+namespace {
 
 // Deep overlap is pushed out by a soft constraint on the push-out velocities (split
 // impulse), never by real speed, so a chain of deep overlaps separates without
@@ -332,7 +336,6 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
 }  // namespace
 
 void prepare_contacts(World& world, SolverScratch& scratch) {
-    pack(scratch);
     const auto count = static_cast<std::uint32_t>(scratch.wide.size());
     world.jobs->parallel_for("PrepareContacts", 0, count, kPrepareGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {

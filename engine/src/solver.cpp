@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 
 #include "stages.hpp"
 
@@ -74,7 +76,8 @@ PointCounts list_manifolds(World& world, SolverScratch& scratch) {
         for (int m = 0; m < contact.manifold_count; ++m) {
             const auto points = static_cast<std::uint64_t>(contact.manifold_at(m).point_count);
             if (points == 0) continue;
-            scratch.manifolds.push_back({c, m, solver_index(contact.body_a), solver_index(contact.body_b)});
+            scratch.manifolds.push_back(
+                {c, static_cast<std::uint32_t>(m), solver_index(contact.body_a), solver_index(contact.body_b)});
             counts.points += points;
             if (contact.friction > 0) counts.friction += points;
             if (contact.restitution > 0) counts.restitution += points;
@@ -119,6 +122,25 @@ void color(SolverScratch& scratch) {
         const int c = assign_color(scratch, scratch.manifolds[k].a, scratch.manifolds[k].b);
         (c >= 0 ? scratch.colors[c] : scratch.overflow).push_back(k);
     }
+}
+
+// Whether the colours and packing of the last colouring hold for this step's
+// constraints: the same manifolds of the same bodies, the same body count (the
+// immovable body is the last) and no joints then or now. A resting pile keeps its
+// manifold list from step to step, and comparing it is far cheaper than colouring.
+bool same_constraints(SolverScratch& scratch) {
+    static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
+    const bool same = scratch.joints.empty() && !scratch.colored_joints &&
+                      scratch.colored_bodies == scratch.bodies.size() &&
+                      scratch.colored_manifolds.size() == scratch.manifolds.size() &&
+                      std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
+                                  scratch.manifolds.size() * sizeof(ManifoldRef)) == 0;
+    if (!same) {
+        scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
+        scratch.colored_bodies = scratch.bodies.size();
+        scratch.colored_joints = !scratch.joints.empty();
+    }
+    return same;
 }
 
 // Runs joint_fn and contact_fn over constraints [lo, hi) of colour `color`: its joints
@@ -213,7 +235,11 @@ void solve(World& world, Real dt) {
     prepare_bodies(world, scratch);
     const PointCounts points = list_manifolds(world, scratch);
     prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
-    color(scratch);
+    if (!same_constraints(scratch)) {
+        color(scratch);
+        pack_contacts(scratch);
+        world.counters.constraint_colorings += 1;
+    }
     prepare_contacts(world, scratch);
     SolverBody* bodies = scratch.bodies.data();
 

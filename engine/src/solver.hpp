@@ -52,7 +52,7 @@ struct WidePoint {
 // A touching manifold of an awake contact, as listed and coloured for the step.
 struct ManifoldRef {
     std::uint32_t contact = 0;
-    int manifold = 0;
+    std::uint32_t manifold = 0;
     std::uint32_t a = 0, b = 0;  // solver bodies
 };
 
@@ -136,6 +136,11 @@ struct SolverPhase {
 struct SolverScratch {
     std::vector<SolverBody> bodies;                 // awake bodies, then the static body
     std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
+    // The colouring below is a function of the manifold list, the joints and the body
+    // count alone: the list it was made for, to reuse it while nothing changed.
+    std::vector<ManifoldRef> colored_manifolds;
+    std::size_t colored_bodies = 0;
+    bool colored_joints = false;
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
     std::vector<WideContact> wide;                   // the colours' manifolds four by four, then the overflow one by one
@@ -160,8 +165,11 @@ struct ContactSolveParams {
     bool use_bias = true;
 };
 
-// contact_solver.cpp. prepare_contacts fills scratch.wide from scratch.manifolds and
-// the colours; the others run per wide contact from the colour loops.
+// contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide
+// (which manifold and bodies each lane holds); prepare_contacts fills in the rest from
+// the manifolds and bodies of the step; the others run per wide contact from the
+// colour loops.
+void pack_contacts(SolverScratch& scratch);
 void prepare_contacts(World& world, SolverScratch& scratch);
 // push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
 void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);

@@ -110,6 +110,55 @@ TEST(Effects, RestingContactsKeepTheirManifolds) {
     EXPECT_NEAR(space.internal_position(box).y(), 0.5, 0.01);
 }
 
+// Colouring only when the constraints changed: a resting stack reuses the last step's
+// colours; a new body (the body count) or a joint colours again.
+TEST(Effects, RestingStacksAreColouredOnlyWhenTheirConstraintsChange) {
+    Space space(awake());
+    add_ground(space);
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.5));
+    std::vector<BodyHandle> boxes;
+    for (int i = 0; i < 5; ++i) {
+        d.position = Vec3(0, 0.5 + i, 0);
+        boxes.push_back(space.create_body(d));
+    }
+    for (int i = 0; i < 60; ++i) space.update();
+    const std::uint64_t settled = space.counters().constraint_colorings;
+    for (int i = 0; i < 60; ++i) space.update();
+    EXPECT_LE(space.counters().constraint_colorings - settled, 2u);
+    EXPECT_NEAR(space.internal_position(boxes.back()).y(), 4.5, 0.05);
+
+    space.create_joint(JointDesc::ball_socket_at(boxes[0], boxes[1], Vec3(0, 1, 0)));
+    const std::uint64_t before_joint = space.counters().constraint_colorings;
+    for (int i = 0; i < 3; ++i) space.update();
+    EXPECT_EQ(space.counters().constraint_colorings, before_joint + 3);  // with joints: every step
+    EXPECT_NEAR(space.internal_position(boxes.back()).y(), 4.5, 0.05);
+}
+
+// The same manifolds but one more body: the packing's immovable body (the last solver
+// body) moved, so the colours are made again. No ground here, so the manifold list
+// itself does not change.
+TEST(Effects, ANewBodyMeansNewColours) {
+    SpaceSettings settings = awake();
+    settings.gravity = Vec3::Zero();
+    Space space(settings);
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.5));
+    d.position = Vec3(0, 0, 0);
+    space.create_body(d);
+    d.position = Vec3(1, 0, 0);  // face to face with the first
+    space.create_body(d);
+    for (int i = 0; i < 10; ++i) space.update();
+    const std::uint64_t settled = space.counters().constraint_colorings;
+    space.update();
+    ASSERT_EQ(space.counters().constraint_colorings, settled);
+    ASSERT_GT(space.last_update().contacts, 0u);
+    d.position = Vec3(20, 0, 0);  // far away: no new contact
+    space.create_body(d);
+    space.update();
+    EXPECT_EQ(space.counters().constraint_colorings, settled + 1);
+}
+
 TEST(Effects, SlidingContactsAreRecomputed) {
     Space space(awake());
     add_ground(space, 0);

@@ -46,6 +46,7 @@ struct WorkCounters {
     std::uint64_t restitution_applied = 0;     // points with restitution > 0 checked
     std::uint64_t friction_applied = 0;        // point-iterations with friction > 0
     std::uint64_t joints_solved = 0;           // joint-iterations
+    std::uint64_t constraint_colorings = 0;    // steps that coloured their constraints (the rest reused the last step's)
     std::uint64_t swept_tests = 0;             // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
 };
