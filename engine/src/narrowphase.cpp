@@ -100,17 +100,22 @@ void update_narrowphase(World& world) {
     const Real dt = world.settings.time_step.duration;
     const std::vector<std::uint32_t>& awake = awake_contacts(world);
     const auto count = static_cast<std::uint32_t>(awake.size());
-    world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+    // Counted per worker while the contacts are at hand (a sum: it does not matter who
+    // counted which), not in a second pass over every contact.
+    world.contact_counts.assign(world.jobs->worker_count(), ContactCounts{});
+    world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         Manifold found[kMaxManifolds];
+        ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
             Contact& contact = world.contacts[awake[k]];
             const std::uint32_t a = contact.body_a, bb = contact.body_b;
             const Transform ta = b.transform(a), tb = b.transform(bb);
             const Vec3 position = ta.apply_inverse(tb.p);
             const Quat rotation = ta.q.conjugate() * tb.q;
-            contact.reused = cache_holds(contact, position, rotation);
-            if (contact.reused) {
+            if (cache_holds(contact, position, rotation)) {
                 follow_bodies(contact, ta, tb);
+                counts.reused += 1;
+                counts.touching += contact.manifold_count > 0 ? 1u : 0u;
                 continue;
             }
             // Speculative contacts reach as far as the bodies can close in one step.
@@ -128,12 +133,13 @@ void update_narrowphase(World& world) {
             if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
             remember(contact, ta, tb, position, rotation);
+            counts.touching += n > 0 ? 1u : 0u;
         }
     });
     std::uint32_t touching = 0, reused = 0;
-    for (std::uint32_t c : awake) {
-        touching += world.contacts[c].manifold_count > 0 ? 1u : 0u;
-        reused += world.contacts[c].reused ? 1u : 0u;
+    for (const ContactCounts& c : world.contact_counts) {
+        touching += c.touching;
+        reused += c.reused;
     }
     world.stats.contacts = touching;
     world.counters.contacts_updated += count;

@@ -104,7 +104,6 @@ struct Contact {
     // B's pose in A's frame when the manifolds were last computed; while the bodies stay
     // within 0.2 mm and half a degree of it, the manifolds are moved, not recomputed.
     bool cached = false;
-    bool reused = false;  // this step's manifolds were moved from the cache
     Vec3 cached_position = Vec3::Zero();
     Quat cached_rotation = Quat::Identity();
 
@@ -119,6 +118,11 @@ struct Contact {
 // each: the workers bump theirs per body.
 struct alignas(64) EffectCounts {
     std::uint64_t gravity = 0, damping = 0, gyro = 0;
+};
+
+// Contacts of one worker in the narrowphase, summed after the stage.
+struct alignas(64) ContactCounts {
+    std::uint32_t touching = 0, reused = 0;
 };
 
 // A sleeping island: its bodies, contacts and joints, kept so one touch wakes them together.
@@ -172,6 +176,7 @@ struct World {
     UpdateStats stats;
     WorkCounters counters;
     std::vector<EffectCounts> scratch_counts;  // per worker
+    std::vector<ContactCounts> contact_counts;  // per worker (narrowphase.cpp)
     std::vector<std::uint32_t> scratch_lost;
     std::vector<FastStart> fast_starts;          // continuous.cpp
     std::vector<std::uint32_t> scratch_candidates;
