@@ -29,6 +29,9 @@ void refresh_proxy(World& world, std::uint32_t slot);
 void remove_contacts_of(World& world, std::uint32_t slot);
 // Creates a contact for a pair key (min slot << 32 | max slot) if there is none.
 void create_contact(World& world, std::uint64_t key);
+// Makes room for `more` contacts at once (a first step finds tens of thousands of pairs:
+// growing by push_back would move every contact again and again).
+void reserve_contacts(World& world, std::size_t more);
 // Removes contacts by their positions in world.contacts (ascending), keeping the order of the rest.
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);
 

@@ -118,8 +118,21 @@ void flip_read_buffers(World& world) {
         world.counters.interpolated_publishes += back[i].interpolate ? 1 : 0;
     };
     // The back buffer is two flips old: refresh what moved in either of the two
-    // updates (awake bodies, and bodies changed by writes, creation or sleep).
-    for (std::uint32_t i : world.awake) publish(i);
+    // updates (awake bodies, and bodies changed by writes, creation or sleep). The
+    // awake ones in parallel (each entry is its own), counted per worker.
+    std::vector<CacheLinePadded<std::uint64_t>>& interpolated = world.publish_counts;
+    interpolated.assign(world.jobs->worker_count(), {});
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+        std::uint64_t count = 0;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t i = world.awake[k];
+            fill(world, i, back[i], interpolating);
+            count += back[i].interpolate ? 1 : 0;
+        }
+        interpolated[worker].value += count;
+    });
+    for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
     for (std::uint32_t i : world.changed_now) {
         if (!b.alive[i] || b.awake_index[i] < 0) publish(i);  // awake ones were published above
     }

@@ -7,6 +7,21 @@
 
 namespace spindle {
 
+void reserve_contacts(World& world, std::size_t more) {
+    const std::size_t needed = world.contacts.size() + more;
+    if (world.contacts.capacity() < needed) {
+        // Geometric, as push_back would grow: room for exactly `needed` would make the
+        // next step's few new contacts reallocate (and move every contact) again.
+        const std::size_t capacity = std::max(needed, 2 * world.contacts.capacity());
+        world.contacts.reserve(capacity);
+        world.contact_keys.reserve(capacity);
+    }
+    if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
+        static_cast<float>(needed)) {
+        world.contact_index.reserve(std::max(needed, 2 * world.contact_index.size()));
+    }
+}
+
 void create_contact(World& world, std::uint64_t key) {
     if (world.contact_index.count(key)) return;
     const auto a = static_cast<std::uint32_t>(key >> 32);

@@ -14,6 +14,7 @@
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/stats.hpp>
+#include <spindle/platform/spin.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
 #include "joints.hpp"
@@ -177,6 +178,7 @@ struct World {
     WorkCounters counters;
     std::vector<EffectCounts> scratch_counts;  // per worker
     std::vector<ContactCounts> contact_counts;  // per worker (narrowphase.cpp)
+    std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     std::vector<std::uint32_t> scratch_lost;
     std::vector<FastStart> fast_starts;          // continuous.cpp
     std::vector<std::uint32_t> scratch_candidates;
