@@ -133,8 +133,9 @@ bool same_constraints(SolverScratch& scratch) {
     const bool same = scratch.joints.empty() && !scratch.colored_joints &&
                       scratch.colored_bodies == scratch.bodies.size() &&
                       scratch.colored_manifolds.size() == scratch.manifolds.size() &&
-                      std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
-                                  scratch.manifolds.size() * sizeof(ManifoldRef)) == 0;
+                      (scratch.manifolds.empty() ||  // memcmp may not see the null data of an empty vector
+                       std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
+                                   scratch.manifolds.size() * sizeof(ManifoldRef)) == 0);
     if (!same) {
         scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
         scratch.colored_bodies = scratch.bodies.size();
