@@ -52,12 +52,14 @@ inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, c
     s.wb += L * row.ib;
 }
 
-// The four lanes' body velocities while a WideContact is solved.
+// The four lanes' body velocities while a WideContact is solved. gather and scatter
+// are forced inline: as calls they returned and copied 768 bytes per pass (+4-5% on
+// the pyramid, one thread, paired runs).
 struct WideVelocities {
     Wide3 va, wa, vb, wb;
 };
 
-WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
+[[gnu::always_inline]] inline WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
     WideVelocities s;
     for (int l = 0; l < kLanes; ++l) {
         const SolverBody& A = bodies[wc.a[l]];
@@ -72,7 +74,7 @@ WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
 
 // Writes the dynamic bodies back: static and kinematic ones (and the empty lanes'
 // immovable body) are shared by constraints of every colour and never written.
-void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
+[[gnu::always_inline]] inline void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
     for (int l = 0; l < kLanes; ++l) {
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
