@@ -16,7 +16,6 @@
 namespace spindle {
 namespace {
 
-constexpr std::uint32_t kPrepareGrain = 8;   // wide contacts per job
 constexpr Real kEmptySeparation = 1e18;      // an empty point slot: far apart, never touching
 
 // A tangent basis for a unit normal, the same for the same normal every time.
@@ -130,7 +129,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     for (int l = 0; l < wc.lanes; ++l) {
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
-        const ContactManifold& m = contact.manifold_at(ref.manifold);
+        const ContactManifold& m = contact.manifold_at(static_cast<int>(ref.manifold));
         const SolverBody& A = scratch.bodies[ref.a];
         const SolverBody& B = scratch.bodies[ref.b];
         Vec3 tangent[2];
@@ -337,13 +336,8 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
 
 }  // namespace
 
-void prepare_contacts(World& world, SolverScratch& scratch) {
-    const auto count = static_cast<std::uint32_t>(scratch.wide.size());
-    world.jobs->parallel_for("PrepareContacts", 0, count, kPrepareGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            prepare_wide(world, scratch, scratch.wide[k]);
-        }
-    });
+void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, scratch.wide[k]);
 }
 
 void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
@@ -397,26 +391,23 @@ void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real
     scatter(wc, bodies, s);
 }
 
-void store_contact_impulses(World& world, SolverScratch& scratch) {
-    const auto count = static_cast<std::uint32_t>(scratch.wide.size());
-    world.jobs->parallel_for("StoreImpulses", 0, count, kPrepareGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            const WideContact& wc = scratch.wide[k];
-            for (int l = 0; l < wc.lanes; ++l) {
-                const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
-                ContactManifold& m = world.contacts[ref.contact].manifold_at(ref.manifold);
-                for (int j = 0; j < m.point_count; ++j) {
-                    const WidePoint& p = wc.points[j];
-                    ContactPoint& dst = m.points[j];
-                    dst.normal_impulse = p.normal_impulse[l];
-                    dst.tangent_impulse[0] = p.tangent_impulse[0][l];
-                    dst.tangent_impulse[1] = p.tangent_impulse[1][l];
-                    dst.max_normal_impulse = p.max_normal_impulse[l];
-                    dst.relative_velocity = p.relative_velocity[l];
-                }
+void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const WideContact& wc = scratch.wide[k];
+        for (int l = 0; l < wc.lanes; ++l) {
+            const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
+            ContactManifold& m = world.contacts[ref.contact].manifold_at(static_cast<int>(ref.manifold));
+            for (int j = 0; j < m.point_count; ++j) {
+                const WidePoint& p = wc.points[j];
+                ContactPoint& dst = m.points[j];
+                dst.normal_impulse = p.normal_impulse[l];
+                dst.tangent_impulse[0] = p.tangent_impulse[0][l];
+                dst.tangent_impulse[1] = p.tangent_impulse[1][l];
+                dst.max_normal_impulse = p.max_normal_impulse[l];
+                dst.relative_velocity = p.relative_velocity[l];
             }
         }
-    });
+    }
 }
 
 }  // namespace spindle

@@ -33,6 +33,8 @@ constexpr std::uint32_t kBodyGrain = 128;
 // Joints or wide contacts (4 manifolds each) per chunk: small, so the end of a colour
 // splits evenly between the workers.
 constexpr std::uint32_t kConstraintGrain = 2;
+// Wide contacts per block when preparing them and storing their impulses.
+constexpr std::uint32_t kWideGrain = 8;
 
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
@@ -192,12 +194,19 @@ void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::ui
     scratch.plan.push_back(SolverPhase{pass, 0});
 }
 
-// The step's solver loop as a list of phases, each over the bodies or one colour.
+void plan_wide_pass(SolverScratch& scratch, Pass pass, const char* name) {
+    scratch.phases.push_back(Phase{name, static_cast<std::uint32_t>(scratch.wide.size()), kWideGrain});
+    scratch.plan.push_back(SolverPhase{pass, 0});
+}
+
+// The step's solver loop as a list of phases, each over the bodies, the wide contacts
+// or one colour.
 void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     const SolverSettings& settings = world.settings.solver;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     scratch.phases.clear();
     scratch.plan.clear();
+    plan_wide_pass(scratch, Pass::PrepareContacts, "PrepareContacts");
     for (int sub = 0; sub < settings.substeps; ++sub) {
         plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
         plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
@@ -206,23 +215,23 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
         for (int it = 0; it < settings.relax_iterations; ++it) plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
     }
     if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
+    plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
+    plan_body_pass(scratch, Pass::FinalizeBodies, "FinalizeBodies", n);
 }
 
-void finalize(World& world, SolverScratch& scratch) {
+// The step's motion into the bodies, awake bodies [lo, hi).
+void finalize_bodies(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
     Bodies& b = world.bodies;
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
-    world.jobs->parallel_for("FinalizeBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            const std::uint32_t i = world.awake[k];
-            const SolverBody& sb = scratch.bodies[k];
-            b.x[i] += sb.dp;
-            b.q[i] = (sb.dq * b.q[i]).normalized();
-            b.v[i] = sb.v;
-            b.w[i] = sb.w;
-            b.force[i] = Vec3::Zero();  // consumed by this step
-            b.torque[i] = Vec3::Zero();
-        }
-    });
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const std::uint32_t i = world.awake[k];
+        const SolverBody& sb = scratch.bodies[k];
+        b.x[i] += sb.dp;
+        b.q[i] = (sb.dq * b.q[i]).normalized();
+        b.v[i] = sb.v;
+        b.w[i] = sb.w;
+        b.force[i] = Vec3::Zero();  // consumed by this step
+        b.torque[i] = Vec3::Zero();
+    }
 }
 
 }  // namespace
@@ -241,7 +250,6 @@ void solve(World& world, Real dt) {
         pack_contacts(scratch);
         world.counters.constraint_colorings += 1;
     }
-    prepare_contacts(world, scratch);
     SolverBody* bodies = scratch.bodies.data();
 
     ContactSolveParams solve_params;
@@ -258,9 +266,10 @@ void solve(World& world, Real dt) {
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
     const JointSolveParams joint_relax{joint_solve.soft, joint_solve.inv_h, false};
 
-    // Every substep's passes in one run_phases: the workers meet at a barrier after each
-    // colour instead of forking and joining about a hundred times per step. Effects are
-    // counted per worker and summed (the sum does not depend on who counted what).
+    // Preparing the contacts, every substep's passes, storing impulses and finalizing the
+    // bodies in one run_phases: the workers meet at a barrier after each colour instead
+    // of forking and joining about a hundred times per step. Effects are counted per
+    // worker and summed (the sum does not depend on who counted what).
     plan_step(world, scratch, points.restitution > 0);  // no pass at all over a scene without bouncy contacts
     world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
     const Real restitution_threshold = settings.restitution_threshold;
@@ -271,6 +280,15 @@ void solve(World& world, Real dt) {
                                                          unsigned worker) {
         const SolverPhase phase = scratch.plan[p];
         switch (phase.pass) {
+        case Pass::PrepareContacts:
+            prepare_contacts(world, scratch, lo, hi);
+            break;
+        case Pass::StoreImpulses:
+            store_contact_impulses(world, scratch, lo, hi);
+            break;
+        case Pass::FinalizeBodies:
+            finalize_bodies(world, scratch, lo, hi);
+            break;
         case Pass::IntegrateVelocities:
             integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
             break;
@@ -304,9 +322,7 @@ void solve(World& world, Real dt) {
         world.counters.damping_applied += c.damping;
         world.counters.gyroscopic_applied += c.gyro;
     }
-    store_contact_impulses(world, scratch);
     if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
-    finalize(world, scratch);
 
     // Work counters, derived from the constraint set (no per-point counting in the hot loop).
     const auto passes = static_cast<std::uint64_t>(substeps * (settings.iterations + settings.relax_iterations));

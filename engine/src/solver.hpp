@@ -127,7 +127,17 @@ inline constexpr int kColorCount = 24;
 
 // What one phase of the step's solver loop does (solver.cpp): a pass over the bodies,
 // or over one colour's constraints (color == kColorCount: the overflow, one block).
-enum class Pass : std::uint8_t { IntegrateVelocities, WarmStart, Solve, IntegratePositions, Relax, Restitution };
+enum class Pass : std::uint8_t {
+    PrepareContacts,
+    IntegrateVelocities,
+    WarmStart,
+    Solve,
+    IntegratePositions,
+    Relax,
+    Restitution,
+    StoreImpulses,
+    FinalizeBodies
+};
 struct SolverPhase {
     Pass pass = Pass::Solve;
     int color = 0;
@@ -170,12 +180,12 @@ struct ContactSolveParams {
 // the manifolds and bodies of the step; the others run per wide contact from the
 // colour loops.
 void pack_contacts(SolverScratch& scratch);
-void prepare_contacts(World& world, SolverScratch& scratch);
+void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);  // wide [lo, hi)
 // push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
 void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
 void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params);
 void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h);
-void store_contact_impulses(World& world, SolverScratch& scratch);
+void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 // joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are
 // none) and prepares them from the bodies of scratch; the others run per joint from
