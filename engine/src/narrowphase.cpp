@@ -103,11 +103,10 @@ void update_narrowphase(World& world) {
     // Counted per worker while the contacts are at hand (a sum: it does not matter who
     // counted which), not in a second pass over every contact.
     world.contact_counts.assign(world.jobs->worker_count(), ContactCounts{});
-    // Contacts are independent, so one phase of run_phases (shares split by worker
-    // count, no deque traffic) does: the result does not depend on the split.
-    const Phase phase{"Narrowphase", count, 16};
-    world.jobs->run_phases("Narrowphase", std::span(&phase, 1), [&](std::uint32_t, std::uint32_t lo, std::uint32_t hi,
-                                                                 unsigned worker) {
+    // A parallel_for, not a run_phases phase: a mesh or hull pair costs a thousand times
+    // a resting box pair, and parallel_for splits the busy worker's range on demand,
+    // where a phase's first block (half a share) could hold all the expensive pairs.
+    world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         Manifold found[kMaxManifolds];
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {

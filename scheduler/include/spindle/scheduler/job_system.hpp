@@ -98,7 +98,9 @@ public:
     // body each). Made for many short phases (the solver's colour passes): one job per
     // worker walks the whole list, claiming blocks and meeting the others at a spin
     // barrier after each phase, so a phase costs a few cache-line transfers instead of a
-    // fork and a join. fn must not throw (std::terminate) nor wait for other jobs (no
+    // fork and a join. Each worker's share is cut into blocks of halving size, which
+    // suits items of similar cost; for very uneven items (collision pairs of different
+    // shapes) parallel_for, which splits a busy range on demand, balances better. fn must not throw (std::terminate) nor wait for other jobs (no
     // parallel_for or wait inside it: the waiting thread could pick up a participant
     // that then waits at a barrier for the block below it). Who may call: any thread,
     // not from inside a phase. Deadlock: none otherwise; a worker that never joins
