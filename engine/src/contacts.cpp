@@ -15,6 +15,7 @@ void reserve_contacts(World& world, std::size_t more) {
         const std::size_t capacity = std::max(needed, 2 * world.contacts.capacity());
         world.contacts.reserve(capacity);
         world.contact_keys.reserve(capacity);
+        world.contact_summaries.reserve(capacity);
     }
     if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
         static_cast<float>(needed)) {
@@ -35,6 +36,7 @@ void create_contact(World& world, std::uint64_t key) {
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
+    world.contact_summaries.push_back(contact_summary(contact));
     world.contacts.push_back(std::move(contact));
     world.contact_keys.push_back(key);
     world.awake_contacts_dirty = true;
@@ -63,12 +65,14 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
         if (write != read) {
             world.contacts[write] = std::move(world.contacts[read]);
             world.contact_keys[write] = world.contact_keys[read];
+            world.contact_summaries[write] = world.contact_summaries[read];
         }
         world.contact_index[world.contact_keys[write]] = static_cast<std::uint32_t>(write);
         ++write;
     }
     world.contacts.resize(write);
     world.contact_keys.resize(write);
+    world.contact_summaries.resize(write);
     world.awake_contacts_dirty = true;
 }
 

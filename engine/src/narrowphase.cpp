@@ -136,6 +136,7 @@ void update_narrowphase(World& world) {
             if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
             remember(contact, ta, tb, position, rotation);
+            world.contact_summaries[awake[k]] = contact_summary(contact);  // a kept manifold keeps its summary
             counts.touching += n > 0 ? 1u : 0u;
         }
     });

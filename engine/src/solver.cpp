@@ -14,6 +14,8 @@
 #include <cstring>
 #include <type_traits>
 
+#include <spindle/platform/assert.hpp>
+
 #include "stages.hpp"
 
 namespace spindle {
@@ -63,7 +65,8 @@ struct PointCounts {
     std::uint64_t points = 0, friction = 0, restitution = 0;
 };
 
-// One ref per touching manifold of an awake contact, in contact order; counts their points.
+// One ref per touching manifold of an awake contact, in contact order; counts their
+// points. Reads only the packed keys and summaries, never a contact.
 PointCounts list_manifolds(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
@@ -74,15 +77,21 @@ PointCounts list_manifolds(World& world, SolverScratch& scratch) {
     PointCounts counts;
     scratch.manifolds.clear();
     for (std::uint32_t c : awake_contacts(world)) {
-        const Contact& contact = world.contacts[c];
-        for (int m = 0; m < contact.manifold_count; ++m) {
-            const auto points = static_cast<std::uint64_t>(contact.manifold_at(m).point_count);
+        const std::uint32_t summary = world.contact_summaries[c];
+        SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]), "solver: a contact's packed summary is stale");
+        const std::uint64_t key = world.contact_keys[c];
+        const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
+        const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
+        const bool friction = (summary & kSummaryFriction) != 0;
+        const bool restitution = (summary & kSummaryRestitution) != 0;
+        std::uint32_t point_counts = summary & 0xffffu;  // 4 bits per manifold
+        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= 4) {
+            const std::uint32_t points = point_counts & 0xfu;
             if (points == 0) continue;
-            scratch.manifolds.push_back(
-                {c, static_cast<std::uint32_t>(m), solver_index(contact.body_a), solver_index(contact.body_b)});
+            scratch.manifolds.push_back({c, m, a, bb});
             counts.points += points;
-            if (contact.friction > 0) counts.friction += points;
-            if (contact.restitution > 0) counts.restitution += points;
+            if (friction) counts.friction += points;
+            if (restitution) counts.restitution += points;
         }
     }
     return counts;

@@ -93,9 +93,9 @@ struct ContactManifold {
     ContactPoint points[kMaxManifoldPoints];
 };
 
-// A pair of bodies whose fat bounds overlap. Shape A has the lower shape type.
+// A pair of bodies whose fat bounds overlap.
 struct Contact {
-    std::uint32_t body_a = 0, body_b = 0;  // slots
+    std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (the key's high half)
     std::uint64_t key = 0;                 // (min slot << 32) | max slot
     Real friction = 0, restitution = 0;
     int manifold_count = 0;
@@ -113,6 +113,20 @@ struct Contact {
         return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)];
     }
 };
+
+// A contact's manifolds packed for the solver's listing: the point count of manifold m
+// in bits [4m, 4m + 4), and whether the contact has friction and restitution.
+inline constexpr std::uint32_t kSummaryFriction = 1u << 16;
+inline constexpr std::uint32_t kSummaryRestitution = 1u << 17;
+inline std::uint32_t contact_summary(const Contact& contact) {
+    static_assert(kMaxManifoldPoints < 16, "a point count in 4 bits");
+    std::uint32_t summary = (contact.friction > 0 ? kSummaryFriction : 0u) |
+                            (contact.restitution > 0 ? kSummaryRestitution : 0u);
+    for (int m = 0; m < contact.manifold_count; ++m) {
+        summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (4 * m);
+    }
+    return summary;
+}
 
 // Effect counts of one worker in the solver's integration, summed after the step (a
 // sum of counts, so the total does not depend on who counted what). A cache line
@@ -154,6 +168,9 @@ struct World {
     std::vector<Contact> contacts;
     std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
     std::vector<std::uint64_t> contact_keys;  // contacts[i].key, packed: a scan of pairs reads 8 bytes per contact
+    // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of
+    // manifolds needs, without reading the contact (the narrowphase writes it).
+    std::vector<std::uint32_t> contact_summaries;
     // Positions of the contacts that are not asleep, ascending; rebuilt only after a
     // contact is made, removed, or changes sleep, so sleeping contacts cost nothing per step.
     std::vector<std::uint32_t> awake_contact_list;
