@@ -4,6 +4,9 @@
 //   ParallelForWork    parallel_for over ~1 ms of real work (items:1000, ~1 us each, grain 1)
 //                      and over ~20 us (items:24): the size of a physics stage, where
 //                      starting and joining the other worker dominate
+//   Phases             128 phases of 24 items (~1 us each) one after another, as 128
+//                      parallel_for calls or as one run_phases call (the solver's colour
+//                      passes): per_phase is the time per phase
 // Results and the targets they are held to: docs/benchmarks.md.
 #include <cmath>
 #include <cstdint>
@@ -98,7 +101,35 @@ void work_cases(benchmark::internal::Benchmark* b) {
     b->UseRealTime();
 }
 
+constexpr std::uint32_t phase_count = 128;
+
+// 128 phases of short_items items each, every phase finished before the next starts:
+// run_phases (state.range(1) == 1) or one parallel_for per phase (0).
+void Spindle_Phases(benchmark::State& state) {
+    auto jobs = spindle_system(static_cast<int>(state.range(0)));
+    const bool one_call = state.range(1) == 1;
+    std::vector<float> out(short_items);
+    const std::vector<spindle::Phase> phases(phase_count, spindle::Phase{"phase", short_items, 1});
+    for (auto _ : state) {
+        if (one_call) {
+            jobs->run_phases("phases", phases, [&](std::uint32_t, std::uint32_t lo, std::uint32_t hi, unsigned) {
+                for (std::uint32_t i = lo; i < hi; ++i) out[i] += work_item(i);
+            });
+        } else {
+            for (std::uint32_t p = 0; p < phase_count; ++p) {
+                jobs->parallel_for("phase", 0, short_items, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                    for (std::uint32_t i = lo; i < hi; ++i) out[i] += work_item(i);
+                });
+            }
+        }
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.counters["per_phase"] =
+        benchmark::Counter(phase_count, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 BENCHMARK(Spindle_EmptyJobs)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
+BENCHMARK(Spindle_Phases)->ArgNames({"workers", "run_phases"})->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})->UseRealTime();
 BENCHMARK(Spindle_ParallelForTrivial)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
 BENCHMARK(Spindle_ParallelForWork)->Apply(work_cases);
 
