@@ -136,12 +136,15 @@ void color(SolverScratch& scratch) {
 }
 
 // Whether the colours and packing of the last colouring hold for this step's
-// constraints: the same manifolds of the same bodies, the same body count (the
-// immovable body is the last) and no joints then or now. A resting pile keeps its
-// manifold list from step to step, and comparing it is far cheaper than colouring.
-bool same_constraints(SolverScratch& scratch) {
+// constraints: the same manifolds of the same bodies, no body made or destroyed (a
+// reused slot could change from kinematic to dynamic, which the colours depend on),
+// the same awake count (the immovable body is the last) and no joints then or now. A
+// resting pile keeps its manifold list from step to step, and comparing it is far
+// cheaper than colouring.
+bool same_constraints(const World& world, SolverScratch& scratch) {
     static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
     const bool same = scratch.joints.empty() && !scratch.colored_joints &&
+                      scratch.colored_body_set == world.body_set_version &&
                       scratch.colored_bodies == scratch.bodies.size() &&
                       scratch.colored_manifolds.size() == scratch.manifolds.size() &&
                       (scratch.manifolds.empty() ||  // memcmp may not see the null data of an empty vector
@@ -150,6 +153,7 @@ bool same_constraints(SolverScratch& scratch) {
     if (!same) {
         scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
         scratch.colored_bodies = scratch.bodies.size();
+        scratch.colored_body_set = world.body_set_version;
         scratch.colored_joints = !scratch.joints.empty();
     }
     return same;
@@ -254,7 +258,7 @@ void solve(World& world, Real dt) {
     prepare_bodies(world, scratch);
     const PointCounts points = list_manifolds(world, scratch);
     prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
-    if (!same_constraints(scratch)) {
+    if (!same_constraints(world, scratch)) {
         color(scratch);
         pack_contacts(scratch);
         world.counters.constraint_colorings += 1;

@@ -146,10 +146,11 @@ struct SolverPhase {
 struct SolverScratch {
     std::vector<SolverBody> bodies;                 // awake bodies, then the static body
     std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
-    // The colouring below is a function of the manifold list, the joints and the body
-    // count alone: the list it was made for, to reuse it while nothing changed.
+    // The colouring below is a function of the manifold list, the joints and the bodies
+    // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
     std::vector<ManifoldRef> colored_manifolds;
     std::size_t colored_bodies = 0;
+    std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
     bool colored_joints = false;
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially

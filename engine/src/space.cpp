@@ -177,6 +177,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
     w.changed_now.push_back(slot);
+    w.body_set_version += 1;
     publish_now(w, slot);
     return BodyHandle{slot, b.generation[slot]};
 }
@@ -197,6 +198,7 @@ void Space::destroy_body(BodyHandle body) {
     w.bodies.desc[slot] = BodyDesc{};  // drop the shape's geometry now
     w.bodies.free_slots.push_back(slot);
     w.changed_now.push_back(slot);
+    w.body_set_version += 1;
     publish_now(w, slot);
 }
 

@@ -190,6 +190,7 @@ struct World {
     // Time stepping.
     Real accumulator = 0;
     std::uint64_t steps = 0;
+    std::uint64_t body_set_version = 0;  // bumped when a body is made or destroyed (solver.cpp reuses colours until then)
 
     UpdateStats stats;
     WorkCounters counters;
