@@ -119,20 +119,36 @@ void flip_read_buffers(World& world) {
     };
     // The back buffer is two flips old: refresh what moved in either of the two
     // updates (awake bodies, and bodies changed by writes, creation or sleep). The
-    // awake ones in parallel (each entry is its own), counted per worker.
-    std::vector<CacheLinePadded<std::uint64_t>>& interpolated = world.publish_counts;
-    interpolated.assign(world.jobs->worker_count(), {});
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
-    world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
-        std::uint64_t count = 0;
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            const std::uint32_t i = world.awake[k];
-            fill(world, i, back[i], interpolating);
-            count += back[i].interpolate ? 1 : 0;
-        }
-        interpolated[worker].value += count;
-    });
-    for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
+    // awake ones in parallel (each entry is its own), counted per worker; and only when
+    // the back buffer has not already got them: an update that took no step and applied
+    // no write leaves the awake bodies as they were at its last fill (the async runner
+    // updates many times per step, and would otherwise copy every awake body each time).
+    // Anything that may have changed an awake body since the last flip: a step, a write,
+    // or a direct change (set_internal_motion_state, creation) noted in changed_now.
+    if (world.stats.steps > 0 || world.stats.writes_applied > 0 || !world.changed_now.empty()) {
+        world.awake_version += 1;
+    }
+    const int k = manager.back_index();
+    const bool awake_stale = world.published_version[k] != world.awake_version ||
+                             world.published_interpolating[k] != interpolating;
+    if (awake_stale) {
+        std::vector<CacheLinePadded<std::uint64_t>>& interpolated = world.publish_counts;
+        interpolated.assign(world.jobs->worker_count(), {});
+        const auto n = static_cast<std::uint32_t>(world.awake.size());
+        world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+            std::uint64_t count = 0;
+            for (std::uint32_t a = lo; a < hi; ++a) {
+                const std::uint32_t i = world.awake[a];
+                fill(world, i, back[i], interpolating);
+                count += back[i].interpolate ? 1 : 0;
+            }
+            interpolated[worker].value += count;
+        });
+        for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
+        world.counters.awake_publishes += n;
+        world.published_version[k] = world.awake_version;
+        world.published_interpolating[k] = interpolating;
+    }
     for (std::uint32_t i : world.changed_now) {
         if (!b.alive[i] || b.awake_index[i] < 0) publish(i);  // awake ones were published above
     }

@@ -190,6 +190,12 @@ struct World {
     // Time stepping.
     Real accumulator = 0;
     std::uint64_t steps = 0;
+    // The awake bodies' state version (bumped by every flip after a step, a write or a
+    // direct change) and the version each published buffer's awake entries were filled at
+    // (buffering.cpp; ~0: never): a flip with nothing new since skips refilling them.
+    std::uint64_t awake_version = 0;
+    std::uint64_t published_version[2] = {~std::uint64_t{0}, ~std::uint64_t{0}};
+    bool published_interpolating[2] = {false, false};
     std::uint64_t body_set_version = 0;  // bumped when a body is made or destroyed (solver.cpp reuses colours until then)
 
     UpdateStats stats;

@@ -85,3 +85,45 @@ TEST(Interpolation, ATeleportJumpsInsteadOfSliding) {
     space.update(kStep);  // one step on: blends between 100 and 100 + kStep only
     EXPECT_GE(space.position(body).x(), 100.0);
 }
+
+// An update that takes no step and applies no write leaves the awake bodies as they
+// were: once both published buffers hold the newest step, flips refill nothing. What
+// changes without a step (a buffered write, a direct internal change) still shows in
+// every later read, whichever buffer is in front.
+TEST(Interpolation, UpdatesWithoutAStepRepublishOnlyWhatChanged) {
+    Space space = make_space();
+    std::vector<BodyHandle> bodies;
+    for (int i = 0; i < 10; ++i) bodies.push_back(space.create_body(moving(i != 4)));  // 4: read unblended
+    space.update(kStep);
+    const double tiny = kStep / 100;
+    space.update(tiny);  // the other buffer catches up with the step
+    const std::uint64_t caught_up = space.counters().awake_publishes;
+    for (int i = 0; i < 20; ++i) space.update(tiny);
+    EXPECT_EQ(space.counters().awake_publishes, caught_up);
+    EXPECT_EQ(space.last_update().steps, 0);
+
+    // An impulse changes the velocity at once, without marking the body changed.
+    BodyDesc ball = moving(false);
+    ball.type = MotionType::Dynamic;
+    ball.position = Vec3(0, 10, 0);
+    ball.mass = 2;
+    const BodyHandle dynamic = space.create_body(ball);
+    space.update(kStep);
+    for (int i = 0; i < 3; ++i) space.update(tiny);
+    const Vec3 pushed = space.linear_velocity(dynamic) + Vec3(0, 5, 0) / 2;  // mass 2 kg
+    space.apply_impulse(dynamic, Vec3(0, 5, 0));
+    for (int i = 0; i < 3; ++i) {
+        space.update(tiny);
+        EXPECT_TRUE(space.linear_velocity(dynamic).isApprox(pushed, 1e-12)) << "flip " << i;
+    }
+    MotionState moved = space.internal_motion_state(bodies[4]);
+    moved.position = Vec3(7, 8, 9);
+    space.set_internal_motion_state(bodies[4], moved);
+    for (int i = 0; i < 3; ++i) {
+        space.update(tiny);
+        EXPECT_TRUE(space.position(bodies[4]).isApprox(Vec3(7, 8, 9), 1e-12)) << "flip " << i;
+    }
+    const std::uint64_t before = space.counters().awake_publishes;
+    for (int i = 0; i < 5; ++i) space.update(tiny);
+    EXPECT_EQ(space.counters().awake_publishes, before);
+}

@@ -58,6 +58,7 @@ public:
     // ---- physics side (the update thread) ----
     // The buffer being filled for the next flip; never read by other threads.
     std::vector<PublishedBody>& back() noexcept { return *m_back; }
+    int back_index() const noexcept { return m_back == &m_buffers[0] ? 0 : 1; }  // which buffer back() is
     // Both buffers, for a caller that holds lock() (publishing a created body at once).
     std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_buffers[k]; }
     // Swaps back and front under the lock; returns seconds the lock was held.

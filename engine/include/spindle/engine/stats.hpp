@@ -49,6 +49,7 @@ struct WorkCounters {
     std::uint64_t constraint_colorings = 0;    // steps that coloured their constraints (the rest reused the last step's)
     std::uint64_t swept_tests = 0;             // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
+    std::uint64_t awake_publishes = 0;         // awake bodies' entries refilled by FlipReadBuffers
 };
 
 }  // namespace spindle
