@@ -11,6 +11,7 @@ namespace spindle {
 namespace {
 
 constexpr int kMaxManifolds = 4;
+static_assert(kMaxManifolds <= 4, "contact_summary (world.hpp) packs the point counts of at most 4 manifolds");
 
 // Within this distance an old point stands for a new one whose feature id changed.
 constexpr Real kCarryDistance = 0.02;
@@ -136,7 +137,8 @@ void update_narrowphase(World& world) {
             if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
             remember(contact, ta, tb, position, rotation);
-            world.contact_summaries[awake[k]] = contact_summary(contact);  // a kept manifold keeps its summary
+            // New manifolds, new summary (a cached pair, above, keeps both).
+            world.contact_summaries[awake[k]] = contact_summary(contact);
             counts.touching += n > 0 ? 1u : 0u;
         }
     });

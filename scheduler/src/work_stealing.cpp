@@ -579,7 +579,6 @@ struct PhaseRun {
     CacheLinePadded<std::atomic<std::uint64_t>> done;
 };
 
-
 // Participant `me`: for each phase, its own share first, then what is left of the
 // others'; then the barrier.
 void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexcept {
