@@ -31,7 +31,6 @@ void create_contact(World& world, std::uint64_t key) {
     Contact contact;
     contact.body_a = a;
     contact.body_b = b;
-    contact.key = key;
     // Mixing rules as most engines: geometric mean friction, largest restitution.
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
@@ -55,7 +54,7 @@ const std::vector<std::uint32_t>& awake_contacts(World& world) {
 
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
     if (positions.empty()) return;
-    for (std::uint32_t p : positions) world.contact_index.erase(world.contacts[p].key);
+    for (std::uint32_t p : positions) world.contact_index.erase(world.contact_keys[p]);
     std::size_t next = 0, write = 0;
     for (std::size_t read = 0; read < world.contacts.size(); ++read) {
         if (next < positions.size() && positions[next] == read) {

@@ -169,8 +169,10 @@ void update_islands(World& world, Real dt) {
         contact.sleeping = true;
         // Recorded in both islands when they differ, so waking either revives it.
         const std::int32_t ia = b.island[contact.body_a], ib = b.island[contact.body_b];
-        if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].contacts.push_back(contact.key);
-        if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].contacts.push_back(contact.key);
+        if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].contacts.push_back(world.contact_keys[c]);
+        if (ib >= 0 && ib != ia) {
+            world.sleeping_islands[static_cast<std::size_t>(ib)].contacts.push_back(world.contact_keys[c]);
+        }
     }
     world.awake_contacts_dirty = true;
     // Joints likewise, so a sleeping island's joints cost nothing until it wakes.

@@ -95,8 +95,7 @@ struct ContactManifold {
 
 // A pair of bodies whose fat bounds overlap.
 struct Contact {
-    std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (the key's high half)
-    std::uint64_t key = 0;                 // (min slot << 32) | max slot
+    std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
     int manifold_count = 0;
     ContactManifold manifold;              // the first (and for convex pairs only) manifold
@@ -167,7 +166,7 @@ struct World {
     std::unique_ptr<BroadphaseState> broadphase;
     std::vector<Contact> contacts;
     std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
-    std::vector<std::uint64_t> contact_keys;  // contacts[i].key, packed: a scan of pairs reads 8 bytes per contact
+    std::vector<std::uint64_t> contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
     // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of
     // manifolds needs, without reading the contact (the narrowphase writes it).
     std::vector<std::uint32_t> contact_summaries;
