@@ -6,16 +6,20 @@ CMAKE_COMMON = -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
 # Sanitizer builds: optimised a little so Eigen-heavy tests stay quick; asserts on.
 SAN_FLAGS = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSPINDLE_BUILD_BENCH=OFF
 
-.PHONY: setup release run test test-release test-asan test-tsan bench accuracy clean
+.PHONY: setup configure-release release run test test-release test-asan test-tsan bench accuracy clean
 
 setup:
 	@bash scripts/setup.sh
 
-release: setup
+configure-release: setup
 	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_COMMON) >/dev/null
+
+release: configure-release
 	@cmake --build $(BUILD)/release -j$(JOBS)
 
-run: release
+# Only the program and what it links: no test or benchmark is built before the scene shows.
+run: configure-release
+	@cmake --build $(BUILD)/release -j$(JOBS) --target spindle
 	./$(BUILD)/release/apps/spindle run
 
 test: test-release test-asan test-tsan
@@ -37,8 +41,7 @@ bench: release
 	@for b in $(BUILD)/release/bench/*/bench_*; do [ -x "$$b" ] && "$$b" --benchmark_min_time=0.2; done
 
 # Builds only bench_accuracy (not all of release) so a fresh clone finishes in minutes.
-accuracy: setup
-	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_COMMON) >/dev/null
+accuracy: configure-release
 	@cmake --build $(BUILD)/release -j$(JOBS) --target bench_accuracy
 	bash scripts/accuracy.sh $(BUILD)/release
 

@@ -1,6 +1,6 @@
 // `spindle bench`: a scene stepped as fast as possible, without the async runner or
 // rendering, in fixed 1/60 s steps; one line of results, for scripts and comparisons.
-#include <spindle/engine/scene.hpp>
+#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/clock.hpp>
 

@@ -5,7 +5,7 @@
 // (work stealing, workers pinned per the layout, the physics loop thread as worker 0).
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
-#include <spindle/engine/scene.hpp>
+#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>

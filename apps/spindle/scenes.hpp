@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include <spindle/engine/scene.hpp>
+#include <spindle/scene/scene.hpp>
 
 #include "args.hpp"
 

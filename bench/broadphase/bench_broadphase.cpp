@@ -1,6 +1,7 @@
 // Broadphase benchmarks: named scenes (a table below) of boxes bouncing in a cube; one
 // iteration is one step: move_proxy for every moving box, then update_pairs.
-#include <spindle/engine/broadphase.hpp>
+#include "spatial/proxy_trees.hpp"
+
 #include <spindle/scheduler/single_threaded.hpp>
 
 #include <benchmark/benchmark.h>
@@ -40,7 +41,7 @@ public:
     explicit Scene(const SceneSpec& spec) : m_rng(1234), m_world(1.5 * std::cbrt(double(spec.moving + spec.statics))) {
         BroadphaseSettings settings;
         settings.validate_each_operation = false;
-        m_bp = Broadphase(settings);
+        m_bp = ProxyTrees(settings);
         for (int i = 0; i < spec.statics; ++i) {
             const Body b = make_body(0);
             m_bp.create_proxy(Aabb::from_center_extents(b.center, b.half), m_next_user++, true);
@@ -74,7 +75,7 @@ public:
         return {enlarged, pairs.size()};
     }
 
-    const Broadphase& broadphase() const { return m_bp; }
+    const ProxyTrees& broadphase() const { return m_bp; }
 
 private:
     double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(m_rng); }
@@ -88,7 +89,7 @@ private:
 
     std::mt19937_64 m_rng;
     double m_world;
-    Broadphase m_bp;
+    ProxyTrees m_bp;
     SingleThreadedJobSystem m_jobs;
     std::vector<Body> m_moving;
     std::uint64_t m_next_user = 1;

@@ -6,10 +6,6 @@
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
 #include "common/jobs.hpp"
-#include "common/run.hpp"
-#include "common/scenes.hpp"
-#include "common/timing.hpp"
-#include "heap_counter.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -19,6 +15,11 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "common/run.hpp"
+#include "common/scenes.hpp"
+#include "common/timing.hpp"
+#include "heap_counter.hpp"
 
 namespace spindle::bench {
 namespace {

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include <spindle/engine/collision.hpp>
-#include <spindle/engine/convex_hull.hpp>
-#include <spindle/engine/triangle_mesh.hpp>
+#include "collision/collide.hpp"
+#include "collision/convex_hull.hpp"
+#include "collision/triangle_mesh.hpp"
 
 namespace {
 

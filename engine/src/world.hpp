@@ -1,6 +1,5 @@
-// World: the live simulation state behind a Space, shared by the stages
-// (one file per stage: buffering.cpp, integrator.cpp, broadphase_stage.cpp,
-// narrowphase.cpp, islands.cpp, solver.cpp, record.cpp). Not thread safe by itself:
+// World: the live simulation state behind a Space, shared by the stages (stages/: one
+// file per stage, called in order by update.cpp) and the API (api/). Not thread safe by itself:
 // only the update thread touches it, and stages split work through the JobSystem.
 #pragma once
 
@@ -10,20 +9,20 @@
 #include <vector>
 
 #include <spindle/engine/body.hpp>
-#include <spindle/engine/collision.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/stats.hpp>
 #include <spindle/platform/spin.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
-#include "joints.hpp"
-#include "write_buffer.hpp"
+#include "api/joint_store.hpp"
+#include "api/write_buffer.hpp"
+#include "collision/collide.hpp"
 
 namespace spindle {
 
-struct BroadphaseState;  // broadphase_stage.hpp
-struct SolverScratch;    // solver.hpp
+struct BroadphaseState;  // stages/broadphase_state.hpp
+struct SolverScratch;    // solver/constraints.hpp
 
 // Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
 // data (pose, velocity, mass) sits in its own arrays; the description (shape,
@@ -176,7 +175,7 @@ struct World {
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
 
-    // Joints (joints.cpp); solved with the contacts, coloured first.
+    // Joints (api/joint_api.cpp); solved with the contacts, coloured first.
     Joints joints;
 
     // Buffering.

@@ -1,5 +1,5 @@
 // Buffered and internal properties, motion states and their lock (the seed, section 2).
-#include <spindle/engine/body_object.hpp>
+#include <spindle/engine/entity.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
@@ -224,8 +224,8 @@ TEST(MotionStates, HoldingTheLockKeepsThePhysicsThreadFromFlipping) {
     EXPECT_TRUE(stable);
 }
 
-TEST(Buffering, ABodyOutsideASpaceReadsAndWritesItsOwnValues) {
-    Body body(body_at(Vec3(1, 0, 0)));
+TEST(Buffering, AnEntityOutsideASpaceReadsAndWritesItsOwnValues) {
+    Entity body(body_at(Vec3(1, 0, 0)));
     EXPECT_FALSE(body.in_space());
     body.set_position(Vec3(2, 0, 0));  // direct: visible at once
     EXPECT_EQ(body.position(), Vec3(2, 0, 0));

@@ -1,7 +1,6 @@
 // Scene building and measuring helpers for the stability tests.
 #include "scene_util.hpp"
 
-#include <spindle/engine/collision.hpp>
 #include <spindle/platform/topology.hpp>
 #include <spindle/scheduler/work_stealing.hpp>
 
@@ -9,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+
+#include "collision/collide.hpp"
 
 namespace spindle::stability {
 namespace {

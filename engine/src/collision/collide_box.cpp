@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "contact.hpp"
-#include "pair_functions.hpp"
+#include "collision/clipping.hpp"
+#include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
 namespace {

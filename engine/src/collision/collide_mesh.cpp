@@ -6,10 +6,9 @@
 #include <array>
 #include <cmath>
 
-#include <spindle/engine/triangle_mesh.hpp>
-
-#include "contact.hpp"
-#include "pair_functions.hpp"
+#include "collision/clipping.hpp"
+#include "collision/pair_functions.hpp"
+#include "collision/triangle_mesh.hpp"
 
 namespace spindle::detail {
 namespace {

@@ -3,10 +3,9 @@
 // each named by its vertex index, and more than four are reduced.
 #include <array>
 
-#include <spindle/engine/convex_hull.hpp>
-
-#include "contact.hpp"
-#include "pair_functions.hpp"
+#include "collision/clipping.hpp"
+#include "collision/convex_hull.hpp"
+#include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
 

@@ -1,7 +1,7 @@
 // ConvexHull construction: quickhull over triangles (each step adds the point farthest
 // outside a face and re-triangulates the horizon), then coplanar triangles merged into
 // polygon faces, collinear loop vertices dropped, and volume moments integrated.
-#include <spindle/engine/convex_hull.hpp>
+#include "collision/convex_hull.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,8 @@
 #include <spindle/platform/assert.hpp>
 #include <spindle/platform/error.hpp>
 
-#include "error_text.hpp"
-#include "polyhedron.hpp"
+#include "collision/error_text.hpp"
+#include "collision/polyhedron.hpp"
 
 namespace spindle {
 namespace {

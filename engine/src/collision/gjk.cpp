@@ -1,6 +1,6 @@
 // GJK on point sets: the simplex is reduced with Ericson's closest-point region tests
 // (Real-Time Collision Detection, 5.1.5), which stay well behaved in double precision.
-#include "gjk.hpp"
+#include "collision/gjk.hpp"
 
 #include <cmath>
 

@@ -1,12 +1,11 @@
 // The narrowphase's pair functions, one per unordered pair of shape types, A being the
-// type that comes first in ShapeType. The dispatch table (narrowphase_dispatch.cpp)
+// type that comes first in ShapeType. The dispatch table (pair_table.cpp)
 // calls them with swapped arguments for the other order and flips the normal.
 // Convex pairs write at most one manifold; all take capacity >= 1.
 #pragma once
 
-#include <spindle/engine/collision.hpp>
-
-#include "polyhedron.hpp"
+#include "collision/collide.hpp"
+#include "collision/polyhedron.hpp"
 
 namespace spindle::detail {
 

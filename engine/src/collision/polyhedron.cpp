@@ -1,5 +1,5 @@
 // Polyhedron views of hulls, boxes and triangles, and edge extraction from face loops.
-#include "polyhedron.hpp"
+#include "collision/polyhedron.hpp"
 
 #include <algorithm>
 #include <vector>

@@ -6,7 +6,7 @@
 #include <array>
 #include <cstdint>
 
-#include <spindle/engine/convex_hull.hpp>
+#include "collision/convex_hull.hpp"
 
 namespace spindle::detail {
 

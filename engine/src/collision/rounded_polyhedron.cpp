@@ -6,11 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include <spindle/engine/convex_hull.hpp>
-
-#include "contact.hpp"
-#include "gjk.hpp"
-#include "pair_functions.hpp"
+#include "collision/clipping.hpp"
+#include "collision/convex_hull.hpp"
+#include "collision/gjk.hpp"
+#include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
 namespace {

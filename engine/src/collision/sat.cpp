@@ -4,10 +4,9 @@
 // between the two edges. All work happens in A's frame.
 #include <cmath>
 
-#include <spindle/engine/convex_hull.hpp>
-
-#include "contact.hpp"
-#include "pair_functions.hpp"
+#include "collision/clipping.hpp"
+#include "collision/convex_hull.hpp"
+#include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
 namespace {

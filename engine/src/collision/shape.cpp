@@ -1,11 +1,12 @@
 // Shape factories (with input validation), world bounds and mass properties. Closed
 // forms for the primitives; hulls integrate their polyhedron (see convex_hull.cpp).
-#include <spindle/engine/convex_hull.hpp>
+#include "collision/convex_hull.hpp"
+
 #include <spindle/engine/shape.hpp>
-#include <spindle/engine/triangle_mesh.hpp>
 #include <spindle/platform/error.hpp>
 
-#include "error_text.hpp"
+#include "collision/error_text.hpp"
+#include "collision/triangle_mesh.hpp"
 
 namespace spindle {
 namespace {

@@ -1,6 +1,6 @@
 // TriangleMesh construction (validation, zero-area triangles dropped, active-edge flags)
 // and its static AABB tree: built top-down with a binned SAH split, queried iteratively.
-#include <spindle/engine/triangle_mesh.hpp>
+#include "collision/triangle_mesh.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 #include <spindle/platform/assert.hpp>
 #include <spindle/platform/error.hpp>
 
-#include "error_text.hpp"
+#include "collision/error_text.hpp"
 
 namespace spindle {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <vector>
 
-#include <spindle/engine/collision.hpp>
-#include <spindle/engine/convex_hull.hpp>
-#include <spindle/engine/triangle_mesh.hpp>
+#include "collision/collide.hpp"
+#include "collision/convex_hull.hpp"
+#include "collision/triangle_mesh.hpp"
 
 namespace spindle::test {
 

@@ -7,9 +7,9 @@
 #include <random>
 #include <set>
 
-#include <spindle/engine/convex_hull.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "collision/convex_hull.hpp"
 #include "collision_test_util.hpp"
 
 namespace spindle {

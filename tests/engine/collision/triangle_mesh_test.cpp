@@ -6,9 +6,9 @@
 #include <random>
 #include <set>
 
-#include <spindle/engine/triangle_mesh.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "collision/triangle_mesh.hpp"
 #include "collision_test_util.hpp"
 
 namespace spindle {

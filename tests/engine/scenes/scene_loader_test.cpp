@@ -1,7 +1,7 @@
 // Scene files: every file in configs/scenes parses and builds, the built-in scenes
 // are what they claim, broken files are rejected at the right line and column, and
 // build() is all or nothing.
-#include <spindle/engine/scene.hpp>
+#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/assert.hpp>
 #include <spindle/platform/error.hpp>

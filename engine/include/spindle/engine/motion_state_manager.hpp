@@ -55,7 +55,10 @@ public:
     std::uint64_t published_steps_locked() const noexcept { return m_steps; }
     double alpha() const;
 
-    // ---- physics side (the update thread) ----
+private:
+    // The physics side (the update thread): only the buffering stages reach it, through
+    // MotionStatePublisher (engine/src/stages/buffering.cpp); a game never does.
+    friend class MotionStatePublisher;
     // The buffer being filled for the next flip; never read by other threads.
     std::vector<PublishedBody>& back() noexcept { return *m_back; }
     int back_index() const noexcept { return m_back == &m_buffers[0] ? 0 : 1; }  // which buffer back() is
@@ -64,7 +67,6 @@ public:
     // Swaps back and front under the lock; returns seconds the lock was held.
     double flip(double alpha, std::uint64_t steps);
 
-private:
     static MotionState blend(const PublishedBody& body, double alpha);
     const PublishedBody& checked_locked(BodyHandle body) const;
 

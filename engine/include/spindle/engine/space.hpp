@@ -124,7 +124,6 @@ public:
     std::uint64_t state_hash() const;
 
     JobSystem& jobs() noexcept;
-    World& world() noexcept { return *m_world; }  // for stages and tests inside the engine
 
 private:
     std::unique_ptr<World> m_world;

@@ -6,15 +6,15 @@
 
 namespace spindle {
 
+// The timed stages of Space::update, in the order they run (stages/update.cpp). Velocity
+// and position integration run inside Solver, once per substep.
 enum class Stage : std::uint8_t {
     ApplyWrites,
-    IntegrateVelocities,
     Broadphase,
     Narrowphase,
     Islands,
     Solver,
-    Continuous,
-    IntegratePositions,
+    Continuous,  // fast bodies' start poses before the solver, swept tests after it
     Record,
     FlipReadBuffers,
     Count

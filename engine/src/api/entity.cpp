@@ -1,0 +1,73 @@
+// Entity: direct values outside a space, the space's buffered accessors inside one.
+#include <spindle/engine/entity.hpp>
+#include <spindle/engine/space.hpp>
+#include <spindle/platform/error.hpp>
+
+namespace spindle {
+
+Entity::Entity(BodyDesc desc) : m_desc(std::move(desc)) {}
+
+void Entity::add_to(Space& space) {
+    if (m_space) throw Error("Entity::add_to: the body is already in a space (" + to_string(m_handle) + ")");
+    m_handle = space.create_body(m_desc);
+    m_space = &space;
+}
+
+void Entity::remove_from_space() {
+    if (!m_space) return;
+    const MotionState s = m_space->internal_motion_state(m_handle);
+    m_desc.position = s.position;
+    m_desc.orientation = s.orientation;
+    m_desc.linear_velocity = s.linear_velocity;
+    m_desc.angular_velocity = s.angular_velocity;
+    m_space->destroy_body(m_handle);
+    m_space = nullptr;
+    m_handle = BodyHandle{};
+}
+
+MotionState Entity::motion_state() const {
+    if (m_space) return m_space->motion_state(m_handle);
+    return MotionState{m_desc.position, m_desc.orientation, m_desc.linear_velocity, m_desc.angular_velocity,
+                       m_desc.position};
+}
+
+Vec3 Entity::position() const { return motion_state().position; }
+Quat Entity::orientation() const { return motion_state().orientation; }
+Vec3 Entity::linear_velocity() const { return motion_state().linear_velocity; }
+Vec3 Entity::angular_velocity() const { return motion_state().angular_velocity; }
+
+void Entity::set_position(const Vec3& position) {
+    if (m_space) return m_space->set_position(m_handle, position);
+    if (!is_finite(position)) throw Error("Entity::set_position: value must be finite");
+    m_desc.position = position;
+}
+
+void Entity::set_orientation(const Quat& orientation) {
+    if (m_space) return m_space->set_orientation(m_handle, orientation);
+    if (!is_finite(orientation) || orientation.norm() < 1e-9) {
+        throw Error("Entity::set_orientation: orientation must be a finite, non-zero quaternion");
+    }
+    m_desc.orientation = orientation.normalized();
+}
+
+void Entity::set_linear_velocity(const Vec3& velocity) {
+    if (m_space) return m_space->set_linear_velocity(m_handle, velocity);
+    if (!is_finite(velocity)) throw Error("Entity::set_linear_velocity: value must be finite");
+    m_desc.linear_velocity = velocity;
+}
+
+void Entity::set_angular_velocity(const Vec3& velocity) {
+    if (m_space) return m_space->set_angular_velocity(m_handle, velocity);
+    if (!is_finite(velocity)) throw Error("Entity::set_angular_velocity: value must be finite");
+    m_desc.angular_velocity = velocity;
+}
+
+void Entity::set_motion_state(const MotionState& state) {
+    if (m_space) return m_space->set_motion_state(m_handle, state);
+    set_position(state.position);
+    set_orientation(state.orientation);
+    set_linear_velocity(state.linear_velocity);
+    set_angular_velocity(state.angular_velocity);
+}
+
+}  // namespace spindle

@@ -1,0 +1,83 @@
+// The joint store behind Space's joint API (joint_api.cpp): slots with generations,
+// each joint's frames in its bodies' centre-of-mass frames, and the impulses kept
+// between steps for warm starting. The solver reads it in joint_solver.cpp.
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <spindle/engine/joint.hpp>
+
+namespace spindle {
+
+struct World;
+
+// What the solver needs of one joint, fixed at creation (frames) or carried between
+// steps (impulses). Frames are relative to each body's centre of mass, in its own
+// frame, so they hold however the bodies move.
+struct Joint {
+    JointType type = JointType::BallSocket;
+    std::uint32_t body_a = 0, body_b = 0;  // slots
+    Vec3 local_a = Vec3::Zero();           // anchor on A
+    Vec3 local_b = Vec3::Zero();           // anchor on B
+    Vec3 axis_a = Vec3::UnitZ();           // hinge axis on A
+    Vec3 axis_b = Vec3::UnitZ();           // hinge axis on B
+    Vec3 ref_a = Vec3::UnitX();            // hinge: perpendicular to the axis, equal in world at creation
+    Vec3 ref_b = Vec3::UnitX();
+    Quat reference = Quat::Identity();     // fixed: B's orientation in A's frame at creation
+    Real rest_length = 0;                  // distance
+    HingeParams hinge;
+    DistanceParams distance;
+    bool collide_connected = false;
+    bool sleeping = false;                 // both bodies asleep (or one asleep, one static)
+
+    // Accumulated impulses of the last step (warm starting).
+    Vec3 linear_impulse = Vec3::Zero();    // point constraint, world
+    Vec3 angular_impulse = Vec3::Zero();   // hinge alignment / fixed rotation, world
+    Real axial_impulse = 0;                // distance: the rigid or spring row
+    Real motor_impulse = 0;
+    Real lower_impulse = 0;
+    Real upper_impulse = 0;
+};
+
+// Joints by slot (holes where joints were destroyed), like Bodies. Hot data (Joint)
+// apart from the description as given (read only on request).
+struct Joints {
+    std::vector<std::uint32_t> generation;
+    std::vector<std::uint8_t> alive;
+    std::vector<std::uint32_t> free_slots;  // LIFO; reused slots get a new generation
+    std::uint32_t live = 0;
+    std::vector<Joint> joint;
+    std::vector<JointDesc> desc;
+    // Pair key (min slot << 32 | max slot) -> number of joints between the two bodies
+    // that switch their collision off (collide_connected = false).
+    std::unordered_map<std::uint64_t, std::uint32_t> blocked_pairs;
+    // Slots of the live joints that are not asleep, ascending; rebuilt only after a joint
+    // is made, destroyed, or changes sleep, so sleeping joints cost nothing per step.
+    std::vector<std::uint32_t> awake_list;
+    bool awake_dirty = false;
+
+    std::uint32_t capacity() const noexcept { return static_cast<std::uint32_t>(generation.size()); }
+    bool is_live(JointHandle h) const noexcept {
+        return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
+               h.generation != 0;
+    }
+    JointHandle handle(std::uint32_t slot) const noexcept { return {slot, generation[slot]}; }
+};
+
+inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t{a < b ? a : b} << 32) | (a < b ? b : a);
+}
+
+// True when a joint between bodies a and b (slots) switches their collision off; the
+// broadphase asks before it makes a contact for a new pair. Free without joints.
+bool joint_blocks_pair(const World& world, std::uint32_t a, std::uint32_t b);
+
+// The awake joints' slots (Joints::awake_list, rebuilt first if stale).
+const std::vector<std::uint32_t>& awake_joints(World& world);
+
+// Destroys every joint attached to a body (destroy_body), waking its partners.
+void destroy_joints_of(World& world, std::uint32_t body_slot);
+
+}  // namespace spindle

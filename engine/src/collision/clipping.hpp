@@ -1,0 +1,117 @@
+// Building blocks shared by the pair functions: feature-id packing, polygon clipping
+// that tracks which features made each point, manifold reduction to four points, and
+// closest points between segments.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "collision/collide.hpp"
+
+namespace spindle::detail {
+
+// ---- Feature ids ----------------------------------------------------------------------
+// Bits 31..30 say what kind of contact made the point:
+//   0 / 1  face contact with the reference face on shape A / on shape B:
+//          bits 29..23 reference face, 22..15 incident face, 14..0 clip-vertex key
+//   2      edge-edge contact: bits 29..15 edge of A, 14..0 edge of B
+//   3      anything else (rounded shapes, planes): bits 29..0 a key chosen by the pair
+// Indices wider than their field wrap; ids only need to stay equal while the same
+// features touch, and a wrap costs at most a cold warm start.
+inline constexpr std::uint32_t face_contact_id(bool reference_is_b, std::uint32_t reference_face,
+                                               std::uint32_t incident_face, std::uint32_t clip_key) {
+    return (reference_is_b ? 1u : 0u) << 30 | (reference_face & 0x7Fu) << 23 | (incident_face & 0xFFu) << 15 |
+           (clip_key & 0x7FFFu);
+}
+inline constexpr std::uint32_t edge_contact_id(std::uint32_t edge_a, std::uint32_t edge_b) {
+    return 2u << 30 | (edge_a & 0x7FFFu) << 15 | (edge_b & 0x7FFFu);
+}
+inline constexpr std::uint32_t other_contact_id(std::uint32_t key) { return 3u << 30 | (key & 0x3FFFFFFFu); }
+
+// ---- Clipping -------------------------------------------------------------------------
+// A vertex of the incident polygon while it is clipped against the reference face's
+// side planes. `key` names the features that made it (14 bits):
+//   kind 0: incident vertex a;  kind 1: incident edge a cut by side plane b;
+//   kind 2: side plane a cut by side plane b (a corner of the reference face).
+// `edge` names what the polygon edge leaving this vertex lies on: an incident edge
+// (bit 15 clear) or a side plane (bit 15 set), so the next cut knows its features.
+struct ClipVertex {
+    Vec3 p;
+    std::uint16_t key = 0;
+    std::uint16_t edge = 0;
+};
+
+inline constexpr std::uint16_t clip_key(std::uint32_t kind, std::uint32_t a, std::uint32_t b) {
+    return static_cast<std::uint16_t>((kind & 3u) << 12 | (a & 0x3Fu) << 6 | (b & 0x3Fu));
+}
+inline constexpr std::uint16_t kSidePlaneBit = 0x8000;
+
+// Half-space dot(normal, p) <= offset.
+struct ClipPlane {
+    Vec3 normal;
+    Real offset;
+};
+
+// Incident polygon p[0..count), counter-clockwise or not; vertices get key (0, i) and
+// edge i. Returns count.
+int start_clip_polygon(const Vec3* p, int count, ClipVertex* out);
+
+// One Sutherland-Hodgman step against `plane` (side plane number `side`). `out` must
+// hold count + 1 vertices. Returns the new count (0 when nothing is left).
+int clip_polygon(const ClipVertex* in, int count, const ClipPlane& plane, std::uint32_t side, ClipVertex* out);
+
+// ---- Reduction ------------------------------------------------------------------------
+struct ContactCandidate {
+    Vec3 point;  // midway between the surfaces
+    Real separation;
+    std::uint32_t id;
+};
+
+// Writes at most four of the candidates into m.points (m.normal must be set): all of them
+// when there are at most four (unless `prune`), else the deepest and then those spanning
+// the largest area. With `prune`, points that add no area (duplicates, points on a line
+// already covered) are dropped even from small sets, as when manifolds are merged.
+void reduce_to_manifold(const ContactCandidate* candidates, int count, Manifold& m, bool prune = false);
+
+// Scratch space that lives on the stack unless a (rare) large hull needs more.
+template <typename T, std::size_t N>
+class ScratchBuffer {
+public:
+    explicit ScratchBuffer(std::size_t size) {
+        if (size > N) m_heap.resize(size);
+        m_data = size > N ? m_heap.data() : m_inline.data();
+    }
+    ScratchBuffer(const ScratchBuffer&) = delete;
+    ScratchBuffer& operator=(const ScratchBuffer&) = delete;
+    T* data() { return m_data; }
+    T& operator[](std::size_t i) { return m_data[i]; }
+
+private:
+    std::array<T, N> m_inline;
+    std::vector<T> m_heap;
+    T* m_data;
+};
+
+// ---- Geometry -------------------------------------------------------------------------
+// Parameter in [0, 1] of the point of segment a + t (b - a) closest to p.
+Real closest_parameter_on_segment(const Vec3& p, const Vec3& a, const Vec3& b);
+
+// Closest points between segments p1 + s d1 and p2 + t d2 (s, t in [0, 1]). Handles
+// zero-length and parallel segments (then picks the middle of the overlap, so a stack
+// of parallel capsules gets a centred point).
+void closest_segment_parameters(const Vec3& p1, const Vec3& d1, const Vec3& p2, const Vec3& d2, Real& s, Real& t);
+
+// A unit vector perpendicular to v (v need not be unit; any non-zero length).
+Vec3 any_perpendicular(const Vec3& v);
+
+// Maps a manifold computed in frame x into the world.
+inline void manifold_to_world(Manifold& m, const Transform& x) {
+    m.normal = x.rotate(m.normal);
+    for (int i = 0; i < m.point_count; ++i) m.points[i].point = x.apply(m.points[i].point);
+}
+
+inline void flip_manifold(Manifold& m) { m.normal = -m.normal; }
+
+}  // namespace spindle::detail

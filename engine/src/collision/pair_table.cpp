@@ -1,0 +1,70 @@
+// collide(): one table lookup per pair. The table is filled once with the pair
+// functions for (lower type, higher type) and flipping wrappers for the other order.
+#include <array>
+
+#include <spindle/platform/assert.hpp>
+
+#include "collision/clipping.hpp"
+#include "collision/collide.hpp"
+#include "collision/pair_functions.hpp"
+
+namespace spindle {
+namespace detail {
+namespace {
+
+constexpr int kTypeCount = static_cast<int>(ShapeType::Count);
+using Table = std::array<std::array<PairFunction, kTypeCount>, kTypeCount>;
+
+// Calls Fn with the shapes swapped and turns the normals round, so they point from a to b.
+template <PairFunction Fn>
+int swapped(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+            Manifold* out, int capacity) {
+    const int count = Fn(b, xb, a, xa, speculative, out, capacity);
+    for (int i = 0; i < count; ++i) flip_manifold(out[i]);
+    return count;
+}
+
+template <PairFunction Fn>
+void add(Table& table, ShapeType a, ShapeType b) {
+    table[static_cast<int>(a)][static_cast<int>(b)] = Fn;
+    if (a != b) table[static_cast<int>(b)][static_cast<int>(a)] = swapped<Fn>;
+}
+
+Table make_table() {
+    using T = ShapeType;
+    Table table{};  // null: static-only pairs (plane, mesh) never collide with each other
+    add<collide_sphere_sphere>(table, T::Sphere, T::Sphere);
+    add<collide_sphere_capsule>(table, T::Sphere, T::Capsule);
+    add<collide_sphere_box>(table, T::Sphere, T::Box);
+    add<collide_sphere_hull>(table, T::Sphere, T::ConvexHull);
+    add<collide_capsule_capsule>(table, T::Capsule, T::Capsule);
+    add<collide_capsule_box>(table, T::Capsule, T::Box);
+    add<collide_capsule_hull>(table, T::Capsule, T::ConvexHull);
+    add<collide_box_box>(table, T::Box, T::Box);
+    add<collide_box_hull>(table, T::Box, T::ConvexHull);
+    add<collide_hull_hull>(table, T::ConvexHull, T::ConvexHull);
+    for (const T convex : {T::Sphere, T::Capsule, T::Box, T::ConvexHull}) {
+        add<collide_convex_plane>(table, convex, T::Plane);
+        add<collide_convex_mesh>(table, convex, T::TriangleMesh);
+    }
+    return table;
+}
+
+const Table& table() {
+    static const Table instance = make_table();
+    return instance;
+}
+
+}  // namespace
+}  // namespace detail
+
+int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
+            Manifold* out, int capacity) {
+    SPINDLE_ASSERT(a.type < ShapeType::Count && b.type < ShapeType::Count, "collide: invalid shape type");
+    if (capacity <= 0) return 0;
+    const detail::PairFunction fn = detail::table()[static_cast<int>(a.type)][static_cast<int>(b.type)];
+    if (fn == nullptr) return 0;
+    return fn(a, xa, b, xb, speculative_distance, out, capacity);
+}
+
+}  // namespace spindle

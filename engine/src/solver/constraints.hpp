@@ -1,0 +1,200 @@
+// Solver data for one step: constraints built from the touching manifolds, and the
+// colours that let each batch run in parallel without two jobs writing one body.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "solver/solver_body.hpp"
+#include "solver/wide.hpp"
+#include "world.hpp"
+
+namespace spindle {
+
+// Soft constraint coefficients (Box2D v3's soft step): a spring of `hertz` with a
+// damping ratio, expressed for a substep of length h.
+struct Softness {
+    Real bias_rate = 0;
+    Real mass_scale = 1;
+    Real impulse_scale = 0;
+};
+Softness make_softness(Real hertz, Real damping_ratio, Real h);
+
+// One velocity row of a single lane, for a push-out row (contact_solver.cpp): relative
+// speed = dir.(vb - va) + rb_x.wb - ra_x.wa, and an impulse L changes wa by -L ia, wb by +L ib.
+struct ContactRow {
+    Vec3 ra_x = Vec3::Zero();  // ra x dir
+    Vec3 rb_x = Vec3::Zero();  // rb x dir
+    Vec3 ia = Vec3::Zero();    // Ia^-1 (ra x dir)
+    Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
+};
+
+// What a WideContact keeps of a row for its four lanes: the inertia-weighted angular
+// terms, in single precision (the passes are bound by the memory they stream, and these
+// only scale an impulse). The row's speed is taken from the point's relative velocity
+// instead, so ra x dir and rb x dir need not be stored.
+struct WideRow {
+    Wide3F ia, ib;
+};
+
+// One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
+// fill has no mass and lies far apart, so it never pushes and never rubs.
+struct WidePoint {
+    Wide3 ra, rb;                 // anchors from each centre of mass, world, fixed for the step
+    Wide adjusted_separation{};   // separation minus n.(rb - ra): current separation = n.d + this
+    WideRow normal_row, tangent_row[2];
+    WideF normal_mass{}, tangent_mass[2]{};
+    Wide normal_impulse{}, tangent_impulse[2]{};
+    Wide max_normal_impulse{};
+    Wide relative_velocity{};     // approach speed at impact (restitution)
+};
+
+// A touching manifold of an awake contact, as listed and coloured for the step.
+struct ManifoldRef {
+    std::uint32_t contact = 0;
+    std::uint32_t manifold = 0;
+    std::uint32_t a = 0, b = 0;  // solver bodies
+};
+
+// Four manifolds of one colour solved together, one per lane (structure of arrays).
+// They share no dynamic body, so the lanes never write the same body. Lanes past the
+// colour's end hold no manifold: both bodies are the immovable one and nothing is written.
+struct WideContact {
+    std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
+    std::uint32_t ref[kLanes] = {};                  // manifold ref per lane
+    int lanes = 0;                                   // lanes holding a manifold
+    Wide3 normal, tangent[2];
+    Wide inv_mass_a{}, inv_mass_b{};
+    Wide friction{}, restitution{};
+    Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
+    WidePoint points[kMaxManifoldPoints];
+    // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
+    // the overlap's centre on the push-out velocities, kept over the step's substeps. The
+    // rows themselves live apart (SolverScratch::push_rows): they are rarely used, and
+    // every pass streams the wide contacts.
+    Real push_impulse[kLanes] = {};
+};
+
+using Vec2 = Eigen::Matrix<Real, 2, 1>;
+using Mat2 = Eigen::Matrix<Real, 2, 2>;
+
+// One joint as the solver sees it for a step (joint_solver.cpp): frames turned into
+// world at the step's start (the substeps rotate them by each body's dq), and the
+// accumulated impulses (warm started from Joint).
+struct JointConstraint {
+    std::uint32_t a = 0, b = 0;  // solver bodies, as for contacts
+    std::uint32_t joint = 0;     // slot in world.joints
+    JointType type = JointType::BallSocket;
+    Vec3 ra = Vec3::Zero();      // anchors from each centre of mass, world
+    Vec3 rb = Vec3::Zero();
+    Vec3 delta_center = Vec3::Zero();  // B's centre of mass minus A's
+
+    // Hinge: A's axis, two perpendiculars of B's axis (the alignment rows), angle references.
+    Vec3 axis_a = Vec3::UnitZ();
+    Vec3 perp_b[2] = {Vec3::UnitX(), Vec3::UnitY()};
+    Vec3 ref_a = Vec3::UnitX(), ref_b = Vec3::UnitX();
+    // Fixed: the rotation that takes B's target orientation to its actual one, world.
+    Quat rotation_error = Quat::Identity();
+    Mat3 rotation_mass = Mat3::Zero();
+    // Effective masses of the other rows are computed as they are solved, from the
+    // frames then: a light body can turn far within one step.
+    Vec3 axis = Vec3::UnitX();  // distance: direction at the step's start (if the anchors meet)
+    Softness spring;            // distance spring
+
+    // Parameters, copied so the hot loop reads one struct.
+    bool enable_limit = false, enable_motor = false, enable_spring = false;
+    Real lower = 0, upper = 0;  // hinge angles or distance lengths
+    Real rest_length = 0;
+    Real motor_speed = 0, max_motor_impulse = 0;
+    Real spring_hertz = 0;
+
+    // Accumulated impulses.
+    Vec3 linear_impulse = Vec3::Zero();
+    Vec3 angular_impulse = Vec3::Zero();  // fixed
+    Vec2 align_impulse = Vec2::Zero();    // hinge, along the two alignment rows
+    Real axial_impulse = 0, motor_impulse = 0, lower_impulse = 0, upper_impulse = 0;
+};
+
+// How joints are solved in one pass: soft position correction with use_bias, none
+// (relax) without.
+struct JointSolveParams {
+    Softness soft;
+    Real inv_h = 0;
+    bool use_bias = true;
+};
+
+inline constexpr int kColorCount = 24;
+
+// What one phase of the step's solver loop does (solver.cpp): a pass over the bodies,
+// or over one colour's constraints (color == kColorCount: the overflow, one block).
+enum class Pass : std::uint8_t {
+    PrepareContacts,
+    IntegrateVelocities,
+    WarmStart,
+    Solve,
+    IntegratePositions,
+    Relax,
+    Restitution,
+    StoreImpulses,
+    FinalizeBodies
+};
+struct SolverPhase {
+    Pass pass = Pass::Solve;
+    int color = 0;
+};
+
+struct SolverScratch {
+    std::vector<SolverBody> bodies;                 // awake bodies, then the static body
+    std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
+    // The colouring below is a function of the manifold list, the joints and the bodies
+    // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
+    std::vector<ManifoldRef> colored_manifolds;
+    std::size_t colored_bodies = 0;
+    std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
+    bool colored_joints = false;
+    std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
+    std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
+    std::vector<WideContact> wide;                   // the colours' manifolds four by four, then the overflow one by one
+    std::vector<ContactRow> push_rows;               // kLanes per wide contact: its push-out rows (written before read)
+    std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
+    std::vector<JointConstraint> joints;             // awake joints, in slot order
+    std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
+    std::vector<std::uint32_t> joint_overflow;
+    std::vector<std::uint32_t> body_colors;          // per solver body: a bit for each colour it is in
+    std::vector<Phase> phases;                       // the step's solver loop, run by run_phases
+    std::vector<SolverPhase> plan;                   // what each phase does
+};
+
+// How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,
+// none (relax) without.
+struct ContactSolveParams {
+    Softness soft;
+    Real inv_h = 0;
+    Real push_out = 0;        // push-out speed
+    Real slop = 0;            // gaps wider than this carry no friction
+    Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
+    bool use_bias = true;
+};
+
+// contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide
+// (which manifold and bodies each lane holds); prepare_contacts fills in the rest from
+// the manifolds and bodies of the step; the others run per wide contact from the
+// colour loops.
+void pack_contacts(SolverScratch& scratch);
+void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);  // wide [lo, hi)
+// push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
+void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params);
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h);
+void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
+
+// joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are
+// none) and prepares them from the bodies of scratch; the others run per joint from
+// the colour loops, so a joint only touches its own two solver bodies.
+Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz, capped; 0: the cap
+void prepare_joints(World& world, SolverScratch& scratch, Real h);
+void warm_start_joint(JointConstraint& jc, SolverBody* bodies);
+void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params);
+void store_joint_impulses(World& world, SolverScratch& scratch);
+
+}  // namespace spindle

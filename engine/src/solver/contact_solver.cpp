@@ -1,0 +1,412 @@
+// Contact constraints of the soft-step solver, four manifolds at a time: each colour's
+// manifolds are packed four to a WideContact (structure of arrays, one manifold per
+// lane) and every pass works on the four lanes together (wide.hpp). The lanes of a
+// WideContact share no dynamic body, so gathering their velocities, solving and
+// scattering them back is the same as solving the four one after another.
+//
+// Per point and pass: the normal row (soft push-out of resting overlap while biased,
+// speculative for a gap), then both friction rows inside Coulomb's cone. Overlap deeper
+// than the recovery depth is pushed out by a split impulse on separate push-out
+// velocities, per lane (rare: bodies created or teleported inside each other).
+#include <algorithm>
+
+#include "solver/constraints.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+namespace {
+
+constexpr Real kEmptySeparation = 1e18;      // an empty point slot: far apart, never touching
+
+// A tangent basis for a unit normal, the same for the same normal every time.
+void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
+    if (std::abs(n.x()) >= 0.57735) {
+        t1 = Vec3(n.y(), -n.x(), 0).normalized();
+    } else {
+        t1 = Vec3(0, n.z(), -n.y()).normalized();
+    }
+    t2 = n.cross(t1);
+}
+
+// Fills a row's angular terms and returns its effective mass.
+Real make_row(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir,
+              ContactRow& row) {
+    row.ra_x = ra.cross(dir);
+    row.rb_x = rb.cross(dir);
+    row.ia = A.inv_inertia * row.ra_x;
+    row.ib = B.inv_inertia * row.rb_x;
+    const Real k = A.inv_mass + B.inv_mass + row.ra_x.dot(row.ia) + row.rb_x.dot(row.ib);
+    return k > 0 ? 1 / k : 0;
+}
+
+// Relative speed along a row's direction, and an impulse of size L along it (one lane).
+inline Real row_speed(const Velocities& s, const Vec3& dir, const ContactRow& row) {
+    return dir.dot(s.vb - s.va) + row.rb_x.dot(s.wb) - row.ra_x.dot(s.wa);
+}
+inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& dir, const ContactRow& row,
+                      Real L) {
+    s.va -= (A.inv_mass * L) * dir;
+    s.wa -= L * row.ia;
+    s.vb += (B.inv_mass * L) * dir;
+    s.wb += L * row.ib;
+}
+
+// The four lanes' body velocities while a WideContact is solved. gather and scatter
+// are forced inline: as calls they returned and copied 768 bytes per pass.
+struct WideVelocities {
+    Wide3 va, wa, vb, wb;
+};
+
+[[gnu::always_inline]] inline WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
+    WideVelocities s;
+    for (int l = 0; l < kLanes; ++l) {
+        const SolverBody& A = bodies[wc.a[l]];
+        const SolverBody& B = bodies[wc.b[l]];
+        s.va.set_lane(l, A.v);
+        s.wa.set_lane(l, A.w);
+        s.vb.set_lane(l, B.v);
+        s.wb.set_lane(l, B.w);
+    }
+    return s;
+}
+
+// Writes the dynamic bodies back: static and kinematic ones (and the empty lanes'
+// immovable body) are shared by constraints of every colour and never written.
+[[gnu::always_inline]] inline void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
+    for (int l = 0; l < kLanes; ++l) {
+        SolverBody& A = bodies[wc.a[l]];
+        SolverBody& B = bodies[wc.b[l]];
+        if (A.dynamic) {
+            A.v = s.va.lane(l);
+            A.w = s.wa.lane(l);
+        }
+        if (B.dynamic) {
+            B.v = s.vb.lane(l);
+            B.w = s.wb.lane(l);
+        }
+    }
+}
+
+// Velocity of B's anchor relative to A's, per lane.
+inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide3& rb) {
+    return s.vb + cross(s.wb, rb) - s.va - cross(s.wa, ra);
+}
+
+inline void apply_row(const WideContact& wc, WideVelocities& s, const Wide3& dir, const WideRow& row, Wide L) {
+    s.va -= (wc.inv_mass_a * L) * dir;
+    s.wa -= L * widen(row.ia);
+    s.vb += (wc.inv_mass_b * L) * dir;
+    s.wb += L * widen(row.ib);
+}
+
+// A row's angular terms for four lanes; returns the effective masses (0 where nothing moves).
+WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
+               const Wide3& rb, const Wide3& dir, WideRow& row) {
+    const Wide3 ra_x = cross(ra, dir);
+    const Wide3 rb_x = cross(rb, dir);
+    const Wide3 ia = inv_inertia_a * ra_x;
+    const Wide3 ib = inv_inertia_b * rb_x;
+    row = {narrow(ia), narrow(ib)};
+    const Wide k = inv_mass_sum + dot(ra_x, ia) + dot(rb_x, ib);
+    return narrow(select(k > splat(0), splat(1) / k, splat(0)));
+}
+
+// A WideContact from its lanes' manifolds, with rows from the bodies at the step's
+// start. Every field is written, so the array is reused from step to step as it is.
+void prepare_wide(const World& world, const SolverScratch& scratch, WideContact& wc) {
+    const Bodies& b = world.bodies;
+    const Vec3 g = world.settings.gravity;
+    // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
+    // far apart.
+    WideMat3 inv_inertia_a, inv_inertia_b;
+    Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
+    Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
+    Wide tangent_impulse[kMaxManifoldPoints][2]{};
+    for (Wide& s : separation) s = splat(kEmptySeparation);
+    wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
+    wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
+    for (int l = 0; l < wc.lanes; ++l) {
+        const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
+        const Contact& contact = world.contacts[ref.contact];
+        const ContactManifold& m = contact.manifold_at(static_cast<int>(ref.manifold));
+        const SolverBody& A = scratch.bodies[ref.a];
+        const SolverBody& B = scratch.bodies[ref.b];
+        Vec3 tangent[2];
+        tangent_basis(m.normal, tangent[0], tangent[1]);
+        wc.normal.set_lane(l, m.normal);
+        wc.tangent[0].set_lane(l, tangent[0]);
+        wc.tangent[1].set_lane(l, tangent[1]);
+        wc.inv_mass_a[l] = A.inv_mass;
+        wc.inv_mass_b[l] = B.inv_mass;
+        inv_inertia_a.set_lane(l, A.inv_inertia);
+        inv_inertia_b.set_lane(l, B.inv_inertia);
+        wc.friction[l] = contact.friction;
+        wc.restitution[l] = contact.restitution;
+        wc.gravity_normal[l] = m.normal.dot((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g -
+                                            (A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g);
+        const Vec3 xa = b.x[contact.body_a];
+        const Vec3 xb = b.x[contact.body_b];
+        for (int j = 0; j < m.point_count; ++j) {
+            const ContactPoint& src = m.points[j];
+            ra[j].set_lane(l, src.geometry.point - xa);
+            rb[j].set_lane(l, src.geometry.point - xb);
+            separation[j][l] = src.geometry.separation;
+            normal_impulse[j][l] = src.normal_impulse;
+            tangent_impulse[j][0][l] = src.tangent_impulse[0];
+            tangent_impulse[j][1][l] = src.tangent_impulse[1];
+        }
+    }
+    const Wide inv_mass_sum = wc.inv_mass_a + wc.inv_mass_b;
+    const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        WidePoint& p = wc.points[j];
+        p.ra = ra[j];
+        p.rb = rb[j];
+        p.adjusted_separation = separation[j] - dot(wc.normal, rb[j] - ra[j]);
+        // A slot no manifold fills gets no mass: it can never push or rub.
+        const Wide point_inv_mass = select(separation[j] < splat(kEmptySeparation), inv_mass_sum, splat(0));
+        p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.normal, p.normal_row);
+        for (int t = 0; t < 2; ++t) {
+            p.tangent_mass[t] =
+                make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.tangent[t], p.tangent_row[t]);
+            p.tangent_impulse[t] = tangent_impulse[j][t];
+        }
+        p.normal_impulse = normal_impulse[j];
+        p.max_normal_impulse = Wide{};
+        p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
+    }
+    for (Real& impulse : wc.push_impulse) impulse = 0;
+}
+
+}  // namespace
+
+// Lays the colours' manifold refs out four by four, then the overflow one per
+// WideContact (its manifolds may share bodies, so they are solved one at a time).
+void pack_contacts(SolverScratch& scratch) {
+    std::size_t count = scratch.overflow.size();
+    for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
+    scratch.wide.resize(count);  // kept from step to step: prepare_wide writes every field
+    scratch.push_rows.resize(count * kLanes);  // a row is written by push_out before it is read
+    const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
+    std::size_t next = 0;
+    auto add = [&](const std::uint32_t* refs, int lanes) {
+        WideContact& wc = scratch.wide[next++];
+        wc.lanes = lanes;
+        for (int l = 0; l < kLanes; ++l) {
+            wc.ref[l] = l < lanes ? refs[l] : 0;
+            wc.a[l] = l < lanes ? scratch.manifolds[refs[l]].a : immovable;
+            wc.b[l] = l < lanes ? scratch.manifolds[refs[l]].b : immovable;
+        }
+    };
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.wide_begin[c] = static_cast<std::uint32_t>(next);
+        const std::vector<std::uint32_t>& refs = scratch.colors[c];
+        for (std::size_t k = 0; k < refs.size(); k += kLanes) {
+            add(refs.data() + k, static_cast<int>(std::min<std::size_t>(kLanes, refs.size() - k)));
+        }
+    }
+    scratch.wide_begin[kColorCount] = static_cast<std::uint32_t>(next);
+    for (const std::uint32_t& ref : scratch.overflow) add(&ref, 1);
+}
+
+namespace {
+
+// Deep overlap is pushed out by a soft constraint on the push-out velocities (split
+// impulse), never by real speed, so a chain of deep overlaps separates without
+// launching anything. One row per manifold, through the overlap's depth-weighted centre,
+// so a face pushes straight and a tilted corner turns back.
+void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
+              const Vec3& rb, const ContactSolveParams& params) {
+    SolverBody& A = bodies[wc.a[lane]];
+    SolverBody& B = bodies[wc.b[lane]];
+    const Vec3 normal = wc.normal.lane(lane);
+    Real& impulse = wc.push_impulse[lane];
+    const Real mass = make_row(A, B, ra, rb, normal, row);
+    Velocities push = load_push(A, B);
+    const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
+    const Real speed = row_speed(push, normal, row);
+    const Real total = std::max(
+        impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * impulse, Real(0));
+    apply_row(A, B, push, normal, row, total - impulse);
+    impulse = total;
+    store_push(A, B, push);
+}
+
+template <bool kBias>
+void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
+    WideVelocities s = gather(wc, bodies);
+    // Current separation from the bodies' motion since the step began:
+    // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
+    // rotation is applied once per lane rather than once per point.
+    Wide3 dpa, dpb;
+    WideQuat dqa, dqb;
+    for (int l = 0; l < kLanes; ++l) {
+        const SolverBody& A = bodies[wc.a[l]];
+        const SolverBody& B = bodies[wc.b[l]];
+        dpa.set_lane(l, A.dp);
+        dpb.set_lane(l, B.dp);
+        dqa.set_lane(l, A.dq);
+        dqb.set_lane(l, B.dq);
+    }
+    const Wide moved = dot(wc.normal, dpb - dpa);
+    const Wide3 na = rotate_inverse(dqa, wc.normal);
+    const Wide3 nb = rotate_inverse(dqb, wc.normal);
+    const Wide zero = splat(0), one = splat(1);
+    const Wide inv_h = splat(params.inv_h);
+    const Wide recovery = splat(params.recovery_depth);
+    // Overlap deeper than the recovery depth, per lane: its depth-weighted excess and centre.
+    Wide deep_weight = zero, deep_excess = zero;
+    Wide3 deep_ra, deep_rb;
+    Wide gap[kMaxManifoldPoints];
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        WidePoint& p = wc.points[j];
+        const Wide separation = moved + dot(nb, p.rb) - dot(na, p.ra) + p.adjusted_separation;
+        gap[j] = separation;
+        const WideMask speculative = separation > zero;  // may close the gap, no more
+        const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
+        Wide impulse;
+        if constexpr (kBias) {
+            const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
+            deep_weight += depth;
+            deep_excess -= depth * depth;
+            deep_ra += depth * p.ra;
+            deep_rb += depth * p.rb;
+            // Resting overlap is corrected by the contact's own soft bias (soft step);
+            // deeper overlap is left to push_out.
+            const Wide soft_bias = wide_max(splat(params.soft.bias_rate) * wide_max(separation, -recovery),
+                                            splat(-params.push_out));
+            const Wide bias = select(speculative, separation * inv_h, soft_bias);
+            const Wide mass_scale = select(speculative, one, splat(params.soft.mass_scale));
+            const Wide impulse_scale = select(speculative, zero, splat(params.soft.impulse_scale));
+            impulse = -widen(p.normal_mass) * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        } else {
+            impulse = -widen(p.normal_mass) * (vn + select(speculative, separation * inv_h, zero));
+        }
+        const Wide total = wide_max(p.normal_impulse + impulse, zero);
+        impulse = total - p.normal_impulse;
+        // Restitution bounces off the approach speed at impact: the speed when the
+        // point first pushes in this step, gravity of the earlier substeps included.
+        const WideMask first_push = (impulse > zero) & (p.max_normal_impulse == zero);
+        p.relative_velocity = select(first_push, wide_min(p.relative_velocity, vn), p.relative_velocity);
+        p.normal_impulse = total;
+        p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
+        apply_row(wc, s, wc.normal, p.normal_row, impulse);
+    }
+    const Wide slop = splat(params.slop);
+    // A lane without friction has an empty cone (its rows come out zero); when no lane
+    // has friction, the rows are skipped outright.
+    const int friction_points = any(wc.friction > zero) ? kMaxManifoldPoints : 0;
+    for (int k = 0; k < friction_points; ++k) {
+        // Friction points in one order when biased and the other when relaxing: Gauss-
+        // Seidel favours the point solved last, and in a resting pyramid a fixed order
+        // creeps the upper layers sideways (0.10 m over 1000 steps, 0.07 alternating).
+        const int j = kBias ? k : kMaxManifoldPoints - 1 - k;
+        // No friction across an open gap: a speculative point far from the body (a
+        // fast sphere's, metres ahead) would spin it up through the lever arm.
+        const WideMask touching = gap[j] <= slop;
+        if (!any(touching)) continue;
+        WidePoint& p = wc.points[j];
+        const Wide old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
+        const Wide3 dv = point_velocity(s, p.ra, p.rb);
+        Wide new0 = old0 - widen(p.tangent_mass[0]) * dot(wc.tangent[0], dv);
+        Wide new1 = old1 - widen(p.tangent_mass[1]) * dot(wc.tangent[1], dv);
+        // Coulomb's cone: the friction impulse stays within friction x normal impulse.
+        const Wide limit = wc.friction * p.normal_impulse;
+        const Wide length_sq = new0 * new0 + new1 * new1;
+        const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), one);
+        new0 = select(touching, new0 * scale, old0);
+        new1 = select(touching, new1 * scale, old1);
+        p.tangent_impulse[0] = new0;
+        p.tangent_impulse[1] = new1;
+        apply_row(wc, s, wc.tangent[0], p.tangent_row[0], new0 - old0);
+        apply_row(wc, s, wc.tangent[1], p.tangent_row[1], new1 - old1);
+    }
+    scatter(wc, bodies, s);
+    if constexpr (kBias) {
+        if (!any(deep_weight > zero)) return;
+        for (int l = 0; l < kLanes; ++l) {
+            if (deep_weight[l] <= 0) continue;
+            const Real w = deep_weight[l];
+            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
+                     params);
+        }
+    }
+}
+
+}  // namespace
+
+void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, scratch.wide[k]);
+}
+
+void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+    WideVelocities s = gather(wc, bodies);
+    const bool friction = any(wc.friction > splat(0));  // else the tangent impulses are all zero
+    for (const WidePoint& p : wc.points) {
+        apply_row(wc, s, wc.normal, p.normal_row, p.normal_impulse);
+        if (!friction) continue;
+        apply_row(wc, s, wc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
+        apply_row(wc, s, wc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
+    }
+    scatter(wc, bodies, s);
+    for (int l = 0; l < kLanes; ++l) {
+        if (wc.push_impulse[l] <= 0) continue;
+        SolverBody& A = bodies[wc.a[l]];
+        SolverBody& B = bodies[wc.b[l]];
+        Velocities push = load_push(A, B);
+        apply_row(A, B, push, wc.normal.lane(l), push_rows[l], wc.push_impulse[l]);
+        store_push(A, B, push);
+    }
+}
+
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
+    if (params.use_bias) {
+        solve_wide<true>(wc, push_rows, bodies, params);
+    } else {
+        solve_wide<false>(wc, push_rows, bodies, params);
+    }
+}
+
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h) {
+    const Wide zero = splat(0);
+    const WideMask bouncy = wc.restitution > zero;
+    if (!any(bouncy)) return;
+    WideVelocities s = gather(wc, bodies);
+    for (WidePoint& p : wc.points) {
+        // Only points that approached fast enough and actually pushed bounce.
+        const WideMask bounce = bouncy & (p.relative_velocity <= splat(-threshold)) & (p.max_normal_impulse > zero);
+        if (!any(bounce)) continue;
+        const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
+        // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
+        // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
+        const Wide approach = p.relative_velocity + wc.gravity_normal * splat(h);
+        const Wide impulse = -widen(p.normal_mass) * (vn + wc.restitution * wide_min(approach, zero));
+        const Wide total = wide_max(p.normal_impulse + impulse, zero);
+        const Wide applied = select(bounce, total - p.normal_impulse, zero);
+        p.normal_impulse += applied;
+        p.max_normal_impulse = wide_max(p.max_normal_impulse, applied);
+        apply_row(wc, s, wc.normal, p.normal_row, applied);
+    }
+    scatter(wc, bodies, s);
+}
+
+void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const WideContact& wc = scratch.wide[k];
+        for (int l = 0; l < wc.lanes; ++l) {
+            const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
+            ContactManifold& m = world.contacts[ref.contact].manifold_at(static_cast<int>(ref.manifold));
+            for (int j = 0; j < m.point_count; ++j) {
+                const WidePoint& p = wc.points[j];
+                ContactPoint& dst = m.points[j];
+                dst.normal_impulse = p.normal_impulse[l];
+                dst.tangent_impulse[0] = p.tangent_impulse[0][l];
+                dst.tangent_impulse[1] = p.tangent_impulse[1][l];
+                dst.max_normal_impulse = p.max_normal_impulse[l];
+                dst.relative_velocity = p.relative_velocity[l];
+            }
+        }
+    }
+}
+
+}  // namespace spindle

@@ -1,0 +1,162 @@
+// ProxyTrees: proxy bookkeeping over the moving and static trees, and update_pairs, the
+// parallel search for pairs around the proxies enlarged since the last step.
+#include "spatial/proxy_trees.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+namespace spindle {
+namespace {
+
+AabbTreeSettings moving_tree_settings(const BroadphaseSettings& s) {
+    return {s.margin, s.displacement_multiplier, s.validate_each_operation};
+}
+AabbTreeSettings static_tree_settings(const BroadphaseSettings& s) {
+    return {Real(0), Real(0), s.validate_each_operation};
+}
+
+Pair make_pair(ProxyId p, std::uint64_t user_p, ProxyId q, std::uint64_t user_q) {
+    if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
+    return {p, q, user_p, user_q};
+}
+
+bool canonical_less(const Pair& a, const Pair& b) {
+    return std::make_tuple(a.user_a, a.user_b, a.proxy_a.key(), a.proxy_b.key()) <
+           std::make_tuple(b.user_a, b.user_b, b.proxy_a.key(), b.proxy_b.key());
+}
+
+}  // namespace
+
+ProxyTrees::ProxyTrees(BroadphaseSettings settings)
+    : m_settings(settings), m_trees{DynamicAabbTree(moving_tree_settings(settings)),
+                                    DynamicAabbTree(static_tree_settings(settings))} {
+    if (m_settings.grain == 0) m_settings.grain = 1;
+}
+
+ProxyId ProxyTrees::create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static) {
+    const std::int32_t tree_id = m_trees[is_static ? 1 : 0].create_proxy(aabb, user);
+    const ProxyId id = ProxyId::make(tree_id, is_static);
+    std::vector<std::int32_t>& slots = slots_of(id);
+    if (slots.size() <= static_cast<std::size_t>(tree_id)) slots.resize(static_cast<std::size_t>(tree_id) + 1, -1);
+    mark_enlarged(id);
+    validate_if_enabled();
+    return id;
+}
+
+void ProxyTrees::destroy_proxy(ProxyId id) {
+    unmark_enlarged(id);
+    tree_of(id).destroy_proxy(id.tree_id());
+    validate_if_enabled();
+}
+
+bool ProxyTrees::move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) {
+    DynamicAabbTree& tree = tree_of(id);
+    const Aabb old_fat = tree.fat_aabb(id.tree_id());
+    if (!tree.move_proxy(id.tree_id(), tight_aabb, displacement)) return false;
+    // A re-insert that only shrank the box (a body slowed down) cannot create pairs.
+    if (old_fat.contains(tree.fat_aabb(id.tree_id()))) return false;
+    mark_enlarged(id);
+    return true;
+}
+
+bool ProxyTrees::is_enlarged(ProxyId id) const {
+    const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
+    const auto i = static_cast<std::size_t>(id.tree_id());
+    return i < slots.size() && slots[i] >= 0;
+}
+
+void ProxyTrees::mark_enlarged(ProxyId id) {
+    std::int32_t& slot = slots_of(id)[static_cast<std::size_t>(id.tree_id())];
+    if (slot >= 0) return;
+    slot = static_cast<std::int32_t>(m_enlarged.size());
+    m_enlarged.push_back(id);
+}
+
+void ProxyTrees::unmark_enlarged(ProxyId id) {
+    std::int32_t& slot = slots_of(id)[static_cast<std::size_t>(id.tree_id())];
+    if (slot < 0) return;
+    // Swap-remove: the list order only decides which job finds a pair, never the result.
+    const ProxyId last = m_enlarged.back();
+    m_enlarged[static_cast<std::size_t>(slot)] = last;
+    slots_of(last)[static_cast<std::size_t>(last.tree_id())] = slot;
+    m_enlarged.pop_back();
+    slot = -1;
+}
+
+// Pairs of one enlarged proxy: moving proxies look in both trees, static ones only in
+// the moving tree. When both proxies are enlarged, both searches meet the pair; only
+// the proxy with the smaller key reports it.
+void ProxyTrees::find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const {
+    const Aabb& box = fat_aabb(proxy);
+    const std::uint64_t user_p = user(proxy);
+    for (int t = proxy.is_static() ? 0 : 1; t >= 0; --t) {
+        const DynamicAabbTree& tree = m_trees[t];
+        tree.query(box, [&](std::int32_t tree_id) {
+            const ProxyId other = ProxyId::make(tree_id, t == 1);
+            if (other == proxy) return true;
+            if (other.key() < proxy.key() && is_enlarged(other)) return true;
+            out.push_back(make_pair(proxy, user_p, other, tree.user(tree_id)));
+            return true;
+        });
+    }
+}
+
+void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
+    new_pairs.clear();
+    const auto count = static_cast<std::uint32_t>(m_enlarged.size());
+    if (count == 0) return;
+
+    const std::uint32_t grain = m_settings.grain;
+    const std::uint32_t chunks = (count + grain - 1) / grain;
+    if (m_chunk_pairs.size() < chunks) m_chunk_pairs.resize(chunks);
+    for (std::uint32_t c = 0; c < chunks; ++c) m_chunk_pairs[c].clear();
+
+    // Jobs only read the trees and the enlarged marks and write their own chunk's list.
+    jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
+        std::vector<Pair>& out = m_chunk_pairs[begin / grain];
+        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], out);
+    });
+
+    std::size_t total = 0;
+    for (std::uint32_t c = 0; c < chunks; ++c) total += m_chunk_pairs[c].size();
+    new_pairs.reserve(total);
+    for (std::uint32_t c = 0; c < chunks; ++c) {
+        new_pairs.insert(new_pairs.end(), m_chunk_pairs[c].begin(), m_chunk_pairs[c].end());
+    }
+    // The chunk order already fixes the result for a given enlarged list; sorting also
+    // frees it from the marking order, so the engine sees pairs in a canonical order.
+    std::sort(new_pairs.begin(), new_pairs.end(), canonical_less);
+
+    for (const ProxyId id : m_enlarged) slots_of(id)[static_cast<std::size_t>(id.tree_id())] = -1;
+    m_enlarged.clear();
+}
+
+void ProxyTrees::rebuild_static_tree() {
+    m_trees[1].rebuild();
+}
+
+void ProxyTrees::validate() const {
+    m_trees[0].validate();
+    m_trees[1].validate();
+    validate_enlarged();
+}
+
+void ProxyTrees::validate_enlarged() const {
+    for (std::size_t i = 0; i < m_enlarged.size(); ++i) {
+        const ProxyId id = m_enlarged[i];
+        const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
+        if (!tree_of(id).is_proxy(id.tree_id()) || static_cast<std::size_t>(id.tree_id()) >= slots.size() ||
+            slots[static_cast<std::size_t>(id.tree_id())] != static_cast<std::int32_t>(i)) {
+            assert_failed("enlarged list consistent", "broadphase: enlarged list and marks disagree", __FILE__, __LINE__);
+        }
+    }
+    std::size_t marked = 0;
+    for (const auto& slots : m_enlarged_slot) {
+        marked += static_cast<std::size_t>(std::count_if(slots.begin(), slots.end(), [](std::int32_t s) { return s >= 0; }));
+    }
+    if (marked != m_enlarged.size()) {
+        assert_failed("marked == enlarged", "broadphase: more proxies marked enlarged than listed", __FILE__, __LINE__);
+    }
+}
+
+}  // namespace spindle

@@ -1,0 +1,152 @@
+// ProxyTrees, the broadphase's data structure: two AABB trees (moving proxies, static
+// proxies) and the search for new pairs of overlapping fat boxes after proxies moved.
+// Knows nothing of bodies or shapes.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <spindle/engine/math.hpp>
+#include <spindle/scheduler/job_system.hpp>
+
+#include "spatial/aabb_tree.hpp"
+
+namespace spindle {
+
+// A proxy handle: the tree it lives in (low bit) and its id in that tree. Ids are reused
+// after destroy_proxy; the engine keeps a handle only while its shape exists.
+class ProxyId {
+public:
+    constexpr ProxyId() noexcept = default;
+    static constexpr ProxyId make(std::int32_t tree_id, bool is_static) noexcept {
+        return ProxyId((static_cast<std::uint32_t>(tree_id) << 1) | (is_static ? 1u : 0u));
+    }
+    constexpr bool valid() const noexcept { return m_key != kInvalid; }
+    constexpr bool is_static() const noexcept { return (m_key & 1u) != 0; }
+    constexpr std::int32_t tree_id() const noexcept { return static_cast<std::int32_t>(m_key >> 1); }
+    // A total order over live proxies, stable for their life: used to break ties.
+    constexpr std::uint32_t key() const noexcept { return m_key; }
+    friend constexpr bool operator==(ProxyId a, ProxyId b) noexcept = default;
+
+private:
+    static constexpr std::uint32_t kInvalid = std::numeric_limits<std::uint32_t>::max();
+    constexpr explicit ProxyId(std::uint32_t key) noexcept : m_key(key) {}
+    std::uint32_t m_key = kInvalid;
+};
+
+// A pair of proxies whose fat boxes overlap. Canonical: user_a <= user_b, and when the
+// user values are equal, proxy_a.key() < proxy_b.key().
+struct Pair {
+    ProxyId proxy_a;
+    ProxyId proxy_b;
+    std::uint64_t user_a = 0;
+    std::uint64_t user_b = 0;
+};
+
+struct BroadphaseSettings {
+    // Fat box margin of moving proxies (metres). Static proxies get none: they rarely move.
+    Real margin = Real(0.1);
+    // Moving fat boxes stretch this many displacements ahead (see AabbTreeSettings).
+    Real displacement_multiplier = Real(2);
+    // Enlarged proxies per pair-finding job. Fixed, so chunks do not depend on workers.
+    std::uint32_t grain = 64;
+    // Validate both trees after every change (O(n) each); default on with SPINDLE_VALIDATE.
+    bool validate_each_operation = SPINDLE_VALIDATE_ENABLED != 0;
+};
+
+// Thread use: every function is called by one thread at a time (the physics stage that
+// owns the broadphase). update_pairs fans out on the JobSystem and returns when done.
+class ProxyTrees {
+public:
+    explicit ProxyTrees(BroadphaseSettings settings = {});
+
+    // Adds a proxy (static: the static tree, else the moving tree) and marks it enlarged,
+    // so its pairs are found at the next update_pairs.
+    ProxyId create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static);
+    void destroy_proxy(ProxyId id);
+    // Updates the proxy's tight box; `displacement` is its motion this step (stretches the
+    // fat box ahead). Returns true and marks the proxy enlarged when the fat box grew.
+    bool move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement);
+    // Whether move_proxy would change the proxy's fat box (const: any number of threads
+    // while nothing writes), so callers can test many proxies in parallel and move few.
+    bool needs_move(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
+        return tree_of(id).needs_move(id.tree_id(), tight_aabb, displacement);
+    }
+
+    // Replaces new_pairs with every pair of proxies whose fat boxes overlap and of which at
+    // least one was enlarged (created or grown) since the last call; never static with
+    // static, each pair once, sorted by (user_a, user_b, proxy_a.key, proxy_b.key), so
+    // the result does not depend on the worker count or on which job ran first. Pairs
+    // found before are found again if one of them grew: the caller skips pairs it has.
+    // Clears the enlarged marks. Who may call: the thread that owns the broadphase; it
+    // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
+    // meanwhile). Safe from inside a job: parallel_for may nest.
+    void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs);
+
+    // Whether the fat boxes of a and b overlap (the engine drops a contact when not).
+    bool test_overlap(ProxyId a, ProxyId b) const { return fat_aabb(a).overlaps(fat_aabb(b)); }
+
+    // Calls callback(ProxyId) -> bool for every proxy (both trees) whose fat box
+    // overlaps box; false stops.
+    template <typename Callback>
+    void query(const Aabb& box, Callback&& callback) const;
+
+    // Rebuilds the static tree top down (after loading many static proxies at once).
+    void rebuild_static_tree();
+
+    const Aabb& fat_aabb(ProxyId id) const { return tree_of(id).fat_aabb(id.tree_id()); }
+    std::uint64_t user(ProxyId id) const { return tree_of(id).user(id.tree_id()); }
+    bool is_enlarged(ProxyId id) const;
+    std::int32_t proxy_count() const noexcept { return m_trees[0].proxy_count() + m_trees[1].proxy_count(); }
+    std::size_t enlarged_count() const noexcept { return m_enlarged.size(); }
+    const DynamicAabbTree& moving_tree() const noexcept { return m_trees[0]; }
+    const DynamicAabbTree& static_tree() const noexcept { return m_trees[1]; }
+    const BroadphaseSettings& settings() const noexcept { return m_settings; }
+
+    // Validates both trees and the enlarged list (any build type; see DynamicAabbTree).
+    void validate() const;
+
+private:
+    const DynamicAabbTree& tree_of(ProxyId id) const {
+        SPINDLE_ASSERT(id.valid(), "ProxyTrees: invalid proxy id");
+        return m_trees[id.is_static() ? 1 : 0];
+    }
+    DynamicAabbTree& tree_of(ProxyId id) {
+        SPINDLE_ASSERT(id.valid(), "ProxyTrees: invalid proxy id");
+        return m_trees[id.is_static() ? 1 : 0];
+    }
+    std::vector<std::int32_t>& slots_of(ProxyId id) { return m_enlarged_slot[id.is_static() ? 1 : 0]; }
+    void mark_enlarged(ProxyId id);
+    void unmark_enlarged(ProxyId id);
+    void find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const;
+    void validate_enlarged() const;
+    // The trees validate themselves after each change; this adds the enlarged list.
+    void validate_if_enabled() const {
+        if (m_settings.validate_each_operation) validate_enlarged();
+    }
+
+    BroadphaseSettings m_settings;
+    DynamicAabbTree m_trees[2];  // [0] moving (dynamic, kinematic), [1] static
+    // Proxies enlarged since the last update_pairs, in marking order, and per tree id the
+    // index into that list (-1 when not enlarged): O(1) marking, unmarking and lookup
+    // from the pair jobs, which test it to report a pair of two enlarged proxies once.
+    std::vector<ProxyId> m_enlarged;
+    std::vector<std::int32_t> m_enlarged_slot[2];
+    // One output list per job chunk, merged in chunk order; kept between calls so a
+    // steady-state update does not allocate.
+    std::vector<std::vector<Pair>> m_chunk_pairs;
+};
+
+template <typename Callback>
+void ProxyTrees::query(const Aabb& box, Callback&& callback) const {
+    bool go_on = true;
+    for (int t = 0; t < 2 && go_on; ++t) {
+        m_trees[t].query(box, [&](std::int32_t id) {
+            go_on = callback(ProxyId::make(id, t == 1));
+            return go_on;
+        });
+    }
+}
+
+}  // namespace spindle

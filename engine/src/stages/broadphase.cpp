@@ -1,0 +1,114 @@
+// Broadphase stage: bounds of awake bodies, proxies moved in the AABB tree, new pairs
+// -> contacts, contacts whose fat bounds separated -> removed.
+#include <algorithm>
+
+#include "stages/broadphase_state.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+namespace {
+
+bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
+    // Two bodies that cannot move each other make no contact.
+    return b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic;
+}
+
+void mark_refit(BroadphaseState& bp, std::uint32_t slot) {
+    if (bp.refit[slot]) return;
+    bp.refit[slot] = 1;
+    bp.refit_slots.push_back(slot);
+}
+
+// Moves a body's proxy, noting when its fat box changed at all (grown or shrunk: either
+// can end an overlap).
+void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
+    const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
+    bp.tree.move_proxy(bp.proxy[slot], box, displacement);
+    const Aabb& after = bp.tree.fat_aabb(bp.proxy[slot]);
+    if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
+}
+
+// The box a body's fat box must hold: its bounds swept over this step's motion (a
+// fast body near the edge of its fat box would otherwise cross a whole step into
+// something before the pair is found).
+Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
+    Aabb swept = b.bounds[i];
+    swept.min += displacement.cwiseMin(Vec3::Zero());
+    swept.max += displacement.cwiseMax(Vec3::Zero());
+    return swept;
+}
+
+}  // namespace
+
+void add_proxy(World& world, std::uint32_t slot) {
+    BroadphaseState& bp = *world.broadphase;
+    const Bodies& b = world.bodies;
+    if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
+    if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
+    bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
+    mark_refit(bp, slot);
+}
+
+void remove_proxy(World& world, std::uint32_t slot) {
+    BroadphaseState& bp = *world.broadphase;
+    bp.tree.destroy_proxy(bp.proxy[slot]);
+    bp.proxy[slot] = ProxyId{};
+}
+
+void refresh_proxy(World& world, std::uint32_t slot) {
+    move_proxy(*world.broadphase, slot, world.bodies.bounds[slot], Vec3::Zero());
+}
+
+void update_broadphase(World& world, Real dt) {
+    Bodies& b = world.bodies;
+    BroadphaseState& bp = *world.broadphase;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    // Bounds, and whether each proxy must move, in parallel; the tree is single-writer,
+    // so the few proxies that left their fat boxes are moved after, in awake order.
+    bp.moving.resize(n);
+    world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t i = world.awake[k];
+            b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            const Vec3 d = b.v[i] * dt;
+            bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
+        }
+    });
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (!bp.moving[k]) continue;
+        const std::uint32_t i = world.awake[k];
+        const Vec3 d = b.v[i] * dt;
+        move_proxy(bp, i, swept_bounds(b, i, d), d);
+    }
+
+    bp.pairs.clear();
+    bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count
+    reserve_contacts(world, bp.pairs.size());
+    for (const Pair& pair : bp.pairs) {
+        const auto i = static_cast<std::uint32_t>(pair.user_a);
+        const auto j = static_cast<std::uint32_t>(pair.user_b);
+        if (!can_collide(b, i, j)) continue;
+        if (joint_blocks_pair(world, i, j)) continue;  // jointed bodies do not collide unless asked
+        create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
+    }
+
+    // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
+    // can have stopped overlapping.
+    std::vector<std::uint32_t>& lost = world.scratch_lost;
+    lost.clear();
+    if (!bp.refit_slots.empty()) {
+        for (std::uint32_t c : awake_contacts(world)) {
+            const std::uint64_t key = world.contact_keys[c];  // packed: no Contact is read
+            const auto i = static_cast<std::uint32_t>(key >> 32);
+            const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
+            if (!bp.refit[i] && !bp.refit[j]) continue;
+            if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) lost.push_back(c);
+        }
+    }
+    remove_contacts(world, lost);
+    // Only the marked slots are cleared: a sleeping pile's slots are not touched.
+    for (std::uint32_t slot : bp.refit_slots) bp.refit[slot] = 0;
+    bp.refit_slots.clear();
+}
+
+}  // namespace spindle

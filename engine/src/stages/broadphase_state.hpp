@@ -1,0 +1,37 @@
+// The broadphase stage's state and the body/contact bookkeeping it owns.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "spatial/proxy_trees.hpp"
+#include "world.hpp"
+
+namespace spindle {
+
+struct BroadphaseState {
+    ProxyTrees tree;               // moving and static AABB trees; proxy user value = body slot
+    std::vector<ProxyId> proxy;    // per body slot
+    std::vector<Pair> pairs;       // scratch: pairs found this step (kept: no allocation per step)
+    // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
+    // can only lose its overlap when one of its bodies' fat boxes changed.
+    std::vector<std::uint8_t> refit;
+    std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
+    std::vector<std::uint8_t> moving;        // scratch, per awake body: its proxy must move this step
+};
+
+void add_proxy(World& world, std::uint32_t slot);
+void remove_proxy(World& world, std::uint32_t slot);
+// Re-fits a proxy to the body's current bounds (a teleport, or a static body moved).
+void refresh_proxy(World& world, std::uint32_t slot);
+// Removes every contact of a body (destroy_body).
+void remove_contacts_of(World& world, std::uint32_t slot);
+// Creates a contact for a pair key (min slot << 32 | max slot) if there is none.
+void create_contact(World& world, std::uint64_t key);
+// Makes room for `more` contacts at once (a first step finds tens of thousands of pairs:
+// growing by push_back would move every contact again and again).
+void reserve_contacts(World& world, std::size_t more);
+// Removes contacts by their positions in world.contacts (ascending), keeping the order of the rest.
+void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);
+
+}  // namespace spindle

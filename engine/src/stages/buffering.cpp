@@ -1,0 +1,185 @@
+// Buffering stages: ApplyWrites (write buffer -> live state) and FlipReadBuffers
+// (live state -> published buffer, swapped under the motion-state lock).
+#include <algorithm>
+
+#include "stages/broadphase_state.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+
+// The physics side of MotionStateManager, private to everything but these two stages.
+class MotionStatePublisher {
+public:
+    explicit MotionStatePublisher(MotionStateManager& manager) : m_manager(manager) {}
+    std::vector<PublishedBody>& back() noexcept { return m_manager.back(); }
+    int back_index() const noexcept { return m_manager.back_index(); }
+    std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_manager.buffer_locked(k); }
+    std::mutex& lock() const noexcept { return m_manager.lock(); }
+    double flip(double alpha, std::uint64_t steps) { return m_manager.flip(alpha, steps); }
+
+private:
+    MotionStateManager& m_manager;
+};
+
+namespace {
+
+// A teleport: the body jumps, so both history entries take the new pose and the
+// interpolation does not slide it there.
+void reset_history(Bodies& b, std::uint32_t i) {
+    const Vec3 origin = b.origin(i);
+    for (int k = 0; k < 2; ++k) {
+        b.history_position[k][i] = origin;
+        b.history_orientation[k][i] = b.q[i];
+    }
+}
+
+}  // namespace
+
+void apply_writes(World& world) {
+    world.writes.drain(world.drained);
+    Bodies& b = world.bodies;
+    for (const BufferedWrite& write : world.drained) {
+        if (!b.is_live(write.body)) {
+            world.stats.writes_rejected += 1;  // the body was destroyed after the write was made
+            continue;
+        }
+        const std::uint32_t i = write.body.index;
+        const bool moves = b.type[i] != MotionType::Static;
+        switch (write.kind) {
+            case WriteKind::Position:
+                b.x[i] = write.vector + b.q[i] * b.local_com[i];
+                reset_history(b, i);
+                break;
+            case WriteKind::Orientation: {
+                const Vec3 origin = b.origin(i);
+                b.q[i] = write.rotation.normalized();
+                b.x[i] = origin + b.q[i] * b.local_com[i];
+                reset_history(b, i);
+                break;
+            }
+            case WriteKind::LinearVelocity:
+                if (moves) b.v[i] = write.vector;
+                break;
+            case WriteKind::AngularVelocity:
+                if (moves) b.w[i] = write.vector;
+                break;
+            case WriteKind::MotionState:
+                b.q[i] = write.state.orientation.normalized();
+                b.x[i] = write.state.position + b.q[i] * b.local_com[i];
+                if (moves) {
+                    b.v[i] = write.state.linear_velocity;
+                    b.w[i] = write.state.angular_velocity;
+                }
+                reset_history(b, i);
+                break;
+            case WriteKind::Force: b.force[i] += write.vector; break;
+            case WriteKind::Torque: b.torque[i] += write.vector; break;
+            case WriteKind::Impulse: b.v[i] += b.inv_mass[i] * write.vector; break;
+            case WriteKind::AngularImpulse: b.w[i] += b.inv_inertia_world(i) * write.vector; break;
+            case WriteKind::Wake: break;
+        }
+        if (moves) wake_body(world, i);
+        if (write.kind <= WriteKind::MotionState) {
+            b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            refresh_proxy(world, i);
+            world.changed_now.push_back(i);
+        }
+        world.stats.writes_applied += 1;
+    }
+}
+
+// Fills one published entry from the live state.
+static void fill(const World& world, std::uint32_t i, PublishedBody& p, bool interpolating) {
+    const Bodies& b = world.bodies;
+    if (!b.alive[i]) {
+        p.generation = 0;
+        return;
+    }
+    p.generation = b.generation[i];
+    p.current.orientation = b.q[i];
+    p.current.position = b.origin(i);
+    p.current.center_of_mass = b.x[i];
+    p.current.linear_velocity = b.v[i];
+    p.current.angular_velocity = b.w[i];
+    p.interpolate = interpolating && b.interpolate[i];
+    if (p.interpolate) {
+        // Bodies without the flag skip this: interpolation costs them nothing.
+        p.previous_position = b.history_position[0][i];
+        p.previous_orientation = b.history_orientation[0][i];
+        p.previous_center_of_mass = p.previous_position + p.previous_orientation * b.local_com[i];
+    }
+}
+
+void publish_now(World& world, std::uint32_t slot) {
+    MotionStatePublisher manager(world.motion_states);
+    const bool interpolating = world.settings.time_step.use_internal_time_stepping;
+    std::scoped_lock guard(manager.lock());
+    for (int k = 0; k < 2; ++k) {
+        std::vector<PublishedBody>& buffer = manager.buffer_locked(k);
+        if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
+        fill(world, slot, buffer[slot], interpolating);
+    }
+}
+
+void flip_read_buffers(World& world) {
+    Bodies& b = world.bodies;
+    MotionStatePublisher manager(world.motion_states);
+    std::vector<PublishedBody>& back = manager.back();
+    if (back.size() < b.capacity()) back.resize(b.capacity());
+    const bool interpolating = world.settings.time_step.use_internal_time_stepping;
+
+    auto publish = [&](std::uint32_t i) {
+        fill(world, i, back[i], interpolating);
+        world.counters.interpolated_publishes += back[i].interpolate ? 1 : 0;
+    };
+    // The back buffer is two flips old: refresh what moved in either of the two
+    // updates (awake bodies, and bodies changed by writes, creation or sleep). The
+    // awake ones in parallel (each entry is its own), counted per worker; and only when
+    // the back buffer has not already got them: an update that took no step and applied
+    // no write leaves the awake bodies as they were at its last fill (the async runner
+    // updates many times per step, and would otherwise copy every awake body each time).
+    // Anything that may have changed an awake body since the last flip: a step, a write,
+    // or a direct change (set_internal_motion_state, creation) noted in changed_now.
+    if (world.stats.steps > 0 || world.stats.writes_applied > 0 || !world.changed_now.empty()) {
+        world.awake_version += 1;
+    }
+    const int k = manager.back_index();
+    const bool awake_stale = world.published_version[k] != world.awake_version ||
+                             world.published_interpolating[k] != interpolating;
+    if (awake_stale) {
+        std::vector<CacheLinePadded<std::uint64_t>>& interpolated = world.publish_counts;
+        interpolated.assign(world.jobs->worker_count(), {});
+        const auto n = static_cast<std::uint32_t>(world.awake.size());
+        world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+            std::uint64_t count = 0;
+            for (std::uint32_t a = lo; a < hi; ++a) {
+                const std::uint32_t i = world.awake[a];
+                fill(world, i, back[i], interpolating);
+                count += back[i].interpolate ? 1 : 0;
+            }
+            interpolated[worker].value += count;
+        });
+        for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
+        world.counters.awake_publishes += n;
+        world.published_version[k] = world.awake_version;
+        world.published_interpolating[k] = interpolating;
+    }
+    for (std::uint32_t i : world.changed_now) {
+        if (!b.alive[i] || b.awake_index[i] < 0) publish(i);  // awake ones were published above
+    }
+    for (std::uint32_t i : world.changed_last) {
+        if (!b.alive[i] || b.awake_index[i] < 0) publish(i);
+    }
+    std::swap(world.changed_last, world.changed_now);
+    world.changed_now.clear();
+    // Bodies awake last update but asleep now were recorded in changed_now by the
+    // islands stage, so nothing is missed.
+
+    const double alpha = interpolating ? world.accumulator / world.settings.time_step.duration : 1.0;
+    world.stats.flip_lock_seconds = manager.flip(alpha, world.steps);
+    // After the swap the new back buffer may be shorter than the body slots.
+    if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
+    world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());
+}
+
+}  // namespace spindle

@@ -1,0 +1,86 @@
+// Contact bookkeeping: creation from pair keys, removal that keeps the order of the
+// remaining contacts (so the solver's order, and so its result, is deterministic).
+#include <algorithm>
+
+#include "stages/broadphase_state.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+
+void reserve_contacts(World& world, std::size_t more) {
+    const std::size_t needed = world.contacts.size() + more;
+    if (world.contacts.capacity() < needed) {
+        // Geometric, as push_back would grow: room for exactly `needed` would make the
+        // next step's few new contacts reallocate (and move every contact) again.
+        const std::size_t capacity = std::max(needed, 2 * world.contacts.capacity());
+        world.contacts.reserve(capacity);
+        world.contact_keys.reserve(capacity);
+        world.contact_summaries.reserve(capacity);
+    }
+    if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
+        static_cast<float>(needed)) {
+        world.contact_index.reserve(std::max(needed, 2 * world.contact_index.size()));
+    }
+}
+
+void create_contact(World& world, std::uint64_t key) {
+    if (world.contact_index.count(key)) return;
+    const auto a = static_cast<std::uint32_t>(key >> 32);
+    const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const Bodies& bodies = world.bodies;
+    Contact contact;
+    contact.body_a = a;
+    contact.body_b = b;
+    // Mixing rules as most engines: geometric mean friction, largest restitution.
+    contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
+    contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
+    world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
+    world.contact_summaries.push_back(contact_summary(contact));
+    world.contacts.push_back(std::move(contact));
+    world.contact_keys.push_back(key);
+    world.awake_contacts_dirty = true;
+}
+
+const std::vector<std::uint32_t>& awake_contacts(World& world) {
+    if (world.awake_contacts_dirty) {
+        world.awake_contact_list.clear();
+        for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+            if (!world.contacts[c].sleeping) world.awake_contact_list.push_back(c);
+        }
+        world.awake_contacts_dirty = false;
+    }
+    return world.awake_contact_list;
+}
+
+void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
+    if (positions.empty()) return;
+    for (std::uint32_t p : positions) world.contact_index.erase(world.contact_keys[p]);
+    std::size_t next = 0, write = 0;
+    for (std::size_t read = 0; read < world.contacts.size(); ++read) {
+        if (next < positions.size() && positions[next] == read) {
+            ++next;
+            continue;
+        }
+        if (write != read) {
+            world.contacts[write] = std::move(world.contacts[read]);
+            world.contact_keys[write] = world.contact_keys[read];
+            world.contact_summaries[write] = world.contact_summaries[read];
+        }
+        world.contact_index[world.contact_keys[write]] = static_cast<std::uint32_t>(write);
+        ++write;
+    }
+    world.contacts.resize(write);
+    world.contact_keys.resize(write);
+    world.contact_summaries.resize(write);
+    world.awake_contacts_dirty = true;
+}
+
+void remove_contacts_of(World& world, std::uint32_t slot) {
+    std::vector<std::uint32_t> positions;
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        if (world.contacts[c].body_a == slot || world.contacts[c].body_b == slot) positions.push_back(c);
+    }
+    remove_contacts(world, positions);
+}
+
+}  // namespace spindle

@@ -1,0 +1,190 @@
+// Islands and sleeping: bodies linked by touching contacts or joints form islands
+// (union-find over the awake bodies each step); an island whose bodies all rested long enough
+// goes to sleep as a whole and costs nothing until something wakes it.
+#include <algorithm>
+#include <numeric>
+
+#include "stages/stages.hpp"
+
+namespace spindle {
+namespace {
+
+std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t i) {
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+// Joins two sets; the lower root wins, so islands do not depend on the link order.
+void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t ra = find(parent, a);
+    const std::uint32_t rb = find(parent, b);
+    if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+}
+
+bool touching(const Contact& c) { return c.manifold_count > 0; }
+
+}  // namespace
+
+void wake_body(World& world, std::uint32_t slot) {
+    Bodies& b = world.bodies;
+    if (b.type[slot] == MotionType::Static) return;
+    b.sleep_time[slot] = 0;
+    if (b.awake_index[slot] >= 0) return;
+    const std::int32_t island = b.island[slot];
+    if (island < 0) {
+        set_awake(world, slot, true);
+        return;
+    }
+    SleepingIsland& sleeping = world.sleeping_islands[static_cast<std::size_t>(island)];
+    for (std::uint32_t member : sleeping.bodies) {
+        set_awake(world, member, true);
+        world.changed_now.push_back(member);
+    }
+    for (std::uint64_t key : sleeping.contacts) {
+        auto it = world.contact_index.find(key);
+        if (it != world.contact_index.end()) world.contacts[it->second].sleeping = false;
+    }
+    world.awake_contacts_dirty = true;
+    for (JointHandle joint : sleeping.joints) {
+        if (world.joints.is_live(joint)) world.joints.joint[joint.index].sleeping = false;
+    }
+    if (!sleeping.joints.empty()) world.joints.awake_dirty = true;
+    sleeping.bodies.clear();
+    sleeping.contacts.clear();
+    sleeping.joints.clear();
+    world.free_islands.push_back(island);
+}
+
+void update_islands(World& world, Real dt) {
+    Bodies& b = world.bodies;
+    const SleepSettings& sleep = world.settings.sleep;
+
+    // Contacts between an awake body and a sleeping one wake the sleeper's island (none
+    // to wake while no island sleeps).
+    const bool any_asleep = world.sleeping_islands.size() > world.free_islands.size();
+    for (std::size_t k = 0; any_asleep && k < awake_contacts(world).size(); ++k) {  // wake_body may rebuild the list
+        const Contact& contact = world.contacts[awake_contacts(world)[k]];
+        if (!touching(contact)) continue;
+        const bool awake_a = b.awake_index[contact.body_a] >= 0, awake_b = b.awake_index[contact.body_b] >= 0;
+        if (awake_a && !awake_b && b.type[contact.body_b] == MotionType::Dynamic) wake_body(world, contact.body_b);
+        if (awake_b && !awake_a && b.type[contact.body_a] == MotionType::Dynamic) wake_body(world, contact.body_a);
+    }
+    // So do joints: a joint cannot hold a body that does not move.
+    Joints& joints = world.joints;
+    for (std::size_t k = 0; any_asleep && k < awake_joints(world).size(); ++k) {  // wake_body may rebuild the list
+        const Joint& joint = joints.joint[awake_joints(world)[k]];
+        const std::uint32_t ja = joint.body_a, jb = joint.body_b;
+        const bool awake_a = b.awake_index[ja] >= 0, awake_b = b.awake_index[jb] >= 0;
+        if (awake_a && !awake_b && b.type[jb] == MotionType::Dynamic) wake_body(world, jb);
+        if (awake_b && !awake_a && b.type[ja] == MotionType::Dynamic) wake_body(world, ja);
+    }
+    if (!sleep.enabled) return;
+
+    // Rest timers.
+    const Real lin2 = sleep.linear_threshold * sleep.linear_threshold;
+    const Real ang2 = sleep.angular_threshold * sleep.angular_threshold;
+    Real longest_rest = 0;
+    for (std::uint32_t i : world.awake) {
+        const bool resting = b.desc[i].allow_sleep && b.v[i].squaredNorm() < lin2 && b.w[i].squaredNorm() < ang2;
+        b.sleep_time[i] = resting ? b.sleep_time[i] + dt : 0;
+        longest_rest = std::max(longest_rest, b.sleep_time[i]);
+    }
+    // An island sleeps only when all its bodies rested long enough: while no body has,
+    // there is no island to find.
+    if (longest_rest < sleep.time_to_sleep) return;
+
+    // Islands over the awake bodies (positions in world.awake).
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    std::vector<std::uint32_t>& parent = world.scratch_parent;
+    parent.resize(n);
+    std::iota(parent.begin(), parent.end(), 0u);
+    for (std::uint32_t c : awake_contacts(world)) {
+        const Contact& contact = world.contacts[c];
+        if (!touching(contact)) continue;
+        if (b.type[contact.body_a] != MotionType::Dynamic || b.type[contact.body_b] != MotionType::Dynamic) continue;
+        const std::int32_t ia = b.awake_index[contact.body_a], ib = b.awake_index[contact.body_b];
+        if (ia < 0 || ib < 0) continue;
+        unite(parent, static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+    }
+    for (std::uint32_t j : awake_joints(world)) {
+        const std::uint32_t ja = joints.joint[j].body_a, jb = joints.joint[j].body_b;
+        if (b.type[ja] != MotionType::Dynamic || b.type[jb] != MotionType::Dynamic) continue;
+        const std::int32_t ia = b.awake_index[ja], ib = b.awake_index[jb];
+        if (ia >= 0 && ib >= 0) unite(parent, static_cast<std::uint32_t>(ia), static_cast<std::uint32_t>(ib));
+    }
+    // An island sleeps when its least-rested body has rested long enough.
+    std::vector<Real>& min_rest = world.scratch_rest;
+    min_rest.assign(n, kHuge);
+    for (std::uint32_t k = 0; k < n; ++k) {
+        const std::uint32_t r = find(parent, k);
+        min_rest[r] = std::min(min_rest[r], b.sleep_time[world.awake[k]]);
+    }
+    std::vector<std::uint32_t>& sleepers = world.scratch_sleepers;
+    sleepers.clear();
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (min_rest[find(parent, k)] >= sleep.time_to_sleep) sleepers.push_back(k);
+    }
+    if (sleepers.empty()) return;
+
+    // Group sleepers by island root; each becomes a SleepingIsland.
+    std::vector<std::int32_t>& island_of_root = world.scratch_island_of_root;
+    island_of_root.assign(n, -1);
+    std::vector<std::uint32_t> slots;
+    for (std::uint32_t k : sleepers) slots.push_back(world.awake[k]);
+    for (std::size_t s = 0; s < sleepers.size(); ++s) {
+        const std::uint32_t root = find(parent, sleepers[s]);
+        if (island_of_root[root] < 0) {
+            std::int32_t id;
+            if (!world.free_islands.empty()) {
+                id = world.free_islands.back();
+                world.free_islands.pop_back();
+            } else {
+                id = static_cast<std::int32_t>(world.sleeping_islands.size());
+                world.sleeping_islands.emplace_back();
+            }
+            island_of_root[root] = id;
+        }
+        const std::uint32_t slot = slots[s];
+        world.sleeping_islands[static_cast<std::size_t>(island_of_root[root])].bodies.push_back(slot);
+        b.island[slot] = island_of_root[root];
+    }
+    for (std::uint32_t slot : slots) {
+        set_awake(world, slot, false);
+        b.v[slot] = Vec3::Zero();
+        b.w[slot] = Vec3::Zero();
+        // Blend nothing while asleep: both history entries hold the resting pose.
+        for (int k = 0; k < 2; ++k) {
+            b.history_position[k][slot] = b.origin(slot);
+            b.history_orientation[k][slot] = b.q[slot];
+        }
+        world.changed_now.push_back(slot);
+    }
+    // Contacts with no awake partner left sleep with their island.
+    for (std::uint32_t c : awake_contacts(world)) {
+        Contact& contact = world.contacts[c];
+        if (b.awake_index[contact.body_a] >= 0 || b.awake_index[contact.body_b] >= 0) continue;
+        contact.sleeping = true;
+        // Recorded in both islands when they differ, so waking either revives it.
+        const std::int32_t ia = b.island[contact.body_a], ib = b.island[contact.body_b];
+        if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].contacts.push_back(world.contact_keys[c]);
+        if (ib >= 0 && ib != ia) {
+            world.sleeping_islands[static_cast<std::size_t>(ib)].contacts.push_back(world.contact_keys[c]);
+        }
+    }
+    world.awake_contacts_dirty = true;
+    // Joints likewise, so a sleeping island's joints cost nothing until it wakes.
+    for (std::uint32_t j : awake_joints(world)) {
+        Joint& joint = joints.joint[j];
+        if (b.awake_index[joint.body_a] >= 0 || b.awake_index[joint.body_b] >= 0) continue;
+        joint.sleeping = true;
+        joints.awake_dirty = true;  // read on the next call: this loop's list stays as it is
+        const std::int32_t ia = b.island[joint.body_a], ib = b.island[joint.body_b];
+        if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].joints.push_back(joints.handle(j));
+        if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].joints.push_back(joints.handle(j));
+    }
+}
+
+}  // namespace spindle

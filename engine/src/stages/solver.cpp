@@ -1,0 +1,349 @@
+// The constraint solver (soft step, as Box2D v3 and Box3D): per step, list the
+// touching manifolds and the joints, colour them, and prepare them (contact_solver.cpp,
+// joint_solver.cpp); per substep, integrate velocities, warm start, solve with soft
+// position bias, integrate positions, relax without bias; then restitution and storing
+// impulses for the next step's warm start. The substeps run as one list of phases
+// (JobSystem::run_phases), a phase per pass over the bodies or over one colour: no two
+// constraints of a colour share a dynamic body, so however a phase is split between
+// workers the result is bitwise the same.
+#include "solver/constraints.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <type_traits>
+
+#include <spindle/platform/assert.hpp>
+
+#include "stages/stages.hpp"
+
+namespace spindle {
+
+Softness make_softness(Real hertz, Real damping_ratio, Real h) {
+    if (hertz == 0) return {0, 1, 0};
+    const Real omega = 2 * kPi * hertz;
+    const Real a1 = 2 * damping_ratio + h * omega;
+    const Real a2 = h * omega * a1;
+    const Real a3 = 1 / (1 + a2);
+    return {omega / a1, a2 * a3, a3};
+}
+
+namespace {
+
+constexpr std::uint32_t kBodyGrain = 128;
+// Joints or wide contacts (4 manifolds each) per chunk: small, so the end of a colour
+// splits evenly between the workers.
+constexpr std::uint32_t kConstraintGrain = 2;
+// Wide contacts per block when preparing them and storing their impulses.
+constexpr std::uint32_t kWideGrain = 8;
+
+void prepare_bodies(World& world, SolverScratch& scratch) {
+    const Bodies& b = world.bodies;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    scratch.bodies.resize(n + 1);
+    world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t i = world.awake[k];
+            SolverBody& sb = scratch.bodies[k];
+            sb.v = b.v[i];
+            sb.w = b.w[i];
+            sb.push_v = Vec3::Zero();
+            sb.push_w = Vec3::Zero();
+            sb.dp = Vec3::Zero();
+            sb.dq = Quat::Identity();
+            sb.dynamic = b.type[i] == MotionType::Dynamic;
+            sb.inv_mass = b.inv_mass[i];
+            sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+        }
+    });
+    scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
+}
+
+// Contact points of the step's manifolds, for the work counters.
+struct PointCounts {
+    std::uint64_t points = 0, friction = 0, restitution = 0;
+};
+
+// One ref per touching manifold of an awake contact, in contact order; counts their
+// points. Reads only the packed keys and summaries, never a contact.
+PointCounts list_manifolds(World& world, SolverScratch& scratch) {
+    const Bodies& b = world.bodies;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    auto solver_index = [&](std::uint32_t slot) {
+        const std::int32_t k = b.awake_index[slot];
+        return k >= 0 ? static_cast<std::uint32_t>(k) : n;
+    };
+    PointCounts counts;
+    scratch.manifolds.clear();
+    for (std::uint32_t c : awake_contacts(world)) {
+        const std::uint32_t summary = world.contact_summaries[c];
+        SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]), "solver: a contact's packed summary is stale");
+        const std::uint64_t key = world.contact_keys[c];
+        const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
+        const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
+        const bool friction = (summary & kSummaryFriction) != 0;
+        const bool restitution = (summary & kSummaryRestitution) != 0;
+        std::uint32_t point_counts = summary & 0xffffu;  // 4 bits per manifold
+        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= 4) {
+            const std::uint32_t points = point_counts & 0xfu;
+            if (points == 0) continue;
+            scratch.manifolds.push_back({c, m, a, bb});
+            counts.points += points;
+            if (friction) counts.friction += points;
+            if (restitution) counts.restitution += points;
+        }
+    }
+    return counts;
+}
+
+// Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
+// neither dynamic body of the constraint; -1 when none is free. Static, kinematic and
+// sleeping partners are shared freely: constraints never write them. Each body keeps a
+// mask of the colours it is in, so the first free colour is one bit scan.
+int assign_color(SolverScratch& scratch, std::uint32_t a, std::uint32_t b) {
+    static_assert(kColorCount <= 32, "one bit per colour in a 32-bit mask");
+    constexpr std::uint32_t kAllColors = kColorCount == 32 ? ~0u : (1u << kColorCount) - 1;
+    const bool dyn_a = scratch.bodies[a].dynamic;
+    const bool dyn_b = scratch.bodies[b].dynamic;
+    std::uint32_t* used = scratch.body_colors.data();
+    const std::uint32_t free = kAllColors & ~((dyn_a ? used[a] : 0u) | (dyn_b ? used[b] : 0u));
+    if (free == 0) return -1;
+    const int c = std::countr_zero(free);
+    if (dyn_a) used[a] |= 1u << c;
+    if (dyn_b) used[b] |= 1u << c;
+    return c;
+}
+
+// Joints first, then contacts, in list order (deterministic), sharing the colours'
+// body sets: a colour's joints and contacts together touch each dynamic body once.
+void color(SolverScratch& scratch) {
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.colors[c].clear();
+        scratch.joint_colors[c].clear();
+    }
+    scratch.body_colors.assign(scratch.bodies.size(), 0);
+    scratch.overflow.clear();
+    scratch.joint_overflow.clear();
+    for (std::uint32_t k = 0; k < scratch.joints.size(); ++k) {
+        const int c = assign_color(scratch, scratch.joints[k].a, scratch.joints[k].b);
+        (c >= 0 ? scratch.joint_colors[c] : scratch.joint_overflow).push_back(k);
+    }
+    for (std::uint32_t k = 0; k < scratch.manifolds.size(); ++k) {
+        const int c = assign_color(scratch, scratch.manifolds[k].a, scratch.manifolds[k].b);
+        (c >= 0 ? scratch.colors[c] : scratch.overflow).push_back(k);
+    }
+}
+
+// Whether the colours and packing of the last colouring hold for this step's
+// constraints: the same manifolds of the same bodies, no body made or destroyed (a
+// reused slot could change from kinematic to dynamic, which the colours depend on),
+// the same awake count (the immovable body is the last) and no joints then or now. A
+// resting pile keeps its manifold list from step to step, and comparing it is far
+// cheaper than colouring.
+bool same_constraints(const World& world, SolverScratch& scratch) {
+    static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
+    const bool same = scratch.joints.empty() && !scratch.colored_joints &&
+                      scratch.colored_body_set == world.body_set_version &&
+                      scratch.colored_bodies == scratch.bodies.size() &&
+                      scratch.colored_manifolds.size() == scratch.manifolds.size() &&
+                      (scratch.manifolds.empty() ||  // memcmp may not see the null data of an empty vector
+                       std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
+                                   scratch.manifolds.size() * sizeof(ManifoldRef)) == 0);
+    if (!same) {
+        scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
+        scratch.colored_bodies = scratch.bodies.size();
+        scratch.colored_body_set = world.body_set_version;
+        scratch.colored_joints = !scratch.joints.empty();
+    }
+    return same;
+}
+
+// Runs joint_fn and contact_fn over constraints [lo, hi) of colour `color`: its joints
+// (if kJoints), then its wide contacts. The overflow (color == kColorCount) is one
+// block, run serially, joints first.
+template <bool kJoints, typename JointFn, typename ContactFn>
+void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, JointFn&& joint_fn,
+                 ContactFn&& contact_fn) {
+    if (color == kColorCount) {
+        if (kJoints) {
+            for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
+        }
+        for (std::size_t k = scratch.wide_begin[kColorCount]; k < scratch.wide.size(); ++k) contact_fn(scratch.wide[k]);
+        return;
+    }
+    const std::vector<std::uint32_t>& joints = scratch.joint_colors[color];
+    const auto joint_count = kJoints ? static_cast<std::uint32_t>(joints.size()) : 0u;
+    WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        if (k < joint_count) {
+            joint_fn(scratch.joints[joints[k]]);
+        } else {
+            contact_fn(contacts[k - joint_count]);
+        }
+    }
+}
+
+// Adds the phases of one pass over the constraints: one per colour that has any (its
+// joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
+void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints) {
+    for (int c = 0; c < kColorCount; ++c) {
+        const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) : 0u;
+        const std::uint32_t count = joints + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
+        if (count == 0) continue;
+        scratch.phases.push_back(Phase{name, count, kConstraintGrain});
+        scratch.plan.push_back(SolverPhase{pass, c});
+    }
+    const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||
+                          scratch.wide.size() > scratch.wide_begin[kColorCount];
+    if (overflow) {
+        scratch.phases.push_back(Phase{name, 1, 1});
+        scratch.plan.push_back(SolverPhase{pass, kColorCount});
+    }
+}
+
+void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
+    scratch.phases.push_back(Phase{name, bodies, kBodyGrain});
+    scratch.plan.push_back(SolverPhase{pass, 0});
+}
+
+void plan_wide_pass(SolverScratch& scratch, Pass pass, const char* name) {
+    scratch.phases.push_back(Phase{name, static_cast<std::uint32_t>(scratch.wide.size()), kWideGrain});
+    scratch.plan.push_back(SolverPhase{pass, 0});
+}
+
+// The step's solver loop as a list of phases, each over the bodies, the wide contacts
+// or one colour.
+void plan_step(World& world, SolverScratch& scratch, bool restitution) {
+    const SolverSettings& settings = world.settings.solver;
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    scratch.phases.clear();
+    scratch.plan.clear();
+    plan_wide_pass(scratch, Pass::PrepareContacts, "PrepareContacts");
+    for (int sub = 0; sub < settings.substeps; ++sub) {
+        plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
+        plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
+        for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
+        plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
+        for (int it = 0; it < settings.relax_iterations; ++it) plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
+    }
+    if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
+    plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
+    plan_body_pass(scratch, Pass::FinalizeBodies, "FinalizeBodies", n);
+}
+
+// The step's motion into the bodies, awake bodies [lo, hi).
+void finalize_bodies(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    Bodies& b = world.bodies;
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const std::uint32_t i = world.awake[k];
+        const SolverBody& sb = scratch.bodies[k];
+        b.x[i] += sb.dp;
+        b.q[i] = (sb.dq * b.q[i]).normalized();
+        b.v[i] = sb.v;
+        b.w[i] = sb.w;
+        b.force[i] = Vec3::Zero();  // consumed by this step
+        b.torque[i] = Vec3::Zero();
+    }
+}
+
+}  // namespace
+
+void solve(World& world, Real dt) {
+    SolverScratch& scratch = *world.solver;
+    const SolverSettings& settings = world.settings.solver;
+    const int substeps = settings.substeps;
+    const Real h = dt / substeps;
+
+    prepare_bodies(world, scratch);
+    const PointCounts points = list_manifolds(world, scratch);
+    prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
+    if (!same_constraints(world, scratch)) {
+        color(scratch);
+        pack_contacts(scratch);
+        world.counters.constraint_colorings += 1;
+    }
+    SolverBody* bodies = scratch.bodies.data();
+
+    ContactSolveParams solve_params;
+    // The contact spring may not be stiffer than a quarter of the substep rate.
+    const Real stiffest = Real(0.25) / h;
+    const Real hertz = settings.contact_hertz > 0 ? std::min(settings.contact_hertz, stiffest) : stiffest;
+    solve_params.soft = make_softness(hertz, settings.damping_ratio, h);
+    solve_params.inv_h = 1 / h;
+    solve_params.push_out = settings.push_out_speed;
+    solve_params.slop = settings.linear_slop;
+    solve_params.recovery_depth = settings.recovery_depth;
+    ContactSolveParams relax_params = solve_params;
+    relax_params.use_bias = false;
+    const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
+    const JointSolveParams joint_relax{joint_solve.soft, joint_solve.inv_h, false};
+
+    // Preparing the contacts, every substep's passes, storing impulses and finalizing the
+    // bodies in one run_phases: the workers meet at a barrier after each colour instead
+    // of forking and joining about a hundred times per step. Effects are counted per
+    // worker and summed (the sum does not depend on who counted what).
+    plan_step(world, scratch, points.restitution > 0);  // no pass at all over a scene without bouncy contacts
+    world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
+    const Real restitution_threshold = settings.restitution_threshold;
+    auto push_rows = [&](const WideContact& wc) {
+        return scratch.push_rows.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
+    };
+    world.jobs->run_phases("Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi,
+                                                         unsigned worker) {
+        const SolverPhase phase = scratch.plan[p];
+        switch (phase.pass) {
+        case Pass::PrepareContacts:
+            prepare_contacts(world, scratch, lo, hi);
+            break;
+        case Pass::StoreImpulses:
+            store_contact_impulses(world, scratch, lo, hi);
+            break;
+        case Pass::FinalizeBodies:
+            finalize_bodies(world, scratch, lo, hi);
+            break;
+        case Pass::IntegrateVelocities:
+            integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
+            break;
+        case Pass::IntegratePositions:
+            integrate_positions(world, bodies, h, lo, hi);
+            break;
+        case Pass::WarmStart:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+                [&](WideContact& wc) { warm_start_contact(wc, push_rows(wc), bodies); });
+            break;
+        case Pass::Solve:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
+                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params); });
+            break;
+        case Pass::Relax:
+            for_colored<true>(
+                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
+                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params); });
+            break;
+        case Pass::Restitution:
+            for_colored<false>(
+                scratch, phase.color, lo, hi, [](JointConstraint&) {},
+                [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h); });
+            break;
+        }
+    });
+    for (const EffectCounts& c : world.scratch_counts) {
+        world.counters.gravity_applied += c.gravity;
+        world.counters.damping_applied += c.damping;
+        world.counters.gyroscopic_applied += c.gyro;
+    }
+    if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
+
+    // Work counters, derived from the constraint set (no per-point counting in the hot loop).
+    const auto passes = static_cast<std::uint64_t>(substeps * (settings.iterations + settings.relax_iterations));
+    world.counters.contact_points_solved += points.points * passes;
+    world.counters.friction_applied += points.friction * passes;
+    world.counters.restitution_applied += points.restitution;
+    world.counters.joints_solved += static_cast<std::uint64_t>(scratch.joints.size()) * passes;
+    world.counters.bodies_integrated += world.awake.size();
+}
+
+}  // namespace spindle

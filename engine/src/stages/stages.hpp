@@ -1,0 +1,46 @@
+// The stages of Space::update (design.md section 2), one file each in this folder, and
+// the bookkeeping they share. Every stage runs on the update thread and splits its work
+// through world.jobs; update.cpp calls them in order.
+#pragma once
+
+#include "world.hpp"
+
+namespace spindle {
+
+// buffering.cpp
+void apply_writes(World& world);       // buffered writes since the last update -> live state
+void flip_read_buffers(World& world);  // publish the newest states under the motion-state lock
+
+// broadphase.cpp: bounds, new pairs -> contacts, lost pairs dropped.
+void update_broadphase(World& world, Real dt);
+// narrowphase.cpp: manifolds for every awake contact, impulses carried by feature id.
+void update_narrowphase(World& world);
+// islands.cpp: wake islands touched by awake bodies; put resting islands to sleep.
+void update_islands(World& world, Real dt);
+// solver.cpp: substeps of integrate velocities, warm start, solve, integrate positions, relax.
+void solve(World& world, Real dt);
+// continuous.cpp: fast bodies swept against static geometry (poses recorded before the solver).
+void record_fast_starts(World& world);
+void sweep_fast_bodies(World& world);
+// integrator.cpp (called by the solver once per substep, in blocks of the awake
+// bodies [lo, hi); effects used are counted into `counts`).
+struct SolverBody;
+void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
+                          EffectCounts& counts);
+void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi);
+// record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
+void record(World& world);
+
+// One step of dt: collide, islands, solve, record (update.cpp).
+void step(World& world, Real dt);
+// The positions of the awake contacts, ascending (contact_list.cpp).
+const std::vector<std::uint32_t>& awake_contacts(World& world);
+// Body bookkeeping shared by stages (api/space.cpp).
+void set_awake(World& world, std::uint32_t slot, bool awake);
+// Wakes a body and, if it sleeps, its whole island (islands.cpp).
+void wake_body(World& world, std::uint32_t slot);
+// Writes a body's current state into both published buffers at once (create/destroy
+// between updates), so buffered reads see it before the next flip (buffering.cpp).
+void publish_now(World& world, std::uint32_t slot);
+
+}  // namespace spindle

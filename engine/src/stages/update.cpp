@@ -1,0 +1,101 @@
+// Space::update, the stage list of design.md section 2: ApplyWrites, k steps (Broadphase,
+// Narrowphase, Islands, Solver, Continuous, Record), FlipReadBuffers. Each stage runs
+// under its trace name and its time is added to the update's stats.
+#include <spindle/engine/space.hpp>
+#include <spindle/platform/clock.hpp>
+#include <spindle/platform/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "api/describe.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+
+const char* to_string(Stage stage) noexcept {
+    switch (stage) {
+        case Stage::ApplyWrites: return "ApplyWrites";
+        case Stage::Broadphase: return "Broadphase";
+        case Stage::Narrowphase: return "Narrowphase";
+        case Stage::Islands: return "Islands";
+        case Stage::Solver: return "Solver";
+        case Stage::Continuous: return "Continuous";
+        case Stage::Record: return "Record";
+        case Stage::FlipReadBuffers: return "FlipReadBuffers";
+        case Stage::Count: break;
+    }
+    return "?";
+}
+
+namespace {
+
+// Runs one stage under its trace name and adds its time to the update's stats.
+template <typename F>
+void run_stage(World& world, Stage stage, F&& body) {
+    StageScope scope(*world.jobs, to_string(stage));
+    const std::int64_t start = now_nanoseconds();
+    body();
+    world.stats.stage_seconds[static_cast<int>(stage)] += static_cast<double>(now_nanoseconds() - start) * 1e-9;
+}
+
+}  // namespace
+
+void Space::update(Real dt) {
+    World& w = *m_world;
+    if (!std::isfinite(dt) || dt < 0) {
+        throw Error("update: dt must be a finite, non-negative number of seconds, got " + number(dt));
+    }
+    const TimeStepSettings& ts = w.settings.time_step;
+    w.stats = UpdateStats{};
+    run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
+
+    int steps = 1;
+    if (ts.use_internal_time_stepping) {
+        w.accumulator += dt;
+        // The small tolerance makes 1/30 s hold exactly two 1/60 s steps.
+        steps = static_cast<int>(std::floor(w.accumulator / ts.duration + 1e-9));
+        steps = std::clamp(steps, ts.min_steps_per_frame, ts.max_steps_per_frame);
+        w.accumulator = std::max<Real>(0, w.accumulator - steps * ts.duration);
+        // Carry at most the cap's worth, so a slow machine cannot spiral.
+        const Real carry_limit = ts.max_steps_per_frame * ts.duration;
+        if (w.accumulator > carry_limit) {
+            w.stats.dropped_seconds = w.accumulator - carry_limit;
+            w.accumulator = carry_limit;
+        }
+    }
+    for (int i = 0; i < steps; ++i) step(w, ts.duration);
+    w.stats.steps = steps;
+
+    run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
+}
+
+void Space::update() {
+    World& w = *m_world;
+    w.stats = UpdateStats{};
+    run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
+    step(w, w.settings.time_step.duration);
+    w.stats.steps = 1;
+    run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
+}
+
+void Space::flush() {
+    World& w = *m_world;
+    w.stats = UpdateStats{};
+    run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
+    run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
+}
+
+void step(World& w, Real dt) {
+    run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
+    run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
+    run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
+    run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });  // poses before the solver moves them
+    run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
+    if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
+    run_stage(w, Stage::Record, [&] { record(w); });
+    w.steps += 1;
+    w.counters.steps += 1;
+}
+
+}  // namespace spindle

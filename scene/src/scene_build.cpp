@@ -1,0 +1,77 @@
+// Building a parsed scene into a Space: settings, shapes made once and shared, bodies
+// in scene order; all or nothing.
+#include <spindle/scene/scene.hpp>
+#include <spindle/engine/space.hpp>
+#include <spindle/platform/error.hpp>
+
+namespace spindle {
+namespace {
+
+[[noreturn]] void fail_at(const SceneDesc& scene, const SceneBody& body, const char* what, const Error& error) {
+    throw Error(scene.source + ":" + std::to_string(body.line) + ":" + std::to_string(body.column) + ": " + what +
+                ": " + error.what());
+}
+
+}  // namespace
+
+std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
+    // Shapes first: a factory that rejects one (or does not exist yet) fails before
+    // anything in the space has changed. Each is made once and shared by its bodies.
+    std::vector<Shape> shapes;
+    shapes.reserve(scene.shapes.size());
+    for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
+        try {
+            shapes.push_back(scene.shapes[i].make());
+        } catch (const Error& e) {
+            for (const SceneBody& body : scene.bodies) {
+                if (body.shape == i) fail_at(scene, body, "shape", e);
+            }
+            throw Error(scene.source + ": shape: " + e.what());  // a [defaults] shape no body uses
+        }
+    }
+
+    const SpaceSettings before = space.settings();
+    TimeStepSettings time_step = scene.settings.time_step;
+    time_step.use_internal_time_stepping = space.settings().time_step.use_internal_time_stepping;
+    space.set_time_step(time_step);
+    space.set_solver(scene.settings.solver);
+    space.set_sleep(scene.settings.sleep);
+    space.set_gravity(scene.settings.gravity);
+
+    std::vector<BodyHandle> handles;
+    handles.reserve(scene.bodies.size());
+    for (const SceneBody& body : scene.bodies) {
+        BodyDesc desc = body.desc;
+        desc.shape = shapes[body.shape];
+        try {
+            handles.push_back(space.create_body(desc));
+        } catch (const Error& e) {
+            for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
+            space.set_time_step(before.time_step);
+            space.set_solver(before.solver);
+            space.set_sleep(before.sleep);
+            space.set_gravity(before.gravity);
+            fail_at(scene, body, "body", e);
+        }
+    }
+    for (const SceneJoint& joint : scene.joints) {
+        const BodyHandle a = handles[joint.body_a], b = handles[joint.body_b];
+        const JointDesc desc = joint.type == JointType::Hinge ? JointDesc::hinge_at(a, b, joint.anchor, joint.axis)
+                                                               : JointDesc::ball_socket_at(a, b, joint.anchor);
+        try {
+            space.create_joint(desc);
+        } catch (const Error& e) {
+            // Destroying the bodies destroys the joints made so far with them.
+            for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
+            space.set_time_step(before.time_step);
+            space.set_solver(before.solver);
+            space.set_sleep(before.sleep);
+            space.set_gravity(before.gravity);
+            throw Error(scene.source + ":" + std::to_string(joint.line) + ":" + std::to_string(joint.column) +
+                        ": joint: " + e.what());
+        }
+    }
+    return handles;
+}
+
+}  // namespace spindle

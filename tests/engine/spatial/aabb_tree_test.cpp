@@ -1,0 +1,341 @@
+// DynamicAabbTree: queries and ray casts against brute force, fat-box rules of
+// move_proxy, validity and height under churn, rebuild, steady-state memory.
+#include "spatial/aabb_tree.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+namespace spindle {
+namespace {
+
+#ifdef NDEBUG
+constexpr int kScale = 8;  // Release: bigger trees
+#else
+constexpr int kScale = 2;  // Debug/ASan: every operation also walks the whole tree
+#endif
+
+struct Rng {
+    std::mt19937_64 engine;
+    explicit Rng(std::uint64_t seed) : engine(seed) {}
+    Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(engine); }
+    int index(int n) { return std::uniform_int_distribution<int>(0, n - 1)(engine); }
+    Vec3 vec(Real lo, Real hi) { return {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)}; }
+    Aabb box(Real world, Real max_half) {
+        return Aabb::from_center_extents(vec(-world, world), vec(Real(0.05), max_half));
+    }
+};
+
+// Slack over the AVL bound (1.44 log2 n) for small trees and SAH rotations.
+int height_limit(std::int32_t n) { return static_cast<int>(2.5 * std::log2(std::max(n, 2))) + 3; }
+
+std::vector<std::int32_t> query_sorted(const DynamicAabbTree& tree, const Aabb& box) {
+    std::vector<std::int32_t> ids;
+    tree.query(box, [&](std::int32_t id) {
+        ids.push_back(id);
+        return true;
+    });
+    std::sort(ids.begin(), ids.end());
+    return ids;
+}
+
+std::vector<std::int32_t> brute_sorted(const DynamicAabbTree& tree, const std::vector<std::int32_t>& live, const Aabb& box) {
+    std::vector<std::int32_t> ids;
+    for (const std::int32_t id : live) {
+        if (tree.fat_aabb(id).overlaps(box)) ids.push_back(id);
+    }
+    std::sort(ids.begin(), ids.end());
+    return ids;
+}
+
+TEST(AabbTree, EmptyTree_QueriesNothingAndValidates) {
+    DynamicAabbTree tree;
+    tree.validate();
+    EXPECT_EQ(tree.height(), 0);
+    EXPECT_EQ(tree.proxy_count(), 0);
+    EXPECT_TRUE(query_sorted(tree, Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(1e9))).empty());
+    tree.rebuild();
+    tree.validate();
+}
+
+TEST(AabbTree, CreateProxy_FatBoxIsTightPlusMarginAndKeepsUser) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0.25});
+    const Aabb tight{Vec3(0, 1, 2), Vec3(1, 2, 3)};
+    const std::int32_t id = tree.create_proxy(tight, 0xfeedface12345678ull);
+    EXPECT_EQ(tree.user(id), 0xfeedface12345678ull);
+    EXPECT_TRUE(tree.fat_aabb(id).min.isApprox(Vec3(-0.25, 0.75, 1.75)));
+    EXPECT_TRUE(tree.fat_aabb(id).max.isApprox(Vec3(1.25, 2.25, 3.25)));
+    tree.destroy_proxy(id);
+    EXPECT_EQ(tree.proxy_count(), 0);
+    tree.validate();
+}
+
+TEST(AabbTree, Query_MatchesBruteForce) {
+    Rng rng(1);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    const int n = 500 * kScale;
+    for (int i = 0; i < n; ++i) live.push_back(tree.create_proxy(rng.box(50, 2), std::uint64_t(i)));
+    tree.validate();
+    for (int q = 0; q < 200; ++q) {
+        const Aabb box = rng.box(50, 8);
+        ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box)) << "query " << q;
+    }
+}
+
+TEST(AabbTree, Query_CallbackFalseStops) {
+    DynamicAabbTree tree;
+    for (int i = 0; i < 10; ++i) tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
+    int calls = 0;
+    tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), [&](std::int32_t) {
+        ++calls;
+        return false;
+    });
+    EXPECT_EQ(calls, 1);
+}
+
+TEST(AabbTree, MoveProxy_KeepsFatBoxWhileTightBoxInside) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0.1, .displacement_multiplier = 2});
+    const Aabb tight = Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(0.5));
+    const std::int32_t id = tree.create_proxy(tight, 7);
+    const Aabb fat = tree.fat_aabb(id);
+    const Vec3 small(0.05, -0.05, 0.02);
+    EXPECT_FALSE(tree.needs_move(id, {tight.min + small, tight.max + small}, small));
+    EXPECT_TRUE(tree.needs_move(id, {tight.min + 3 * small, tight.max + 3 * small}, 3 * small));
+    EXPECT_FALSE(tree.move_proxy(id, {tight.min + small, tight.max + small}, small));
+    EXPECT_TRUE(tree.fat_aabb(id).min == fat.min && tree.fat_aabb(id).max == fat.max);
+}
+
+TEST(AabbTree, MoveProxy_ReinsertsStretchedAlongDisplacementWhenTightBoxLeaves) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0.1, .displacement_multiplier = 2});
+    const Aabb tight = Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(0.5));
+    const std::int32_t id = tree.create_proxy(tight, 7);
+    tree.create_proxy(Aabb::from_center_extents(Vec3(5, 0, 0), Vec3::Constant(0.5)), 8);
+    const Vec3 d(0.3, -0.2, 0);
+    const Aabb moved{tight.min + d, tight.max + d};
+    EXPECT_TRUE(tree.move_proxy(id, moved, d));
+    const Aabb& fat = tree.fat_aabb(id);
+    // Margin on every side, plus 2 x displacement on the side it moves towards.
+    EXPECT_TRUE(fat.min.isApprox(Vec3(-0.2 - 0.1, -0.7 - 0.1 - 0.4, -0.5 - 0.1)));
+    EXPECT_TRUE(fat.max.isApprox(Vec3(0.8 + 0.1 + 0.6, 0.3 + 0.1, 0.5 + 0.1)));
+    EXPECT_TRUE(fat.contains(moved));
+    EXPECT_EQ(tree.user(id), 7u);
+    tree.validate();
+}
+
+TEST(AabbTree, MoveProxy_SteadyMotionReinsertsOnlyWhenLeavingAndShrinksAfterStop) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0.1, .displacement_multiplier = 2});
+    Aabb tight = Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(0.5));
+    const std::int32_t id = tree.create_proxy(tight, 1);
+    const Vec3 d(1.0, 0, 0);  // fast: ten margins per step
+    int reinserts = 0;
+    for (int step = 0; step < 20; ++step) {
+        tight = {tight.min + d, tight.max + d};
+        reinserts += tree.move_proxy(id, tight, d) ? 1 : 0;
+        ASSERT_TRUE(tree.fat_aabb(id).contains(tight));
+    }
+    // Stretched two displacements ahead, the box lasts two steps.
+    EXPECT_LE(reinserts, 11);
+    // The body stops: the long box is shrunk back to tight + margin (needs_move says so
+    // first, and asking twice changes nothing).
+    EXPECT_TRUE(tree.needs_move(id, tight, Vec3::Zero()));
+    EXPECT_TRUE(tree.needs_move(id, tight, Vec3::Zero()));
+    EXPECT_TRUE(tree.move_proxy(id, tight, Vec3::Zero()));
+    EXPECT_FALSE(tree.needs_move(id, tight, Vec3::Zero()));
+    EXPECT_TRUE(tree.fat_aabb(id).max.isApprox(tight.max + Vec3::Constant(0.1)));
+    EXPECT_FALSE(tree.move_proxy(id, tight, Vec3::Zero()));
+}
+
+TEST(AabbTree, Churn_StaysValidShallowAndMatchesBruteForce) {
+    Rng rng(2);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    std::vector<Vec3> centers;
+    const int target = 400 * kScale;
+    const int operations = 6000 * kScale;
+    for (int op = 0; op < operations; ++op) {
+        const int kind = rng.index(10);
+        if (live.size() < 4 || (kind < 3 && static_cast<int>(live.size()) < target)) {
+            live.push_back(tree.create_proxy(rng.box(40, 1.5), std::uint64_t(op)));
+        } else if (kind < 5) {
+            const int i = rng.index(static_cast<int>(live.size()));
+            tree.destroy_proxy(live[static_cast<std::size_t>(i)]);
+            live[static_cast<std::size_t>(i)] = live.back();
+            live.pop_back();
+        } else {
+            const std::int32_t id = live[static_cast<std::size_t>(rng.index(static_cast<int>(live.size())))];
+            const Vec3 d = rng.vec(-0.5, 0.5);
+            const Aabb fat = tree.fat_aabb(id);
+            const Aabb tight{fat.min + Vec3::Constant(0.1) + d, fat.max - Vec3::Constant(0.1) + d};
+            if (tight.valid()) tree.move_proxy(id, tight, d);
+        }
+        if (op % 500 == 0) {
+            tree.validate();
+            ASSERT_LE(tree.height(), height_limit(tree.proxy_count())) << "after " << op << " operations";
+            const Aabb box = rng.box(40, 6);
+            ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box));
+        }
+    }
+    tree.validate();
+    EXPECT_LE(tree.height(), height_limit(tree.proxy_count()));
+}
+
+TEST(AabbTree, SortedInsertion_StaysShallow) {
+    // Boxes on a line, inserted in order: the worst case for a tree without rotations.
+    DynamicAabbTree tree;
+    const int n = 1024 * kScale;
+    std::vector<std::int32_t> ids;
+    for (int i = 0; i < n; ++i) {
+        ids.push_back(tree.create_proxy(Aabb::from_center_extents(Vec3(i, 0, 0), Vec3::Constant(0.4)), std::uint64_t(i)));
+    }
+    tree.validate();
+    EXPECT_LE(tree.height(), height_limit(n));
+    // And removed in order.
+    for (int i = 0; i < n / 2; ++i) tree.destroy_proxy(ids[static_cast<std::size_t>(i)]);
+    tree.validate();
+    EXPECT_LE(tree.height(), height_limit(tree.proxy_count()));
+}
+
+TEST(AabbTree, SteadyChurn_DoesNotGrowNodePool) {
+    Rng rng(3);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    const int n = 300 * kScale;
+    for (int i = 0; i < n; ++i) live.push_back(tree.create_proxy(rng.box(30, 1), std::uint64_t(i)));
+    const std::size_t capacity = tree.node_capacity();
+    for (int op = 0; op < 2000 * kScale; ++op) {
+        const auto i = static_cast<std::size_t>(rng.index(n));
+        if (op % 2 == 0) {
+            tree.destroy_proxy(live[i]);
+            live[i] = tree.create_proxy(rng.box(30, 1), std::uint64_t(op));
+        } else {
+            const Vec3 d = rng.vec(-1, 1);
+            const Aabb tight = Aabb::from_center_extents(tree.fat_aabb(live[i]).center() + d, Vec3::Constant(0.5));
+            tree.move_proxy(live[i], tight, d);
+        }
+    }
+    EXPECT_EQ(tree.node_capacity(), capacity);
+    tree.validate();
+}
+
+TEST(AabbTree, Rebuild_KeepsProxiesAndQueriesAndLowersCost) {
+    Rng rng(4);
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    std::vector<std::int32_t> live;
+    const int n = 800 * kScale;
+    for (int i = 0; i < n; ++i) live.push_back(tree.create_proxy(rng.box(60, 3), std::uint64_t(1000 + i)));
+    // Holes in the id range, so rebuild has free nodes between leaves.
+    for (int i = 0; i < n / 4; ++i) {
+        tree.destroy_proxy(live.back());
+        live.pop_back();
+    }
+    std::vector<Aabb> boxes;
+    std::vector<std::uint64_t> users;
+    for (const std::int32_t id : live) {
+        boxes.push_back(tree.fat_aabb(id));
+        users.push_back(tree.user(id));
+    }
+    const Real incremental_cost = tree.area_cost();
+    const std::size_t capacity = tree.node_capacity();
+
+    tree.rebuild();
+    tree.validate();
+    EXPECT_EQ(tree.proxy_count(), static_cast<std::int32_t>(live.size()));
+    EXPECT_LE(tree.node_capacity(), capacity);
+    for (std::size_t i = 0; i < live.size(); ++i) {
+        ASSERT_TRUE(tree.is_proxy(live[i]));
+        EXPECT_EQ(tree.user(live[i]), users[i]);
+        EXPECT_TRUE(tree.fat_aabb(live[i]).min == boxes[i].min && tree.fat_aabb(live[i]).max == boxes[i].max);
+    }
+    EXPECT_LE(tree.area_cost(), incremental_cost * 1.1);
+    EXPECT_LE(tree.height(), height_limit(tree.proxy_count()));
+    for (int q = 0; q < 100; ++q) {
+        const Aabb box = rng.box(60, 10);
+        ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box));
+    }
+    // Incremental use goes on after a rebuild.
+    for (int i = 0; i < 50; ++i) live.push_back(tree.create_proxy(rng.box(60, 3), std::uint64_t(i)));
+    tree.destroy_proxy(live.front());
+    tree.validate();
+}
+
+TEST(AabbTree, Rebuild_IdenticalBoxesGiveBalancedTree) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    const int n = 1000;
+    for (int i = 0; i < n; ++i) tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
+    tree.rebuild();
+    tree.validate();
+    EXPECT_LE(tree.height(), static_cast<int>(std::ceil(std::log2(n))));
+}
+
+bool segment_hits(const Aabb& b, const Vec3& origin, const Vec3& translation, Real max_fraction) {
+    Real lo = 0;
+    Real hi = max_fraction;
+    for (int k = 0; k < 3; ++k) {
+        if (translation[k] == 0) {
+            if (origin[k] < b.min[k] || origin[k] > b.max[k]) return false;
+            continue;
+        }
+        Real t1 = (b.min[k] - origin[k]) / translation[k];
+        Real t2 = (b.max[k] - origin[k]) / translation[k];
+        if (t1 > t2) std::swap(t1, t2);
+        lo = std::max(lo, t1);
+        hi = std::min(hi, t2);
+    }
+    return lo <= hi;
+}
+
+TEST(AabbTree, RayCast_MatchesBruteForceAndStops) {
+    Rng rng(5);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    for (int i = 0; i < 300 * kScale; ++i) live.push_back(tree.create_proxy(rng.box(30, 2), std::uint64_t(i)));
+    for (int r = 0; r < 100; ++r) {
+        const Vec3 origin = rng.vec(-40, 40);
+        Vec3 translation = rng.vec(-60, 60);
+        if (r % 10 == 0) translation.y() = 0;  // axis-parallel components
+        std::vector<std::int32_t> hits;
+        tree.ray_cast(origin, translation, 1, [&](std::int32_t id, Real max_fraction) {
+            hits.push_back(id);
+            return max_fraction;
+        });
+        std::sort(hits.begin(), hits.end());
+        std::vector<std::int32_t> expected;
+        for (const std::int32_t id : live) {
+            if (segment_hits(tree.fat_aabb(id), origin, translation, 1)) expected.push_back(id);
+        }
+        ASSERT_EQ(hits, expected) << "ray " << r;
+        if (!expected.empty()) {
+            int calls = 0;
+            tree.ray_cast(origin, translation, 1, [&](std::int32_t, Real) {
+                ++calls;
+                return Real(0);
+            });
+            EXPECT_EQ(calls, 1);
+        }
+    }
+}
+
+#ifndef NDEBUG
+[[noreturn]] void throwing_handler(const char*, const char* message, const char*, int) { throw std::logic_error(message); }
+
+TEST(AabbTree, StaleProxyId_Asserts) {
+    const AssertHandler previous = set_assert_handler(&throwing_handler);
+    DynamicAabbTree tree;
+    const std::int32_t a = tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), 1);
+    tree.create_proxy(Aabb::from_center_extents(Vec3::Ones(), Vec3::Ones()), 2);
+    tree.destroy_proxy(a);
+    EXPECT_THROW(tree.destroy_proxy(a), std::logic_error);
+    EXPECT_THROW((void)tree.fat_aabb(12345), std::logic_error);
+    EXPECT_THROW(tree.create_proxy(Aabb{}, 3), std::logic_error);  // empty box: min > max
+    set_assert_handler(previous);
+    tree.validate();
+}
+#endif
+
+}  // namespace
+}  // namespace spindle

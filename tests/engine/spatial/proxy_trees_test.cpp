@@ -1,0 +1,364 @@
+// ProxyTrees: update_pairs against an O(n^2) brute force over random moving scenes,
+// the same pairs from any JobSystem, and the reporting rules (once, never static-static).
+#include "spatial/proxy_trees.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "test_job_systems.hpp"
+
+namespace spindle {
+namespace {
+
+using UserPair = std::pair<std::uint64_t, std::uint64_t>;
+
+Aabb cube(const Vec3& c, Real half) { return Aabb::from_center_extents(c, Vec3::Constant(half)); }
+
+std::vector<UserPair> user_pairs(const std::vector<Pair>& pairs) {
+    std::vector<UserPair> out;
+    for (const Pair& p : pairs) out.emplace_back(p.user_a, p.user_b);
+    return out;
+}
+
+bool is_canonical_and_unique(const std::vector<Pair>& pairs) {
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+        if (pairs[i].user_a > pairs[i].user_b) return false;
+        if (i > 0 && !(UserPair(pairs[i - 1].user_a, pairs[i - 1].user_b) < UserPair(pairs[i].user_a, pairs[i].user_b))) {
+            return false;  // users are unique per proxy in these tests, so pairs must strictly increase
+        }
+    }
+    return true;
+}
+
+TEST(ProxyTrees, NewProxies_ReportEachOverlapOnceAndNeverStaticWithStatic) {
+    ProxyTrees bp;
+    SingleThreadedJobSystem jobs;
+    bp.create_proxy(cube(Vec3(0, 0, 0), 1), 10, true);
+    bp.create_proxy(cube(Vec3(1, 0, 0), 1), 11, true);  // overlaps static 10: never reported
+    bp.create_proxy(cube(Vec3(0, 1.5, 0), 1), 3, false);  // overlaps 10, 11 and moving 4
+    bp.create_proxy(cube(Vec3(0, 3, 0), 1), 4, false);
+    bp.create_proxy(cube(Vec3(50, 0, 0), 1), 5, false);  // alone
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{3, 4}, {3, 10}, {3, 11}}));
+    for (const Pair& p : pairs) {
+        EXPECT_EQ(bp.user(p.proxy_a), p.user_a);
+        EXPECT_EQ(bp.user(p.proxy_b), p.user_b);
+    }
+    EXPECT_EQ(bp.enlarged_count(), 0u);
+    bp.update_pairs(jobs, pairs);
+    EXPECT_TRUE(pairs.empty());  // nothing moved
+}
+
+TEST(ProxyTrees, MoveInsideFatBox_ReportsNothing_MoveOutside_ReportsAgain) {
+    ProxyTrees bp(BroadphaseSettings{.margin = 0.2});
+    SingleThreadedJobSystem jobs;
+    const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
+    bp.create_proxy(cube(Vec3(2.3, 0, 0), 1), 2, false);
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{1, 2}}));  // fat boxes overlap: 1.2 + 1.2 > 2.3
+
+    EXPECT_FALSE(bp.move_proxy(a, cube(Vec3(0.1, 0, 0), 1), Vec3(0.1, 0, 0)));
+    bp.update_pairs(jobs, pairs);
+    EXPECT_TRUE(pairs.empty());
+
+    // Grows: found again (the engine skips pairs it already has).
+    EXPECT_TRUE(bp.move_proxy(a, cube(Vec3(0.4, 0, 0), 1), Vec3(0.3, 0, 0)));
+    EXPECT_TRUE(bp.is_enlarged(a));
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{1, 2}}));
+}
+
+TEST(ProxyTrees, TwoEnlargedProxies_PairReportedOnce) {
+    ProxyTrees bp;
+    SingleThreadedJobSystem jobs;
+    const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
+    const ProxyId b = bp.create_proxy(cube(Vec3(10, 0, 0), 1), 2, false);
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_TRUE(pairs.empty());
+    EXPECT_TRUE(bp.move_proxy(a, cube(Vec3(4, 0, 0), 1), Vec3(4, 0, 0)));
+    EXPECT_TRUE(bp.move_proxy(b, cube(Vec3(5, 0, 0), 1), Vec3(-5, 0, 0)));
+    bp.update_pairs(jobs, pairs);
+    ASSERT_EQ(pairs.size(), 1u);
+    EXPECT_EQ(pairs[0].proxy_a, a);
+    EXPECT_EQ(pairs[0].proxy_b, b);
+}
+
+TEST(ProxyTrees, MovedStaticProxy_FindsMovingButNotStatic) {
+    ProxyTrees bp;
+    SingleThreadedJobSystem jobs;
+    const ProxyId s = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, true);
+    bp.create_proxy(cube(Vec3(10, 0, 0), 1), 2, true);
+    bp.create_proxy(cube(Vec3(10, 2, 0), 1), 3, false);
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{2, 3}}));
+    EXPECT_TRUE(bp.move_proxy(s, cube(Vec3(10, 1, 0), 1), Vec3::Zero()));  // teleported onto both
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{1, 3}}));
+}
+
+TEST(ProxyTrees, DestroyedEnlargedProxy_IsNotReported) {
+    ProxyTrees bp;
+    SingleThreadedJobSystem jobs;
+    const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
+    const ProxyId b = bp.create_proxy(cube(Vec3(1, 0, 0), 1), 2, false);
+    bp.create_proxy(cube(Vec3(0, 1, 0), 1), 3, false);
+    bp.destroy_proxy(a);
+    bp.validate();
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{2, 3}}));
+    bp.destroy_proxy(b);
+    bp.validate();
+}
+
+TEST(ProxyTrees, TestOverlap_UsesFatBoxes) {
+    ProxyTrees bp(BroadphaseSettings{.margin = 0.1});
+    const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
+    const ProxyId b = bp.create_proxy(cube(Vec3(2.15, 0, 0), 1), 2, false);  // tight gap 0.15 < 2 margins
+    const ProxyId c = bp.create_proxy(cube(Vec3(2.3, 0, 0), 1), 3, true);    // static: no margin
+    EXPECT_TRUE(bp.test_overlap(a, b));
+    EXPECT_FALSE(bp.test_overlap(a, c));
+    EXPECT_TRUE(bp.test_overlap(b, c));
+}
+
+TEST(ProxyTrees, NothingEnlarged_RunsNoJobs) {
+    ProxyTrees bp;
+    test::CountingJobSystem jobs;
+    std::vector<Pair> pairs{Pair{}};
+    bp.update_pairs(jobs, pairs);
+    EXPECT_TRUE(pairs.empty());
+    EXPECT_EQ(jobs.chunks, 0);
+    const ProxyId a = bp.create_proxy(cube(Vec3::Zero(), 1), 1, false);
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(jobs.chunks, 1);
+    bp.move_proxy(a, cube(Vec3(0.01, 0, 0), 1), Vec3(0.01, 0, 0));
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(jobs.chunks, 1);
+}
+
+// A random scene of boxes: a fraction static, the rest moving with constant velocity
+// (some fast) and bouncing inside a cube; bodies are destroyed and created as it runs.
+class Scene {
+public:
+    Scene(int bodies, std::uint64_t seed, BroadphaseSettings settings = {})
+        : m_rng(seed), m_bp(settings), m_world(3.0 * std::cbrt(Real(bodies)) / 2) {
+        for (int i = 0; i < bodies; ++i) add_body(uniform(0, 1) < 0.2);
+    }
+
+    ProxyTrees& broadphase() { return m_bp; }
+    std::size_t body_count() const { return m_bodies.size(); }
+
+    // One step: every moving body moves; a few are destroyed, created, teleported.
+    void step() {
+        const Real dt = 1.0 / 60.0;
+        for (Body& b : m_bodies) {
+            if (b.is_static) continue;
+            Vec3 d = b.velocity * dt;
+            for (int k = 0; k < 3; ++k) {
+                if (std::abs(b.center[k] + d[k]) > m_world) {
+                    b.velocity[k] = -b.velocity[k];
+                    d[k] = -d[k];
+                }
+            }
+            b.center += d;
+            if (m_bp.move_proxy(b.proxy, tight(b), d)) b.enlarged = true;
+        }
+        const int churn = std::max(1, static_cast<int>(m_bodies.size()) / 100);
+        for (int i = 0; i < churn; ++i) {
+            const std::size_t victim = index(m_bodies.size());
+            m_bp.destroy_proxy(m_bodies[victim].proxy);
+            m_bodies[victim] = m_bodies.back();
+            m_bodies.pop_back();
+            add_body(uniform(0, 1) < 0.2);
+        }
+        // Teleport one static body (the engine allows moving a static body by hand).
+        for (Body& b : m_bodies) {
+            if (!b.is_static) continue;
+            b.center = random_point();
+            if (m_bp.move_proxy(b.proxy, tight(b), Vec3::Zero())) b.enlarged = true;
+            break;
+        }
+    }
+
+    // Brute force over every pair: all overlapping fat-box pairs (not static-static), and
+    // those with at least one proxy enlarged since the last update.
+    void brute_force(std::set<UserPair>& overlapping, std::vector<UserPair>& expected_new) const {
+        overlapping.clear();
+        expected_new.clear();
+        const std::size_t n = m_bodies.size();
+        std::vector<Aabb> fat(n);
+        for (std::size_t i = 0; i < n; ++i) fat[i] = m_bp.fat_aabb(m_bodies[i].proxy);
+        for (std::size_t i = 0; i < n; ++i) {
+            const Body& a = m_bodies[i];
+            for (std::size_t j = i + 1; j < n; ++j) {
+                const Body& b = m_bodies[j];
+                if (a.is_static && b.is_static) continue;
+                if (!fat[i].overlaps(fat[j])) continue;
+                const UserPair p(std::min(a.user, b.user), std::max(a.user, b.user));
+                overlapping.insert(p);
+                if (a.enlarged || b.enlarged) expected_new.push_back(p);
+            }
+        }
+        std::sort(expected_new.begin(), expected_new.end());
+    }
+
+    void clear_enlarged() {
+        for (Body& b : m_bodies) b.enlarged = false;
+    }
+
+private:
+    struct Body {
+        ProxyId proxy;
+        std::uint64_t user;
+        bool is_static;
+        bool enlarged;
+        Vec3 center;
+        Vec3 half;
+        Vec3 velocity;
+    };
+
+    Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(m_rng); }
+    std::size_t index(std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(m_rng); }
+    Vec3 random_point() { return {uniform(-m_world, m_world), uniform(-m_world, m_world), uniform(-m_world, m_world)}; }
+    static Aabb tight(const Body& b) { return Aabb::from_center_extents(b.center, b.half); }
+
+    void add_body(bool is_static) {
+        Body b;
+        b.user = m_next_user++;
+        b.is_static = is_static;
+        b.enlarged = true;  // a new proxy finds its pairs at the next update
+        b.center = random_point();
+        b.half = Vec3(uniform(0.2, 1.0), uniform(0.2, 1.0), uniform(0.2, 1.0));
+        const Real speed = uniform(0, 1) < 0.1 ? 30.0 : 2.0;  // some fast bodies stretch their boxes
+        b.velocity = Vec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)) * speed;
+        b.proxy = m_bp.create_proxy(tight(b), b.user, is_static);
+        m_bodies.push_back(b);
+    }
+
+    std::mt19937_64 m_rng;
+    ProxyTrees m_bp;
+    Real m_world;
+    std::uint64_t m_next_user = 1;
+    std::vector<Body> m_bodies;
+};
+
+struct SceneCase {
+    int bodies;
+    int steps;
+};
+
+class BroadphaseScenes : public ::testing::TestWithParam<SceneCase> {};
+
+// The engine's view: it adds the new pairs to its contacts and drops contacts whose fat
+// boxes stopped overlapping. After every update its contacts must be exactly the
+// overlapping pairs, and update_pairs must return exactly the brute-force new pairs.
+TEST_P(BroadphaseScenes, UpdatePairs_MatchesBruteForce) {
+    const SceneCase c = GetParam();
+    Scene scene(c.bodies, 42 + static_cast<std::uint64_t>(c.bodies));
+    test::ReverseThreadedJobSystem jobs(3);
+    std::set<UserPair> contacts;
+    std::set<UserPair> overlapping;
+    std::vector<UserPair> expected_new;
+    std::vector<Pair> pairs;
+    for (int step = 0; step < c.steps; ++step) {
+        if (step > 0) scene.step();
+        scene.brute_force(overlapping, expected_new);
+        scene.broadphase().update_pairs(jobs, pairs);
+        scene.clear_enlarged();
+        ASSERT_TRUE(is_canonical_and_unique(pairs)) << "step " << step;
+        ASSERT_EQ(user_pairs(pairs), expected_new) << "step " << step;
+        ASSERT_EQ(scene.broadphase().enlarged_count(), 0u);
+
+        for (auto it = contacts.begin(); it != contacts.end();) {
+            it = overlapping.count(*it) ? std::next(it) : contacts.erase(it);
+        }
+        for (const Pair& p : pairs) {
+            ASSERT_TRUE(scene.broadphase().test_overlap(p.proxy_a, p.proxy_b));
+            contacts.emplace(p.user_a, p.user_b);
+        }
+        ASSERT_EQ(contacts, overlapping) << "step " << step;
+    }
+    scene.broadphase().validate();
+    EXPECT_LE(scene.broadphase().moving_tree().height(),
+              static_cast<int>(2.5 * std::log2(std::max(2, scene.broadphase().moving_tree().proxy_count()))) + 3);
+}
+
+#ifdef NDEBUG
+INSTANTIATE_TEST_SUITE_P(Sizes, BroadphaseScenes,
+                         ::testing::Values(SceneCase{10, 200}, SceneCase{200, 200}, SceneCase{2000, 60},
+                                           SceneCase{10000, 12}));
+#else
+// Debug and sanitizer builds validate both trees after every operation: smaller scenes.
+INSTANTIATE_TEST_SUITE_P(Sizes, BroadphaseScenes,
+                         ::testing::Values(SceneCase{10, 100}, SceneCase{200, 60}, SceneCase{1000, 20}));
+#endif
+
+// Two broadphases fed the same operations, one updated by SingleThreadedJobSystem with
+// the default grain, one by threads running chunks backwards with a tiny grain: the new
+// pair lists are identical, proxy ids included.
+TEST(ProxyTrees, UpdatePairs_SameResultForAnyJobSystemAndGrain) {
+#ifdef NDEBUG
+    const int bodies = 3000;
+    const int steps = 30;
+#else
+    const int bodies = 600;
+    const int steps = 15;
+#endif
+    Scene single(bodies, 7);
+    Scene threaded(bodies, 7, BroadphaseSettings{.grain = 3});
+    SingleThreadedJobSystem jobs_single;
+    test::ReverseThreadedJobSystem jobs_threaded(4);
+    std::vector<Pair> a;
+    std::vector<Pair> b;
+    std::size_t total = 0;
+    for (int step = 0; step < steps; ++step) {
+        single.step();
+        threaded.step();
+        single.broadphase().update_pairs(jobs_single, a);
+        threaded.broadphase().update_pairs(jobs_threaded, b);
+        ASSERT_EQ(a.size(), b.size()) << "step " << step;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            ASSERT_EQ(a[i].proxy_a, b[i].proxy_a);
+            ASSERT_EQ(a[i].proxy_b, b[i].proxy_b);
+            ASSERT_EQ(a[i].user_a, b[i].user_a);
+            ASSERT_EQ(a[i].user_b, b[i].user_b);
+        }
+        total += a.size();
+    }
+    EXPECT_GT(total, 0u);
+}
+
+TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
+    ProxyTrees bp;
+    SingleThreadedJobSystem jobs;
+    std::vector<ProxyId> statics;
+    for (int i = 0; i < 200; ++i) statics.push_back(bp.create_proxy(cube(Vec3(i * 1.5, 0, 0), 1), std::uint64_t(i), true));
+    std::vector<Pair> pairs;
+    bp.update_pairs(jobs, pairs);
+    EXPECT_TRUE(pairs.empty());
+    bp.rebuild_static_tree();
+    bp.validate();
+    const ProxyId m = bp.create_proxy(cube(Vec3(30, 1.5, 0), 1), 1000, false);
+    bp.update_pairs(jobs, pairs);
+    EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{19, 1000}, {20, 1000}, {21, 1000}}));
+    for (const ProxyId s : statics) EXPECT_EQ(bp.user(s), static_cast<std::uint64_t>(bp.fat_aabb(s).center().x() / 1.5 + 0.5));
+    int found = 0;
+    bp.query(cube(Vec3(30, 0.7, 0), 0.1), [&](ProxyId id) {
+        found += (id == m || id.is_static()) ? 1 : 0;
+        return true;
+    });
+    EXPECT_EQ(found, 2);  // static 20 and the moving proxy
+}
+
+}  // namespace
+}  // namespace spindle
