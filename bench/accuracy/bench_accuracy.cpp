@@ -87,16 +87,18 @@ int run(const Options& options) {
         std::fprintf(stderr, "bench_accuracy: %s\n", cases[ci].name);
         for (int s : substeps) {
             for (int i : iterations) {
-                for (int hz : step_hz) rows.push_back(measure(static_cast<int>(ci), cases[ci], {s, i, hz}, options, info.runs));
+                for (int hz : step_hz)
+                    rows.push_back(measure(static_cast<int>(ci), cases[ci], {s, i, hz}, options, info.runs));
             }
         }
     }
     mark_pareto(rows);
     write_csv(options.out + "/accuracy.csv", cases, rows);
-    write_gnuplot(options.out + "/accuracy.gp", options.out + "/accuracy.dat", options.docs + "/accuracy.png", cases, rows, info);
+    write_gnuplot(options.out + "/accuracy.gp", options.out + "/accuracy.dat", options.docs + "/accuracy.png", cases,
+                  rows, info);
     write_markdown(options.docs + "/accuracy.md", cases, rows, info);
-    std::fprintf(stderr, "bench_accuracy: %zu rows -> %s/accuracy.csv, %s/accuracy.md\n", rows.size(), options.out.c_str(),
-                 options.docs.c_str());
+    std::fprintf(stderr, "bench_accuracy: %zu rows -> %s/accuracy.csv, %s/accuracy.md\n", rows.size(),
+                 options.out.c_str(), options.docs.c_str());
     return 0;
 }
 
@@ -116,8 +118,10 @@ int main(int argc, char** argv) {
         } else if (std::strcmp(argv[i], "--quick") == 0) {
             options.quick = true;
         } else {
-            std::fprintf(stderr, "bench_accuracy: unknown argument '%s'\n"
-                                 "usage: bench_accuracy [--out DIR] [--docs DIR] [--min-time S] [--quick]\n", argv[i]);
+            std::fprintf(stderr,
+                         "bench_accuracy: unknown argument '%s'\n"
+                         "usage: bench_accuracy [--out DIR] [--docs DIR] [--min-time S] [--quick]\n",
+                         argv[i]);
             return 1;
         }
     }

@@ -30,7 +30,8 @@ constexpr double kDiverged = 1e3;
 // A single-threaded Space under one setting that times its own steps.
 class TimedSpace {
 public:
-    TimedSpace(const Setting& setting, const Vec3& gravity) : m_space(make_settings(setting, gravity)), m_dt(setting.dt()) {}
+    TimedSpace(const Setting& setting, const Vec3& gravity)
+        : m_space(make_settings(setting, gravity)), m_dt(setting.dt()) {}
 
     Space& space() { return m_space; }
     void step() {
@@ -189,7 +190,8 @@ CaseRun drop(const Setting& setting, DropMetric metric) {
     }
     if (metric == DropMetric::Penetration) return t.result(deepest);
     Real worst = 0;
-    for (const Ball& ball : balls) worst = std::max(worst, ball.contact ? std::abs(*ball.contact - ball.exact) : ball.exact);
+    for (const Ball& ball : balls)
+        worst = std::max(worst, ball.contact ? std::abs(*ball.contact - ball.exact) : ball.exact);
     return t.result(worst);
 }
 
@@ -310,7 +312,8 @@ CaseRun pendulum(const Setting& setting) {
     space.create_joint(JointDesc::ball_socket_at(anchor, ball, pivot));
 
     const Real inertia_at_pivot = kMass * kLength * kLength + 0.4 * kMass * kRadius * kRadius;
-    const Real exact = 2 * kPi * std::sqrt(inertia_at_pivot / (kMass * kGravity * kLength)) / agm(1, std::cos(kTheta0 / 2));
+    const Real exact = 2 * kPi * std::sqrt(inertia_at_pivot / (kMass * kGravity * kLength)) /
+                       agm(1, std::cos(kTheta0 / 2));
     std::vector<Real> crossings;
     Real previous = bob.position.x() - pivot.x();
     for (int n = 0, steps = t.steps_for(10); n < steps; ++n) {
@@ -372,9 +375,15 @@ constexpr Case kCases[] = {
     {"free_fall", "five spheres dropped 10-10.24 m: worst first-contact time against sqrt(2h/g)", "s", free_fall},
     {"drop_penetration", "five spheres dropped 10-10.24 m: deepest any sinks into the ground", "m", drop_penetration},
     {"projectile", "sphere thrown, no ground: position against the exact parabola after 2 s", "m", projectile},
-    {"spin_energy", "box spun about its intermediate axis, gyroscopic, 10 s: worst relative change of kinetic energy", "rel", spin_energy},
-    {"pendulum", "1 m ball-socket pendulum released at 1 rad: relative period error over 10 s (exact: physical pendulum, AGM amplitude correction)", "rel", pendulum},
-    {"chain_joint_error", "ten 1 kg bars and a 100 kg ball on ball-socket joints, released horizontally, 3 s: worst anchor separation", "m", chain_joint_error},
+    {"spin_energy", "box spun about its intermediate axis, gyroscopic, 10 s: worst relative change of kinetic energy",
+     "rel", spin_energy},
+    {"pendulum",
+     "1 m ball-socket pendulum released at 1 rad: relative period error over 10 s (exact: physical pendulum, AGM "
+     "amplitude correction)",
+     "rel", pendulum},
+    {"chain_joint_error",
+     "ten 1 kg bars and a 100 kg ball on ball-socket joints, released horizontally, 3 s: worst anchor separation", "m",
+     chain_joint_error},
     {"bounce", "sphere, restitution 1, dropped 5 m: relative error of the 5th apex height", "rel", bounce},
 };
 

@@ -15,7 +15,7 @@ struct Row {
     Setting setting;
     double ms_per_second = 0;  // wall ms of stepping per simulated second
     double error = 0;
-    bool pareto = false;       // no other setting of the case is both cheaper and more accurate
+    bool pareto = false;  // no other setting of the case is both cheaper and more accurate
 };
 
 struct ReportInfo {
@@ -28,7 +28,8 @@ struct ReportInfo {
 void mark_pareto(std::vector<Row>& rows);
 
 void write_csv(const std::string& path, std::span<const Case> cases, std::span<const Row> rows);
-void write_markdown(const std::string& path, std::span<const Case> cases, std::span<const Row> rows, const ReportInfo& info);
+void write_markdown(const std::string& path, std::span<const Case> cases, std::span<const Row> rows,
+                    const ReportInfo& info);
 // data_path: the points file this writes too; png_path: where gnuplot will draw.
 void write_gnuplot(const std::string& script_path, const std::string& data_path, const std::string& png_path,
                    std::span<const Case> cases, std::span<const Row> rows, const ReportInfo& info);

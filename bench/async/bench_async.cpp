@@ -51,8 +51,8 @@ void GetMotionStates(benchmark::State& state) {
         benchmark::DoNotOptimize(states.data());
     }
     state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(n * sizeof(MotionState)));
-    state.counters["ns_per_body"] =
-        benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["ns_per_body"] = benchmark::Counter(
+        static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 void Memcpy(benchmark::State& state) {
@@ -63,8 +63,8 @@ void Memcpy(benchmark::State& state) {
         benchmark::DoNotOptimize(to.data());
     }
     state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(n * sizeof(MotionState)));
-    state.counters["ns_per_body"] =
-        benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["ns_per_body"] = benchmark::Counter(
+        static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 // One update that takes a step, with the flip's lock hold reported from UpdateStats.

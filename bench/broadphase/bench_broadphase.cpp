@@ -118,12 +118,14 @@ void bm_build(benchmark::State& state, bool bulk) {
     std::uniform_real_distribution<double> pos(-30, 30), size(0.2, 1.0);
     std::vector<Aabb> boxes;
     for (int i = 0; i < n; ++i) {
-        boxes.push_back(Aabb::from_center_extents(Vec3(pos(rng), pos(rng), pos(rng)), Vec3(size(rng), size(rng), size(rng))));
+        boxes.push_back(
+            Aabb::from_center_extents(Vec3(pos(rng), pos(rng), pos(rng)), Vec3(size(rng), size(rng), size(rng))));
     }
     double cost = 0;
     int height = 0;
     for (auto _ : state) {
-        DynamicAabbTree tree(AabbTreeSettings{.margin = 0, .displacement_multiplier = 0, .validate_each_operation = false});
+        DynamicAabbTree tree(
+            AabbTreeSettings{.margin = 0, .displacement_multiplier = 0, .validate_each_operation = false});
         for (int i = 0; i < n; ++i) tree.create_proxy(boxes[static_cast<std::size_t>(i)], std::uint64_t(i));
         if (bulk) tree.rebuild();
         cost = tree.area_cost();
@@ -144,7 +146,9 @@ int main(int argc, char** argv) {
             ->Unit(benchmark::kMillisecond);
     }
     benchmark::RegisterBenchmark("build/incremental", bm_build, false)->Arg(10000)->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark("build/incremental+rebuild", bm_build, true)->Arg(10000)->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("build/incremental+rebuild", bm_build, true)
+        ->Arg(10000)
+        ->Unit(benchmark::kMillisecond);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();

@@ -67,7 +67,8 @@ BoxScene box_grid_scene(int per_side) {
     BoxScene scene = on_floor("box_grid", half_floor, half_floor, 0.6);
     for (int a = 0; a < per_side; ++a) {
         for (int b = 0; b < per_side; ++b) {
-            scene.boxes.push_back({Vec3(centered(a, per_side, kPitch), kHalf, centered(b, per_side, kPitch)), Vec3::Constant(kHalf)});
+            scene.boxes.push_back(
+                {Vec3(centered(a, per_side, kPitch), kHalf, centered(b, per_side, kPitch)), Vec3::Constant(kHalf)});
         }
     }
     return scene;
@@ -104,7 +105,9 @@ std::vector<BodyHandle> add_to_space(Space& space, const BoxScene& scene, const 
 namespace {
 
 // Rolling terrain: two crossed waves, at most ~1.3 m high.
-Real terrain_height(Real x, Real z) { return std::sin(0.15 * x) * std::cos(0.12 * z) + 0.3 * std::sin(0.5 * x + 0.3 * z); }
+Real terrain_height(Real x, Real z) {
+    return std::sin(0.15 * x) * std::cos(0.12 * z) + 0.3 * std::sin(0.5 * x + 0.3 * z);
+}
 
 Shape terrain_mesh(int cells, Real cell_size) {
     const int n = cells + 1;
@@ -133,8 +136,9 @@ Shape terrain_mesh(int cells, Real cell_size) {
 
 // An irregular 10-point rock, about 1 m across.
 Shape rock_hull() {
-    const Vec3 points[] = {{0.5, 0, 0},     {-0.45, 0.05, 0},  {0, 0.35, 0.1},  {0.05, -0.3, 0},   {0, 0, 0.4},
-                           {0.1, 0, -0.45}, {0.3, 0.25, 0.25}, {-0.3, -0.2, 0.2}, {-0.2, 0.2, -0.3}, {0.25, -0.2, -0.25}};
+    const Vec3 points[] = {{0.5, 0, 0},       {-0.45, 0.05, 0},   {0, 0.35, 0.1},    {0.05, -0.3, 0},
+                           {0, 0, 0.4},       {0.1, 0, -0.45},    {0.3, 0.25, 0.25}, {-0.3, -0.2, 0.2},
+                           {-0.2, 0.2, -0.3}, {0.25, -0.2, -0.25}};
     return Shape::convex_hull(points);
 }
 
@@ -151,7 +155,8 @@ std::vector<BodyHandle> add_mixed_pile_on_mesh(Space& space, int count) {
     ground.friction = 0.6;
     space.create_body(ground);
 
-    const Shape shapes[] = {Shape::sphere(0.5), Shape::box(Vec3(0.4, 0.5, 0.6)), Shape::capsule(0.4, 0.35), rock_hull()};
+    const Shape shapes[] = {Shape::sphere(0.5), Shape::box(Vec3(0.4, 0.5, 0.6)), Shape::capsule(0.4, 0.35),
+                            rock_hull()};
     std::vector<BodyHandle> handles;
     handles.reserve(static_cast<std::size_t>(count));
     BodyDesc body;

@@ -78,7 +78,8 @@ std::unique_ptr<Space> chains(Effect effect) {
             const double pitch = effect == kJoints ? 0.4 : 1.0;
             link.position = top + Vec3(0, -pitch * k - 0.2, 0);
             const BodyHandle h = space->create_body(link);
-            if (effect == kJoints) space->create_joint(JointDesc::ball_socket_at(previous, h, top + Vec3(0, -0.4 * k, 0)));
+            if (effect == kJoints)
+                space->create_joint(JointDesc::ball_socket_at(previous, h, top + Vec3(0, -0.4 * k, 0)));
             previous = h;
         }
     }
@@ -146,7 +147,8 @@ void run(benchmark::State& state, Make make, bool internal_stepping = false) {
 
 void FreeBodies(benchmark::State& state) {
     const auto e = static_cast<Effect>(state.range(0));
-    run(state, [&] { return free_bodies(e); }, true);
+    run(
+        state, [&] { return free_bodies(e); }, true);
 }
 void RestingBoxes(benchmark::State& state) {
     const auto e = static_cast<Effect>(state.range(0));
@@ -168,8 +170,19 @@ void Grid10k(benchmark::State& state) {
 }  // namespace
 
 // Arg: 0 = without the effect, else the effect (see Effect).
-BENCHMARK(FreeBodies)->Arg(kNone)->Arg(kDamping)->Arg(kGyroscopic)->Arg(kInterpolation)->ArgName("effect")->Unit(benchmark::kMicrosecond);
-BENCHMARK(RestingBoxes)->Arg(kNone)->Arg(kFriction)->Arg(kRestitution)->ArgName("effect")->Unit(benchmark::kMicrosecond);
+BENCHMARK(FreeBodies)
+    ->Arg(kNone)
+    ->Arg(kDamping)
+    ->Arg(kGyroscopic)
+    ->Arg(kInterpolation)
+    ->ArgName("effect")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(RestingBoxes)
+    ->Arg(kNone)
+    ->Arg(kFriction)
+    ->Arg(kRestitution)
+    ->ArgName("effect")
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(Chains)->Arg(kNone)->Arg(kJoints)->ArgName("effect")->Unit(benchmark::kMicrosecond);
 BENCHMARK(FastSpheres)->Arg(kNone)->Arg(kContinuous)->ArgName("effect")->Unit(benchmark::kMicrosecond);
 BENCHMARK(Grid10k)->Arg(0)->Arg(1)->ArgName("sleeping")->Unit(benchmark::kMicrosecond);

@@ -51,7 +51,7 @@ constexpr EngineScene kScenes[] = {
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
 };
 
-constexpr int kGridPerSide = 100;     // 10,000 boxes
+constexpr int kGridPerSide = 100;  // 10,000 boxes
 constexpr int kMixedPileBodies = 2048;
 constexpr int kChains = 100;
 constexpr int kLinksPerChain = 10;

@@ -30,7 +30,8 @@ Shape rock() {
     std::mt19937 rng(3);
     std::normal_distribution<Real> g;
     std::vector<Vec3> p;
-    for (int i = 0; i < 32; ++i) p.push_back(Vec3(g(rng), g(rng), g(rng)).normalized().cwiseProduct(Vec3(0.6, 0.4, 0.5)));
+    for (int i = 0; i < 32; ++i)
+        p.push_back(Vec3(g(rng), g(rng), g(rng)).normalized().cwiseProduct(Vec3(0.6, 0.4, 0.5)));
     return Shape::convex_hull(p);
 }
 
@@ -58,7 +59,7 @@ struct Case {
     std::string name;
     Shape a;
     Shape b;
-    Real spread;  // how far B's centre wanders from the touching distance
+    Real spread;    // how far B's centre wanders from the touching distance
     Real distance;  // centre distance at which the pair roughly touches
 };
 

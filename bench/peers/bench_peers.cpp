@@ -114,8 +114,9 @@ void print_summary() {
     std::printf("  Bullet  skipped: Bullet was not found when this binary was configured\n");
 #endif
     if (g_spindle) {
-        std::printf("  Spindle %8.1f steps/s (%8.1f per CPU second)   top_y %6.2f   (floor: %s)\n", g_spindle->steps_per_s,
-                    g_spindle->cpu_steps_per_s, g_spindle->top_y, g_options.floor == FloorShape::Box ? "box" : "plane");
+        std::printf("  Spindle %8.1f steps/s (%8.1f per CPU second)   top_y %6.2f   (floor: %s)\n",
+                    g_spindle->steps_per_s, g_spindle->cpu_steps_per_s, g_spindle->top_y,
+                    g_options.floor == FloorShape::Box ? "box" : "plane");
     }
     if (g_bullet && g_spindle) {
         std::printf("  Spindle/Bullet %.2f (wall), %.2f (CPU)\n", g_spindle->steps_per_s / g_bullet->steps_per_s,

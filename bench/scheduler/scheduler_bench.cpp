@@ -29,12 +29,12 @@
 
 namespace {
 
-constexpr int empty_batch = 1000;          // jobs per submit-and-wait round
+constexpr int empty_batch = 1000;  // jobs per submit-and-wait round
 constexpr std::uint32_t trivial_items = 1'000'000;
 constexpr std::uint32_t trivial_grain = 1024;
 constexpr std::uint32_t work_items = 1000;
 constexpr std::uint32_t short_items = 24;
-constexpr int work_iterations = 220;        // ~1 us per item on the reference machine
+constexpr int work_iterations = 220;  // ~1 us per item on the reference machine
 
 // ~1 us of dependent floating-point work per item (a sqrt chain: no vectorising it away).
 float work_item(std::uint32_t i) {
@@ -47,13 +47,14 @@ float work_item(std::uint32_t i) {
 std::unique_ptr<spindle::WorkStealingJobSystem> spindle_system(int workers) {
     const std::vector<unsigned> machine = spindle::current_binding();
     spindle::WorkStealingJobSystem::Options options;
-    for (int i = 0; i < workers; ++i) options.worker_pus.push_back(machine[static_cast<std::size_t>(i) % machine.size()]);
+    for (int i = 0; i < workers; ++i)
+        options.worker_pus.push_back(machine[static_cast<std::size_t>(i) % machine.size()]);
     return std::make_unique<spindle::WorkStealingJobSystem>(options);
 }
 
 void per_job_counter(benchmark::State& state, double jobs_per_iteration) {
-    state.counters["per_job"] =
-        benchmark::Counter(jobs_per_iteration, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["per_job"] = benchmark::Counter(jobs_per_iteration, benchmark::Counter::kIsIterationInvariantRate |
+                                                                           benchmark::Counter::kInvert);
 }
 
 void Spindle_EmptyJobs(benchmark::State& state) {
@@ -70,9 +71,10 @@ void Spindle_ParallelForTrivial(benchmark::State& state) {
     auto jobs = spindle_system(static_cast<int>(state.range(0)));
     std::vector<float> data(trivial_items, 1.0f);
     for (auto _ : state) {
-        jobs->parallel_for("trivial", 0, trivial_items, trivial_grain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-            for (std::uint32_t i = lo; i < hi; ++i) data[i] += 1.0f;
-        });
+        jobs->parallel_for("trivial", 0, trivial_items, trivial_grain,
+                           [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                               for (std::uint32_t i = lo; i < hi; ++i) data[i] += 1.0f;
+                           });
         benchmark::DoNotOptimize(data.data());
     }
     state.SetItemsProcessed(state.iterations() * trivial_items);
@@ -129,7 +131,13 @@ void Spindle_Phases(benchmark::State& state) {
 }
 
 BENCHMARK(Spindle_EmptyJobs)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
-BENCHMARK(Spindle_Phases)->ArgNames({"workers", "run_phases"})->Args({1, 0})->Args({1, 1})->Args({2, 0})->Args({2, 1})->UseRealTime();
+BENCHMARK(Spindle_Phases)
+    ->ArgNames({"workers", "run_phases"})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({2, 0})
+    ->Args({2, 1})
+    ->UseRealTime();
 BENCHMARK(Spindle_ParallelForTrivial)->ArgName("workers")->Arg(1)->Arg(2)->UseRealTime();
 BENCHMARK(Spindle_ParallelForWork)->Apply(work_cases);
 

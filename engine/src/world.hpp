@@ -36,20 +36,20 @@ struct Bodies {
 
     // Hot.
     std::vector<MotionType> type;
-    std::vector<Vec3> x;   // centre of mass, world
-    std::vector<Quat> q;   // orientation
-    std::vector<Vec3> v;   // linear velocity
-    std::vector<Vec3> w;   // angular velocity, world
+    std::vector<Vec3> x;  // centre of mass, world
+    std::vector<Quat> q;  // orientation
+    std::vector<Vec3> v;  // linear velocity
+    std::vector<Vec3> w;  // angular velocity, world
     std::vector<Real> inv_mass;
     std::vector<Mat3> inv_inertia_local;  // about the centre of mass, body frame
     std::vector<Mat3> inertia_local;      // the same, not inverted (gyroscopic bodies read it)
     std::vector<Vec3> local_com;          // centre of mass in the shape's frame
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
-    std::vector<Aabb> bounds;             // tight, world
+    std::vector<Aabb> bounds;               // tight, world
     std::vector<std::int32_t> awake_index;  // position in World::awake, -1 if static or asleep
     std::vector<Real> sleep_time;
-    std::vector<std::int32_t> island;     // sleeping island id, -1 when awake
+    std::vector<std::int32_t> island;  // sleeping island id, -1 when awake
 
     // Interpolation history (the last two recorded steps), origin pose.
     std::vector<Vec3> history_position[2];
@@ -61,7 +61,8 @@ struct Bodies {
 
     std::uint32_t capacity() const noexcept { return static_cast<std::uint32_t>(generation.size()); }
     bool is_live(BodyHandle h) const noexcept {
-        return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation && h.generation != 0;
+        return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
+               h.generation != 0;
     }
     Vec3 origin(std::uint32_t i) const { return x[i] - q[i] * local_com[i]; }
     Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
@@ -97,8 +98,8 @@ struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
     int manifold_count = 0;
-    ContactManifold manifold;              // the first (and for convex pairs only) manifold
-    std::vector<ContactManifold> extra;    // further manifolds (triangle meshes)
+    ContactManifold manifold;            // the first (and for convex pairs only) manifold
+    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
     bool sleeping = false;
     // B's pose in A's frame when the manifolds were last computed; while the bodies stay
     // within 0.2 mm and half a degree of it, the manifolds are moved, not recomputed.
@@ -165,7 +166,8 @@ struct World {
     std::unique_ptr<BroadphaseState> broadphase;
     std::vector<Contact> contacts;
     std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
-    std::vector<std::uint64_t> contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
+    std::vector<std::uint64_t>
+        contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
     // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of
     // manifolds needs, without reading the contact (the narrowphase writes it).
     std::vector<std::uint32_t> contact_summaries;
@@ -194,15 +196,16 @@ struct World {
     std::uint64_t awake_version = 0;
     std::uint64_t published_version[2] = {~std::uint64_t{0}, ~std::uint64_t{0}};
     bool published_interpolating[2] = {false, false};
-    std::uint64_t body_set_version = 0;  // bumped when a body is made or destroyed (solver.cpp reuses colours until then)
+    std::uint64_t body_set_version =
+        0;  // bumped when a body is made or destroyed (solver.cpp reuses colours until then)
 
     UpdateStats stats;
     WorkCounters counters;
-    std::vector<EffectCounts> scratch_counts;  // per worker
-    std::vector<ContactCounts> contact_counts;  // per worker (narrowphase.cpp)
+    std::vector<EffectCounts> scratch_counts;                    // per worker
+    std::vector<ContactCounts> contact_counts;                   // per worker (narrowphase.cpp)
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     std::vector<std::uint32_t> scratch_lost;
-    std::vector<FastStart> fast_starts;          // continuous.cpp
+    std::vector<FastStart> fast_starts;  // continuous.cpp
     std::vector<std::uint32_t> scratch_candidates;
 
     // Islands.

@@ -22,8 +22,7 @@ hwloc_topology_t system_topology() {
 
 namespace {
 
-void read_topology(hwloc_topology_t t, std::vector<PuInfo>& pus, std::vector<CoreInfo>& cores,
-                       unsigned& packages) {
+void read_topology(hwloc_topology_t t, std::vector<PuInfo>& pus, std::vector<CoreInfo>& cores, unsigned& packages) {
     const int n = hwloc_get_nbobjs_by_type(t, HWLOC_OBJ_PU);
     const int n_packages = hwloc_get_nbobjs_by_type(t, HWLOC_OBJ_PACKAGE);
     packages = n_packages > 0 ? static_cast<unsigned>(n_packages) : 1u;
@@ -65,8 +64,7 @@ Topology Topology::from_synthetic(std::string_view description) {
     detail::HwlocTopology t;
     const std::string text(description);
     if (hwloc_topology_set_synthetic(t.get(), text.c_str()) != 0 || hwloc_topology_load(t.get()) != 0) {
-        throw Error("hwloc rejected the synthetic topology \"" + text +
-                    "\" (expected e.g. \"package:1 core:3 pu:2\")");
+        throw Error("hwloc rejected the synthetic topology \"" + text + "\" (expected e.g. \"package:1 core:3 pu:2\")");
     }
     Topology result;
     read_topology(t.get(), result.m_pus, result.m_cores, result.m_packages);
@@ -78,8 +76,8 @@ Topology Topology::from_synthetic(std::string_view description) {
 
 std::string Topology::summary() const {
     std::ostringstream out;
-    out << m_description << ": " << m_packages << (m_packages == 1 ? " package, " : " packages, ")
-        << m_cores.size() << (m_cores.size() == 1 ? " core, " : " cores, ") << m_pus.size()
+    out << m_description << ": " << m_packages << (m_packages == 1 ? " package, " : " packages, ") << m_cores.size()
+        << (m_cores.size() == 1 ? " core, " : " cores, ") << m_pus.size()
         << (m_pus.size() == 1 ? " hardware thread" : " hardware threads") << '\n';
     for (const CoreInfo& core : m_cores) {
         out << "  package " << core.package << " core " << core.logical << ": PU";

@@ -1,8 +1,8 @@
 // Building a parsed scene into a Space: settings, shapes made once and shared, bodies
 // in scene order; all or nothing.
-#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
+#include <spindle/scene/scene.hpp>
 
 namespace spindle {
 namespace {
@@ -57,7 +57,7 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
     for (const SceneJoint& joint : scene.joints) {
         const BodyHandle a = handles[joint.body_a], b = handles[joint.body_b];
         const JointDesc desc = joint.type == JointType::Hinge ? JointDesc::hinge_at(a, b, joint.anchor, joint.axis)
-                                                               : JointDesc::ball_socket_at(a, b, joint.anchor);
+                                                              : JointDesc::ball_socket_at(a, b, joint.anchor);
         try {
             space.create_joint(desc);
         } catch (const Error& e) {

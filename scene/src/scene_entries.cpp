@@ -78,7 +78,7 @@ std::vector<Vec3> pyramid_2d(const Vec3& origin, std::int64_t base, Real sx, Rea
 // hangs from a small static anchor body. `end_mass` makes the last link that heavy.
 struct Chain {
     std::int64_t links = 0;
-    Real spacing = 0;                  // centre to centre, m
+    Real spacing = 0;  // centre to centre, m
     Vec3 direction = Vec3::UnitX();
     JointType joint = JointType::BallSocket;
     Vec3 axis = Vec3::UnitZ();
@@ -121,7 +121,8 @@ Chain parse_chain(const TomlReader& r, const toml::table& entry, const std::stri
 // The anchor body and joints of one chain whose links start at scene.bodies[first].
 void add_chain_joints(SceneDesc& scene, const Chain& chain, const Vec3& origin, std::uint32_t first,
                       const toml::source_position& at) {
-    if (chain.end_mass > 0) scene.bodies[first + static_cast<std::uint32_t>(chain.links) - 1].desc.mass = chain.end_mass;
+    if (chain.end_mass > 0)
+        scene.bodies[first + static_cast<std::uint32_t>(chain.links) - 1].desc.mass = chain.end_mass;
     ShapeSpec anchor_shape;
     anchor_shape.type = ShapeType::Sphere;
     anchor_shape.radius = 0.05;

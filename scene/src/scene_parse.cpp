@@ -1,7 +1,7 @@
 // Scene files: the top level (name, description, [settings], [defaults], entries in
 // file order) and the body properties every entry shares. docs/scenes.md lists every key.
-#include <spindle/scene/scene.hpp>
 #include <spindle/platform/error.hpp>
+#include <spindle/scene/scene.hpp>
 
 #include <algorithm>
 #include <fstream>
@@ -16,10 +16,26 @@ namespace {
 SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
     const toml::table& t = r.table(node, "settings", "([settings])");
     r.check_keys(t, "[settings]",
-                 {"gravity", "time_step", "max_steps_per_frame", "min_steps_per_frame", "substeps", "iterations",
-                  "relax_iterations", "contact_hertz", "contact_damping_ratio", "joint_hertz",
-                  "joint_damping_ratio", "push_out_speed", "recovery_depth", "restitution_threshold", "speculative_distance",
-                  "linear_slop", "sleep", "time_to_sleep", "sleep_linear_threshold", "sleep_angular_threshold"});
+                 {"gravity",
+                  "time_step",
+                  "max_steps_per_frame",
+                  "min_steps_per_frame",
+                  "substeps",
+                  "iterations",
+                  "relax_iterations",
+                  "contact_hertz",
+                  "contact_damping_ratio",
+                  "joint_hertz",
+                  "joint_damping_ratio",
+                  "push_out_speed",
+                  "recovery_depth",
+                  "restitution_threshold",
+                  "speculative_distance",
+                  "linear_slop",
+                  "sleep",
+                  "time_to_sleep",
+                  "sleep_linear_threshold",
+                  "sleep_angular_threshold"});
     SpaceSettings s;
     TimeStepSettings& ts = s.time_step;
     SolverSettings& solver = s.solver;
@@ -89,7 +105,8 @@ Quat parse_orientation(const TomlReader& r, const toml::node& node, const std::s
     if ((degrees != nullptr) == (radians != nullptr)) {
         r.fail(node, what + ": expected exactly one of degrees or radians");
     }
-    const Real angle = degrees ? r.number(*degrees, what + ".degrees") * kPi / 180 : r.number(*radians, what + ".radians");
+    const Real angle = degrees ? r.number(*degrees, what + ".degrees") * kPi / 180
+                               : r.number(*radians, what + ".radians");
     return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized()));
 }
 
@@ -109,11 +126,22 @@ struct Entry {
 }  // namespace
 
 const std::vector<std::string_view>& body_property_keys() {
-    static const std::vector<std::string_view> keys = {
-        "type",          "shape",          "orientation",     "velocity",        "angular_velocity",
-        "density",       "mass",           "friction",        "restitution",     "gravity_scale",
-        "linear_damping", "angular_damping", "gyroscopic",    "allow_interpolation", "allow_sleep",
-        "fast"};
+    static const std::vector<std::string_view> keys = {"type",
+                                                       "shape",
+                                                       "orientation",
+                                                       "velocity",
+                                                       "angular_velocity",
+                                                       "density",
+                                                       "mass",
+                                                       "friction",
+                                                       "restitution",
+                                                       "gravity_scale",
+                                                       "linear_damping",
+                                                       "angular_damping",
+                                                       "gyroscopic",
+                                                       "allow_interpolation",
+                                                       "allow_sleep",
+                                                       "fast"};
     return keys;
 }
 

@@ -36,8 +36,8 @@ const std::vector<std::string_view>& body_property_keys();
 
 // Applies one body property to `body`. Returns false when `key` is not a body property
 // (the caller handles it or reports it as unknown). A shape is appended to scene.shapes.
-bool apply_body_key(const TomlReader& reader, std::string_view key, const toml::node& value,
-                    std::string_view where, BodyTemplate& body, SceneDesc& scene);
+bool apply_body_key(const TomlReader& reader, std::string_view key, const toml::node& value, std::string_view where,
+                    BodyTemplate& body, SceneDesc& scene);
 
 // Checks an entry's finished template: it has a shape, and a plane or mesh only on a static body.
 void check_body_template(const TomlReader& reader, const BodyTemplate& body, const toml::table& entry,

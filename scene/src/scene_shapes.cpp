@@ -1,7 +1,7 @@
 // Scene shapes: the `shape = { ... }` tables (sphere, box, capsule, hull, plane, mesh,
 // heightfield), their check at parse time, and the Shape factories at build time.
-#include <spindle/scene/scene.hpp>
 #include <spindle/platform/error.hpp>
+#include <spindle/scene/scene.hpp>
 
 #include <cmath>
 
@@ -122,8 +122,8 @@ ShapeSpec parse_heightfield(const TomlReader& r, const toml::node& node, const s
     for (std::size_t iz = 0; iz + 1 < rows; ++iz) {
         for (std::size_t ix = 0; ix + 1 < columns; ++ix) {
             const auto v00 = static_cast<std::uint32_t>(iz * columns + ix);
-            const auto v10 = v00 + 1;                                      // +x
-            const auto v01 = static_cast<std::uint32_t>(v00 + columns);    // +z
+            const auto v10 = v00 + 1;                                    // +x
+            const auto v01 = static_cast<std::uint32_t>(v00 + columns);  // +z
             const auto v11 = v01 + 1;
             s.indices.insert(s.indices.end(), {v00, v01, v10, v10, v01, v11});
         }
@@ -138,8 +138,8 @@ std::vector<Vec3> parse_points(const TomlReader& r, const toml::node& node, std:
     const std::string w(what);
     const toml::array& list = r.array(node, w, "of [x, y, z] points");
     if (list.size() < min_count) {
-        r.fail(node, w + ": expected at least " + std::to_string(min_count) + " points, got " +
-                         std::to_string(list.size()));
+        r.fail(node,
+               w + ": expected at least " + std::to_string(min_count) + " points, got " + std::to_string(list.size()));
     }
     std::vector<Vec3> points;
     points.reserve(list.size());

@@ -89,8 +89,8 @@ std::int64_t TomlReader::integer(const toml::node& node, std::string_view what, 
     const auto value = node.value_exact<std::int64_t>();
     if (!value) fail(node, std::string(what) + ": expected an integer, got " + kind(node));
     if (*value < min || *value > max) {
-        fail(node, std::string(what) + ": expected an integer in [" + std::to_string(min) + ", " +
-                       std::to_string(max) + "], got " + std::to_string(*value));
+        fail(node, std::string(what) + ": expected an integer in [" + std::to_string(min) + ", " + std::to_string(max) +
+                       "], got " + std::to_string(*value));
     }
     return *value;
 }
@@ -112,8 +112,8 @@ std::vector<Real> TomlReader::numbers(const toml::node& node, std::string_view w
     const toml::array* list = node.as_array();
     if (!list || list->size() != n) {
         fail(node, std::string(what) + ": expected an array of " + std::to_string(n) + " numbers [" +
-                       std::string(meaning) + "], got " + (list ? "an array of " + std::to_string(list->size())
-                                                                : kind(node)));
+                       std::string(meaning) + "], got " +
+                       (list ? "an array of " + std::to_string(list->size()) : kind(node)));
     }
     std::vector<Real> values;
     values.reserve(n);

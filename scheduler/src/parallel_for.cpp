@@ -76,8 +76,8 @@ void run_for(TaskHeader* header, std::uint64_t range, Worker& self) {
 
 }  // namespace
 
-void WorkStealingJobSystem::parallel_for(const char* name, std::uint32_t begin, std::uint32_t end,
-                                         std::uint32_t grain, RangeFn fn) {
+void WorkStealingJobSystem::parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
+                                         RangeFn fn) {
     if (end <= begin) return;  // zero items spawn nothing
     if (grain == 0) grain = 1;
     const std::uint32_t chunks = (end - begin - 1) / grain + 1;

@@ -56,7 +56,8 @@ void write_chrome_trace(std::ostream& out, const std::vector<TraceEvent>& events
         // Stage spans on their own row (tid 1000) so they frame the job rows.
         const unsigned tid = std::string_view(e.stage) == "stage" ? 1000u : e.worker;
         out << (i ? ",\n" : "\n") << "{\"name\":\"" << e.name << "\",\"cat\":\"" << e.stage
-            << "\",\"ph\":\"X\",\"pid\":1,\"tid\":" << tid << ",\"ts\":" << static_cast<double>(e.begin_ns - origin) / 1e3
+            << "\",\"ph\":\"X\",\"pid\":1,\"tid\":" << tid
+            << ",\"ts\":" << static_cast<double>(e.begin_ns - origin) / 1e3
             << ",\"dur\":" << static_cast<double>(e.end_ns - e.begin_ns) / 1e3 << ",\"args\":{\"worker\":" << e.worker
             << ",\"pu\":" << e.pu << "}}";
     }

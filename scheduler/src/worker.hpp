@@ -38,7 +38,7 @@ struct Worker {
     std::mutex mailbox_lock;  // pinned jobs for this worker only
     std::vector<JobRecord*> mailbox;
     std::atomic<bool> has_mail{false};
-    std::vector<TraceEvent> events;  // written only by the thread acting as this worker
+    std::vector<TraceEvent> events;        // written only by the thread acting as this worker
     std::vector<JobRecord*> free_records;  // this worker's record pool (see m_free_records)
     bool idle = false;                     // counted in the system's m_idle
 

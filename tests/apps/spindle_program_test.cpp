@@ -107,9 +107,9 @@ private:
     bool number() {
         const std::size_t start = m_pos;
         if (peek('-')) ++m_pos;
-        while (m_pos < m_text.size() && (std::isdigit(static_cast<unsigned char>(m_text[m_pos])) ||
-                                         m_text[m_pos] == '.' || m_text[m_pos] == 'e' || m_text[m_pos] == 'E' ||
-                                         m_text[m_pos] == '+' || m_text[m_pos] == '-')) {
+        while (m_pos < m_text.size() &&
+               (std::isdigit(static_cast<unsigned char>(m_text[m_pos])) || m_text[m_pos] == '.' ||
+                m_text[m_pos] == 'e' || m_text[m_pos] == 'E' || m_text[m_pos] == '+' || m_text[m_pos] == '-')) {
             ++m_pos;
         }
         return m_pos > start && std::isdigit(static_cast<unsigned char>(m_text[m_pos - 1]));
@@ -170,8 +170,8 @@ TEST(SpindleProgram, RunWithEveryLayout_PrintsSummaryAndWritesTraceAndRecord) {
         SCOPED_TRACE(layout.string());
         const fs::path trace = temp_path(layout.stem().string() + ".json");
         const fs::path record = temp_path(layout.stem().string() + ".csv");
-        const Result r = spindle("run stack --seconds 1 --layout '" + layout.string() + "' --trace '" +
-                                 trace.string() + "' --record '" + record.string() + "'");
+        const Result r = spindle("run stack --seconds 1 --layout '" + layout.string() + "' --trace '" + trace.string() +
+                                 "' --record '" + record.string() + "'");
         ASSERT_EQ(r.exit_code, 0) << r.output;
         expect_contains(r.output, "summary: scene stack, layout " + layout.stem().string());
         expect_contains(r.output, "smoothness");
@@ -189,8 +189,8 @@ TEST(SpindleProgram, RunWithEveryLayout_PrintsSummaryAndWritesTraceAndRecord) {
         const std::string csv = read_file(record);
         ASSERT_EQ(csv.rfind("frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz\n", 0), 0u);
         const auto rows = static_cast<std::size_t>(std::count(csv.begin(), csv.end(), '\n')) - 1;
-        EXPECT_GT(rows, 21u * 30u);   // stack: 21 bodies, about 60 frames in a second
-        EXPECT_EQ(rows % 21u, 0u);    // whole frames only
+        EXPECT_GT(rows, 21u * 30u);  // stack: 21 bodies, about 60 frames in a second
+        EXPECT_EQ(rows % 21u, 0u);   // whole frames only
         fs::remove(trace);
         fs::remove(record);
     }
@@ -283,8 +283,8 @@ TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {
         if (entry.path().extension() == ".toml") expect_contains(r.output, entry.path().stem().string() + " ");
     }
     // name, dynamic bodies, other bodies, description
-    for (const auto& [scene, dynamic] :
-         std::vector<std::pair<std::string, std::string>>{{"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}}) {
+    for (const auto& [scene, dynamic] : std::vector<std::pair<std::string, std::string>>{
+             {"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}}) {
         const std::vector<std::string> w = line_starting_with(r.output, scene);
         ASSERT_GE(w.size(), 3u) << scene << " not listed in\n" << r.output;
         EXPECT_EQ(w[1], dynamic) << scene;

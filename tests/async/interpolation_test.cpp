@@ -34,7 +34,7 @@ BodyDesc moving(bool interpolate) {
 TEST(Interpolation, SeedExampleBlendsPointFourOfNewestAndPointSixOfPrevious) {
     Space space = make_space();
     const BodyHandle body = space.create_body(moving(true));
-    space.update(kStep);  // step 1: x = kStep
+    space.update(kStep);             // step 1: x = kStep
     space.update(kStep + 0.006667);  // step 2: x = 2 kStep, 0.006667 left over
     ASSERT_EQ(space.last_update().steps, 1);
     EXPECT_NEAR(space.motion_states().alpha(), 0.4, 1e-4);

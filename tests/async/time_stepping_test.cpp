@@ -43,7 +43,7 @@ TEST(TimeStepping, CapTakesTenAndCarriesNoMoreThanTheCapsWorth) {
     Space space(internal_stepping(10));
     space.update(1.0);
     EXPECT_EQ(space.last_update().steps, 10);
-    EXPECT_NEAR(space.accumulated_time(), 10.0 / 60.0, 1e-12);            // carried: the cap's worth
+    EXPECT_NEAR(space.accumulated_time(), 10.0 / 60.0, 1e-12);                   // carried: the cap's worth
     EXPECT_NEAR(space.last_update().dropped_seconds, 1.0 - 20.0 / 60.0, 1e-12);  // reported, not kept
     space.update(0.0);
     EXPECT_EQ(space.last_update().steps, 10);  // "trying again in the next update"

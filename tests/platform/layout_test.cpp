@@ -121,7 +121,8 @@ TEST(Layout, NativeUsesEveryPuOfTheMachine) {
 }
 
 TEST(LayoutErrors, UnknownKeyNamesItsLine) {
-    const std::string e = error_of("model = \"package:1 core:3 pu:2\"\ngame = 1\nphysics = 3\nworkers = [3]\nwokers = 2\n");
+    const std::string e =
+        error_of("model = \"package:1 core:3 pu:2\"\ngame = 1\nphysics = 3\nworkers = [3]\nwokers = 2\n");
     EXPECT_NE(e.find("bad.toml:5:"), std::string::npos) << e;
     EXPECT_NE(e.find("unknown key 'wokers'"), std::string::npos) << e;
 }

@@ -378,14 +378,16 @@ TEST(WorkStealing, AnIdleWorkerTakesPartInPhases) {
         std::atomic<int> started{0};
         std::atomic<int> met{0};
         const Phase phase{"pair", 2, 1};
-        jobs->run_phases("pair", std::span(&phase, 1), [&](std::uint32_t, std::uint32_t lo, std::uint32_t hi, unsigned) {
-            for (std::uint32_t i = lo; i < hi; ++i) {
-                started.fetch_add(1);
-                const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
-                while (started.load() < 2 && std::chrono::steady_clock::now() < until) std::this_thread::yield();
-                if (started.load() == 2) met.fetch_add(1);
-            }
-        });
+        jobs->run_phases("pair", std::span(&phase, 1),
+                         [&](std::uint32_t, std::uint32_t lo, std::uint32_t hi, unsigned) {
+                             for (std::uint32_t i = lo; i < hi; ++i) {
+                                 started.fetch_add(1);
+                                 const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+                                 while (started.load() < 2 && std::chrono::steady_clock::now() < until)
+                                     std::this_thread::yield();
+                                 if (started.load() == 2) met.fetch_add(1);
+                             }
+                         });
         together = met.load() == 2;
     }
     EXPECT_TRUE(together) << "one worker ran both blocks of the phase in every attempt";
@@ -421,7 +423,8 @@ TEST(WorkStealing, PhaseBlocksAreTracedByPhaseName) {
     jobs->run_phases("Greek", phases, [](std::uint32_t, std::uint32_t, std::uint32_t, unsigned) {});
     const std::vector<TraceEvent> events = jobs->trace_events();
     auto count = [&](const char* name) {
-        return std::count_if(events.begin(), events.end(), [&](const TraceEvent& e) { return std::strcmp(e.name, name) == 0; });
+        return std::count_if(events.begin(), events.end(),
+                             [&](const TraceEvent& e) { return std::strcmp(e.name, name) == 0; });
     };
     EXPECT_EQ(count("alpha"), 8);  // two shares of 5 items, each in blocks of 2, 1, 1, 1 (halving)
     EXPECT_EQ(count("beta"), 0);

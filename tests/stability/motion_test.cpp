@@ -162,7 +162,8 @@ TEST(FastBodies, SpheresAtManyAnglesDoNotTunnelThroughAThinWall) {
         angles.push_back(off_normal);
         const double around = n * 0.7;
         const double speed = 100 + 200 * (n % 5) / 4.0;
-        const Vec3 dir(std::cos(off_normal), std::sin(off_normal) * std::cos(around), std::sin(off_normal) * std::sin(around));
+        const Vec3 dir(std::cos(off_normal), std::sin(off_normal) * std::cos(around),
+                       std::sin(off_normal) * std::sin(around));
         BodyDesc d;
         d.shape = Shape::sphere(0.1);
         d.fast = true;
@@ -171,7 +172,8 @@ TEST(FastBodies, SpheresAtManyAnglesDoNotTunnelThroughAThinWall) {
         // Start so that, unhindered, each would be inside or past the wall after a step
         // at a different phase of its path.
         const double steps_to_wall = 1.3 + 0.37 * n;
-        d.position = Vec3(-0.15, 0, 0) - dir * speed * kStep * steps_to_wall + Vec3(0, 2.0 * (n % 4) - 3, 2.0 * (n / 4) - 3);
+        d.position = Vec3(-0.15, 0, 0) - dir * speed * kStep * steps_to_wall +
+                     Vec3(0, 2.0 * (n % 4) - 3, 2.0 * (n / 4) - 3);
         d.linear_velocity = dir * speed;
         spheres.push_back(space->create_body(d));
     }
@@ -205,7 +207,8 @@ TEST(LongRun, BusySceneStaysFiniteAndGainsNoEnergyOver100kSteps) {
     auto space = make_space();
     constexpr double kHalf = 3;
     add_closed_box(*space, kHalf);
-    const Vec3 hull_points[] = {{0.4, 0, 0}, {-0.4, 0, 0}, {0, 0.5, 0}, {0, -0.3, 0.25}, {0, 0, -0.4}, {0.15, 0.25, 0.3}};
+    const Vec3 hull_points[] = {{0.4, 0, 0},     {-0.4, 0, 0}, {0, 0.5, 0},
+                                {0, -0.3, 0.25}, {0, 0, -0.4}, {0.15, 0.25, 0.3}};
     const Shape shapes[] = {Shape::box(Vec3(0.4, 0.25, 0.3)), Shape::sphere(0.3), Shape::capsule(0.25, 0.2),
                             Shape::convex_hull(hull_points)};
     std::mt19937_64 rng(5);

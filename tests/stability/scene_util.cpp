@@ -25,7 +25,6 @@ MassProperties mass_of(const BodyDesc& d) {
 
 }  // namespace
 
-
 std::unique_ptr<Space> make_space(const SpaceSettings& settings, JobSystem* jobs) {
     SpaceSettings s = settings;
     s.sleep.enabled = false;
@@ -62,7 +61,8 @@ BodyHandle add_box(Space& space, const Vec3& half_extents, const Vec3& position,
 
 std::vector<BodyHandle> add_cube_stack(Space& space, int count, const Vec3& base, double spacing) {
     std::vector<BodyHandle> boxes;
-    for (int i = 0; i < count; ++i) boxes.push_back(add_box(space, Vec3::Constant(0.5), base + Vec3(0, 0.5 + i * spacing, 0)));
+    for (int i = 0; i < count; ++i)
+        boxes.push_back(add_box(space, Vec3::Constant(0.5), base + Vec3(0, 0.5 + i * spacing, 0)));
     return boxes;
 }
 
@@ -137,7 +137,8 @@ double deepest_penetration(const Space& space, const std::vector<BodyHandle>& bo
             const int n = collide(space.internal_desc(bodies[i]).shape, poses[i], space.internal_desc(bodies[j]).shape,
                                   poses[j], 0, found, 4);
             for (int m = 0; m < n; ++m) {
-                for (int k = 0; k < found[m].point_count; ++k) deepest = std::max(deepest, -found[m].points[k].separation);
+                for (int k = 0; k < found[m].point_count; ++k)
+                    deepest = std::max(deepest, -found[m].points[k].separation);
             }
         }
     }

@@ -108,7 +108,8 @@ HeavyRun run_heavy_on_light(double ratio, int substeps) {
     all.push_back(add_box(*space, Vec3::Constant(0.5), Vec3(-3, 0.5, 0), 1));
     const BodyHandle cube = add_box(*space, Vec3::Constant(0.5), Vec3(-3, 1.5, 0), ratio);
     for (int i = 0; i < 4; ++i) {
-        all.push_back(add_box(*space, Vec3::Constant(0.5), Vec3(2 + ((i & 1) ? 0.5 : -0.5), 0.5, (i & 2) ? 0.5 : -0.5), 1));
+        all.push_back(
+            add_box(*space, Vec3::Constant(0.5), Vec3(2 + ((i & 1) ? 0.5 : -0.5), 0.5, (i & 2) ? 0.5 : -0.5), 1));
     }
     const BodyHandle plate = add_box(*space, Vec3(1, 0.5, 1), Vec3(2, 1.5, 0), ratio);
     all.push_back(cube);

@@ -18,7 +18,8 @@ void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, 
         // last flip; ApplyWrites checks those. Older ones are certainly stale.
         stale = !manager.is_published_locked(body) && manager.published_generation_locked(body.index) > body.generation;
     }
-    if (stale) throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
+    if (stale)
+        throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
 }
 
 void check_finite_write(const Vec3& v, const char* what) {
@@ -48,7 +49,9 @@ void push_vector(World& world, BodyHandle body, WriteKind kind, const Vec3& valu
 
 }  // namespace
 
-void Space::set_position(BodyHandle body, const Vec3& p) { push_vector(*m_world, body, WriteKind::Position, p, "set_position"); }
+void Space::set_position(BodyHandle body, const Vec3& p) {
+    push_vector(*m_world, body, WriteKind::Position, p, "set_position");
+}
 void Space::set_linear_velocity(BodyHandle body, const Vec3& v) {
     push_vector(*m_world, body, WriteKind::LinearVelocity, v, "set_linear_velocity");
 }
@@ -56,7 +59,9 @@ void Space::set_angular_velocity(BodyHandle body, const Vec3& w) {
     push_vector(*m_world, body, WriteKind::AngularVelocity, w, "set_angular_velocity");
 }
 void Space::add_force(BodyHandle body, const Vec3& f) { push_vector(*m_world, body, WriteKind::Force, f, "add_force"); }
-void Space::add_torque(BodyHandle body, const Vec3& t) { push_vector(*m_world, body, WriteKind::Torque, t, "add_torque"); }
+void Space::add_torque(BodyHandle body, const Vec3& t) {
+    push_vector(*m_world, body, WriteKind::Torque, t, "add_torque");
+}
 void Space::apply_impulse(BodyHandle body, const Vec3& j) {
     push_vector(*m_world, body, WriteKind::Impulse, j, "apply_impulse");
 }

@@ -15,6 +15,8 @@ inline std::string number(Real value) {
     return out.str();
 }
 
-inline std::string vec(const Vec3& v) { return "(" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + ")"; }
+inline std::string vec(const Vec3& v) {
+    return "(" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + ")";
+}
 
 }  // namespace spindle

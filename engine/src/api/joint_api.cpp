@@ -87,8 +87,10 @@ void require_ordered(Real lower, Real upper, const char* lower_field, const char
 
 void validate(const World& world, const JointDesc& d) {
     const Bodies& b = world.bodies;
-    if (!b.is_live(d.body_a)) reject("body_a: " + to_string(d.body_a) + " is not a live body (stale or foreign handle)");
-    if (!b.is_live(d.body_b)) reject("body_b: " + to_string(d.body_b) + " is not a live body (stale or foreign handle)");
+    if (!b.is_live(d.body_a))
+        reject("body_a: " + to_string(d.body_a) + " is not a live body (stale or foreign handle)");
+    if (!b.is_live(d.body_b))
+        reject("body_b: " + to_string(d.body_b) + " is not a live body (stale or foreign handle)");
     if (d.body_a == d.body_b) reject("body_a and body_b must be different bodies, both are " + to_string(d.body_a));
     if (b.type[d.body_a.index] != MotionType::Dynamic && b.type[d.body_b.index] != MotionType::Dynamic) {
         reject("at least one of body_a and body_b must be dynamic");
@@ -107,7 +109,8 @@ void validate(const World& world, const JointDesc& d) {
         require_axis(h.axis_a, "hinge.axis_a");
         require_axis(h.axis_b, "hinge.axis_b");
         if (h.enable_limit) {
-            for (auto [value, field] : {std::pair{h.lower_angle, "hinge.lower_angle"}, {h.upper_angle, "hinge.upper_angle"}}) {
+            for (auto [value, field] :
+                 {std::pair{h.lower_angle, "hinge.lower_angle"}, {h.upper_angle, "hinge.upper_angle"}}) {
                 require(std::isfinite(value) && std::abs(value) <= kPi, field, "must be in [-pi, pi]", number(value));
             }
             require_ordered(h.lower_angle, h.upper_angle, "hinge.lower_angle", "hinge.upper_angle");
@@ -169,7 +172,8 @@ Joint make_joint(const World& world, const JointDesc& d) {
 }
 
 const Joint& live_joint(const World& world, JointHandle h, const char* what) {
-    if (!world.joints.is_live(h)) throw Error(std::string(what) + ": " + to_string(h) + " is not a live joint (stale or foreign handle)");
+    if (!world.joints.is_live(h))
+        throw Error(std::string(what) + ": " + to_string(h) + " is not a live joint (stale or foreign handle)");
     return world.joints.joint[h.index];
 }
 
@@ -288,7 +292,8 @@ void Space::set_hinge_motor(JointHandle handle, bool enable, Real speed, Real ma
     World& w = *m_world;
     live_joint(w, handle, "set_hinge_motor");
     Joint& j = w.joints.joint[handle.index];
-    if (j.type != JointType::Hinge) throw Error("set_hinge_motor: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
+    if (j.type != JointType::Hinge)
+        throw Error("set_hinge_motor: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
     if (!std::isfinite(speed)) throw Error("set_hinge_motor: speed must be finite, got " + number(speed));
     if (!std::isfinite(max_torque) || max_torque < 0) {
         throw Error("set_hinge_motor: max_torque must be finite and >= 0, got " + number(max_torque));
@@ -340,7 +345,8 @@ JointError Space::internal_joint_error(JointHandle handle) const {
 Real Space::internal_hinge_angle(JointHandle handle) const {
     const World& w = *m_world;
     const Joint& j = live_joint(w, handle, "internal_hinge_angle");
-    if (j.type != JointType::Hinge) throw Error("internal_hinge_angle: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
+    if (j.type != JointType::Hinge)
+        throw Error("internal_hinge_angle: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
     const Quat qa = w.bodies.q[j.body_a], qb = w.bodies.q[j.body_b];
     const Vec3 axis = qa * j.axis_a, ra = qa * j.ref_a, rb = qb * j.ref_b;
     return std::atan2(axis.dot(ra.cross(rb)), ra.dot(rb));

@@ -25,17 +25,17 @@ struct Joint {
     Vec3 axis_b = Vec3::UnitZ();           // hinge axis on B
     Vec3 ref_a = Vec3::UnitX();            // hinge: perpendicular to the axis, equal in world at creation
     Vec3 ref_b = Vec3::UnitX();
-    Quat reference = Quat::Identity();     // fixed: B's orientation in A's frame at creation
-    Real rest_length = 0;                  // distance
+    Quat reference = Quat::Identity();  // fixed: B's orientation in A's frame at creation
+    Real rest_length = 0;               // distance
     HingeParams hinge;
     DistanceParams distance;
     bool collide_connected = false;
-    bool sleeping = false;                 // both bodies asleep (or one asleep, one static)
+    bool sleeping = false;  // both bodies asleep (or one asleep, one static)
 
     // Accumulated impulses of the last step (warm starting).
-    Vec3 linear_impulse = Vec3::Zero();    // point constraint, world
-    Vec3 angular_impulse = Vec3::Zero();   // hinge alignment / fixed rotation, world
-    Real axial_impulse = 0;                // distance: the rigid or spring row
+    Vec3 linear_impulse = Vec3::Zero();   // point constraint, world
+    Vec3 angular_impulse = Vec3::Zero();  // hinge alignment / fixed rotation, world
+    Real axial_impulse = 0;               // distance: the rigid or spring row
     Real motor_impulse = 0;
     Real lower_impulse = 0;
     Real upper_impulse = 0;

@@ -33,7 +33,8 @@ void check_finite(const Vec3& v, const char* field) {
 }
 
 void check_non_negative(Real value, const char* field) {
-    if (!std::isfinite(value) || value < 0) reject(std::string(field) + " must be finite and >= 0, got " + number(value));
+    if (!std::isfinite(value) || value < 0)
+        reject(std::string(field) + " must be finite and >= 0, got " + number(value));
 }
 
 // Everything create_body needs to know is valid, checked before anything changes.
@@ -119,7 +120,8 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         b.generation.push_back(0);
         b.alive.push_back(0);
         grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
-        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
+        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.force, n),
+            grow(b.torque, n), grow(b.bounds, n);
         grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
         grow(b.history_position[0], n), grow(b.history_position[1], n);
         grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
@@ -159,7 +161,8 @@ BodyHandle Space::create_body(const BodyDesc& input) {
 
 void Space::destroy_body(BodyHandle body) {
     World& w = *m_world;
-    if (!w.bodies.is_live(body)) throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
+    if (!w.bodies.is_live(body))
+        throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
     const std::uint32_t slot = body.index;
     // A body leaving a sleeping island wakes it: what rested on the body may fall, and
     // the island's member list must not keep a dead slot.
@@ -227,8 +230,8 @@ void Space::set_solver(const SolverSettings& s) {
     if (s.relax_iterations < 0) {
         throw Error("solver: relax_iterations must be >= 0, got " + std::to_string(s.relax_iterations));
     }
-    if (!(s.contact_hertz >= 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) ||
-        !(s.recovery_depth >= 0) || !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
+    if (!(s.contact_hertz >= 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) || !(s.recovery_depth >= 0) ||
+        !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
         throw Error("solver: contact_hertz, damping_ratio, push_out_speed, recovery_depth, speculative_distance and "
                     "restitution_threshold must be >= 0");
     }

@@ -30,9 +30,9 @@ struct BufferedWrite {
     std::uint64_t sequence = 0;
     BodyHandle body;
     WriteKind kind = WriteKind::Wake;
-    Vec3 vector = Vec3::Zero();           // position, velocity, force, impulse
-    Quat rotation = Quat::Identity();     // orientation
-    MotionState state;                    // motion state
+    Vec3 vector = Vec3::Zero();        // position, velocity, force, impulse
+    Quat rotation = Quat::Identity();  // orientation
+    MotionState state;                 // motion state
 };
 
 class WriteBuffer {

@@ -175,7 +175,8 @@ void closest_segment_parameters(const Vec3& p1, const Vec3& d1, const Vec3& p2, 
 Vec3 any_perpendicular(const Vec3& v) {
     // Cross with the axis least aligned with v, so the result is never tiny.
     const Vec3 a = v.cwiseAbs();
-    const Vec3 axis = a.x() <= a.y() && a.x() <= a.z() ? Vec3::UnitX() : (a.y() <= a.z() ? Vec3::UnitY() : Vec3::UnitZ());
+    const Vec3 axis = a.x() <= a.y() && a.x() <= a.z() ? Vec3::UnitX()
+                                                       : (a.y() <= a.z() ? Vec3::UnitY() : Vec3::UnitZ());
     return v.cross(axis).normalized();
 }
 

@@ -13,10 +13,10 @@
 namespace spindle::detail {
 namespace {
 
-constexpr int kMaxMeshManifolds = 32;    // distinct normals kept while walking triangles
-constexpr Real kSameNormal = 0.999;      // manifolds closer than this merge
-constexpr Real kFaceNormal = 1 - 1e-6;   // a contact this aligned with the face is a face contact
-constexpr Real kOnEdge = 1e-6;           // barycentric weight below which a point is on an edge
+constexpr int kMaxMeshManifolds = 32;   // distinct normals kept while walking triangles
+constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
+constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
+constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
 
 // Triangle t in the mesh frame against convex a posed there by xa.
 bool collide_triangle(const Shape& a, const Transform& xa, const BoxPoly* box, const TrianglePoly& tri,

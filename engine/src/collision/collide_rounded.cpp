@@ -93,8 +93,8 @@ int collide_sphere_capsule(const Shape& a, const Transform& xa, const Shape& b, 
     return rounded_contact(xa.p, cb, a.radius, b.radius, across, speculative, out[0]) ? 1 : 0;
 }
 
-int collide_capsule_capsule(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                            Real speculative, Manifold* out, int) {
+int collide_capsule_capsule(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                            Manifold* out, int) {
     const Vec3 ha = xa.rotate(Vec3(0, a.half_height, 0));
     const Vec3 hb = xb.rotate(Vec3(0, b.half_height, 0));
     const Vec3 a0 = xa.p - ha, da = 2 * ha;

@@ -210,7 +210,8 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
         if (!tris[t].alive) continue;
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t u = qh.neighbour(tris[t].v[k], tris[t].v[(k + 1) % 3]);
-            const std::uint32_t far_u = tris[u].v[0] + tris[u].v[1] + tris[u].v[2] - tris[t].v[k] - tris[t].v[(k + 1) % 3];
+            const std::uint32_t far_u = tris[u].v[0] + tris[u].v[1] + tris[u].v[2] - tris[t].v[k] -
+                                        tris[t].v[(k + 1) % 3];
             const std::uint32_t far_t = tris[t].v[(k + 2) % 3];
             if (std::abs(tris[t].normal.dot(points[far_u]) - tris[t].offset) <= merge_tolerance &&
                 std::abs(tris[u].normal.dot(points[far_t]) - tris[u].offset) <= merge_tolerance &&
@@ -241,7 +242,8 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
         std::uint32_t start = UINT32_MAX;
         for (const auto& [a, b] : next) start = std::min(start, a);
         std::vector<std::uint32_t> loop{start};
-        for (std::uint32_t v = next[loop[0]]; v != loop[0] && loop.size() <= next.size(); v = next[v]) loop.push_back(v);
+        for (std::uint32_t v = next[loop[0]]; v != loop[0] && loop.size() <= next.size(); v = next[v])
+            loop.push_back(v);
         SPINDLE_ASSERT(loop.size() == next.size(), "a merged hull face must have one boundary loop");
         // Drop vertices that sit on a straight run of the loop: they are not corners.
         std::vector<std::uint32_t> corners;

@@ -17,8 +17,8 @@ using Table = std::array<std::array<PairFunction, kTypeCount>, kTypeCount>;
 
 // Calls Fn with the shapes swapped and turns the normals round, so they point from a to b.
 template <PairFunction Fn>
-int swapped(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-            Manifold* out, int capacity) {
+int swapped(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative, Manifold* out,
+            int capacity) {
     const int count = Fn(b, xb, a, xa, speculative, out, capacity);
     for (int i = 0; i < count; ++i) flip_manifold(out[i]);
     return count;

@@ -58,7 +58,8 @@ int face_points(const Core& core, const PolyView& b, std::uint32_t f, const Vec3
         const Vec3 s = core.s[0] + t[i] * d;
         const Real separation = (face.normal.dot(s) - face.offset) / slant - core.radius;
         if (separation > speculative) continue;
-        points[n++] = {s - out * (core.radius + Real(0.5) * separation), separation, face_contact_id(true, f, 0, key[i])};
+        points[n++] = {s - out * (core.radius + Real(0.5) * separation), separation,
+                       face_contact_id(true, f, 0, key[i])};
     }
     return n;
 }

@@ -117,8 +117,8 @@ EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
 }
 
 // Clips the incident face of `inc` against reference face `face` of `ref`.
-int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative,
-                 Vec3& n, ContactCandidate* out) {
+int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative, Vec3& n,
+                 ContactCandidate* out) {
     n = ref.normal(face);
     const Real d = ref.offset(face, n);
     std::uint32_t incident = 0;
@@ -167,8 +167,8 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
 
 }  // namespace
 
-bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,
-                       Real speculative, Manifold& m) {
+bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,
+                       Manifold& m) {
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);

@@ -40,13 +40,13 @@ struct WideRow {
 // One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
 // fill has no mass and lies far apart, so it never pushes and never rubs.
 struct WidePoint {
-    Wide3 ra, rb;                 // anchors from each centre of mass, world, fixed for the step
-    Wide adjusted_separation{};   // separation minus n.(rb - ra): current separation = n.d + this
+    Wide3 ra, rb;                // anchors from each centre of mass, world, fixed for the step
+    Wide adjusted_separation{};  // separation minus n.(rb - ra): current separation = n.d + this
     WideRow normal_row, tangent_row[2];
     WideF normal_mass{}, tangent_mass[2]{};
     Wide normal_impulse{}, tangent_impulse[2]{};
     Wide max_normal_impulse{};
-    Wide relative_velocity{};     // approach speed at impact (restitution)
+    Wide relative_velocity{};  // approach speed at impact (restitution)
 };
 
 // A touching manifold of an awake contact, as listed and coloured for the step.
@@ -61,8 +61,8 @@ struct ManifoldRef {
 // colour's end hold no manifold: both bodies are the immovable one and nothing is written.
 struct WideContact {
     std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
-    std::uint32_t ref[kLanes] = {};                  // manifold ref per lane
-    int lanes = 0;                                   // lanes holding a manifold
+    std::uint32_t ref[kLanes] = {};                // manifold ref per lane
+    int lanes = 0;                                 // lanes holding a manifold
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{}, restitution{};
@@ -85,7 +85,7 @@ struct JointConstraint {
     std::uint32_t a = 0, b = 0;  // solver bodies, as for contacts
     std::uint32_t joint = 0;     // slot in world.joints
     JointType type = JointType::BallSocket;
-    Vec3 ra = Vec3::Zero();      // anchors from each centre of mass, world
+    Vec3 ra = Vec3::Zero();  // anchors from each centre of mass, world
     Vec3 rb = Vec3::Zero();
     Vec3 delta_center = Vec3::Zero();  // B's centre of mass minus A's
 
@@ -144,8 +144,8 @@ struct SolverPhase {
 };
 
 struct SolverScratch {
-    std::vector<SolverBody> bodies;                 // awake bodies, then the static body
-    std::vector<ManifoldRef> manifolds;             // touching manifolds of awake contacts, in contact order
+    std::vector<SolverBody> bodies;      // awake bodies, then the static body
+    std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
     std::vector<ManifoldRef> colored_manifolds;
@@ -154,15 +154,15 @@ struct SolverScratch {
     bool colored_joints = false;
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
-    std::vector<WideContact> wide;                   // the colours' manifolds four by four, then the overflow one by one
-    std::vector<ContactRow> push_rows;               // kLanes per wide contact: its push-out rows (written before read)
-    std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
-    std::vector<JointConstraint> joints;             // awake joints, in slot order
+    std::vector<WideContact> wide;      // the colours' manifolds four by four, then the overflow one by one
+    std::vector<ContactRow> push_rows;  // kLanes per wide contact: its push-out rows (written before read)
+    std::uint32_t wide_begin[kColorCount + 1] = {};        // colour c holds wide[wide_begin[c], wide_begin[c + 1])
+    std::vector<JointConstraint> joints;                   // awake joints, in slot order
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
     std::vector<std::uint32_t> joint_overflow;
-    std::vector<std::uint32_t> body_colors;          // per solver body: a bit for each colour it is in
-    std::vector<Phase> phases;                       // the step's solver loop, run by run_phases
-    std::vector<SolverPhase> plan;                   // what each phase does
+    std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
+    std::vector<Phase> phases;               // the step's solver loop, run by run_phases
+    std::vector<SolverPhase> plan;           // what each phase does
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,

@@ -16,7 +16,7 @@
 namespace spindle {
 namespace {
 
-constexpr Real kEmptySeparation = 1e18;      // an empty point slot: far apart, never touching
+constexpr Real kEmptySeparation = 1e18;  // an empty point slot: far apart, never touching
 
 // A tangent basis for a unit normal, the same for the same normal every time.
 void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
@@ -167,8 +167,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         const Wide point_inv_mass = select(separation[j] < splat(kEmptySeparation), inv_mass_sum, splat(0));
         p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.normal, p.normal_row);
         for (int t = 0; t < 2; ++t) {
-            p.tangent_mass[t] =
-                make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.tangent[t], p.tangent_row[t]);
+            p.tangent_mass[t] = make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.tangent[t],
+                                         p.tangent_row[t]);
             p.tangent_impulse[t] = tangent_impulse[j][t];
         }
         p.normal_impulse = normal_impulse[j];
@@ -185,7 +185,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
 void pack_contacts(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
-    scratch.wide.resize(count);  // kept from step to step: prepare_wide writes every field
+    scratch.wide.resize(count);                // kept from step to step: prepare_wide writes every field
     scratch.push_rows.resize(count * kLanes);  // a row is written by push_out before it is read
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     std::size_t next = 0;
@@ -327,8 +327,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         for (int l = 0; l < kLanes; ++l) {
             if (deep_weight[l] <= 0) continue;
             const Real w = deep_weight[l];
-            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
-                     params);
+            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w, params);
         }
     }
 }

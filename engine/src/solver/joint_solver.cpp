@@ -92,8 +92,8 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     // K from the anchors now: a light link can turn far within a step, and a mass from
     // the step's start would then overshoot.
     const Mat3 mass = point_mass(A, B, ra, rb);
-    const Vec3 impulse =
-        -soft.mass_scale * (mass * (cdot + soft.bias_rate * c)) - soft.impulse_scale * jc.linear_impulse;
+    const Vec3 impulse = -soft.mass_scale * (mass * (cdot + soft.bias_rate * c)) -
+                         soft.impulse_scale * jc.linear_impulse;
     jc.linear_impulse += impulse;
     apply(A, B, s, ra, rb, impulse);
 }
@@ -113,11 +113,9 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     }
     if (jc.enable_limit) {
         const Real angle = hinge_angle(jc, rows.axis, A.dq, B.dq);
-        const Real lower =
-            limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p);
+        const Real lower = limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p);
         apply_angular(A, B, s, lower * rows.axis);
-        const Real upper =
-            limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p);
+        const Real upper = limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p);
         apply_angular(A, B, s, -upper * rows.axis);
     }
     {
@@ -142,16 +140,16 @@ void solve_fixed(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     const Softness soft = pass_softness(p);
     const Vec3 c = rotation_error(jc, A.dq, B.dq);
     const Vec3 cdot = s.wb - s.wa;
-    const Vec3 impulse =
-        -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) - soft.impulse_scale * jc.angular_impulse;
+    const Vec3 impulse = -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) -
+                         soft.impulse_scale * jc.angular_impulse;
     jc.angular_impulse += impulse;
     apply_angular(A, B, s, impulse);
     solve_point(jc, A, B, s, p);
 }
 
 // Current direction between the anchors and its length.
-Vec3 distance_axis(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, const Vec3& ra,
-                   const Vec3& rb, Real& length) {
+Vec3 distance_axis(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb,
+                   Real& length) {
     const Vec3 d = (B.dp - A.dp) + (rb - ra) + jc.delta_center;
     length = d.norm();
     return length > 1e-9 ? Vec3(d / length) : jc.axis;
@@ -169,8 +167,8 @@ void solve_distance(JointConstraint& jc, const SolverBody& A, const SolverBody& 
         // Rigid rod: softened like every joint, relaxed without bias.
         const Softness soft = pass_softness(p);
         const Real c = length - jc.rest_length;
-        const Real impulse =
-            -soft.mass_scale * mass * (speed() + soft.bias_rate * c) - soft.impulse_scale * jc.axial_impulse;
+        const Real impulse = -soft.mass_scale * mass * (speed() + soft.bias_rate * c) -
+                             soft.impulse_scale * jc.axial_impulse;
         jc.axial_impulse += impulse;
         apply(A, B, s, ra, rb, impulse * axis);
         return;
@@ -289,7 +287,8 @@ void prepare_joints(World& world, SolverScratch& scratch, Real h) {
     const SolverBody* bodies = scratch.bodies.data();
     world.jobs->parallel_for("PrepareJoints", 0, static_cast<std::uint32_t>(scratch.joints.size()), kJointGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-                                 for (std::uint32_t k = lo; k < hi; ++k) prepare_joint(world, bodies, scratch.joints[k], h);
+                                 for (std::uint32_t k = lo; k < hi; ++k)
+                                     prepare_joint(world, bodies, scratch.joints[k], h);
                              });
 }
 
@@ -303,7 +302,8 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
         case JointType::Hinge: {
             const AlignRows rows = align_rows(jc, A.dq, B.dq);
             const Real axial = jc.motor_impulse + jc.lower_impulse - jc.upper_impulse;
-            apply_angular(A, B, s, jc.align_impulse.x() * rows.u[0] + jc.align_impulse.y() * rows.u[1] + axial * rows.axis);
+            apply_angular(A, B, s,
+                          jc.align_impulse.x() * rows.u[0] + jc.align_impulse.y() * rows.u[1] + axial * rows.axis);
             apply(A, B, s, ra, rb, jc.linear_impulse);
             break;
         }

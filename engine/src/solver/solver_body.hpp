@@ -11,8 +11,8 @@ namespace spindle {
 struct SolverBody {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
-    Vec3 dp = Vec3::Zero();        // position change since the step began
-    Quat dq = Quat::Identity();    // rotation change since the step began
+    Vec3 dp = Vec3::Zero();      // position change since the step began
+    Quat dq = Quat::Identity();  // rotation change since the step began
     // Push-out velocities of the current substep (split impulse): they move the body out
     // of overlaps in integrate_positions and are then dropped, so pushing apart never
     // becomes real speed. Capped per body in integrate_positions: pushing never makes a

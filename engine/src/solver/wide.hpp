@@ -76,7 +76,7 @@ inline Wide3 operator*(const WideMat3& a, const Wide3& v) {
 
 // A unit quaternion per lane.
 struct WideQuat {
-    Wide3 v;      // x, y, z
+    Wide3 v;  // x, y, z
     Wide w{};
 
     void set_lane(int i, const Quat& q) {

@@ -138,7 +138,8 @@ std::int32_t DynamicAabbTree::find_best_sibling(const Aabb& box) const {
                 best_cost = cost;
                 best = child[k];
             }
-            lower_bound[k] = c.height == 0 ? kHuge : inherited + direct + std::min(area_new - c.box.perimeter(), Real(0));
+            lower_bound[k] = c.height == 0 ? kHuge
+                                           : inherited + direct + std::min(area_new - c.box.perimeter(), Real(0));
         }
         if (best_cost <= lower_bound[0] && best_cost <= lower_bound[1]) break;
         if (lower_bound[0] == lower_bound[1]) {
@@ -186,7 +187,8 @@ void DynamicAabbTree::remove_leaf(std::int32_t leaf) {
     const std::int32_t parent = m_nodes[static_cast<std::size_t>(leaf)].parent_or_next;
     const Node& p = m_nodes[static_cast<std::size_t>(parent)];
     const std::int32_t grand = p.parent_or_next;
-    const std::int32_t sibling = p.payload.children.first == leaf ? p.payload.children.second : p.payload.children.first;
+    const std::int32_t sibling = p.payload.children.first == leaf ? p.payload.children.second
+                                                                  : p.payload.children.first;
     m_nodes[static_cast<std::size_t>(sibling)].parent_or_next = grand;
     m_nodes[static_cast<std::size_t>(leaf)].parent_or_next = kNull;
     free_node(parent);
@@ -258,9 +260,14 @@ bool DynamicAabbTree::rotate(std::int32_t a) {
             const std::int32_t y = grand[k];
             const std::int32_t z = grand[1 - k];
             const int height_o = 1 + std::max(h(x), h(z));
-            const Swap s{x, y, o, 1 + std::max(h(y), height_o), std::abs(h(y) - height_o),
-                         m_nodes[static_cast<std::size_t>(x)].box.merged(m_nodes[static_cast<std::size_t>(z)].box).perimeter() -
-                             node_o.box.perimeter()};
+            const Swap s{
+                x,
+                y,
+                o,
+                1 + std::max(h(y), height_o),
+                std::abs(h(y) - height_o),
+                m_nodes[static_cast<std::size_t>(x)].box.merged(m_nodes[static_cast<std::size_t>(z)].box).perimeter() -
+                    node_o.box.perimeter()};
             bool acceptable;
             bool better;
             if (must_balance) {
@@ -303,7 +310,8 @@ void DynamicAabbTree::validate() const {
     std::int32_t leaves = 0;
     if (m_root != kNull) {
         SPINDLE_TREE_CHECK(m_root >= 0 && m_root < node_count, "tree: root out of range");
-        SPINDLE_TREE_CHECK(m_nodes[static_cast<std::size_t>(m_root)].parent_or_next == kNull, "tree: root has a parent");
+        SPINDLE_TREE_CHECK(m_nodes[static_cast<std::size_t>(m_root)].parent_or_next == kNull,
+                           "tree: root has a parent");
         TraversalStack stack;
         stack.push(m_root);
         while (!stack.empty()) {
@@ -336,7 +344,8 @@ void DynamicAabbTree::validate() const {
     std::int32_t free_nodes = 0;
     for (std::int32_t id = m_free_list; id != kNull; id = m_nodes[static_cast<std::size_t>(id)].parent_or_next) {
         SPINDLE_TREE_CHECK(id >= 0 && id < node_count, "tree: free list index out of range");
-        SPINDLE_TREE_CHECK(m_nodes[static_cast<std::size_t>(id)].height == kFreeHeight, "tree: a used node is on the free list");
+        SPINDLE_TREE_CHECK(m_nodes[static_cast<std::size_t>(id)].height == kFreeHeight,
+                           "tree: a used node is on the free list");
         ++free_nodes;
         SPINDLE_TREE_CHECK(free_nodes <= node_count, "tree: cycle in the free list");
     }

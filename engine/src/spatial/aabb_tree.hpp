@@ -92,8 +92,8 @@ private:
     struct alignas(64) Node {
         Aabb box;
         union Payload {
-            Children children;    // internal nodes (height > 0)
-            std::uint64_t user;   // leaves (height == 0)
+            Children children;   // internal nodes (height > 0)
+            std::uint64_t user;  // leaves (height == 0)
         } payload;
         std::int32_t parent_or_next;  // parent while used, next free node while free
         std::int32_t height;          // 0 leaf, > 0 internal, kFreeHeight on the free list

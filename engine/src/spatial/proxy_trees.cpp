@@ -28,8 +28,8 @@ bool canonical_less(const Pair& a, const Pair& b) {
 }  // namespace
 
 ProxyTrees::ProxyTrees(BroadphaseSettings settings)
-    : m_settings(settings), m_trees{DynamicAabbTree(moving_tree_settings(settings)),
-                                    DynamicAabbTree(static_tree_settings(settings))} {
+    : m_settings(settings),
+      m_trees{DynamicAabbTree(moving_tree_settings(settings)), DynamicAabbTree(static_tree_settings(settings))} {
     if (m_settings.grain == 0) m_settings.grain = 1;
 }
 
@@ -131,9 +131,7 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
     m_enlarged.clear();
 }
 
-void ProxyTrees::rebuild_static_tree() {
-    m_trees[1].rebuild();
-}
+void ProxyTrees::rebuild_static_tree() { m_trees[1].rebuild(); }
 
 void ProxyTrees::validate() const {
     m_trees[0].validate();
@@ -147,12 +145,14 @@ void ProxyTrees::validate_enlarged() const {
         const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
         if (!tree_of(id).is_proxy(id.tree_id()) || static_cast<std::size_t>(id.tree_id()) >= slots.size() ||
             slots[static_cast<std::size_t>(id.tree_id())] != static_cast<std::int32_t>(i)) {
-            assert_failed("enlarged list consistent", "broadphase: enlarged list and marks disagree", __FILE__, __LINE__);
+            assert_failed("enlarged list consistent", "broadphase: enlarged list and marks disagree", __FILE__,
+                          __LINE__);
         }
     }
     std::size_t marked = 0;
     for (const auto& slots : m_enlarged_slot) {
-        marked += static_cast<std::size_t>(std::count_if(slots.begin(), slots.end(), [](std::int32_t s) { return s >= 0; }));
+        marked +=
+            static_cast<std::size_t>(std::count_if(slots.begin(), slots.end(), [](std::int32_t s) { return s >= 0; }));
     }
     if (marked != m_enlarged.size()) {
         assert_failed("marked == enlarged", "broadphase: more proxies marked enlarged than listed", __FILE__, __LINE__);

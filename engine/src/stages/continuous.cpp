@@ -56,7 +56,7 @@ Real time_of_impact(const Sweep& s, const Shape& shape, Real reach_radius, const
         if (!distance(shape, s.at(t), wall, xw, reach, d, normal)) return 1;  // never within reach
         if (d < target) return iter == 0 ? 1 : t;  // touching at the start: contacts handle it
         const Real bound = std::max(Real(0), moved.dot(normal)) + turned * reach_radius;
-        if (bound < 1e-12) return 1;  // not closing in
+        if (bound < 1e-12) return 1;      // not closing in
         t += (d - 0.5 * target) / bound;  // the surfaces cannot meet before this
         if (t >= 1) return 1;
     }
@@ -93,7 +93,8 @@ void sweep_fast_bodies(World& world) {
         std::sort(candidates.begin(), candidates.end());  // the same order whatever the tree's shape
         Real first = 1;
         for (std::uint32_t wall : candidates) {
-            first = std::min(first, time_of_impact(sweep, shape, reach_radius, b.desc[wall].shape, b.transform(wall), target));
+            first = std::min(first,
+                             time_of_impact(sweep, shape, reach_radius, b.desc[wall].shape, b.transform(wall), target));
             world.counters.swept_tests += 1;
         }
         if (first >= 1) continue;

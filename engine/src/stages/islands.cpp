@@ -183,7 +183,8 @@ void update_islands(World& world, Real dt) {
         joints.awake_dirty = true;  // read on the next call: this loop's list stays as it is
         const std::int32_t ia = b.island[joint.body_a], ib = b.island[joint.body_b];
         if (ia >= 0) world.sleeping_islands[static_cast<std::size_t>(ia)].joints.push_back(joints.handle(j));
-        if (ib >= 0 && ib != ia) world.sleeping_islands[static_cast<std::size_t>(ib)].joints.push_back(joints.handle(j));
+        if (ib >= 0 && ib != ia)
+            world.sleeping_islands[static_cast<std::size_t>(ib)].joints.push_back(joints.handle(j));
     }
 }
 

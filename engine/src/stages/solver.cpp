@@ -225,7 +225,8 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
         plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
         for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
         plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
-        for (int it = 0; it < settings.relax_iterations; ++it) plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
+        for (int it = 0; it < settings.relax_iterations; ++it)
+            plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
     }
     if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
     plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
@@ -289,47 +290,41 @@ void solve(World& world, Real dt) {
     auto push_rows = [&](const WideContact& wc) {
         return scratch.push_rows.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
     };
-    world.jobs->run_phases("Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi,
-                                                         unsigned worker) {
-        const SolverPhase phase = scratch.plan[p];
-        switch (phase.pass) {
-        case Pass::PrepareContacts:
-            prepare_contacts(world, scratch, lo, hi);
-            break;
-        case Pass::StoreImpulses:
-            store_contact_impulses(world, scratch, lo, hi);
-            break;
-        case Pass::FinalizeBodies:
-            finalize_bodies(world, scratch, lo, hi);
-            break;
-        case Pass::IntegrateVelocities:
-            integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
-            break;
-        case Pass::IntegratePositions:
-            integrate_positions(world, bodies, h, lo, hi);
-            break;
-        case Pass::WarmStart:
-            for_colored<true>(
-                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-                [&](WideContact& wc) { warm_start_contact(wc, push_rows(wc), bodies); });
-            break;
-        case Pass::Solve:
-            for_colored<true>(
-                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
-                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params); });
-            break;
-        case Pass::Relax:
-            for_colored<true>(
-                scratch, phase.color, lo, hi, [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
-                [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params); });
-            break;
-        case Pass::Restitution:
-            for_colored<false>(
-                scratch, phase.color, lo, hi, [](JointConstraint&) {},
-                [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h); });
-            break;
-        }
-    });
+    world.jobs->run_phases(
+        "Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+            const SolverPhase phase = scratch.plan[p];
+            switch (phase.pass) {
+                case Pass::PrepareContacts: prepare_contacts(world, scratch, lo, hi); break;
+                case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
+                case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
+                case Pass::IntegrateVelocities:
+                    integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
+                    break;
+                case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi); break;
+                case Pass::WarmStart:
+                    for_colored<true>(
+                        scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+                        [&](WideContact& wc) { warm_start_contact(wc, push_rows(wc), bodies); });
+                    break;
+                case Pass::Solve:
+                    for_colored<true>(
+                        scratch, phase.color, lo, hi,
+                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
+                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params); });
+                    break;
+                case Pass::Relax:
+                    for_colored<true>(
+                        scratch, phase.color, lo, hi,
+                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
+                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params); });
+                    break;
+                case Pass::Restitution:
+                    for_colored<false>(
+                        scratch, phase.color, lo, hi, [](JointConstraint&) {},
+                        [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h); });
+                    break;
+            }
+        });
     for (const EffectCounts& c : world.scratch_counts) {
         world.counters.gravity_applied += c.gravity;
         world.counters.damping_applied += c.damping;

@@ -91,7 +91,7 @@ void step(World& w, Real dt) {
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
     run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });  // poses before the solver moves them
-    run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
+    run_stage(w, Stage::Solver, [&] { solve(w, dt); });               // substeps integrate velocities and positions
     if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;

@@ -30,9 +30,10 @@ TEST(Friction, BoxSlidingAt10MetresPerSecondDeceleratesAtMuG) {
         const double expected = std::max(0.0, 10 - kMu * kGravity * t);
         worst = std::max(worst, std::abs(space->internal_linear_velocity(box).x() - expected));
     }
-    std::printf("[ measure  ] sliding box: worst |v - (10 - mu g t)| %.3g m/s over 2.5 s (stops at %.3f s), final x %.4f "
-                "(analytic %.4f)\n",
-                worst, stop_time, space->internal_position(box).x(), -20 + 10 * stop_time / 2);
+    std::printf(
+        "[ measure  ] sliding box: worst |v - (10 - mu g t)| %.3g m/s over 2.5 s (stops at %.3f s), final x %.4f "
+        "(analytic %.4f)\n",
+        worst, stop_time, space->internal_position(box).x(), -20 + 10 * stop_time / 2);
     EXPECT_LT(worst, 2e-2);
 }
 
@@ -70,7 +71,8 @@ RampRun slide_on_ramp(double mu) {
 TEST(Friction, BoxOnA025RadianRampSticksForMuFromPoint3) {
     for (const double mu : {0.3, 0.4, 0.6}) {
         const RampRun run = slide_on_ramp(mu);
-        std::printf("[ measure  ] ramp mu %.1f: moved %.3g m, speed %.3g m/s after 1 s\n", mu, run.moved, run.speed_down);
+        std::printf("[ measure  ] ramp mu %.1f: moved %.3g m, speed %.3g m/s after 1 s\n", mu, run.moved,
+                    run.speed_down);
         EXPECT_LT(std::abs(run.moved), 1e-3) << "mu " << mu;
         EXPECT_LT(std::abs(run.speed_down), 1e-3) << "mu " << mu;
     }
@@ -80,8 +82,9 @@ TEST(Friction, BoxOnA025RadianRampSlidesAtCoulombsAccelerationForMuUpToPoint2) {
     for (const double mu : {0.0, 0.1, 0.2}) {
         const RampRun run = slide_on_ramp(mu);
         const double a = kGravity * (std::sin(kRampAngle) - mu * std::cos(kRampAngle));
-        std::printf("[ measure  ] ramp mu %.1f: speed %.4f m/s after 1 s (analytic %.4f), moved %.4f m (analytic %.4f)\n",
-                    mu, run.speed_down, a, run.moved, a / 2);
+        std::printf(
+            "[ measure  ] ramp mu %.1f: speed %.4f m/s after 1 s (analytic %.4f), moved %.4f m (analytic %.4f)\n", mu,
+            run.speed_down, a, run.moved, a / 2);
         EXPECT_NEAR(run.speed_down, a, 2e-2) << "mu " << mu;
     }
 }

@@ -23,9 +23,7 @@ std::set<std::uint32_t> ids(const Manifold& m) {
     return s;
 }
 
-TEST(BoxBox, RestingCubeHasFourCornerPoints) {
-    test::expect_resting_cube_contact(kFloor, kCube);
-}
+TEST(BoxBox, RestingCubeHasFourCornerPoints) { test::expect_resting_cube_contact(kFloor, kCube); }
 
 TEST(BoxBox, SeparatedGivesNothingOrSpeculativePoints) {
     EXPECT_TRUE(run(kFloor, at(Vec3::Zero()), kCube, at(Vec3(0, 1.1, 0))).empty());
@@ -62,9 +60,7 @@ TEST(BoxBox, TiltedCubeRestsOnOneEdgeWithTwoPoints) {
     for (int i = 0; i < 2; ++i) EXPECT_NEAR(m[0].points[i].separation, -0.01, 1e-12);
 }
 
-TEST(BoxBox, CrossedEdgesGiveOneEdgePoint) {
-    test::expect_crossed_edges_contact(Shape::box(Vec3(1, 1, 1)));
-}
+TEST(BoxBox, CrossedEdgesGiveOneEdgePoint) { test::expect_crossed_edges_contact(Shape::box(Vec3(1, 1, 1))); }
 
 TEST(BoxBox, DeepOverlapPushesOutAlongShallowestFace) {
     const Shape cube = Shape::box(Vec3(1, 1, 1));

@@ -72,4 +72,5 @@ void expect_swapped_order_flips(const Shape& a, const Transform& xa, const Shape
 }  // namespace spindle::test
 
 #define SPINDLE_EXPECT_VEC_NEAR(actual, expected, tol) \
-    EXPECT_LT(((actual) - (expected)).norm(), tol) << "actual " << (actual).transpose() << " expected " << (expected).transpose()
+    EXPECT_LT(((actual) - (expected)).norm(), tol)     \
+        << "actual " << (actual).transpose() << " expected " << (expected).transpose()

@@ -75,8 +75,10 @@ TEST(ConvexConsistency, SwappedOrderFlipsNormalAndKeepsDepth) {
         for (const Shape& b : shapes) {
             SCOPED_TRACE(std::string(to_string(a.type)) + " vs " + to_string(b.type));
             for (int trial = 0; trial < 100; ++trial) {
-                const Transform xa = at(Vec3(u(rng), u(rng), u(rng)) * 0.1, about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
-                const Transform xb = at(Vec3(u(rng), u(rng), u(rng)) * 0.8, about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
+                const Transform xa = at(Vec3(u(rng), u(rng), u(rng)) * 0.1,
+                                        about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
+                const Transform xb = at(Vec3(u(rng), u(rng), u(rng)) * 0.8,
+                                        about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
                 const auto ab = test::run(a, xa, b, xb, 0.05);
                 const auto ba = test::run(b, xb, a, xa, 0.05);
                 ASSERT_EQ(ab.size(), ba.size());
@@ -104,7 +106,8 @@ TEST(ConvexConsistency, DepthMatchesBruteForcePenetration) {
             int checked = 0, exact = 0;
             for (int trial = 0; trial < 40; ++trial) {
                 const Transform xa = at(Vec3::Zero(), about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
-                const Transform xb = at(Vec3(u(rng), u(rng), u(rng)) * 0.7, about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
+                const Transform xb = at(Vec3(u(rng), u(rng), u(rng)) * 0.7,
+                                        about(Vec3(u(rng), u(rng), u(rng)), 3 * u(rng)));
                 const Real depth = penetration_depth(a, xa, b, xb);
                 const auto m = test::run(a, xa, b, xb);
                 if (depth <= 1e-6) {

@@ -46,9 +46,9 @@ void expect_valid(const ConvexHull& hull) {
 
 TEST(ConvexHull, CubeMergesIntoSixQuads) {
     std::vector<Vec3> points = test::box_corners(Vec3(1, 2, 3));
-    points.emplace_back(0, 0, 0);      // interior
-    points.emplace_back(1, 0, 0);      // middle of a face
-    points.emplace_back(1, 2, 0);      // middle of an edge
+    points.emplace_back(0, 0, 0);  // interior
+    points.emplace_back(1, 0, 0);  // middle of a face
+    points.emplace_back(1, 2, 0);  // middle of an edge
     const ConvexHull hull(points);
     EXPECT_EQ(hull.vertices().size(), 8u);
     EXPECT_EQ(hull.faces().size(), 6u);
@@ -94,7 +94,8 @@ TEST(ConvexHull, SupportIsTheFarthestVertex) {
 
 TEST(ConvexHull, RejectsTooFewNonFiniteAndZeroThicknessSets) {
     EXPECT_EQ(error_of({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}), "convex hull: needs at least 4 points, got 3");
-    EXPECT_EQ(error_of({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, std::numeric_limits<Real>::quiet_NaN(), 1)}),
+    EXPECT_EQ(error_of(
+                  {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, std::numeric_limits<Real>::quiet_NaN(), 1)}),
               "convex hull: point 3 must be finite, got (0, nan, 1)");
     EXPECT_EQ(error_of({Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(1, 1, 1)}),
               "convex hull: zero-thickness hull: all points coincide");
@@ -102,7 +103,8 @@ TEST(ConvexHull, RejectsTooFewNonFiniteAndZeroThicknessSets) {
               "convex hull: zero-thickness hull: the points are collinear");
     const std::string flat = error_of({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0), Vec3(0.5, 0.5, 0)});
     EXPECT_EQ(flat.rfind("convex hull: zero-thickness hull: the points are coplanar", 0), 0u) << flat;
-    EXPECT_THROW(Shape::convex_hull(std::vector<Vec3>{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(0, 1, 0)}), Error);
+    EXPECT_THROW(Shape::convex_hull(std::vector<Vec3>{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(0, 1, 0)}),
+                 Error);
 }
 
 }  // namespace

@@ -76,7 +76,8 @@ TEST(Degenerate, ZeroThicknessHullIsRejectedAtBuild) {
 
 TEST(Degenerate, ZeroAreaTriangleIsDroppedAndNeverCollides) {
     // The sliver sits right under the sphere; only the real triangle far away remains.
-    const std::vector<Vec3> v{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(10, 0, 0), Vec3(10, 0, 1), Vec3(11, 0, 0)};
+    const std::vector<Vec3> v{Vec3(0, 0, 0),  Vec3(1, 0, 0),  Vec3(2, 0, 0),
+                              Vec3(10, 0, 0), Vec3(10, 0, 1), Vec3(11, 0, 0)};
     const Shape mesh = Shape::triangle_mesh(v, std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5});
     EXPECT_EQ(mesh.mesh->triangles().size(), 1u);
     EXPECT_TRUE(run(Shape::sphere(0.5), at(Vec3(1, 0.2, 0)), mesh, at(Vec3::Zero())).empty());

@@ -24,9 +24,7 @@ TEST(HullHull, RestingCubeHasFourCornerPoints) {
     test::expect_resting_cube_contact(test::hull_box(Vec3(2, 0.5, 2)), test::hull_box(Vec3(0.5, 0.5, 0.5)));
 }
 
-TEST(HullHull, CrossedEdgesGiveOneEdgePoint) {
-    test::expect_crossed_edges_contact(test::hull_box(Vec3(1, 1, 1)));
-}
+TEST(HullHull, CrossedEdgesGiveOneEdgePoint) { test::expect_crossed_edges_contact(test::hull_box(Vec3(1, 1, 1))); }
 
 TEST(HullHull, TetrahedronApexPokesIntoAFace) {
     const auto m = run(test::hull_box(Vec3(1, 1, 1)), at(Vec3::Zero()), tetrahedron_point_down(),

@@ -33,7 +33,8 @@ Shape flat_grid(int n) {
 
 // A V-shaped valley along z: two planes at 45 degrees meeting at x = 0, y = 0.
 Shape valley() {
-    const std::vector<Vec3> v{Vec3(-2, 2, -2), Vec3(-2, 2, 2), Vec3(0, 0, -2), Vec3(0, 0, 2), Vec3(2, 2, -2), Vec3(2, 2, 2)};
+    const std::vector<Vec3> v{Vec3(-2, 2, -2), Vec3(-2, 2, 2), Vec3(0, 0, -2),
+                              Vec3(0, 0, 2),   Vec3(2, 2, -2), Vec3(2, 2, 2)};
     const std::vector<std::uint32_t> idx{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
     return Shape::triangle_mesh(v, idx);
 }
@@ -86,7 +87,8 @@ TEST(ConvexMesh, RollingCapsuleAndHullStayOnFaceNormals) {
 
 TEST(ConvexMesh, SphereOnARidgeTakesTheEdgeNormal) {
     // Roof ridge along x at y = 1: a sharp (active) edge.
-    const std::vector<Vec3> v{Vec3(-2, 1, 0), Vec3(2, 1, 0), Vec3(-2, 0, -1), Vec3(2, 0, -1), Vec3(-2, 0, 1), Vec3(2, 0, 1)};
+    const std::vector<Vec3> v{Vec3(-2, 1, 0), Vec3(2, 1, 0),  Vec3(-2, 0, -1),
+                              Vec3(2, 0, -1), Vec3(-2, 0, 1), Vec3(2, 0, 1)};
     const Shape roof = Shape::triangle_mesh(v, std::vector<std::uint32_t>{0, 1, 2, 1, 3, 2, 1, 0, 4, 1, 4, 5});
     const auto m = run(Shape::sphere(0.5), at(Vec3(0, 1.45, 0)), roof, at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
@@ -133,10 +135,12 @@ TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
     // run() checks every normal, point and separation; the mesh mixes flat seams, a
     // ridge and a valley.
     const std::vector<Vec3> v{Vec3(-2, 0, -2), Vec3(-2, 0, 2), Vec3(0, 1, -2), Vec3(0, 1, 2),
-                              Vec3(2, 0, -2), Vec3(2, 0, 2),  Vec3(4, 1, -2), Vec3(4, 1, 2)};
-    const Shape mesh = Shape::triangle_mesh(v, std::vector<std::uint32_t>{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4, 4, 5, 7, 4, 7, 6});
+                              Vec3(2, 0, -2),  Vec3(2, 0, 2),  Vec3(4, 1, -2), Vec3(4, 1, 2)};
+    const Shape mesh =
+        Shape::triangle_mesh(v, std::vector<std::uint32_t>{0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4, 4, 5, 7, 4, 7, 6});
     std::vector<Vec3> cloud;
-    for (int i = 0; i < 12; ++i) cloud.emplace_back(std::cos(i * 1.3) * 0.4, std::sin(i * 2.1) * 0.3, std::cos(i * 0.7) * 0.5);
+    for (int i = 0; i < 12; ++i)
+        cloud.emplace_back(std::cos(i * 1.3) * 0.4, std::sin(i * 2.1) * 0.3, std::cos(i * 0.7) * 0.5);
     const Shape shapes[] = {Shape::sphere(0.4), Shape::capsule(0.4, 0.2), Shape::box(Vec3(0.3, 0.4, 0.5)),
                             Shape::convex_hull(cloud)};
     unsigned seed = 3;
@@ -147,10 +151,12 @@ TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
     int hits = 0;
     for (const Shape& s : shapes) {
         for (int trial = 0; trial < 100; ++trial) {
-            const Transform x = at(Vec3(1 + 3 * rnd(), 0.5 + 0.6 * rnd(), 1.5 * rnd()), about(Vec3(rnd(), rnd(), rnd()), 3 * rnd()));
+            const Transform x = at(Vec3(1 + 3 * rnd(), 0.5 + 0.6 * rnd(), 1.5 * rnd()),
+                                   about(Vec3(rnd(), rnd(), rnd()), 3 * rnd()));
             const auto m = run(s, x, mesh, at(Vec3::Zero()), 0.05, 4);
             hits += m.empty() ? 0 : 1;
-            for (std::size_t i = 1; i < m.size(); ++i) EXPECT_LE(test::min_separation(m[i - 1]), test::min_separation(m[i]));
+            for (std::size_t i = 1; i < m.size(); ++i)
+                EXPECT_LE(test::min_separation(m[i - 1]), test::min_separation(m[i]));
         }
     }
     EXPECT_GT(hits, 100);

@@ -38,7 +38,8 @@ TEST(ShapeFactory, RejectsBadSizesNamingFieldAndValue) {
     EXPECT_EQ(error_of([] { Shape::capsule(-0.5, 1); }), "capsule: half_height must be positive and finite, got -0.5");
     EXPECT_EQ(error_of([] { Shape::capsule(1, std::numeric_limits<Real>::infinity()); }),
               "capsule: radius must be positive and finite, got inf");
-    EXPECT_EQ(error_of([] { Shape::plane(Vec3::Zero(), 1); }), "plane: normal must be finite and non-zero, got (0, 0, 0)");
+    EXPECT_EQ(error_of([] { Shape::plane(Vec3::Zero(), 1); }),
+              "plane: normal must be finite and non-zero, got (0, 0, 0)");
     EXPECT_EQ(error_of([] { Shape::plane(Vec3::UnitY(), std::numeric_limits<Real>::infinity()); }),
               "plane: offset must be finite, got inf");
 }

@@ -37,7 +37,8 @@ BarRun spin_bar_at_wall(bool fast) {
     for (int i = 0; i < 30; ++i) {
         space.update();
         const MotionState s = space.internal_motion_state(h);
-        for (double end : {2.0, -2.0}) run.max_tip_x = std::max(run.max_tip_x, (s.position + s.orientation * Vec3(end, 0, 0)).x());
+        for (double end : {2.0, -2.0})
+            run.max_tip_x = std::max(run.max_tip_x, (s.position + s.orientation * Vec3(end, 0, 0)).x());
     }
     run.swept_tests = space.counters().swept_tests;
     return run;

@@ -25,7 +25,8 @@ std::unique_ptr<JobSystem> jobs_for(unsigned workers) {
     if (workers == 1) return std::make_unique<SingleThreadedJobSystem>();
     const Topology machine = Topology::from_system();
     WorkStealingJobSystem::Options options;
-    for (unsigned i = 0; i < workers; ++i) options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
+    for (unsigned i = 0; i < workers; ++i)
+        options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
     options.pin = workers <= machine.pus().size();
     return std::make_unique<WorkStealingJobSystem>(options);
 }

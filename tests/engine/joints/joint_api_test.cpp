@@ -43,7 +43,8 @@ TEST(JointValidation, BadJointsAreRejectedNamingTheFieldAndChangeNothing) {
     };
     expect(JointDesc::ball_socket_at(a, a, Vec3::Zero()), "body_a and body_b must be different bodies");
     expect(JointDesc::ball_socket_at(ground, wall, Vec3::Zero()), "at least one of body_a and body_b must be dynamic");
-    expect(JointDesc::ball_socket_at(BodyHandle{99, 1}, a, Vec3::Zero()), "body_a: body 99 (generation 1) is not a live body");
+    expect(JointDesc::ball_socket_at(BodyHandle{99, 1}, a, Vec3::Zero()),
+           "body_a: body 99 (generation 1) is not a live body");
     expect(JointDesc::ball_socket_at(a, BodyHandle{}, Vec3::Zero()), "body_b:");
     expect(JointDesc::ball_socket_at(a, b, Vec3(nan, 0, 0)), "anchors.a must be finite");
     JointDesc local = JointDesc::ball_socket_at(a, b, Vec3::Zero());

@@ -135,7 +135,8 @@ TEST(Distance, RigidRodKeepsItsLength) {
     space.set_sleep(SleepSettings{.enabled = false});
     const BodyHandle anchor = add_static(space, Vec3(0, 3, 0));
     const BodyHandle bob = add_sphere(space, Vec3(1.5, 3, 0), 0.1, 1);
-    const JointHandle joint = space.create_joint(JointDesc::distance_between(anchor, bob, Vec3(0, 3, 0), Vec3(1.5, 3, 0)));
+    const JointHandle joint =
+        space.create_joint(JointDesc::distance_between(anchor, bob, Vec3(0, 3, 0), Vec3(1.5, 3, 0)));
     double worst = 0;
     for (int i = 0; i < 300; ++i) {
         space.update();
@@ -234,7 +235,8 @@ TEST(Counters, JointsSolvedCountsJointIterations) {
     const Chain chain = make_chain(space, Vec3(0, 5, 0), Vec3::UnitX(), 3, 0.5, 1);
     for (int i = 0; i < 10; ++i) space.update();
     const SolverSettings& s = space.settings().solver;
-    EXPECT_EQ(space.counters().joints_solved, 3u * 10u * static_cast<unsigned>(s.substeps * (s.iterations + s.relax_iterations)));
+    EXPECT_EQ(space.counters().joints_solved,
+              3u * 10u * static_cast<unsigned>(s.substeps * (s.iterations + s.relax_iterations)));
 }
 
 TEST(Sleeping, AHangingChainSleepsAsOneIslandAndWakesTogether) {

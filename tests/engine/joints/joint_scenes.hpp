@@ -41,8 +41,8 @@ struct Chain {
 // A chain hung from a static anchor at `top`: `links` bars of length `spacing` along
 // `direction`, joined end to end by ball-socket joints; with end_mass > 0, a ball of
 // that mass hangs from the last bar.
-inline Chain make_chain(Space& space, const Vec3& top, const Vec3& direction, int links, Real spacing,
-                        Real link_mass, Real end_mass = 0) {
+inline Chain make_chain(Space& space, const Vec3& top, const Vec3& direction, int links, Real spacing, Real link_mass,
+                        Real end_mass = 0) {
     Chain chain;
     const Quat along = Quat::FromTwoVectors(Vec3::UnitX(), direction);
     BodyHandle previous = add_static(space, top);

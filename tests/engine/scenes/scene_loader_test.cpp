@@ -1,10 +1,10 @@
 // Scene files: every file in configs/scenes parses and builds, the built-in scenes
 // are what they claim, broken files are rejected at the right line and column, and
 // build() is all or nothing.
-#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/assert.hpp>
 #include <spindle/platform/error.hpp>
+#include <spindle/scene/scene.hpp>
 
 #include <gtest/gtest.h>
 
@@ -48,11 +48,11 @@ std::string build_error(const SceneDesc& scene, Space& space) {
     return "(no error)";
 }
 
-#define EXPECT_REJECTED(text, where, what)                                  \
-    do {                                                                    \
-        const std::string message = parse_error(text);                      \
+#define EXPECT_REJECTED(text, where, what)                                                                \
+    do {                                                                                                  \
+        const std::string message = parse_error(text);                                                    \
         EXPECT_NE(message.find(std::string("bad.toml:") + (where) + ": "), std::string::npos) << message; \
-        EXPECT_NE(message.find(what), std::string::npos) << message;        \
+        EXPECT_NE(message.find(what), std::string::npos) << message;                                      \
     } while (0)
 
 TEST(SceneFiles, EveryConfigScene_Parses) {
@@ -149,8 +149,8 @@ TEST(SceneFiles, OtherScenes_HaveWhatTheyPromise) {
     const SceneDesc pile = load("pile");
     std::vector<bool> seen(static_cast<int>(ShapeType::Count), false);
     for (const SceneBody& b : pile.bodies) seen[static_cast<int>(pile.shapes[b.shape].type)] = true;
-    for (ShapeType t : {ShapeType::Sphere, ShapeType::Box, ShapeType::Capsule, ShapeType::ConvexHull,
-                        ShapeType::TriangleMesh}) {
+    for (ShapeType t :
+         {ShapeType::Sphere, ShapeType::Box, ShapeType::Capsule, ShapeType::ConvexHull, ShapeType::TriangleMesh}) {
         EXPECT_TRUE(seen[static_cast<int>(t)]) << to_string(t);
     }
     const SceneDesc mass_ratio = load("mass_ratio");
@@ -345,18 +345,18 @@ count = 2
 spacing = 4
 )",
                                         "order.toml");
-    std::vector<Vec3> expected = {{100, 0, 0},
-                                  {0, 0.25, 0}, {0, 0.85, 0}, {0, 1.45, 0},               // 0.5 high + 0.1 gap
-                                  {1, 2, 3}, {11, 2, 3}, {1, 2, 23}, {11, 2, 23}, {1, 2, 43}, {11, 2, 43},  // x fastest
-                                  {0, 0, 5}, {1, 0, 5}, {2, 0, 5}, {0.5, 0.5, 5}, {1.5, 0.5, 5}, {1, 1, 5},
-                                  {0, 0, 0}, {0, 4, 0}};
+    std::vector<Vec3> expected = {{100, 0, 0},   {0, 0.25, 0}, {0, 0.85, 0}, {0, 1.45, 0},  // 0.5 high + 0.1 gap
+                                  {1, 2, 3},     {11, 2, 3},   {1, 2, 23},   {11, 2, 23},
+                                  {1, 2, 43},    {11, 2, 43},  // x fastest
+                                  {0, 0, 5},     {1, 0, 5},    {2, 0, 5},    {0.5, 0.5, 5},
+                                  {1.5, 0.5, 5}, {1, 1, 5},    {0, 0, 0},    {0, 4, 0}};
     ASSERT_EQ(scene.bodies.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
         EXPECT_TRUE(scene.bodies[i].desc.position.isApprox(expected[i], 1e-12))
             << i << ": " << scene.bodies[i].desc.position.transpose();
     }
     EXPECT_EQ(scene.bodies[0].line, 5u);  // the [[body]] header
-    EXPECT_EQ(scene.shapes.size(), 1u);  // one shape shared by every body
+    EXPECT_EQ(scene.shapes.size(), 1u);   // one shape shared by every body
 }
 
 TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
@@ -377,7 +377,8 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
     EXPECT_REJECTED("[settings]\nmax_steps_per_frame = 2\nmin_steps_per_frame = 3\n", "3:23",
                     "expected at most max_steps_per_frame (2)");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nposition = [0, 1, 0\n", "3:21", "");  // TOML syntax
-    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nfriction = 1\nfriction = 2\n", "4:12", "redefine");  // duplicate key
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nfriction = 1\nfriction = 2\n", "4:12",
+                    "redefine");  // duplicate key
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ntype = \"wobbly\"\n", "3:8",
                     "expected \"dynamic\", \"static\" or \"kinematic\"");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nrestitution = 2\n", "3:15", "expected a number in [0, 1]");
@@ -387,16 +388,17 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nposition = [0, nan, 0]\n", "3:16", "expected a finite number");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncopies = { count = [2, 0, 1], step = [1, 1, 1] }\n", "3:24",
                     "body.copies.count: expected an integer in [1, 1000000], got 0");
-    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncopies = { count = [1000, 1000, 10], step = [1, 1, 1] }\n", "1:1",
-                    "a scene may have at most 1000000");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncopies = { count = [1000, 1000, 10], step = [1, 1, 1] }\n",
+                    "1:1", "a scene may have at most 1000000");
     EXPECT_REJECTED("[[pyramid]]\nshape = { box = [1, 1, 1] }\n", "1:1", "pyramid: missing key 'layers'");
     EXPECT_REJECTED("[[stack]]\nshape = { sphere = 1 }\ncount = 2\ngap = 0.1\nspacing = 3\n", "5:11",
                     "stack.spacing: not allowed together with gap");
     EXPECT_REJECTED("[[body]]\ntype = \"static\"\nshape = { mesh = { vertices = [[0, 0, 0], [1, 0, 0], [0, 0, 1]], "
                     "triangles = [[0, 1, 3]] } }\n",
                     "3:86", "body.shape.mesh.triangles: expected an integer in [0, 2], got 3");
-    EXPECT_REJECTED("[[body]]\ntype = \"static\"\nshape = { heightfield = { size = [1, 1], heights = [[0, 0, 0], [0, 0]] } }\n",
-                    "3:64", "expected every row to have 3 heights, got 2");
+    EXPECT_REJECTED(
+        "[[body]]\ntype = \"static\"\nshape = { heightfield = { size = [1, 1], heights = [[0, 0, 0], [0, 0]] } }\n",
+        "3:64", "expected every row to have 3 heights, got 2");
     EXPECT_REJECTED("[[body]]\nshape = { hull = [[0, 0, 0], [1, 0, 0], [0, 1, 0]] }\n", "2:18",
                     "expected at least 4 points, got 3");
     EXPECT_REJECTED("[body]\nshape = { sphere = 1 }\n", "1:1", "body: expected [[body]] entries");
@@ -484,18 +486,18 @@ TEST(SceneBuild, ARejectedShape_FailsBeforeAnyBodyIsCreated) {
 namespace spindle {
 
 TEST(SceneParse, Chain_MakesLinksAnAnchorAndJoints) {
-    const SceneDesc scene = parse_scene(
-        "[[chain]]\nshape = { box = [0.25, 0.1, 0.1] }\nlinks = 3\nposition = [1, 5, 0]\nend_mass = 50\n"
-        "copies = { count = [1, 1, 2], step = [0, 0, 2] }\n",
-        "chain.toml");
+    const SceneDesc scene =
+        parse_scene("[[chain]]\nshape = { box = [0.25, 0.1, 0.1] }\nlinks = 3\nposition = [1, 5, 0]\nend_mass = 50\n"
+                    "copies = { count = [1, 1, 2], step = [0, 0, 2] }\n",
+                    "chain.toml");
     ASSERT_EQ(scene.bodies.size(), 8u);  // (3 links + 1 anchor) x 2 copies
     ASSERT_EQ(scene.joints.size(), 6u);
     // First copy: links centred 0.25, 0.75, 1.25 m along x from the anchor at (1, 5, 0).
     EXPECT_NEAR(scene.bodies[0].desc.position.x(), 1.25, 1e-12);
     EXPECT_NEAR(scene.bodies[2].desc.position.x(), 2.25, 1e-12);
-    EXPECT_EQ(scene.bodies[2].desc.mass, 50.0);  // the heavy end
+    EXPECT_EQ(scene.bodies[2].desc.mass, 50.0);                // the heavy end
     EXPECT_EQ(scene.bodies[3].desc.type, MotionType::Static);  // the anchor
-    EXPECT_EQ(scene.joints[0].body_a, 3u);  // anchor to first link
+    EXPECT_EQ(scene.joints[0].body_a, 3u);                     // anchor to first link
     EXPECT_EQ(scene.joints[0].body_b, 0u);
     EXPECT_EQ(scene.joints[2].body_a, 1u);
     EXPECT_NEAR(scene.joints[2].anchor.x(), 2.0, 1e-12);

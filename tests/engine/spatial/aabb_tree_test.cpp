@@ -43,7 +43,8 @@ std::vector<std::int32_t> query_sorted(const DynamicAabbTree& tree, const Aabb& 
     return ids;
 }
 
-std::vector<std::int32_t> brute_sorted(const DynamicAabbTree& tree, const std::vector<std::int32_t>& live, const Aabb& box) {
+std::vector<std::int32_t> brute_sorted(const DynamicAabbTree& tree, const std::vector<std::int32_t>& live,
+                                       const Aabb& box) {
     std::vector<std::int32_t> ids;
     for (const std::int32_t id : live) {
         if (tree.fat_aabb(id).overlaps(box)) ids.push_back(id);
@@ -89,7 +90,8 @@ TEST(AabbTree, Query_MatchesBruteForce) {
 
 TEST(AabbTree, Query_CallbackFalseStops) {
     DynamicAabbTree tree;
-    for (int i = 0; i < 10; ++i) tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
+    for (int i = 0; i < 10; ++i)
+        tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
     int calls = 0;
     tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), [&](std::int32_t) {
         ++calls;
@@ -190,7 +192,8 @@ TEST(AabbTree, SortedInsertion_StaysShallow) {
     const int n = 1024 * kScale;
     std::vector<std::int32_t> ids;
     for (int i = 0; i < n; ++i) {
-        ids.push_back(tree.create_proxy(Aabb::from_center_extents(Vec3(i, 0, 0), Vec3::Constant(0.4)), std::uint64_t(i)));
+        ids.push_back(
+            tree.create_proxy(Aabb::from_center_extents(Vec3(i, 0, 0), Vec3::Constant(0.4)), std::uint64_t(i)));
     }
     tree.validate();
     EXPECT_LE(tree.height(), height_limit(n));
@@ -266,7 +269,8 @@ TEST(AabbTree, Rebuild_KeepsProxiesAndQueriesAndLowersCost) {
 TEST(AabbTree, Rebuild_IdenticalBoxesGiveBalancedTree) {
     DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
     const int n = 1000;
-    for (int i = 0; i < n; ++i) tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
+    for (int i = 0; i < n; ++i)
+        tree.create_proxy(Aabb::from_center_extents(Vec3::Zero(), Vec3::Ones()), std::uint64_t(i));
     tree.rebuild();
     tree.validate();
     EXPECT_LE(tree.height(), static_cast<int>(std::ceil(std::log2(n))));
@@ -321,7 +325,9 @@ TEST(AabbTree, RayCast_MatchesBruteForceAndStops) {
 }
 
 #ifndef NDEBUG
-[[noreturn]] void throwing_handler(const char*, const char* message, const char*, int) { throw std::logic_error(message); }
+[[noreturn]] void throwing_handler(const char*, const char* message, const char*, int) {
+    throw std::logic_error(message);
+}
 
 TEST(AabbTree, StaleProxyId_Asserts) {
     const AssertHandler previous = set_assert_handler(&throwing_handler);

@@ -29,7 +29,8 @@ std::vector<UserPair> user_pairs(const std::vector<Pair>& pairs) {
 bool is_canonical_and_unique(const std::vector<Pair>& pairs) {
     for (std::size_t i = 0; i < pairs.size(); ++i) {
         if (pairs[i].user_a > pairs[i].user_b) return false;
-        if (i > 0 && !(UserPair(pairs[i - 1].user_a, pairs[i - 1].user_b) < UserPair(pairs[i].user_a, pairs[i].user_b))) {
+        if (i > 0 &&
+            !(UserPair(pairs[i - 1].user_a, pairs[i - 1].user_b) < UserPair(pairs[i].user_a, pairs[i].user_b))) {
             return false;  // users are unique per proxy in these tests, so pairs must strictly increase
         }
     }
@@ -40,7 +41,7 @@ TEST(ProxyTrees, NewProxies_ReportEachOverlapOnceAndNeverStaticWithStatic) {
     ProxyTrees bp;
     SingleThreadedJobSystem jobs;
     bp.create_proxy(cube(Vec3(0, 0, 0), 1), 10, true);
-    bp.create_proxy(cube(Vec3(1, 0, 0), 1), 11, true);  // overlaps static 10: never reported
+    bp.create_proxy(cube(Vec3(1, 0, 0), 1), 11, true);    // overlaps static 10: never reported
     bp.create_proxy(cube(Vec3(0, 1.5, 0), 1), 3, false);  // overlaps 10, 11 and moving 4
     bp.create_proxy(cube(Vec3(0, 3, 0), 1), 4, false);
     bp.create_proxy(cube(Vec3(50, 0, 0), 1), 5, false);  // alone
@@ -342,7 +343,8 @@ TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
     ProxyTrees bp;
     SingleThreadedJobSystem jobs;
     std::vector<ProxyId> statics;
-    for (int i = 0; i < 200; ++i) statics.push_back(bp.create_proxy(cube(Vec3(i * 1.5, 0, 0), 1), std::uint64_t(i), true));
+    for (int i = 0; i < 200; ++i)
+        statics.push_back(bp.create_proxy(cube(Vec3(i * 1.5, 0, 0), 1), std::uint64_t(i), true));
     std::vector<Pair> pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_TRUE(pairs.empty());
@@ -351,7 +353,8 @@ TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
     const ProxyId m = bp.create_proxy(cube(Vec3(30, 1.5, 0), 1), 1000, false);
     bp.update_pairs(jobs, pairs);
     EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{19, 1000}, {20, 1000}, {21, 1000}}));
-    for (const ProxyId s : statics) EXPECT_EQ(bp.user(s), static_cast<std::uint64_t>(bp.fat_aabb(s).center().x() / 1.5 + 0.5));
+    for (const ProxyId s : statics)
+        EXPECT_EQ(bp.user(s), static_cast<std::uint64_t>(bp.fat_aabb(s).center().x() / 1.5 + 0.5));
     int found = 0;
     bp.query(cube(Vec3(30, 0.7, 0), 0.1), [&](ProxyId id) {
         found += (id == m || id.is_static()) ? 1 : 0;

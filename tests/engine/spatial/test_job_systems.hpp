@@ -18,8 +18,7 @@ class ReverseThreadedJobSystem final : public JobSystem {
 public:
     explicit ReverseThreadedJobSystem(unsigned workers) : m_workers(workers == 0 ? 1 : workers) {}
     unsigned worker_count() const noexcept override { return m_workers; }
-    void parallel_for(const char*, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
-                      RangeFn fn) override {
+    void parallel_for(const char*, std::uint32_t begin, std::uint32_t end, std::uint32_t grain, RangeFn fn) override {
         if (begin >= end) return;
         if (grain == 0) grain = 1;
         const std::uint64_t chunks = (std::uint64_t(end - begin) + grain - 1) / grain;

@@ -28,8 +28,8 @@ struct AsyncRunnerOptions {
 struct AsyncStats {
     std::uint64_t updates = 0;
     std::uint64_t steps = 0;
-    std::uint64_t steps_dropped = 0;      // whole steps' worth of time dropped by the cap
-    double seconds = 0;                   // wall time the loop has run
+    std::uint64_t steps_dropped = 0;  // whole steps' worth of time dropped by the cap
+    double seconds = 0;               // wall time the loop has run
     double steps_per_second = 0;
     double update_ms_p50 = 0, update_ms_p99 = 0, update_ms_max = 0;  // updates that took a step
     double lock_us_p50 = 0, lock_us_p99 = 0, lock_us_max = 0;        // flip's hold of the motion-state lock

@@ -29,7 +29,7 @@ enum class MotionType : std::uint8_t {
 
 // Everything that describes a body's motion at one instant.
 struct MotionState {
-    Vec3 position = Vec3::Zero();          // the shape's origin, world
+    Vec3 position = Vec3::Zero();  // the shape's origin, world
     Quat orientation = Quat::Identity();
     Vec3 linear_velocity = Vec3::Zero();   // of the centre of mass
     Vec3 angular_velocity = Vec3::Zero();  // world
@@ -53,7 +53,7 @@ struct BodyDesc {
     bool gyroscopic = false;   // implicit gyroscopic torque (spinning asymmetric bodies)
     bool allow_interpolation = true;
     bool allow_sleep = true;
-    bool fast = false;         // also swept against static geometry (continuous collision)
+    bool fast = false;  // also swept against static geometry (continuous collision)
     std::uint64_t user_data = 0;
 };
 

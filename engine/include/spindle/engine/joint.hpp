@@ -68,8 +68,8 @@ struct DistanceParams {
     Real spring_hertz = 0;          // 0 with enable_spring: no spring force (a rope within the limits)
     Real spring_damping_ratio = 0;  // 1 = critical
     bool enable_limit = false;
-    Real min_length = 0;     // m
-    Real max_length = kHuge; // m; >= min_length
+    Real min_length = 0;      // m
+    Real max_length = kHuge;  // m; >= min_length
 };
 
 struct JointDesc {
@@ -77,8 +77,8 @@ struct JointDesc {
     BodyHandle body_a;
     BodyHandle body_b;
     JointAnchors anchors;
-    HingeParams hinge;        // used by Hinge
-    DistanceParams distance;  // used by Distance
+    HingeParams hinge;               // used by Hinge
+    DistanceParams distance;         // used by Distance
     bool collide_connected = false;  // false: the two bodies never make contacts with each other
     std::uint64_t user_data = 0;
 

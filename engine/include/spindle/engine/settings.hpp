@@ -7,45 +7,45 @@ namespace spindle {
 
 // Internal time stepping (the seed, section 1.A; design.md section 3).
 struct TimeStepSettings {
-    Real duration = 1.0 / 60.0;        // seconds per step
-    int max_steps_per_frame = 10;      // cap per update(); leftover beyond the cap's worth is dropped
-    int min_steps_per_frame = 0;       // steps taken by every update(dt) even without elapsed time
+    Real duration = 1.0 / 60.0;    // seconds per step
+    int max_steps_per_frame = 10;  // cap per update(); leftover beyond the cap's worth is dropped
+    int min_steps_per_frame = 0;   // steps taken by every update(dt) even without elapsed time
     bool use_internal_time_stepping = false;
 };
 
 struct SolverSettings {
     int substeps = 4;
-    int iterations = 1;             // solve iterations per substep
-    int relax_iterations = 1;       // relax iterations per substep
+    int iterations = 1;        // solve iterations per substep
+    int relax_iterations = 1;  // relax iterations per substep
     // Contact stiffness in hertz; 0 picks the stiffest stable one, a quarter of the
     // substep rate (60 Hz at 4 substeps of 1/60 s), and larger values are capped there.
     // Soft contacts compress in proportion to the load they carry, so a tall stack on
     // contacts too soft for its height buckles: 20 boxes need 60 Hz, 30 need 90 Hz
     // (6 substeps). More substeps buy stiffness.
     Real contact_hertz = 0;
-    Real damping_ratio = 10;        // contact damping ratio
+    Real damping_ratio = 10;  // contact damping ratio
     // Joint stiffness in hertz, capped like contacts at a quarter of the substep rate; 0
     // picks that cap, the stiffest stable (60 Hz at 4 substeps of 1/60 s). Soft joints
     // are springs for their effective mass: a load F stretches one by about
     // F / (m_eff (2 pi hz)^2), so a heavy body on light links wants more substeps.
     Real joint_hertz = 60;
     Real joint_damping_ratio = 2;
-    Real push_out_speed = 3;        // m/s: most speed used to push overlapping bodies apart
+    Real push_out_speed = 3;  // m/s: most speed used to push overlapping bodies apart
     // m: overlap up to this depth is corrected by the soft contact itself (it carries
     // the load: a heavy body compresses soft contacts by a few cm); deeper overlap is
     // pushed out by a split impulse that moves bodies without giving them speed, at most
     // push_out_speed per body, so a chain of overlapping bodies separates without launching.
     Real recovery_depth = 0.02;
-    Real restitution_threshold = 1; // m/s: slower approaches do not bounce
+    Real restitution_threshold = 1;    // m/s: slower approaches do not bounce
     Real speculative_distance = 0.04;  // m: contacts are made this far before touching
-    Real linear_slop = 0.005;       // m: allowed penetration
+    Real linear_slop = 0.005;          // m: allowed penetration
 };
 
 struct SleepSettings {
     bool enabled = true;
-    Real time_to_sleep = 0.5;        // s a whole island must rest
-    Real linear_threshold = 0.05;    // m/s
-    Real angular_threshold = 0.05;   // rad/s
+    Real time_to_sleep = 0.5;       // s a whole island must rest
+    Real linear_threshold = 0.05;   // m/s
+    Real angular_threshold = 0.05;  // rad/s
 };
 
 struct SpaceSettings {

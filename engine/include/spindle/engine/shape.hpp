@@ -26,11 +26,11 @@ struct MassProperties {
 
 struct Shape {
     ShapeType type = ShapeType::Sphere;
-    Real radius = 0;                     // sphere, capsule
-    Real half_height = 0;                // capsule: segment from (0,-h,0) to (0,h,0)
-    Vec3 half_extents = Vec3::Zero();    // box
-    Vec3 normal = Vec3::UnitY();         // plane: points x with normal . x = offset (shape frame)
-    Real offset = 0;                     // plane
+    Real radius = 0;                   // sphere, capsule
+    Real half_height = 0;              // capsule: segment from (0,-h,0) to (0,h,0)
+    Vec3 half_extents = Vec3::Zero();  // box
+    Vec3 normal = Vec3::UnitY();       // plane: points x with normal . x = offset (shape frame)
+    Real offset = 0;                   // plane
     std::shared_ptr<const ConvexHull> hull;
     std::shared_ptr<const TriangleMesh> mesh;
 

@@ -78,11 +78,11 @@ public:
     Vec3 center_of_mass(BodyHandle body) const;
     Vec3 linear_velocity(BodyHandle body) const;
     Vec3 angular_velocity(BodyHandle body) const;
-    void set_position(BodyHandle body, const Vec3& position);           // a teleport
-    void set_orientation(BodyHandle body, const Quat& orientation);     // a teleport
+    void set_position(BodyHandle body, const Vec3& position);        // a teleport
+    void set_orientation(BodyHandle body, const Quat& orientation);  // a teleport
     void set_linear_velocity(BodyHandle body, const Vec3& velocity);
     void set_angular_velocity(BodyHandle body, const Vec3& velocity);
-    void set_motion_state(BodyHandle body, const MotionState& state);   // all of it; a teleport
+    void set_motion_state(BodyHandle body, const MotionState& state);  // all of it; a teleport
     // Accumulate until a step consumes them (an update that takes no step loses nothing).
     void add_force(BodyHandle body, const Vec3& force);    // at the centre of mass, for one step
     void add_torque(BodyHandle body, const Vec3& torque);  // for one step

@@ -22,32 +22,32 @@ enum class Stage : std::uint8_t {
 const char* to_string(Stage stage) noexcept;
 
 struct UpdateStats {
-    int steps = 0;                   // steps taken by this update
-    double dropped_seconds = 0;      // time beyond the cap's worth, thrown away
+    int steps = 0;               // steps taken by this update
+    double dropped_seconds = 0;  // time beyond the cap's worth, thrown away
     int writes_applied = 0;
-    int writes_rejected = 0;         // buffered writes to bodies destroyed since (reported, not applied)
+    int writes_rejected = 0;  // buffered writes to bodies destroyed since (reported, not applied)
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};  // summed over the steps
-    double flip_lock_seconds = 0;    // how long FlipReadBuffers held the motion-state lock
+    double flip_lock_seconds = 0;  // how long FlipReadBuffers held the motion-state lock
     std::uint32_t awake_bodies = 0;
-    std::uint32_t contacts = 0;      // touching manifolds after the last step
+    std::uint32_t contacts = 0;  // touching manifolds after the last step
 };
 
 // Totals since the space was created. Each counts the work of one effect, so a test
 // can show an effect costs nothing where a scene does not use it.
 struct WorkCounters {
     std::uint64_t steps = 0;
-    std::uint64_t bodies_integrated = 0;       // body-steps of velocity integration
-    std::uint64_t gravity_applied = 0;         // body-substeps with gravity
-    std::uint64_t damping_applied = 0;         // body-substeps with damping
-    std::uint64_t gyroscopic_applied = 0;      // body-substeps with gyroscopic torque
-    std::uint64_t contacts_updated = 0;        // contact-steps through the narrowphase
-    std::uint64_t manifolds_reused = 0;        // of those, moved with the bodies instead of recomputed
-    std::uint64_t contact_points_solved = 0;   // point-iterations in the contact solver
-    std::uint64_t restitution_applied = 0;     // points with restitution > 0 checked
-    std::uint64_t friction_applied = 0;        // point-iterations with friction > 0
-    std::uint64_t joints_solved = 0;           // joint-iterations
-    std::uint64_t constraint_colorings = 0;    // steps that coloured their constraints (the rest reused the last step's)
-    std::uint64_t swept_tests = 0;             // continuous-collision sweeps
+    std::uint64_t bodies_integrated = 0;      // body-steps of velocity integration
+    std::uint64_t gravity_applied = 0;        // body-substeps with gravity
+    std::uint64_t damping_applied = 0;        // body-substeps with damping
+    std::uint64_t gyroscopic_applied = 0;     // body-substeps with gyroscopic torque
+    std::uint64_t contacts_updated = 0;       // contact-steps through the narrowphase
+    std::uint64_t manifolds_reused = 0;       // of those, moved with the bodies instead of recomputed
+    std::uint64_t contact_points_solved = 0;  // point-iterations in the contact solver
+    std::uint64_t restitution_applied = 0;    // points with restitution > 0 checked
+    std::uint64_t friction_applied = 0;       // point-iterations with friction > 0
+    std::uint64_t joints_solved = 0;          // joint-iterations
+    std::uint64_t constraint_colorings = 0;   // steps that coloured their constraints (the rest reused the last step's)
+    std::uint64_t swept_tests = 0;            // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
     std::uint64_t awake_publishes = 0;         // awake bodies' entries refilled by FlipReadBuffers
 };

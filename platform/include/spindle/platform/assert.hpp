@@ -14,8 +14,8 @@ AssertHandler set_assert_handler(AssertHandler handler);
 }  // namespace spindle
 
 #if !defined(NDEBUG) || defined(SPINDLE_ENABLE_ASSERTS)
-#define SPINDLE_ASSERT(cond, message)                                          \
-    do {                                                                       \
+#define SPINDLE_ASSERT(cond, message)                                              \
+    do {                                                                           \
         if (!(cond)) ::spindle::assert_failed(#cond, message, __FILE__, __LINE__); \
     } while (false)
 #else

@@ -9,9 +9,7 @@ namespace spindle {
 using Clock = std::chrono::steady_clock;
 
 // Seconds on the monotonic clock since an arbitrary fixed point.
-inline double now_seconds() noexcept {
-    return std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
-}
+inline double now_seconds() noexcept { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
 inline std::int64_t now_nanoseconds() noexcept {
     return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
@@ -22,9 +20,7 @@ class Stopwatch {
 public:
     Stopwatch() noexcept : m_start(Clock::now()) {}
     void restart() noexcept { m_start = Clock::now(); }
-    double elapsed_seconds() const noexcept {
-        return std::chrono::duration<double>(Clock::now() - m_start).count();
-    }
+    double elapsed_seconds() const noexcept { return std::chrono::duration<double>(Clock::now() - m_start).count(); }
     std::int64_t elapsed_nanoseconds() const noexcept {
         return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - m_start).count();
     }

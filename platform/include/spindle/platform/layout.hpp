@@ -15,17 +15,16 @@ namespace spindle {
 
 struct Layout {
     std::string name;
-    std::string source;           // file it came from (or "<embedded>")
-    std::string model;            // hwloc synthetic description, or "machine"
-    unsigned game = 0;            // modelled hardware thread (logical PU index)
-    unsigned physics = 0;         // modelled hardware thread of the physics loop
+    std::string source;             // file it came from (or "<embedded>")
+    std::string model;              // hwloc synthetic description, or "machine"
+    unsigned game = 0;              // modelled hardware thread (logical PU index)
+    unsigned physics = 0;           // modelled hardware thread of the physics loop
     std::vector<unsigned> workers;  // modelled hardware threads of the workers, in order
 
     // Parses TOML. Unknown keys, wrong types, out-of-range, duplicate or missing
     // threads throw spindle::Error "source:line:column: <what was expected>".
     // A model of "machine" is resolved against `machine` (the real one by default).
-    static Layout parse(std::string_view toml_text, std::string_view source_name,
-                        const Topology* machine = nullptr);
+    static Layout parse(std::string_view toml_text, std::string_view source_name, const Topology* machine = nullptr);
     static Layout load(const std::string& path, const Topology* machine = nullptr);
     // The layout used when none is given: the real machine, workers on every PU,
     // game and physics loop on the first PU.
@@ -51,7 +50,7 @@ struct LayoutMapping {
     // hardware thread is in the worker list), as in the seed's Xbox 360 example.
     std::optional<unsigned> physics_worker;
     bool model_larger_than_machine = false;  // threads share: modelled core c -> real core c mod n
-    std::vector<std::string> shared;           // one line per real PU that several roles share
+    std::vector<std::string> shared;         // one line per real PU that several roles share
 
     // Real PU OS indices of the workers, in worker order.
     std::vector<unsigned> worker_pus() const;

@@ -20,12 +20,12 @@ class Space;
 // ShapeSpec and every body made from it shares the result.
 struct ShapeSpec {
     ShapeType type = ShapeType::Sphere;
-    Real radius = 0;                   // sphere, capsule (m)
-    Real half_height = 0;              // capsule (m)
-    Vec3 half_extents = Vec3::Zero();  // box (m)
-    Vec3 normal = Vec3::UnitY();       // plane
-    Real offset = 0;                   // plane (m)
-    std::vector<Vec3> points;          // hull points, or mesh vertices (m, body frame)
+    Real radius = 0;                     // sphere, capsule (m)
+    Real half_height = 0;                // capsule (m)
+    Vec3 half_extents = Vec3::Zero();    // box (m)
+    Vec3 normal = Vec3::UnitY();         // plane
+    Real offset = 0;                     // plane (m)
+    std::vector<Vec3> points;            // hull points, or mesh vertices (m, body frame)
     std::vector<std::uint32_t> indices;  // mesh: 3 per triangle, counter-clockwise from the front
 
     // Calls the Shape factory. Throws spindle::Error when the factory rejects it.
@@ -54,12 +54,12 @@ struct SceneJoint {
 };
 
 struct SceneDesc {
-    std::string name;         // the file's `name`, else its file name without .toml
+    std::string name;  // the file's `name`, else its file name without .toml
     std::string description;
-    std::string source;       // file name (or the name it was parsed under)
-    SpaceSettings settings;   // time_step.use_internal_time_stepping is left to the program
+    std::string source;      // file name (or the name it was parsed under)
+    SpaceSettings settings;  // time_step.use_internal_time_stepping is left to the program
     std::vector<ShapeSpec> shapes;
-    std::vector<SceneBody> bodies;  // generators expanded, in file order
+    std::vector<SceneBody> bodies;   // generators expanded, in file order
     std::vector<SceneJoint> joints;  // made by [[chain]]; created after the bodies
 
     std::size_t dynamic_body_count() const noexcept;

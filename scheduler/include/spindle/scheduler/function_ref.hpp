@@ -14,9 +14,8 @@ class FunctionRef;
 template <typename R, typename... Args>
 class FunctionRef<R(Args...)> {
 public:
-    template <typename F,
-              typename = std::enable_if_t<!std::is_same_v<std::remove_cvref_t<F>, FunctionRef> &&
-                                          std::is_invocable_r_v<R, F&, Args...>>>
+    template <typename F, typename = std::enable_if_t<!std::is_same_v<std::remove_cvref_t<F>, FunctionRef> &&
+                                                      std::is_invocable_r_v<R, F&, Args...>>>
     FunctionRef(F&& f) noexcept  // NOLINT: implicit by design, like std::function_ref
         : m_object(const_cast<void*>(static_cast<const void*>(std::addressof(f)))),
           m_call([](void* object, Args... args) -> R {

@@ -66,7 +66,7 @@ private:
         const char* name;
         Fn fn;
         std::vector<std::uint32_t> dependents;
-        std::uint32_t prerequisites = 0;  // how many nodes must finish first
+        std::uint32_t prerequisites = 0;        // how many nodes must finish first
         std::atomic<std::uint32_t> waiting{0};  // counts down while running
         Node(const char* n, Fn f) : name(n), fn(f) {}
         Node(Node&& o) noexcept
@@ -100,11 +100,10 @@ public:
     // barrier after each phase, so a phase costs a few cache-line transfers instead of a
     // fork and a join. Each worker's share is cut into blocks of halving size, which
     // suits items of similar cost; for very uneven items (collision pairs of different
-    // shapes) parallel_for, which splits a busy range on demand, balances better. fn must not throw (std::terminate) nor wait for other jobs (no
-    // parallel_for or wait inside it: the waiting thread could pick up a participant
-    // that then waits at a barrier for the block below it). Who may call: any thread,
-    // not from inside a phase. Deadlock: none otherwise; a worker that never joins
-    // leaves its blocks to the others.
+    // shapes) parallel_for, which splits a busy range on demand, balances better. fn must not throw (std::terminate)
+    // nor wait for other jobs (no parallel_for or wait inside it: the waiting thread could pick up a participant that
+    // then waits at a barrier for the block below it). Who may call: any thread, not from inside a phase. Deadlock:
+    // none otherwise; a worker that never joins leaves its blocks to the others.
     virtual void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) = 0;
 
     // Runs a stage graph to completion: each node after its prerequisites, nodes in

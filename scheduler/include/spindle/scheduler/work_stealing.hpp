@@ -5,16 +5,16 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <iosfwd>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <string>
 #include <thread>
 #include <type_traits>
-#include <new>
-#include <cstddef>
 #include <vector>
 
 #include <spindle/platform/spin.hpp>
@@ -164,15 +164,15 @@ private:
     // Each hot counter on its own cache line: m_idle is read per parallel_for chunk and
     // m_sleeping per push, while the others change; sharing a line would make every
     // read a miss.
-    CacheLinePadded<std::atomic<std::uint32_t>> m_wake;      // bumped when work arrives (sleepers wait on it)
+    CacheLinePadded<std::atomic<std::uint32_t>> m_wake;  // bumped when work arrives (sleepers wait on it)
     CacheLinePadded<std::atomic<std::int32_t>> m_sleeping;
-    CacheLinePadded<std::atomic<std::int32_t>> m_idle;       // workers looking for work or asleep
-    std::atomic<std::uint64_t> m_foreign_submitted{0};        // pinned jobs submitted by non-worker threads
+    CacheLinePadded<std::atomic<std::int32_t>> m_idle;  // workers looking for work or asleep
+    std::atomic<std::uint64_t> m_foreign_submitted{0};  // pinned jobs submitted by non-worker threads
     // Own cache lines: the external thread locks m_external once per submit, and every
     // job reads m_trace_on; on one line each lock would take the line from the workers.
     alignas(cache_line_size) std::mutex m_external;  // one external thread acts as worker 0 at a time
     alignas(cache_line_size) std::atomic<bool> m_trace_on{false};
-    mutable std::mutex m_stage_lock;              // stage spans (a few per step) from the owner thread
+    mutable std::mutex m_stage_lock;  // stage spans (a few per step) from the owner thread
     std::vector<TraceEvent> m_stage_events;
     std::vector<std::pair<const char*, std::int64_t>> m_open_stages;
 
