@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   g++ cmake make pkg-config
   libeigen3-dev libhwloc-dev libtomlplusplus-dev
+  libcli11-dev               # the spindle program's command line
   libgtest-dev libgmock-dev libbenchmark-dev
   libtbb-dev libbullet-dev   # bench-only peers
   gnuplot-nox                # docs/accuracy.png

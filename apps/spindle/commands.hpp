@@ -1,14 +1,25 @@
-// The spindle commands, one per file; each returns the process exit code and reports a
-// bad command line as UsageError, a bad file or value as spindle::Error.
+// The spindle commands, one per file: each adds its subcommand (options, checks, help) to
+// the program's command line and says how to run it once the line parsed.
 #pragma once
 
-#include "args.hpp"
+#include <functional>
+
+namespace CLI {
+class App;
+}
 
 namespace spindle::app {
 
-int run_command(Args& args);     // run.cpp
-int bench_command(Args& args);   // bench.cpp
-int scenes_command(Args& args);  // scenes.cpp
-int layout_command(Args& args);  // layout.cpp
+struct Command {
+    CLI::App* cli;  // the subcommand; parsed() when it was given
+    // Runs the command with what was parsed (or the defaults) and returns the exit code;
+    // a bad file or value is a spindle::Error.
+    std::function<int()> run;
+};
+
+Command add_run_command(CLI::App& program);     // run.cpp
+Command add_bench_command(CLI::App& program);   // bench.cpp
+Command add_scenes_command(CLI::App& program);  // scenes.cpp
+Command add_layout_command(CLI::App& program);  // layout.cpp
 
 }  // namespace spindle::app

@@ -39,9 +39,9 @@ void MotionRecorder::write_frame(std::uint64_t frame, double time, std::span<con
         out = put(out, end, time);
         *out++ = ',';
         out = put(out, end, static_cast<std::uint64_t>(i));
-        for (const double v : {s.position.x(), s.position.y(), s.position.z(), s.orientation.w(), s.orientation.x(),
-                               s.orientation.y(), s.orientation.z(), s.linear_velocity.x(), s.linear_velocity.y(),
-                               s.linear_velocity.z()}) {
+        for (const double v :
+             {s.position.x(), s.position.y(), s.position.z(), s.orientation.w(), s.orientation.x(), s.orientation.y(),
+              s.orientation.z(), s.linear_velocity.x(), s.linear_velocity.y(), s.linear_velocity.z()}) {
             out = put(out, end, v);
         }
         *out++ = '\n';

@@ -5,25 +5,26 @@
 // (work stealing, workers pinned per the layout, the physics loop thread as worker 0).
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
-#include <spindle/scene/scene.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/layout.hpp>
 #include <spindle/platform/thread.hpp>
 #include <spindle/platform/topology.hpp>
+#include <spindle/scene/scene.hpp>
 
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-#include <iostream>
 #include <memory>
 #include <optional>
 #include <thread>
 
+#include "checks.hpp"
 #include "commands.hpp"
 #include "jobs.hpp"
 #include "physics_probe.hpp"
@@ -36,30 +37,13 @@
 namespace spindle::app {
 namespace {
 
-constexpr const char* kRunUsage =
-    "usage: spindle run [SCENE] [options]\n"
-    "Plays SCENE (a built-in scene name, see `spindle scenes`, or a .toml file; default: pile)\n"
-    "asynchronously: the game thread renders interpolated motion states while the physics loop\n"
-    "thread steps the space with internal time stepping. Prints progress and a summary.\n"
-    "options:\n"
-    "  --layout FILE     affinity layout (configs/layouts/*.toml); default: this machine, all PUs\n"
-    "  --seconds S       how long to run, wall clock (default 5)\n"
-    "  --render-hz HZ    frames per second the game thread reads states at (default 60)\n"
-    "  --idle MODE       what the physics loop does between steps: poll (update every 0.5 ms, so\n"
-    "                    every frame gets a fresh interpolation; default), spin (update without\n"
-    "                    pause, the seed's loop; burns its hardware thread) or sleep (until the\n"
-    "                    next step is due: publishes only at steps, little to interpolate)\n"
-    "  --trace FILE      write a Chrome trace-event JSON of the run (open in Perfetto)\n"
-    "  --record FILE     write every rendered frame's motion states as CSV:\n"
-    "                    frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz\n";
-
 // --idle poll: the physics loop updates at most this often between steps. A frame at
 // 60 Hz then sees a publish at most 0.5 ms old (3% of the frame), for a few percent of
 // a hardware thread instead of all of it.
 constexpr double kPollInterval = 0.5e-3;
 
 struct RunOptions {
-    std::string scene;
+    std::string scene{kDefaultScene};
     std::optional<std::string> layout_file;
     double seconds = 5;
     double render_hz = 60;
@@ -67,24 +51,6 @@ struct RunOptions {
     std::optional<std::string> trace_file;
     std::optional<std::string> record_file;
 };
-
-RunOptions parse_options(Args& args) {
-    RunOptions o;
-    o.layout_file = args.option("layout");
-    o.seconds = args.number("seconds", 0.01, 1e6).value_or(o.seconds);
-    o.render_hz = args.number("render-hz", 1, 1000).value_or(o.render_hz);
-    if (const auto idle = args.option("idle")) {
-        if (*idle != "poll" && *idle != "spin" && *idle != "sleep") {
-            throw UsageError("--idle: expected poll, spin or sleep, got '" + *idle + "'");
-        }
-        o.idle = *idle;
-    }
-    o.trace_file = args.option("trace");
-    o.record_file = args.option("record");
-    const std::vector<std::string> scene = args.positionals(1);
-    o.scene = scene.empty() ? std::string(kDefaultScene) : scene[0];
-    return o;
-}
 
 // What the game thread measured.
 struct GameStats {
@@ -143,7 +109,8 @@ void print_summary(const SceneDesc& scene, const Layout& layout, const RunOption
         std::printf("                 %-20s %10.4f %12.4f %6.1f%%\n", to_string(static_cast<Stage>(i)), s,
                     probe.steps ? s * 1e3 / static_cast<double>(probe.steps) : 0.0, total > 0 ? 100 * s / total : 0.0);
     }
-    std::printf("  smoothness     motion per frame: mean, jerk (rms change frame to frame), jerk/mean, frozen frames\n");
+    std::printf(
+        "  smoothness     motion per frame: mean, jerk (rms change frame to frame), jerk/mean, frozen frames\n");
     print_smoothness("interpolated", interpolated);
     print_smoothness("raw steps", raw);
     if (interpolated.jerk_rms_m > 0 && raw.jerk_rms_m > 0) {
@@ -154,14 +121,7 @@ void print_summary(const SceneDesc& scene, const Layout& layout, const RunOption
     }
 }
 
-}  // namespace
-
-int run_command(Args& args) {
-    if (args.help()) {
-        std::cout << kRunUsage;
-        return 0;
-    }
-    const RunOptions o = parse_options(args);
+int run(const RunOptions& o) {
     const SceneDesc scene = resolve_scene(o.scene);
 
     const Topology real = Topology::from_system();
@@ -185,7 +145,8 @@ int run_command(Args& args) {
     auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
     std::vector<GameSpan> frames;  // the game thread's side of the trace
     if (o.trace_file) {
-        if (!scheduler) throw Error("--trace: the trace comes from the work-stealing scheduler, which make_jobs did not choose");
+        if (!scheduler)
+            throw Error("--trace: the trace comes from the work-stealing scheduler, which make_jobs did not choose");
         scheduler->enable_trace(true);
         frames.reserve(static_cast<std::size_t>(o.seconds * o.render_hz) + 16);
     }
@@ -282,6 +243,50 @@ int run_command(Args& args) {
         std::printf("  trace          %s (%zu spans)\n", o.trace_file->c_str(), events.size() + frames.size());
     }
     return 0;
+}
+
+}  // namespace
+
+Command add_run_command(CLI::App& program) {
+    CLI::App* cli = program.add_subcommand("run", "play a scene asynchronously, like a game (the default command)");
+    cli->footer("Plays SCENE asynchronously: the game thread renders interpolated motion states while the\n"
+                "physics loop thread steps the space with internal time stepping. Prints progress and a\n"
+                "summary. `spindle` without a command runs the default scene for 5 s.");
+    auto o = std::make_shared<RunOptions>();
+    cli->add_option("--layout", o->layout_file,
+                    "affinity layout (configs/layouts/*.toml); default: this machine, all PUs")
+        ->option_text("FILE")
+        ->check(not_an_option());
+    cli->add_option("--seconds", o->seconds, "how long to run, wall clock, 0.01 to 1000000 (default 5)")
+        ->option_text("S")
+        ->check(real_in(0.01, 1e6));
+    cli->add_option("--render-hz", o->render_hz,
+                    "frames per second the game thread reads states at, 1 to 1000 (default 60)")
+        ->option_text("HZ")
+        ->check(real_in(1, 1000));
+    cli->add_option("--idle", o->idle,
+                    "what the physics loop does between steps: poll (update every 0.5 ms, so\n"
+                    "every frame gets a fresh interpolation; default), spin (update without\n"
+                    "pause, the seed's loop; burns its hardware thread) or sleep (until the\n"
+                    "next step is due: publishes only at steps, little to interpolate)")
+        ->option_text("MODE")
+        ->check(CLI::IsMember({"poll", "spin", "sleep"}));
+    cli->add_option("--trace", o->trace_file, "write a Chrome trace-event JSON of the run (open in Perfetto)")
+        ->option_text("FILE")
+        ->check(not_an_option());
+    cli->add_option("--record", o->record_file,
+                    "write every rendered frame's motion states as CSV:\n"
+                    "frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz")
+        ->option_text("FILE")
+        ->check(not_an_option());
+    // After the options: CLI11 checks in this order, and a FILE option that took the next option
+    // as its value ("missing value") says more than the positional it left over.
+    cli->add_option("SCENE", o->scene,
+                    "a built-in scene (see `spindle scenes`) or a .toml scene file (default " +
+                        std::string(kDefaultScene) + ")")
+        ->type_name("")
+        ->check(check_scene);
+    return {cli, [o] { return run(*o); }};
 }
 
 }  // namespace spindle::app

@@ -8,8 +8,6 @@
 
 #include <spindle/scene/scene.hpp>
 
-#include "args.hpp"
-
 namespace spindle::app {
 
 struct BuiltinScene {
@@ -26,9 +24,14 @@ std::span<const BuiltinScene> builtin_scenes() noexcept;
 // pyramid is the benchmark, not the demo).
 inline constexpr std::string_view kDefaultScene = "pile";
 
-// A built-in scene's name, or the path of a scene file (anything with a '/' or
-// ending in .toml). Unknown names are a UsageError listing the built-in scenes; a
-// bad file is a spindle::Error naming file:line:column.
+// Empty when the argument is a built-in scene's name or the path of a scene file
+// (anything with a '/' or ending in .toml); otherwise what is wrong, listing the
+// built-in scenes. The commands check their SCENE with it, so that an unknown name is
+// a bad command line.
+std::string check_scene(const std::string& name_or_path);
+
+// The scene check_scene accepted: a bad file is a spindle::Error naming
+// file:line:column (as is an unknown name, which check_scene would have refused).
 SceneDesc resolve_scene(const std::string& name_or_path);
 
 }  // namespace spindle::app

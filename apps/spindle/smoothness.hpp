@@ -13,11 +13,11 @@
 namespace spindle::app {
 
 struct SmoothnessReport {
-    std::uint64_t frames = 0;          // frames with a previous frame to compare with
-    double mean_step_m = 0;            // mean per-frame displacement (m)
-    double jerk_rms_m = 0;             // RMS of the frame-to-frame change of that displacement (m)
-    double relative_jerk = 0;          // jerk_rms / mean_step: scale-free, 0 = perfectly even
-    std::uint64_t frozen_frames = 0;   // frames showing exactly the previous frame's poses
+    std::uint64_t frames = 0;         // frames with a previous frame to compare with
+    double mean_step_m = 0;           // mean per-frame displacement (m)
+    double jerk_rms_m = 0;            // RMS of the frame-to-frame change of that displacement (m)
+    double relative_jerk = 0;         // jerk_rms / mean_step: scale-free, 0 = perfectly even
+    std::uint64_t frozen_frames = 0;  // frames showing exactly the previous frame's poses
 };
 
 class SmoothnessMeter {

@@ -1,6 +1,7 @@
 // The spindle program end to end: run with every layout (summary, trace JSON naming
-// the stages, CSV record), bench's one line, scenes, help, and bad arguments giving a
-// message and a non-zero exit code. SPINDLE_PROGRAM is the built binary.
+// the stages, CSV record), bench's one line, scenes, every command's options and help,
+// and bad files (exit 1) and bad command lines (exit 2) giving a message naming the
+// command. SPINDLE_PROGRAM is the built binary.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -292,55 +293,220 @@ TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {
     }
 }
 
-TEST(SpindleProgram, Help_ForEveryCommand) {
-    for (const char* args : {"--help", "help", "run --help", "bench --help", "scenes --help", "layout --help"}) {
-        SCOPED_TRACE(args);
-        const Result r = spindle(args);
+TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
+    struct Case {
+        std::string args;
+        std::string usage;
+        std::vector<std::string> options;
+    };
+    const std::vector<Case> cases = {
+        {"--help", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help", "exit codes"}},
+        {"-h", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help"}},
+        {"help", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help"}},
+        {"run --help", "usage: spindle run [OPTIONS] [SCENE]",
+         {"SCENE", "--layout FILE", "--seconds S", "--render-hz HZ", "--idle MODE", "--trace FILE", "--record FILE",
+          "poll", "spin", "sleep", "frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz"}},
+        {"run -h", "usage: spindle run [OPTIONS] [SCENE]", {"--seconds S"}},
+        {"bench --help", "usage: spindle bench [OPTIONS] SCENE",
+         {"SCENE", "--threads N", "--steps N", "--substeps N", "--stages", "steps_per_s"}},
+        {"scenes --help", "usage: spindle scenes [OPTIONS]", {"-h,--help"}},
+        {"layout --help", "usage: spindle layout [OPTIONS] FILE", {"FILE", "configs/layouts"}},
+        {"help --help", "usage: spindle help [OPTIONS] [COMMAND]", {"COMMAND"}},
+        // Help wins over what else is on the line, as long as that parses.
+        {"run stack --seconds 3 --help", "usage: spindle run", {"--seconds S"}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const Result r = spindle(c.args, true);
         EXPECT_EQ(r.exit_code, 0) << r.output;
-        expect_contains(r.output, "usage: spindle");
+        expect_contains(r.output, c.usage);
+        for (const std::string& option : c.options) expect_contains(r.output, option);
+    }
+    // `help COMMAND` is the command's --help.
+    for (const char* command : {"run", "bench", "scenes", "layout", "help"}) {
+        SCOPED_TRACE(command);
+        const Result help = spindle(std::string("help ") + command, true);
+        const Result flag = spindle(std::string(command) + " --help", true);
+        EXPECT_EQ(help.exit_code, 0);
+        EXPECT_EQ(help.output, flag.output);
     }
     const Result layout = spindle("layout '" + (kSource / "configs" / "layouts" / "xbox360.toml").string() + "'");
     EXPECT_EQ(layout.exit_code, 0) << layout.output;
     expect_contains(layout.output, "layout xbox360");
 }
 
-TEST(SpindleProgram, BadArguments_FailWithAMessage) {
-    const fs::path bad = temp_path("bad.toml");
-    std::ofstream(bad) << "[[body]]\nshape = { sphere = 1 }\nfriction = \"high\"\n";
+// Every option of every command is taken, in both spellings (--name VALUE and
+// --name=VALUE), and does what it says: each case's output shows what it was given.
+TEST(SpindleProgram, EveryOption_IsAcceptedAndTakesEffect) {
+    const std::string layout = (kSource / "configs" / "layouts" / "xbox360.toml").string();
+    const fs::path trace = temp_path("options.json");
+    const fs::path record = temp_path("options.csv");
     struct Case {
         std::string args;
-        int exit_code;
-        std::string message;
+        std::vector<std::string> expected;
     };
     const std::vector<Case> cases = {
-        {"frob", 2, "unknown command 'frob'"},
-        {"run nope", 2, "unknown scene 'nope' (built-in scenes: "},
-        {"run --bogus", 2, "unknown option '--bogus'"},
-        {"run --seconds", 2, "--seconds: missing value"},
-        {"run --seconds abc", 2, "--seconds: expected a number, got 'abc'"},
-        {"run --seconds -1", 2, "--seconds: expected a number in"},
-        {"run --render-hz 0", 2, "--render-hz: expected a number in"},
-        {"run --idle nap", 2, "--idle: expected poll, spin or sleep"},
-        {"run stack extra", 2, "unexpected argument 'extra'"},
-        {"run --layout /nonexistent/layout.toml", 1, "/nonexistent/layout.toml: cannot open layout file"},
-        {"run --trace /nonexistent/dir/trace.json --seconds 0.1", 1, "cannot write the trace file"},
-        {"run '" + bad.string() + "'", 1, bad.string() + ":3:12: body.friction: expected a number, got a string"},
-        {"bench", 2, "missing the SCENE"},
-        {"bench pyramid --steps x", 2, "--steps: expected an integer, got 'x'"},
-        {"bench pyramid --steps 0", 2, "--steps: expected an integer in [1, "},
-        {"bench pyramid --threads 1.5", 2, "--threads: expected an integer, got '1.5'"},
-        {"bench pyramid --substeps", 2, "--substeps: missing value"},
-        {"bench /nonexistent/scene.toml", 1, "/nonexistent/scene.toml: cannot open scene file"},
-        {"scenes extra", 2, "unexpected argument 'extra'"},
-        {"layout", 2, "missing the layout FILE"},
-        {"layout '" + bad.string() + "'", 1, "unknown key"},
+        {"run stack --seconds 0.3 --render-hz 30 --idle spin --layout '" + layout + "' --trace '" + trace.string() +
+             "' --record '" + record.string() + "'",
+         {"summary: scene stack, layout xbox360", "idle spin", "at 30 Hz", "  trace ", "  record "}},
+        {"run --seconds=0.2 --render-hz=1000 --idle=poll --layout=" + layout + " stack",
+         {"summary: scene stack, layout xbox360", "idle poll", "at 1000 Hz"}},
+        {"run stack --idle sleep --seconds 0.01 --render-hz 1", {"idle sleep", " 1 frames at 1 Hz"}},
+        {"bench stack --threads 2 --steps 7 --substeps 3 --stages",
+         {"scene=stack bodies=20 threads=2 steps=7 ", "stages_ms "}},
+        {"bench stack --threads=1 --steps=3 --substeps=1000", {"threads=1 steps=3 "}},
+        {"bench stack --steps 010", {"steps=10 "}},  // decimal, not octal
+        {"scenes", {"pyramid ", "pile "}},
+        {"layout '" + layout + "'", {"layout xbox360"}},
+        {"help layout", {"usage: spindle layout"}},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.args);
         const Result r = spindle(c.args);
-        EXPECT_EQ(r.exit_code, c.exit_code) << r.output;
-        expect_contains(r.output, c.message);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        for (const std::string& e : c.expected) expect_contains(r.output, e);
     }
+    EXPECT_TRUE(fs::exists(trace));
+    EXPECT_TRUE(fs::exists(record));
+    fs::remove(trace);
+    fs::remove(record);
+
+    // --substeps reaches the solver: another state after the same steps.
+    const auto hash = [](const std::string& args) {
+        const Result r = spindle(args, true);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        const std::size_t at = r.output.find("hash=");
+        return at == std::string::npos ? r.output : r.output.substr(at);
+    };
+    EXPECT_NE(hash("bench stack --steps 30 --substeps 1"), hash("bench stack --steps 30 --substeps 8"));
+}
+
+TEST(SpindleProgram, NoArguments_RunsTheDefaultSceneForFiveSeconds) {
+    const Result r = spindle("", false, "/");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    expect_contains(r.output, "summary: scene pile, layout native");
+    const std::vector<std::string> w = line_starting_with(r.output, "summary:");
+    ASSERT_GE(w.size(), 6u) << r.output;
+    EXPECT_GE(std::stod(w[5]), 5.0) << r.output;  // summary: scene pile, layout native, 5.00 s wall, ...
+}
+
+struct BadCase {
+    std::string args;
+    std::string message;
+};
+
+// Runs each case, expecting `exit_code` and, on stderr alone, "spindle[ COMMAND]: "
+// then the message; a bad command line also says where to get help.
+void expect_failures(const std::vector<BadCase>& cases, int exit_code) {
+    for (const BadCase& c : cases) {
+        SCOPED_TRACE(c.args);
+        const Result r = spindle(c.args);
+        EXPECT_EQ(r.exit_code, exit_code) << r.output;
+        expect_contains(r.output, c.message);
+        const std::vector<std::string> w = words(c.args);
+        const std::vector<std::string> commands = {"run", "bench", "scenes", "layout", "help"};
+        const bool command = !w.empty() && std::find(commands.begin(), commands.end(), w[0]) != commands.end();
+        const std::string name = command ? "spindle " + w[0] : "spindle";
+        EXPECT_EQ(r.output.rfind(name + ": ", 0), 0u) << r.output;
+        if (exit_code == 2) expect_contains(r.output, "(see " + name + " --help)");
+        EXPECT_EQ(spindle(c.args, true).output, "") << "the message belongs on stderr";
+    }
+}
+
+TEST(SpindleProgram, BadCommandLines_ExitTwoNamingTheCommandAndWhatWasWrong) {
+    expect_failures(
+        {
+            // unknown command, or an option before it
+            {"frob", "spindle: unknown command 'frob'"},
+            {"Run", "spindle: unknown command 'Run'"},
+            {"--bogus", "spindle: unknown option '--bogus'"},
+            {"--seconds 1", "spindle: unknown option '--seconds'"},
+            {"help frob", "COMMAND: unknown command 'frob'"},
+            // unknown option
+            {"run --bogus", "unknown option '--bogus'"},
+            {"run --bogus=3", "unknown option '--bogus=3'"},
+            {"run -x", "unknown option '-x'"},
+            {"bench stack --bogus", "unknown option '--bogus'"},
+            {"bench stack --seconds 1", "unknown option '--seconds'"},  // run's, not bench's
+            {"scenes --bogus", "unknown option '--bogus'"},
+            {"layout --bogus x.toml", "unknown option '--bogus'"},
+            {"help --bogus", "unknown option '--bogus'"},
+            // missing value: at the end, empty, or the next option taken for it
+            {"run --seconds", "--seconds: 1 required FLOAT missing"},
+            {"run --seconds=", "--seconds: 1 required FLOAT missing"},
+            {"run --layout", "--layout: 1 required TEXT missing"},
+            {"run --idle", "--idle: 1 required TEXT"},
+            {"bench stack --substeps", "--substeps: 1 required INT missing"},
+            {"bench stack --threads", "--threads: 1 required INT missing"},
+            {"run --seconds --idle spin", "--seconds: missing value (got the option '--idle')"},
+            {"run --layout --seconds 1", "--layout: missing value (got the option '--seconds')"},
+            {"run --trace --record x.csv", "--trace: missing value (got the option '--record')"},
+            {"run --record --seconds 1", "--record: missing value (got the option '--seconds')"},
+            {"bench stack --steps --stages", "--steps: missing value (got the option '--stages')"},
+            // not a number
+            {"run --seconds abc", "--seconds: expected a number, got 'abc'"},
+            {"run --seconds inf", "--seconds: expected a number, got 'inf'"},
+            {"run --render-hz 60hz", "--render-hz: expected a number, got '60hz'"},
+            {"bench pyramid --steps x", "--steps: expected an integer, got 'x'"},
+            {"bench pyramid --threads 1.5", "--threads: expected an integer, got '1.5'"},
+            {"bench pyramid --substeps 2x", "--substeps: expected an integer, got '2x'"},
+            {"bench pyramid --steps 0x10", "--steps: expected an integer, got '0x10'"},
+            {"bench pyramid --steps ''", "--steps: expected an integer, got ''"},
+            // out of range, both ends
+            {"run --seconds -1", "--seconds: expected a number in [0.01, 1000000], got -1"},
+            {"run --seconds 0.001", "--seconds: expected a number in [0.01, 1000000], got 0.001"},
+            {"run --seconds 2e6", "--seconds: expected a number in [0.01, 1000000], got 2e6"},
+            {"run --render-hz 0", "--render-hz: expected a number in [1, 1000], got 0"},
+            {"run --render-hz 1001", "--render-hz: expected a number in [1, 1000], got 1001"},
+            {"bench pyramid --steps 0", "--steps: expected an integer in [1, 100000000], got 0"},
+            {"bench pyramid --steps 100000001", "--steps: expected an integer in [1, 100000000], got 100000001"},
+            {"bench pyramid --threads 0", "--threads: expected an integer in [1, 1024], got 0"},
+            {"bench pyramid --threads 1025", "--threads: expected an integer in [1, 1024], got 1025"},
+            {"bench pyramid --substeps 0", "--substeps: expected an integer in [1, 1000], got 0"},
+            {"bench pyramid --substeps 1001", "--substeps: expected an integer in [1, 1000], got 1001"},
+            {"bench pyramid --steps 99999999999999999999",
+             "--steps: expected an integer, got '99999999999999999999'"},
+            // not one of the choices
+            {"run --idle nap", "--idle: nap not in {poll,spin,sleep}"},
+            {"run nope", "SCENE: unknown scene 'nope' (built-in scenes: "},
+            {"run scenes", "SCENE: unknown scene 'scenes'"},
+            {"bench nope", "SCENE: unknown scene 'nope' (built-in scenes: "},
+            // too many positionals
+            {"run stack extra", "unexpected argument 'extra'"},
+            {"bench stack extra", "unexpected argument 'extra'"},
+            {"scenes extra", "unexpected argument 'extra'"},
+            {"layout a.toml b.toml", "unexpected argument 'b.toml'"},
+            {"help run bench", "unexpected argument 'bench'"},
+            // missing positional
+            {"bench", "SCENE is required"},
+            {"bench --steps 5", "SCENE is required"},
+            {"layout", "FILE is required"},
+            // a flag given a value
+            {"bench stack --stages=yes", "--stages: takes no value, got 'yes'"},
+            {"bench stack --stages=0", "--stages: takes no value, got '0'"},
+            // an option given twice
+            {"run --seconds 1 --seconds 2", "--seconds: At Most 1 required but received 2"},
+        },
+        2);
+}
+
+TEST(SpindleProgram, BadFilesAndValues_ExitOneNamingTheCommandAndTheFile) {
+    const fs::path bad = temp_path("bad.toml");
+    std::ofstream(bad) << "[[body]]\nshape = { sphere = 1 }\nfriction = \"high\"\n";
+    expect_failures(
+        {
+            {"run --layout /nonexistent/layout.toml", "/nonexistent/layout.toml: cannot open layout file"},
+            {"run --layout '" + bad.string() + "'", "unknown key"},
+            {"run --trace /nonexistent/dir/trace.json --seconds 0.1", "cannot write the trace file"},
+            {"run --record /nonexistent/dir/record.csv --seconds 0.1", "/nonexistent/dir/record.csv: cannot write the record file"},
+            {"run '" + bad.string() + "'", bad.string() + ":3:12: body.friction: expected a number, got a string"},
+            {"run /nonexistent/scene.toml", "/nonexistent/scene.toml: cannot open scene file"},
+            {"bench /nonexistent/scene.toml", "/nonexistent/scene.toml: cannot open scene file"},
+            {"bench '" + bad.string() + "' --steps 1", bad.string() + ":3:12: body.friction"},
+            {"layout /nonexistent/layout.toml", "/nonexistent/layout.toml: cannot open layout file"},
+            {"layout '" + bad.string() + "'", "unknown key"},
+        },
+        1);
     fs::remove(bad);
 }
 
