@@ -143,7 +143,7 @@ void color(SolverScratch& scratch) {
 // cheaper than colouring.
 bool same_constraints(const World& world, SolverScratch& scratch) {
     static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
-    const bool same = scratch.joints.empty() && !scratch.colored_joints &&
+    const bool same = scratch.reuse_colors && scratch.joints.empty() && !scratch.colored_joints &&
                       scratch.colored_body_set == world.body_set_version &&
                       scratch.colored_bodies == scratch.bodies.size() &&
                       scratch.colored_manifolds.size() == scratch.manifolds.size() &&

@@ -126,6 +126,7 @@ public:
     JobSystem& jobs() noexcept;
 
 private:
+    friend struct SpaceInternals;  // engine/src/api/space_internals.hpp: the engine's own tests reach World
     std::unique_ptr<World> m_world;
 };
 

@@ -1,0 +1,102 @@
+// Stored state hashes of built-in scenes (Box2D v3's test_determinism.c keeps its
+// expected hash in the test): any change of results, from a code change, a build flag
+// or the worker count, fails here. A change of physics made on purpose updates the
+// table below in the same commit, and says why.
+#include <spindle/engine/space.hpp>
+#include <spindle/platform/topology.hpp>
+#include <spindle/scene/scene.hpp>
+#include <spindle/scheduler/single_threaded.hpp>
+#include <spindle/scheduler/work_stealing.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "api/space_internals.hpp"
+#include "solver/constraints.hpp"
+
+using namespace spindle;
+
+namespace {
+
+struct Golden {
+    const char* scene;
+    int steps;
+    std::uint64_t hash;
+};
+
+// The results every build must reproduce (SPINDLE_PORTABLE_MATH, on by default, keeps
+// them independent of the build machine's CPU and the optimisation level).
+// clang-format off
+constexpr Golden kGolden[] = {
+    {"pyramid",     30, 0xb60093e2c8288ff4ull},
+    {"chains",     120, 0x3e35274aefd53fc2ull},
+    {"pile",       120, 0x53b132bfe980acc0ull},
+    {"mass_ratio", 120, 0x35bb354505b479adull},
+    {"dominoes",   120, 0x6dc4a62b971dd2abull},
+};
+// clang-format on
+
+std::unique_ptr<JobSystem> work_stealing(unsigned workers) {
+    const Topology machine = Topology::from_system();
+    WorkStealingJobSystem::Options options;
+    for (unsigned i = 0; i < workers; ++i)
+        options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
+    options.pin = workers <= machine.pus().size();
+    return std::make_unique<WorkStealingJobSystem>(options);
+}
+
+std::uint64_t run_scene(const std::string& name, int steps, JobSystem& jobs, bool reuse_colors = true,
+                        std::uint64_t* colorings = nullptr, bool sleeping = true) {
+    const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/" + name + ".toml");
+    Space space(SpaceSettings{}, &jobs);
+    build(scene, space);
+    SpaceInternals::world(space).solver->reuse_colors = reuse_colors;
+    if (!sleeping) space.set_sleep(SleepSettings{.enabled = false});
+    for (int i = 0; i < steps; ++i) space.update();
+    if (colorings) *colorings = space.counters().constraint_colorings;
+    return space.state_hash();
+}
+
+std::string hex(std::uint64_t value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(value));
+    return text;
+}
+
+}  // namespace
+
+TEST(GoldenHash, BuiltInScenesMatchTheStoredHashOnOneToFourWorkers) {
+    for (const Golden& golden : kGolden) {
+        SingleThreadedJobSystem single;
+        EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, single)), hex(golden.hash))
+            << golden.scene << ", single-threaded job system";
+        for (unsigned workers : {1u, 2u, 3u, 4u}) {
+            auto jobs = work_stealing(workers);
+            EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, *jobs)), hex(golden.hash))
+                << golden.scene << ", work stealing with " << workers << " workers";
+        }
+    }
+}
+
+TEST(GoldenHash, RepeatedRunsOnOneJobSystemMatchTheStoredHash) {
+    auto jobs = work_stealing(2);
+    const Golden& golden = kGolden[1];
+    for (int run = 0; run < 3; ++run) EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, *jobs)), hex(golden.hash));
+}
+
+// A resting stack (kept awake) keeps its manifold list, so the solver reuses the last
+// step's colours and packing; colouring afresh every step must give the same bits.
+TEST(GoldenHash, ReusedColoursGiveTheSameBitsAsFreshColouring) {
+    for (unsigned workers : {1u, 2u}) {
+        auto jobs = work_stealing(workers);
+        std::uint64_t reused_colorings = 0, fresh_colorings = 0;
+        const std::uint64_t reused = run_scene("stack", 240, *jobs, true, &reused_colorings, false);
+        const std::uint64_t fresh = run_scene("stack", 240, *jobs, false, &fresh_colorings, false);
+        EXPECT_EQ(fresh_colorings, 240u);
+        EXPECT_LT(reused_colorings, 120u) << "the resting stack should reuse its colours for most steps";
+        EXPECT_EQ(hex(reused), hex(fresh)) << workers << " workers";
+    }
+}
