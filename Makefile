@@ -1,12 +1,20 @@
-# Spindle quick start:  make run   (set up, build Release, run the default scene)
-#                       make test  (set up, build, run every test: Release, ASan+UBSan, TSan)
+# Spindle quick start:  make run    (set up, build the program in Release, run the default scene)
+#                       make test   (set up, check formatting, build, run every test: Release, ASan+UBSan, TSan)
+#                       make format (rewrite the C++ sources per .clang-format)
+#                       make tidy   (clang-tidy per .clang-tidy over the sources; slow, not part of make test)
 JOBS ?= 2
 BUILD ?= build
 CMAKE_COMMON = -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
 # Sanitizer builds: optimised a little so Eigen-heavy tests stay quick; asserts on.
 SAN_FLAGS = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DSPINDLE_BUILD_BENCH=OFF
+# The C++ sources under version control, at any depth below these folders (generated and
+# build files are not tracked); a folder that does not exist matches nothing.
+SOURCE_DIRS = engine scheduler platform scene apps tests bench
+CXX_SOURCES = git ls-files -- $(foreach d,$(SOURCE_DIRS),'$(d)/*.cpp' '$(d)/*.hpp')
+CLANG_FORMAT ?= clang-format
+CLANG_TIDY ?= clang-tidy
 
-.PHONY: setup configure-release release run test test-release test-asan test-tsan bench accuracy clean
+.PHONY: setup configure-release release run test test-release test-asan test-tsan format format-check tidy bench accuracy clean
 
 setup:
 	@bash scripts/setup.sh
@@ -22,7 +30,23 @@ run: configure-release
 	@cmake --build $(BUILD)/release -j$(JOBS) --target spindle
 	./$(BUILD)/release/apps/spindle run
 
-test: test-release test-asan test-tsan
+test: format-check test-release test-asan test-tsan
+
+# Rewrites every C++ source in place per .clang-format.
+format: setup
+	@$(CXX_SOURCES) | xargs -r $(CLANG_FORMAT) -i
+
+# Fails, naming the lines, if any C++ source differs from what `make format` writes.
+format-check: setup
+	@$(CXX_SOURCES) | xargs -r $(CLANG_FORMAT) --dry-run --Werror || \
+		{ echo "format-check: run 'make format'" >&2; exit 1; }
+
+# clang-tidy per .clang-tidy over the .cpp files (their project headers come with them),
+# using the Release build's compile_commands.json. The compile commands are GCC's: clang
+# ignores the warning flags it does not know, and reports its warnings without -Werror.
+tidy: configure-release
+	@git ls-files -- $(foreach d,$(SOURCE_DIRS),'$(d)/*.cpp') | xargs -r -P$(JOBS) -n1 $(CLANG_TIDY) -p $(BUILD)/release --quiet \
+		--extra-arg=-Wno-unknown-warning-option --extra-arg=-Wno-error
 
 test-release: release
 	cd $(BUILD)/release && ctest --output-on-failure -j$(JOBS)

@@ -11,6 +11,7 @@ packages=(
   libtbb-dev libbullet-dev   # bench-only peers
   gnuplot-nox                # docs/accuracy.png
   python3                    # test helpers (JSON checks)
+  clang-format clang-tidy    # make format / format-check (part of make test), make tidy
 )
 
 missing=()

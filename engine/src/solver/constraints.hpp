@@ -152,7 +152,7 @@ struct SolverScratch {
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
     bool colored_joints = false;
-    bool reuse_colors = true;  // false colours every step (tests compare the two)
+    bool reuse_colors = true;                        // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
     std::vector<WideContact> wide;      // the colours' manifolds four by four, then the overflow one by one
