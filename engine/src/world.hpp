@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <spindle/engine/body.hpp>
@@ -23,6 +25,11 @@ namespace spindle {
 
 struct BroadphaseState;  // stages/broadphase_state.hpp
 struct SolverScratch;    // solver/constraints.hpp
+
+// awake_index of a body woken since World::awake was last settled (settle_awake, islands.cpp):
+// awake, but not yet at a position in the list.
+inline constexpr std::int32_t kAwakePending = std::numeric_limits<std::int32_t>::max();
+inline constexpr std::size_t kNoPosition = std::numeric_limits<std::size_t>::max();
 
 // Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
 // data (pose, velocity, mass) sits in its own arrays; the description (shape,
@@ -47,7 +54,7 @@ struct Bodies {
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
     std::vector<Aabb> bounds;               // tight, world
-    std::vector<std::int32_t> awake_index;  // position in World::awake, -1 if static or asleep
+    std::vector<std::int32_t> awake_index;  // position in World::awake, kAwakePending, or -1 if static or asleep
     std::vector<Real> sleep_time;
     std::vector<std::int32_t> island;  // sleeping island id, -1 when awake
 
@@ -160,6 +167,11 @@ struct World {
 
     Bodies bodies;
     std::vector<std::uint32_t> awake;  // awake dynamic and kinematic bodies, ascending slot order
+    // Changes to `awake` not yet settled (settle_awake): the bodies woken since, and the
+    // lowest position whose body left. Waking or sleeping an island merges them in once
+    // instead of shifting the list per body; the stages read `awake` only when settled.
+    std::vector<std::uint32_t> awake_pending;
+    std::size_t awake_left_from = kNoPosition;
 
     // Collision: contacts in a deterministic order (creation order from canonical
     // pair lists; removal keeps the order of the rest).
@@ -211,7 +223,10 @@ struct World {
     // Islands.
     std::vector<SleepingIsland> sleeping_islands;
     std::vector<std::int32_t> free_islands;
-    std::vector<std::uint32_t> scratch_parent, scratch_sleepers;
+    std::vector<std::uint32_t> scratch_parent, scratch_sleepers, scratch_awake_tail;
+    // Awake positions of (dynamic, kinematic) bodies touching or jointed: the dynamic one's
+    // island sleeps only with the kinematic body (islands.cpp).
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> scratch_kinematic_links;
     std::vector<std::int32_t> scratch_island_of_root;
     std::vector<Real> scratch_rest;
 

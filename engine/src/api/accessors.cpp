@@ -132,12 +132,12 @@ void Space::set_internal_motion_state(BodyHandle body, const MotionState& state)
         throw Error("set_internal_motion_state: every field must be finite and the orientation non-zero");
     }
     Bodies& b = m_world->bodies;
+    wake_touching(*m_world, i);  // a static body too; before its proxy moves
     b.q[i] = state.orientation.normalized();
     b.x[i] = state.position + b.q[i] * b.local_com[i];
     if (b.type[i] != MotionType::Static) {
         b.v[i] = state.linear_velocity;
         b.w[i] = state.angular_velocity;
-        wake_body(*m_world, i);
     }
     b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
     refresh_proxy(*m_world, i);

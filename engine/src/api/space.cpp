@@ -1,4 +1,4 @@
-// Space: construction, body creation (validated first) and destruction, the awake list,
+// Space: construction, body creation (validated first) and destruction,
 // settings and reports. The accessors are in accessors.cpp, update() in stages/update.cpp.
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
@@ -164,9 +164,9 @@ void Space::destroy_body(BodyHandle body) {
     if (!w.bodies.is_live(body))
         throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
     const std::uint32_t slot = body.index;
-    // A body leaving a sleeping island wakes it: what rested on the body may fall, and
-    // the island's member list must not keep a dead slot.
-    if (w.bodies.island[slot] >= 0) wake_body(w, slot);
+    // Wake the body's island (its member list must not keep a dead slot) and every island
+    // it touches, even if the body is static: what rested on it may fall.
+    wake_touching(w, slot);
     destroy_joints_of(w, slot);
     remove_contacts_of(w, slot);
     remove_proxy(w, slot);
@@ -182,29 +182,6 @@ void Space::destroy_body(BodyHandle body) {
 
 bool Space::contains(BodyHandle body) const noexcept { return m_world->bodies.is_live(body); }
 std::size_t Space::body_count() const noexcept { return m_world->bodies.live; }
-
-void set_awake(World& world, std::uint32_t slot, bool awake) {
-    Bodies& b = world.bodies;
-    std::vector<std::uint32_t>& list = world.awake;
-    if (awake) {
-        if (b.awake_index[slot] >= 0) return;
-        // Keep the list in ascending slot order: the order of work never depends on
-        // the order bodies woke in (determinism across runs and worker counts).
-        auto it = std::lower_bound(list.begin(), list.end(), slot);
-        it = list.insert(it, slot);
-        for (auto i = it; i != list.end(); ++i) b.awake_index[*i] = static_cast<std::int32_t>(i - list.begin());
-        b.sleep_time[slot] = 0;
-        b.island[slot] = -1;
-    } else {
-        const std::int32_t index = b.awake_index[slot];
-        if (index < 0) return;
-        list.erase(list.begin() + index);
-        b.awake_index[slot] = -1;
-        for (std::size_t i = static_cast<std::size_t>(index); i < list.size(); ++i) {
-            b.awake_index[list[i]] = static_cast<std::int32_t>(i);
-        }
-    }
-}
 
 // ---- settings and reports ----
 

@@ -78,7 +78,15 @@ void apply_writes(World& world) {
             case WriteKind::AngularImpulse: b.w[i] += b.inv_inertia_world(i) * write.vector; break;
             case WriteKind::Wake: break;
         }
-        if (moves) wake_body(world, i);
+        const bool pose = write.kind == WriteKind::Position || write.kind == WriteKind::Orientation ||
+                          write.kind == WriteKind::MotionState;
+        if (pose) {
+            // A static body too: what rests on it must not hang where it was. Before the
+            // proxy moves, so the contacts are found where the body was.
+            wake_touching(world, i);
+        } else if (moves) {
+            wake_body(world, i);
+        }
         if (write.kind <= WriteKind::MotionState) {
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
             refresh_proxy(world, i);
@@ -86,6 +94,7 @@ void apply_writes(World& world) {
         }
         world.stats.writes_applied += 1;
     }
+    settle_awake(world);
 }
 
 // Fills one published entry from the live state.

@@ -35,10 +35,17 @@ void record(World& world);
 void step(World& world, Real dt);
 // The positions of the awake contacts, ascending (contact_list.cpp).
 const std::vector<std::uint32_t>& awake_contacts(World& world);
-// Body bookkeeping shared by stages (api/space.cpp).
+// The awake list (islands.cpp). set_awake notes a body woken or put to sleep; world.awake
+// and the awake positions are brought up to date by settle_awake, which ApplyWrites and the
+// Islands stage call before anything reads them. awake_index >= 0 tells awake at any time.
 void set_awake(World& world, std::uint32_t slot, bool awake);
+void settle_awake(World& world);
 // Wakes a body and, if it sleeps, its whole island (islands.cpp).
 void wake_body(World& world, std::uint32_t slot);
+// Wakes a body (unless static) and the island of every body it has a contact or a joint
+// with: for a change that can take away what rests on it (destroying it, moving it by a
+// write, changing its shape or motion type). Call before its proxy moves (islands.cpp).
+void wake_touching(World& world, std::uint32_t slot);
 // Writes a body's current state into both published buffers at once (create/destroy
 // between updates), so buffered reads see it before the next flip (buffering.cpp).
 void publish_now(World& world, std::uint32_t slot);

@@ -2,6 +2,7 @@
 // Narrowphase, Islands, Solver, Continuous, Record), FlipReadBuffers. Each stage runs
 // under its trace name and its time is added to the update's stats.
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/assert.hpp>
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 
@@ -87,6 +88,8 @@ void Space::flush() {
 }
 
 void step(World& w, Real dt) {
+    SPINDLE_ASSERT(w.awake_pending.empty() && w.awake_left_from == kNoPosition,
+                   "step: the awake list has changes not settled (settle_awake after waking or sleeping)");
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
