@@ -52,7 +52,7 @@ test-release: release
 	cd $(BUILD)/release && ctest --output-on-failure -j$(JOBS)
 
 test-asan: setup
-	@cmake -S . -B $(BUILD)/asan -DSPINDLE_SANITIZE=address $(SAN_FLAGS) $(CMAKE_COMMON) >/dev/null
+	@cmake -S . -B $(BUILD)/asan -DSPINDLE_SANITIZE=address -DSPINDLE_VALIDATE_STATE=ON $(SAN_FLAGS) $(CMAKE_COMMON) >/dev/null
 	@cmake --build $(BUILD)/asan -j$(JOBS)
 	cd $(BUILD)/asan && ctest --output-on-failure -j$(JOBS) -LE "stability|install"
 

@@ -4,6 +4,8 @@
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "api/validation.hpp"
+#include "solver/speed_limit.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -22,8 +24,18 @@ void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, 
         throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
 }
 
-void check_finite_write(const Vec3& v, const char* what) {
-    if (!is_finite(v)) throw Error(std::string(what) + ": value must be finite");
+// The field a vector write carries, for its error message.
+const char* field_of(WriteKind kind) {
+    switch (kind) {
+        case WriteKind::Position: return "position";
+        case WriteKind::LinearVelocity: return "linear_velocity";
+        case WriteKind::AngularVelocity: return "angular_velocity";
+        case WriteKind::Force: return "force";
+        case WriteKind::Torque: return "torque";
+        case WriteKind::Impulse: return "impulse";
+        case WriteKind::AngularImpulse: return "angular_impulse";
+        default: return "value";
+    }
 }
 
 }  // namespace
@@ -38,7 +50,7 @@ Vec3 Space::angular_velocity(BodyHandle body) const { return motion_state(body).
 namespace {
 
 void push_vector(World& world, BodyHandle body, WriteKind kind, const Vec3& value, const char* what) {
-    check_finite_write(value, what);
+    check_finite(value, what, field_of(kind));
     check_handle_for_write(world.motion_states, body, what);
     BufferedWrite write;
     write.body = body;
@@ -70,9 +82,7 @@ void Space::apply_angular_impulse(BodyHandle body, const Vec3& j) {
 }
 
 void Space::set_orientation(BodyHandle body, const Quat& orientation) {
-    if (!is_finite(orientation) || orientation.norm() < 1e-9) {
-        throw Error("set_orientation: orientation must be a finite, non-zero quaternion");
-    }
+    check_orientation(orientation, "set_orientation", "orientation");
     check_handle_for_write(m_world->motion_states, body, "set_orientation");
     BufferedWrite write;
     write.body = body;
@@ -82,10 +92,7 @@ void Space::set_orientation(BodyHandle body, const Quat& orientation) {
 }
 
 void Space::set_motion_state(BodyHandle body, const MotionState& state) {
-    if (!is_finite(state.position) || !is_finite(state.linear_velocity) || !is_finite(state.angular_velocity) ||
-        !is_finite(state.orientation) || state.orientation.norm() < 1e-9) {
-        throw Error("set_motion_state: every field must be finite and the orientation non-zero");
-    }
+    validate(state, "set_motion_state");
     check_handle_for_write(m_world->motion_states, body, "set_motion_state");
     BufferedWrite write;
     write.body = body;
@@ -127,17 +134,14 @@ Vec3 Space::internal_angular_velocity(BodyHandle body) const { return internal_m
 
 void Space::set_internal_motion_state(BodyHandle body, const MotionState& state) {
     const std::uint32_t i = live_slot(*m_world, body, "set_internal_motion_state");
-    if (!is_finite(state.position) || !is_finite(state.linear_velocity) || !is_finite(state.angular_velocity) ||
-        !is_finite(state.orientation) || state.orientation.norm() < 1e-9) {
-        throw Error("set_internal_motion_state: every field must be finite and the orientation non-zero");
-    }
+    validate(state, "set_internal_motion_state");
     Bodies& b = m_world->bodies;
     wake_touching(*m_world, i);  // a static body too; before its proxy moves
     b.q[i] = state.orientation.normalized();
     b.x[i] = state.position + b.q[i] * b.local_com[i];
     if (b.type[i] != MotionType::Static) {
-        b.v[i] = state.linear_velocity;
-        b.w[i] = state.angular_velocity;
+        b.v[i] = limit_speed(state.linear_velocity, m_world->settings.solver.max_linear_speed);
+        b.w[i] = limit_speed(state.angular_velocity, m_world->settings.solver.max_angular_speed);
     }
     b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
     refresh_proxy(*m_world, i);

@@ -1,5 +1,5 @@
 // Values as the API's error messages print them ("got (1, nan, 0)"), shared by the
-// validation of bodies (space.cpp) and joints (joint_api.cpp).
+// input checks (validation.cpp, joint_api.cpp) and the state check (stages/update.cpp).
 #pragma once
 
 #include <sstream>

@@ -3,6 +3,8 @@
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "api/validation.hpp"
+
 namespace spindle {
 
 Entity::Entity(BodyDesc desc) : m_desc(std::move(desc)) {}
@@ -38,32 +40,31 @@ Vec3 Entity::angular_velocity() const { return motion_state().angular_velocity; 
 
 void Entity::set_position(const Vec3& position) {
     if (m_space) return m_space->set_position(m_handle, position);
-    if (!is_finite(position)) throw Error("Entity::set_position: value must be finite");
+    check_finite(position, "Entity::set_position", "position");
     m_desc.position = position;
 }
 
 void Entity::set_orientation(const Quat& orientation) {
     if (m_space) return m_space->set_orientation(m_handle, orientation);
-    if (!is_finite(orientation) || orientation.norm() < 1e-9) {
-        throw Error("Entity::set_orientation: orientation must be a finite, non-zero quaternion");
-    }
+    check_orientation(orientation, "Entity::set_orientation", "orientation");
     m_desc.orientation = orientation.normalized();
 }
 
 void Entity::set_linear_velocity(const Vec3& velocity) {
     if (m_space) return m_space->set_linear_velocity(m_handle, velocity);
-    if (!is_finite(velocity)) throw Error("Entity::set_linear_velocity: value must be finite");
+    check_finite(velocity, "Entity::set_linear_velocity", "linear_velocity");
     m_desc.linear_velocity = velocity;
 }
 
 void Entity::set_angular_velocity(const Vec3& velocity) {
     if (m_space) return m_space->set_angular_velocity(m_handle, velocity);
-    if (!is_finite(velocity)) throw Error("Entity::set_angular_velocity: value must be finite");
+    check_finite(velocity, "Entity::set_angular_velocity", "angular_velocity");
     m_desc.angular_velocity = velocity;
 }
 
 void Entity::set_motion_state(const MotionState& state) {
     if (m_space) return m_space->set_motion_state(m_handle, state);
+    validate(state, "Entity::set_motion_state");  // all or nothing
     set_position(state.position);
     set_orientation(state.orientation);
     set_linear_velocity(state.linear_velocity);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "api/describe.hpp"
+#include "api/validation.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -63,18 +64,12 @@ namespace {
 
 // Throws "create_joint: <field> <rule>, got <value>" unless ok.
 void require(bool ok, const char* field, const char* rule, const std::string& got) {
-    if (!ok) throw Error(std::string("create_joint: ") + field + " " + rule + ", got " + got);
+    if (!ok) reject_field("create_joint", field, rule, got);
 }
 
-void require_finite(const Vec3& v, const char* field) { require(is_finite(v), field, "must be finite", vec(v)); }
-
-void require_axis(const Vec3& v, const char* field) {
-    require(is_finite(v) && v.norm() >= 1e-9, field, "must be a finite, non-zero vector", vec(v));
-}
-
-void require_non_negative(Real value, const char* field) {
-    require(std::isfinite(value) && value >= 0, field, "must be finite and >= 0", number(value));
-}
+void require_finite(const Vec3& v, const char* field) { check_finite(v, "create_joint", field); }
+void require_axis(const Vec3& v, const char* field) { check_direction(v, "create_joint", field); }
+void require_non_negative(Real value, const char* field) { check_non_negative(value, "create_joint", field); }
 
 void require_ordered(Real lower, Real upper, const char* lower_field, const char* upper_field) {
     if (!(lower <= upper)) {
@@ -124,7 +119,7 @@ void validate(const World& world, const JointDesc& d) {
         require_non_negative(p.spring_hertz, "distance.spring_hertz");
         require_non_negative(p.spring_damping_ratio, "distance.spring_damping_ratio");
         require_non_negative(p.min_length, "distance.min_length");
-        require(!std::isnan(p.max_length), "distance.max_length", "must be a number", number(p.max_length));
+        require(std::isfinite(p.max_length), "distance.max_length", "must be finite", number(p.max_length));
         require_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
     }
 }
@@ -294,10 +289,8 @@ void Space::set_hinge_motor(JointHandle handle, bool enable, Real speed, Real ma
     Joint& j = w.joints.joint[handle.index];
     if (j.type != JointType::Hinge)
         throw Error("set_hinge_motor: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
-    if (!std::isfinite(speed)) throw Error("set_hinge_motor: speed must be finite, got " + number(speed));
-    if (!std::isfinite(max_torque) || max_torque < 0) {
-        throw Error("set_hinge_motor: max_torque must be finite and >= 0, got " + number(max_torque));
-    }
+    check_finite(speed, "set_hinge_motor", "speed");
+    check_non_negative(max_torque, "set_hinge_motor", "max_torque");
     if (j.hinge.enable_motor != enable) j.motor_impulse = 0;
     j.hinge.enable_motor = enable;
     j.hinge.motor_speed = speed;

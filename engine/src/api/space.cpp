@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "api/describe.hpp"
+#include "api/validation.hpp"
 #include "solver/constraints.hpp"
+#include "solver/speed_limit.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -26,42 +28,6 @@ World::~World() = default;
 
 namespace {
 
-[[noreturn]] void reject(const std::string& what) { throw Error("create_body: " + what); }
-
-void check_finite(const Vec3& v, const char* field) {
-    if (!is_finite(v)) reject(std::string(field) + " must be finite, got " + vec(v));
-}
-
-void check_non_negative(Real value, const char* field) {
-    if (!std::isfinite(value) || value < 0)
-        reject(std::string(field) + " must be finite and >= 0, got " + number(value));
-}
-
-// Everything create_body needs to know is valid, checked before anything changes.
-void validate(const BodyDesc& d) {
-    check_finite(d.position, "position");
-    if (!is_finite(d.orientation) || d.orientation.norm() < 1e-9) {
-        reject("orientation must be a finite, non-zero quaternion, got (w " + number(d.orientation.w()) + ", " +
-               vec(d.orientation.vec()) + ")");
-    }
-    check_finite(d.linear_velocity, "linear_velocity");
-    check_finite(d.angular_velocity, "angular_velocity");
-    if (d.shape.static_only() && d.type != MotionType::Static) {
-        reject(std::string("a ") + to_string(d.shape.type) + " shape can only belong to a static body");
-    }
-    if (d.type == MotionType::Dynamic) {
-        if (!std::isfinite(d.mass) || d.mass < 0) reject("mass must be positive, got " + number(d.mass));
-        if (d.mass == 0 && (!std::isfinite(d.density) || d.density <= 0)) {
-            reject("density must be positive when mass is 0, got " + number(d.density));
-        }
-    }
-    check_non_negative(d.friction, "friction");
-    check_non_negative(d.restitution, "restitution");
-    check_non_negative(d.linear_damping, "linear_damping");
-    check_non_negative(d.angular_damping, "angular_damping");
-    if (!std::isfinite(d.gravity_scale)) reject("gravity_scale must be finite, got " + number(d.gravity_scale));
-}
-
 template <typename T>
 void grow(std::vector<T>& v, std::size_t n) {
     if (v.size() < n) v.resize(n);
@@ -70,8 +36,8 @@ void grow(std::vector<T>& v, std::size_t n) {
 }  // namespace
 
 Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make_unique<World>()) {
+    validate(settings);  // the same checks as each setter's
     m_world->settings = settings;
-    set_time_step(settings.time_step);
     if (!jobs) {
         m_world->own_jobs = std::make_unique<SingleThreadedJobSystem>();
         jobs = m_world->own_jobs.get();
@@ -101,9 +67,15 @@ BodyHandle Space::create_body(const BodyDesc& input) {
             mp.inertia *= desc.mass / mp.mass;
             mp.mass = desc.mass;
         }
-        if (!(mp.mass > 0) || !mp.inertia.allFinite()) reject("the shape has no volume (mass " + number(mp.mass) + ")");
+        if (!(mp.mass > 0) || !mp.inertia.allFinite()) {
+            throw Error("create_body: the shape has no volume (mass " + number(mp.mass) + ")");
+        }
         inv_mass = 1 / mp.mass;
         inv_inertia = mp.inertia.inverse();
+        // A mass so small that its inverse overflows would turn every impulse into NaN.
+        if (!std::isfinite(inv_mass) || !inv_inertia.allFinite()) {
+            throw Error("create_body: mass " + number(mp.mass) + " is too small: its inverse is not finite");
+        }
         inertia = mp.inertia;
         local_com = mp.center_of_mass;
     } else if (desc.shape.type != ShapeType::Plane && desc.shape.type != ShapeType::TriangleMesh) {
@@ -134,8 +106,11 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.q[slot] = desc.orientation;
     b.local_com[slot] = local_com;
     b.x[slot] = desc.position + desc.orientation * local_com;
-    b.v[slot] = desc.type == MotionType::Static ? Vec3::Zero() : desc.linear_velocity;
-    b.w[slot] = desc.type == MotionType::Static ? Vec3::Zero() : desc.angular_velocity;
+    const SolverSettings& limits = w.settings.solver;
+    b.v[slot] = desc.type == MotionType::Static ? Vec3::Zero()
+                                                : limit_speed(desc.linear_velocity, limits.max_linear_speed);
+    b.w[slot] = desc.type == MotionType::Static ? Vec3::Zero()
+                                                : limit_speed(desc.angular_velocity, limits.max_angular_speed);
     b.inv_mass[slot] = inv_mass;
     b.inv_inertia_local[slot] = inv_inertia;
     b.inertia_local[slot] = inertia;
@@ -187,41 +162,24 @@ std::size_t Space::body_count() const noexcept { return m_world->bodies.live; }
 
 const SpaceSettings& Space::settings() const noexcept { return m_world->settings; }
 
+// Each setter checks with the constructor's function for its struct (api/validation.cpp).
 void Space::set_time_step(const TimeStepSettings& s) {
-    if (!std::isfinite(s.duration) || s.duration <= 0) {
-        throw Error("time step: duration must be positive, got " + number(s.duration));
-    }
-    if (s.max_steps_per_frame < 1) {
-        throw Error("time step: max_steps_per_frame must be at least 1, got " + std::to_string(s.max_steps_per_frame));
-    }
-    if (s.min_steps_per_frame < 0 || s.min_steps_per_frame > s.max_steps_per_frame) {
-        throw Error("time step: min_steps_per_frame must be in [0, max_steps_per_frame], got " +
-                    std::to_string(s.min_steps_per_frame));
-    }
+    validate(s);
     m_world->settings.time_step = s;
 }
 
 void Space::set_solver(const SolverSettings& s) {
-    if (s.substeps < 1) throw Error("solver: substeps must be at least 1, got " + std::to_string(s.substeps));
-    if (s.iterations < 1) throw Error("solver: iterations must be at least 1, got " + std::to_string(s.iterations));
-    if (s.relax_iterations < 0) {
-        throw Error("solver: relax_iterations must be >= 0, got " + std::to_string(s.relax_iterations));
-    }
-    if (!(s.contact_hertz >= 0) || !(s.damping_ratio >= 0) || !(s.push_out_speed >= 0) || !(s.recovery_depth >= 0) ||
-        !(s.speculative_distance >= 0) || !(s.restitution_threshold >= 0)) {
-        throw Error("solver: contact_hertz, damping_ratio, push_out_speed, recovery_depth, speculative_distance and "
-                    "restitution_threshold must be >= 0");
-    }
-    if (!(s.joint_hertz >= 0) || !std::isfinite(s.joint_hertz) || !(s.joint_damping_ratio >= 0)) {
-        throw Error("solver: joint_hertz and joint_damping_ratio must be finite and >= 0");
-    }
+    validate(s);
     m_world->settings.solver = s;
 }
 
-void Space::set_sleep(const SleepSettings& s) { m_world->settings.sleep = s; }
+void Space::set_sleep(const SleepSettings& s) {
+    validate(s);
+    m_world->settings.sleep = s;
+}
 
 void Space::set_gravity(const Vec3& gravity) {
-    if (!is_finite(gravity)) throw Error("gravity must be finite, got " + vec(gravity));
+    validate_gravity(gravity);
     m_world->settings.gravity = gravity;
 }
 

@@ -2,6 +2,7 @@
 // (live state -> published buffer, swapped under the motion-state lock).
 #include <algorithm>
 
+#include "solver/speed_limit.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -38,6 +39,8 @@ void reset_history(Bodies& b, std::uint32_t i) {
 void apply_writes(World& world) {
     world.writes.drain(world.drained);
     Bodies& b = world.bodies;
+    const Real max_linear = world.settings.solver.max_linear_speed;
+    const Real max_angular = world.settings.solver.max_angular_speed;
     for (const BufferedWrite& write : world.drained) {
         if (!b.is_live(write.body)) {
             world.stats.writes_rejected += 1;  // the body was destroyed after the write was made
@@ -72,12 +75,16 @@ void apply_writes(World& world) {
                 }
                 reset_history(b, i);
                 break;
-            case WriteKind::Force: b.force[i] += write.vector; break;
-            case WriteKind::Torque: b.torque[i] += write.vector; break;
+            case WriteKind::Force: b.force[i] = saturate(b.force[i] + write.vector); break;
+            case WriteKind::Torque: b.torque[i] = saturate(b.torque[i] + write.vector); break;
             case WriteKind::Impulse: b.v[i] += b.inv_mass[i] * write.vector; break;
-            case WriteKind::AngularImpulse: b.w[i] += b.inv_inertia_world(i) * write.vector; break;
+            case WriteKind::AngularImpulse:
+                b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), write.vector, max_angular);
+                break;
             case WriteKind::Wake: break;
         }
+        b.v[i] = limit_speed(b.v[i], max_linear);
+        b.w[i] = limit_speed(b.w[i], max_angular);
         const bool pose = write.kind == WriteKind::Position || write.kind == WriteKind::Orientation ||
                           write.kind == WriteKind::MotionState;
         if (pose) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "solver/solver_body.hpp"
+#include "solver/speed_limit.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -33,17 +34,27 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
                           EffectCounts& c) {
     const Bodies& b = world.bodies;
     const Vec3 gravity = world.settings.gravity;
+    const Real max_linear = world.settings.solver.max_linear_speed;
+    const Real max_angular = world.settings.solver.max_angular_speed;
     for (std::uint32_t k = lo; k < hi; ++k) {
         SolverBody& sb = bodies[k];
-        if (!sb.dynamic) continue;
+        if (!sb.dynamic) {
+            // A kinematic body moves by its velocity alone: limited all the same.
+            sb.v = limit_speed(sb.v, max_linear);
+            sb.w = limit_speed(sb.w, max_angular);
+            continue;
+        }
         const std::uint32_t i = world.awake[k];
         const BodyDesc& d = b.desc[i];
         if (d.gravity_scale != 0) {
             sb.v += h * d.gravity_scale * gravity;
             ++c.gravity;
         }
-        sb.v += h * sb.inv_mass * b.force[i];
-        sb.w += h * (sb.inv_inertia * b.torque[i]);
+        sb.v += h * sb.inv_mass * b.force[i];  // at worst infinite components, which the limit turns back
+        sb.w = add_angular(sb.w, h, sb.inv_inertia, b.torque[i], max_angular);
+        // Before the gyroscopic step, which needs a finite spin.
+        sb.v = limit_speed(sb.v, max_linear);
+        sb.w = limit_speed(sb.w, max_angular);
         if (d.gyroscopic) {
             const Quat q = (sb.dq * b.q[i]).normalized();
             sb.w = solve_gyroscopic(q, b.inertia_local[i], sb.w, h);

@@ -16,6 +16,7 @@
 
 #include <spindle/platform/assert.hpp>
 
+#include "solver/speed_limit.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -236,13 +237,17 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
 // The step's motion into the bodies, awake bodies [lo, hi).
 void finalize_bodies(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
     Bodies& b = world.bodies;
+    const Real max_linear = world.settings.solver.max_linear_speed;
+    const Real max_angular = world.settings.solver.max_angular_speed;
     for (std::uint32_t k = lo; k < hi; ++k) {
         const std::uint32_t i = world.awake[k];
         const SolverBody& sb = scratch.bodies[k];
         b.x[i] += sb.dp;
         b.q[i] = (sb.dq * b.q[i]).normalized();
-        b.v[i] = sb.v;
-        b.w[i] = sb.w;
+        // Constraints may push a body past the limits its integration kept: the stored
+        // velocity is held to them too.
+        b.v[i] = limit_speed(sb.v, max_linear);
+        b.w[i] = limit_speed(sb.w, max_angular);
         b.force[i] = Vec3::Zero();  // consumed by this step
         b.torque[i] = Vec3::Zero();
     }

@@ -33,6 +33,10 @@ void record(World& world);
 
 // One step of dt: collide, islands, solve, record (update.cpp).
 void step(World& world, Real dt);
+// Throws spindle::Error naming the first awake body whose pose or velocity is not finite
+// and the stage just run. Built with SPINDLE_VALIDATE_STATE, run_stage calls it after
+// every stage (update.cpp).
+void check_state(const World& world, Stage stage);
 // The positions of the awake contacts, ascending (contact_list.cpp).
 const std::vector<std::uint32_t>& awake_contacts(World& world);
 // The awake list (islands.cpp). set_awake notes a body woken or put to sleep; world.awake

@@ -29,15 +29,38 @@ const char* to_string(Stage stage) noexcept {
     return "?";
 }
 
+void check_state(const World& world, Stage stage) {
+    const Bodies& b = world.bodies;
+    auto fail = [&](std::uint32_t i, const char* field, const std::string& value) {
+        throw Error("state check: " + to_string(BodyHandle{i, b.generation[i]}) + " has a non-finite " + field + " " +
+                    value + " after stage " + to_string(stage));
+    };
+    for (const std::uint32_t i : world.awake) {
+        if (!is_finite(b.x[i])) fail(i, "center_of_mass", vec(b.x[i]));
+        if (!is_finite(b.q[i])) fail(i, "orientation", "(w " + number(b.q[i].w()) + ", " + vec(b.q[i].vec()) + ")");
+        if (!is_finite(b.v[i])) fail(i, "linear_velocity", vec(b.v[i]));
+        if (!is_finite(b.w[i])) fail(i, "angular_velocity", vec(b.w[i]));
+    }
+}
+
 namespace {
 
-// Runs one stage under its trace name and adds its time to the update's stats.
+#ifdef SPINDLE_VALIDATE_STATE
+constexpr bool kValidateState = true;
+#else
+constexpr bool kValidateState = false;
+#endif
+
+// Runs one stage under its trace name and adds its time to the update's stats. With
+// SPINDLE_VALIDATE_STATE, then checks every awake body's state, so the first stage that
+// makes a value non-finite is the one named.
 template <typename F>
 void run_stage(World& world, Stage stage, F&& body) {
     StageScope scope(*world.jobs, to_string(stage));
     const std::int64_t start = now_nanoseconds();
     body();
     world.stats.stage_seconds[static_cast<int>(stage)] += static_cast<double>(now_nanoseconds() - start) * 1e-9;
+    if constexpr (kValidateState) check_state(world, stage);
 }
 
 }  // namespace
@@ -53,10 +76,13 @@ void Space::update(Real dt) {
 
     int steps = 1;
     if (ts.use_internal_time_stepping) {
-        w.accumulator += dt;
-        // The small tolerance makes 1/30 s hold exactly two 1/60 s steps.
-        steps = static_cast<int>(std::floor(w.accumulator / ts.duration + 1e-9));
-        steps = std::clamp(steps, ts.min_steps_per_frame, ts.max_steps_per_frame);
+        // Saturates instead of overflowing: a dt near the largest double is just "too much".
+        w.accumulator = std::min<Real>(w.accumulator + dt, kHuge);
+        // Counted in floating point and clamped before the cast, so any finite dt is fine
+        // (the quotient can be far beyond an int). The small tolerance makes 1/30 s hold
+        // exactly two 1/60 s steps.
+        const Real held = std::floor(w.accumulator / ts.duration + 1e-9);
+        steps = static_cast<int>(std::clamp<Real>(held, ts.min_steps_per_frame, ts.max_steps_per_frame));
         w.accumulator = std::max<Real>(0, w.accumulator - steps * ts.duration);
         // Carry at most the cap's worth, so a slow machine cannot spiral.
         const Real carry_limit = ts.max_steps_per_frame * ts.duration;

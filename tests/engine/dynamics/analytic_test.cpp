@@ -156,7 +156,7 @@ TEST(Validation, BadBodiesAreRejectedNamingTheFieldAndChangeNothing) {
     };
     BodyDesc d = sphere_at(Vec3::Zero());
     d.mass = -1;
-    EXPECT_NE(message(d).find("mass must be positive, got -1"), std::string::npos);
+    EXPECT_NE(message(d).find("mass must be finite and >= 0, got -1"), std::string::npos);
     d = sphere_at(Vec3(std::nan(""), 0, 0));
     EXPECT_NE(message(d).find("position"), std::string::npos);
     d = sphere_at(Vec3::Zero());

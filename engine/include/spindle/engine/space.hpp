@@ -32,7 +32,8 @@ struct World;
 class Space {
 public:
     // jobs: the scheduler that runs the parallel stages; null runs everything on the
-    // caller of update(). The JobSystem must outlive the Space.
+    // caller of update(). The JobSystem must outlive the Space. Every setting is checked
+    // as its setter checks it (spindle::Error naming the struct and field).
     explicit Space(const SpaceSettings& settings = {}, JobSystem* jobs = nullptr);
     ~Space();
     Space(const Space&) = delete;
@@ -63,7 +64,8 @@ public:
     // With internal time stepping: adds dt to the accumulator and takes the steps it
     // holds (at least min, at most max_steps_per_frame). Without: exactly one step of
     // TimeStepSettings::duration whatever dt is. Negative, NaN or infinite dt throws
-    // before anything changes.
+    // before anything changes; any finite dt is fine: a huge one takes max_steps_per_frame
+    // steps, keeps that many steps' worth and drops the rest (last_update().dropped_seconds).
     void update(Real dt);
     // One step of TimeStepSettings::duration (after ApplyWrites, before the flip).
     void update();
@@ -107,7 +109,9 @@ public:
     MotionStateManager& motion_states() noexcept;
     const MotionStateManager& motion_states() const noexcept;
 
-    // Settings: read any time from the update thread; change between updates.
+    // Settings: read any time from the update thread; change between updates. Each setter
+    // checks every field (finite, in range) and throws spindle::Error naming the first bad
+    // one ("solver: damping_ratio must be finite and >= 0, got inf") before anything changes.
     const SpaceSettings& settings() const noexcept;
     void set_time_step(const TimeStepSettings& settings);
     void set_solver(const SolverSettings& settings);

@@ -1,0 +1,47 @@
+// The speed limits of SolverSettings (max_linear_speed, max_angular_speed), applied
+// wherever a velocity is written: integration, buffered writes, creation. With them no
+// finite input, however large, makes a velocity or a position infinite.
+#pragma once
+
+#include <cmath>
+
+#include <spindle/engine/math.hpp>
+
+namespace spindle {
+
+// The direction of a non-zero v without NaN, as a unit vector; infinite components (a
+// finite input that overflowed on the way) dominate. Scaled before squaring, since the
+// square of a huge component overflows.
+inline Vec3 unit_of(const Vec3& v) {
+    if (!is_finite(v)) {
+        Vec3 sign = Vec3::Zero();
+        for (int k = 0; k < 3; ++k) {
+            if (std::isinf(v[k])) sign[k] = std::copysign(Real(1), v[k]);
+        }
+        return sign.normalized();
+    }
+    return (v / v.cwiseAbs().maxCoeff()).normalized();
+}
+
+// v, or v shortened to `limit` keeping its direction. Below the limit v is returned
+// untouched (bit for bit). NaN passes through: it is a bug upstream, for the state check
+// (SPINDLE_VALIDATE_STATE) to find, not something to hide.
+inline Vec3 limit_speed(const Vec3& v, Real limit) {
+    if (!(v.squaredNorm() > limit * limit)) return v;
+    return limit * unit_of(v);
+}
+
+// v + scale * (m * j) for an inverse inertia m and a finite torque or impulse j, exactly
+// as written while that is finite. When a huge j makes it overflow (m j may then hold
+// inf - inf, a NaN), a vector of length `limit` in m j's direction instead: what the
+// speed limit would have made of it.
+inline Vec3 add_angular(const Vec3& v, Real scale, const Mat3& m, const Vec3& j, Real limit) {
+    const Vec3 sum = v + scale * (m * j);
+    if (is_finite(sum)) return sum;
+    return limit * unit_of(m * (j / j.cwiseAbs().maxCoeff()));
+}
+
+// An accumulated force or torque stays finite however many huge ones are added.
+inline Vec3 saturate(const Vec3& v) { return v.cwiseMax(Vec3::Constant(-kHuge)).cwiseMin(Vec3::Constant(kHuge)); }
+
+}  // namespace spindle
