@@ -12,14 +12,11 @@
 namespace spindle {
 namespace {
 
+// Lock-free, so a thread holding the motion-state lock can still write. Newer
+// generations than the published one may be bodies created since; ApplyWrites checks
+// those. Older ones are certainly stale.
 void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* what) {
-    bool stale = body.generation == 0;
-    if (!stale) {
-        std::scoped_lock guard(manager.lock());
-        // Newer generations than the published one may be bodies created since the
-        // last flip; ApplyWrites checks those. Older ones are certainly stale.
-        stale = !manager.is_published_locked(body) && manager.published_generation_locked(body.index) > body.generation;
-    }
+    const bool stale = body.generation == 0 || manager.published_generation(body.index) > body.generation;
     if (stale)
         throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
 }

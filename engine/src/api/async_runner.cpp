@@ -1,12 +1,17 @@
-// AsyncRunner: the physics loop thread, its clean stop, and its statistics.
+// AsyncRunner: the physics loop thread, its clean stop, what it does with exceptions,
+// and its statistics.
 #include <spindle/engine/async_runner.hpp>
+#include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/assert.hpp>
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/thread.hpp>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <utility>
 
 namespace spindle {
 namespace {
@@ -28,11 +33,23 @@ AsyncRunner::AsyncRunner(Space& space, AsyncRunnerOptions options) : m_space(spa
 }
 
 AsyncRunner::~AsyncRunner() {
-    if (m_thread.joinable()) stop();
+    if (!m_thread.joinable()) return;
+    std::string why = "AsyncRunner::stop failed";
+    try {
+        stop();
+    } catch (const std::exception& e) {
+        why = e.what();
+    } catch (...) {
+    }
+    // stop() returns with the thread still running only where stopping would deadlock
+    // (see stop()); a destructor cannot throw, and a joinable std::thread would
+    // terminate without a word, so say why.
+    if (m_thread.joinable())
+        assert_failed("AsyncRunner destroyed while it could not stop", why.c_str(), __FILE__, __LINE__);
 }
 
 void AsyncRunner::start() {
-    if (m_thread.joinable()) throw Error("AsyncRunner::start: already running");
+    if (m_thread.joinable()) throw Error("AsyncRunner::start: already started (call stop() first)");
     m_stop.store(false);
     std::promise<void> started;
     std::future<void> ready = started.get_future();
@@ -46,24 +63,53 @@ void AsyncRunner::start() {
 }
 
 void AsyncRunner::stop() {
+    // Checked before anything changes, so the runner keeps running after these errors.
+    if (m_loop_thread.load(std::memory_order_acquire) == std::this_thread::get_id()) {
+        throw Error("AsyncRunner::stop: called on the physics loop thread (from a posted function); "
+                    "it would wait for itself");
+    }
     if (!m_thread.joinable()) return;
+    if (m_space.motion_states().lock().held_by_this_thread()) {
+        throw Error("AsyncRunner::stop: this thread holds the motion-state lock, which the loop's flip waits for; "
+                    "release it first");
+    }
     m_stop.store(true, std::memory_order_release);
     m_thread.join();
     m_running.store(false, std::memory_order_release);
     // The loop is gone: this thread may now update. Run what was posted, then apply
-    // and publish the writes that arrived after the loop's last update.
+    // and publish the writes that arrived after the loop's last update; the loop's
+    // failure, if any, after that, so no write is lost to it.
     std::vector<std::function<void(Space&)>> posted;
+    std::exception_ptr failure;
     {
         std::scoped_lock guard(m_posted_lock);
         posted.swap(m_posted);
+        failure = std::exchange(m_failure, nullptr);
     }
-    for (auto& fn : posted) fn(m_space);
-    m_space.flush();
+    run_posted(posted);
+    try {
+        m_space.flush();
+    } catch (...) {
+        if (!failure) throw;  // the loop's failure came first; report that one
+    }
+    if (failure) std::rethrow_exception(failure);
 }
 
-void AsyncRunner::post(std::function<void(Space&)> fn) {
+void AsyncRunner::enqueue(std::function<void(Space&)> fn) {
     std::scoped_lock guard(m_posted_lock);
+    if (m_failure) std::rethrow_exception(m_failure);
     m_posted.push_back(std::move(fn));
+}
+
+// Each posted function wraps a packaged_task, which keeps fn's exception for its future.
+void AsyncRunner::run_posted(std::vector<std::function<void(Space&)>>& posted) {
+    for (auto& fn : posted) fn(m_space);
+    posted.clear();
+}
+
+void AsyncRunner::rethrow_failure() const {
+    std::scoped_lock guard(m_posted_lock);
+    if (m_failure) std::rethrow_exception(m_failure);
 }
 
 void AsyncRunner::loop(std::promise<void>* started) {
@@ -74,45 +120,55 @@ void AsyncRunner::loop(std::promise<void>* started) {
         started->set_exception(std::current_exception());
         return;
     }
+    m_loop_thread.store(std::this_thread::get_id(), std::memory_order_release);
     m_running.store(true, std::memory_order_release);
     started->set_value();
 
     std::vector<std::function<void(Space&)>> posted;
     Stopwatch since_last;  // the time at the start of each iteration, as the seed asks
     const Stopwatch total;
-    while (!m_stop.load(std::memory_order_acquire)) {
-        const double dt = since_last.lap();
-        {
-            std::scoped_lock guard(m_posted_lock);
-            posted.swap(m_posted);
-        }
-        for (auto& fn : posted) fn(m_space);
-        posted.clear();
+    try {
+        while (!m_stop.load(std::memory_order_acquire)) {
+            const double dt = since_last.lap();
+            {
+                std::scoped_lock guard(m_posted_lock);
+                posted.swap(m_posted);
+            }
+            run_posted(posted);
 
-        const std::int64_t begin = now_nanoseconds();
-        m_space.update(dt);
-        const double update_seconds = static_cast<double>(now_nanoseconds() - begin) * 1e-9;
-        const UpdateStats& u = m_space.last_update();
-        record(update_seconds, u.flip_lock_seconds, u.steps, u.dropped_seconds);
-        {
-            std::scoped_lock guard(m_stats_lock);
-            m_totals.seconds = total.elapsed_seconds();
-        }
+            const std::int64_t begin = now_nanoseconds();
+            m_space.update(dt);
+            const double update_seconds = static_cast<double>(now_nanoseconds() - begin) * 1e-9;
+            // The settings are read here, on the loop thread that changes them, never by stats().
+            const TimeStepSettings& ts = m_space.settings().time_step;
+            const UpdateStats& u = m_space.last_update();
+            record(update_seconds, u.flip_lock_seconds, u.steps, u.dropped_seconds / ts.duration);
+            {
+                std::scoped_lock guard(m_stats_lock);
+                m_totals.seconds = total.elapsed_seconds();
+            }
 
-        const TimeStepSettings& ts = m_space.settings().time_step;
-        if (m_options.sleep_when_idle && ts.use_internal_time_stepping) {
-            // Sleep until the next step is due (what is banked subtracts from it).
-            const double due = ts.duration - m_space.accumulated_time() - since_last.elapsed_seconds();
-            if (due > 0) std::this_thread::sleep_for(std::chrono::duration<double>(due));
+            if (m_options.sleep_when_idle && ts.use_internal_time_stepping) {
+                // Sleep until the next step is due (what is banked subtracts from it).
+                const double due = ts.duration - m_space.accumulated_time() - since_last.elapsed_seconds();
+                if (due > 0) std::this_thread::sleep_for(std::chrono::duration<double>(due));
+            }
         }
+    } catch (...) {
+        // An update failed: end the loop and keep the exception for the game's next
+        // stats(), post() or stop(). Buffered writes not yet applied stay in the buffer.
+        std::scoped_lock guard(m_posted_lock);
+        m_failure = std::current_exception();
     }
+    m_running.store(false, std::memory_order_release);
+    m_loop_thread.store(std::thread::id{}, std::memory_order_release);
 }
 
-void AsyncRunner::record(double update_seconds, double lock_seconds, int steps, double dropped_seconds) {
+void AsyncRunner::record(double update_seconds, double lock_seconds, int steps, double dropped_steps) {
     std::scoped_lock guard(m_stats_lock);
     m_totals.updates += 1;
     m_totals.steps += static_cast<std::uint64_t>(steps);
-    m_dropped_seconds += dropped_seconds;
+    m_dropped_steps += dropped_steps;
     const auto ms = static_cast<float>(update_seconds * 1e3);
     const auto us = static_cast<float>(lock_seconds * 1e6);
     if (steps > 0) {
@@ -128,6 +184,7 @@ void AsyncRunner::record(double update_seconds, double lock_seconds, int steps, 
 }
 
 AsyncStats AsyncRunner::stats() const {
+    rethrow_failure();
     std::vector<float> updates, locks;
     AsyncStats s;
     {
@@ -135,7 +192,7 @@ AsyncStats AsyncRunner::stats() const {
         s = m_totals;
         updates = m_update_samples;
         locks = m_lock_samples;
-        s.steps_dropped = static_cast<std::uint64_t>(m_dropped_seconds / m_space.settings().time_step.duration + 0.5);
+        s.steps_dropped = static_cast<std::uint64_t>(std::llround(m_dropped_steps));
     }
     s.steps_per_second = s.seconds > 0 ? static_cast<double>(s.steps) / s.seconds : 0;
     s.update_ms_p50 = percentile(updates, 0.5);

@@ -1,9 +1,75 @@
-// MotionStateManager: locked copies out of the published buffer, and the flip.
+// MotionStateManager: locked copies out of the published buffer, the flip, the lock
+// that knows its holder, and the lock-free copy of each slot's published generation.
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 
+#include <bit>
+
 namespace spindle {
+
+// ---- the lock ----
+
+// Only the holder stores its id, and it clears it before unlocking, so a thread reads
+// its own id exactly while it holds the lock (relaxed is enough for that question).
+bool MotionStateLock::held_by_this_thread() const noexcept {
+    return m_owner.load(std::memory_order_relaxed) == std::this_thread::get_id();
+}
+
+void MotionStateLock::lock() {
+    if (held_by_this_thread()) {
+        throw Error("motion-state lock: this thread holds it already (taking it again would wait forever)");
+    }
+    m_mutex.lock();
+    m_owner.store(std::this_thread::get_id(), std::memory_order_relaxed);
+}
+
+bool MotionStateLock::try_lock() {
+    if (held_by_this_thread()) throw Error("motion-state lock: this thread holds it already");
+    if (!m_mutex.try_lock()) return false;
+    m_owner.store(std::this_thread::get_id(), std::memory_order_relaxed);
+    return true;
+}
+
+void MotionStateLock::unlock() noexcept {
+    m_owner.store(std::thread::id{}, std::memory_order_relaxed);
+    m_mutex.unlock();
+}
+
+// ---- published generations ----
+
+MotionStateManager::~MotionStateManager() = default;
+
+MotionStateManager::SlotGenerations::~SlotGenerations() {
+    for (auto& chunk : m_chunks) delete[] chunk.load(std::memory_order_relaxed);
+}
+
+// Chunk c holds kFirstChunk << c slots, starting at kFirstChunk * (2^c - 1).
+int MotionStateManager::SlotGenerations::chunk_of(std::uint32_t slot, std::uint32_t& offset) noexcept {
+    const std::uint32_t q = slot / kFirstChunk + 1;
+    const int c = std::bit_width(q) - 1;
+    offset = slot - kFirstChunk * ((std::uint32_t{1} << c) - 1);
+    return c;
+}
+
+std::uint32_t MotionStateManager::SlotGenerations::load(std::uint32_t slot) const noexcept {
+    std::uint32_t offset = 0;
+    const std::atomic<std::uint32_t>* chunk = m_chunks[chunk_of(slot, offset)].load(std::memory_order_acquire);
+    return chunk ? chunk[offset].load(std::memory_order_acquire) : 0;
+}
+
+void MotionStateManager::SlotGenerations::store(std::uint32_t slot, std::uint32_t generation) {
+    std::uint32_t offset = 0;
+    const int c = chunk_of(slot, offset);
+    std::atomic<std::uint32_t>* chunk = m_chunks[c].load(std::memory_order_relaxed);
+    if (!chunk) {
+        chunk = new std::atomic<std::uint32_t>[std::size_t{kFirstChunk} << c]();
+        m_chunks[c].store(chunk, std::memory_order_release);
+    }
+    chunk[offset].store(generation, std::memory_order_release);
+}
+
+// ---- reads and the flip ----
 
 MotionState MotionStateManager::blend(const PublishedBody& body, double alpha) {
     if (!body.interpolate || alpha >= 1) return body.current;
@@ -29,13 +95,13 @@ bool MotionStateManager::is_published_locked(BodyHandle body) const noexcept {
 MotionState MotionStateManager::read_locked(BodyHandle body) const { return blend(checked_locked(body), m_alpha); }
 
 MotionState MotionStateManager::read(BodyHandle body) const {
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     return read_locked(body);
 }
 
 std::size_t MotionStateManager::get_motion_states(std::vector<BodyHandle>& handles,
                                                   std::vector<MotionState>& states) const {
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     const std::vector<PublishedBody>& front = *m_front;
     std::size_t count = 0;
     for (const PublishedBody& b : front) count += b.generation != 0;
@@ -53,25 +119,25 @@ std::size_t MotionStateManager::get_motion_states(std::vector<BodyHandle>& handl
 
 void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
     if (out.size() < bodies.size()) throw Error("get_motion_states: output span is shorter than the handle list");
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     for (BodyHandle b : bodies) checked_locked(b);
     for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend((*m_front)[bodies[i].index], m_alpha);
 }
 
 void MotionStateManager::get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
     if (out.size() < bodies.size()) throw Error("get_raw_motion_states: output span is shorter than the handle list");
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     for (BodyHandle b : bodies) checked_locked(b);
     for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = (*m_front)[bodies[i].index].current;
 }
 
 std::uint64_t MotionStateManager::published_steps() const {
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     return m_steps;
 }
 
 double MotionStateManager::alpha() const {
-    std::scoped_lock guard(m_lock);
+    const MotionStateLock::Hold guard(m_lock);
     return m_alpha;
 }
 

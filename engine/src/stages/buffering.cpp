@@ -15,7 +15,10 @@ public:
     std::vector<PublishedBody>& back() noexcept { return m_manager.back(); }
     int back_index() const noexcept { return m_manager.back_index(); }
     std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_manager.buffer_locked(k); }
-    std::mutex& lock() const noexcept { return m_manager.lock(); }
+    MotionStateLock& lock() const noexcept { return m_manager.lock(); }
+    void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
+        m_manager.set_published_generation(slot, generation);
+    }
     double flip(double alpha, std::uint64_t steps) { return m_manager.flip(alpha, steps); }
 
 private:
@@ -129,12 +132,17 @@ static void fill(const World& world, std::uint32_t i, PublishedBody& p, bool int
 void publish_now(World& world, std::uint32_t slot) {
     MotionStatePublisher manager(world.motion_states);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
-    std::scoped_lock guard(manager.lock());
+    // The update thread may hold the lock itself (a posted function reading one step
+    // while it creates bodies); then publishing goes ahead under its hold.
+    const MotionStateLock::Hold guard(manager.lock());
     for (int k = 0; k < 2; ++k) {
         std::vector<PublishedBody>& buffer = manager.buffer_locked(k);
         if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
         fill(world, slot, buffer[slot], interpolating);
     }
+    // Creation and destruction are the only changes of a slot's generation, and both
+    // publish here, so the lock-free copy buffered writes check stays exact.
+    manager.set_published_generation(slot, manager.buffer_locked(0)[slot].generation);
 }
 
 void flip_read_buffers(World& world) {

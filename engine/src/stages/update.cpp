@@ -63,10 +63,19 @@ void run_stage(World& world, Stage stage, F&& body) {
     if constexpr (kValidateState) check_state(world, stage);
 }
 
+// The flip waits for the motion-state lock; a thread holding it would wait for itself.
+void check_not_holding_motion_state_lock(const World& world, const char* what) {
+    if (world.motion_states.lock().held_by_this_thread()) {
+        throw Error(std::string(what) +
+                    ": this thread holds the motion-state lock, which the flip would wait for forever");
+    }
+}
+
 }  // namespace
 
 void Space::update(Real dt) {
     World& w = *m_world;
+    check_not_holding_motion_state_lock(w, "update");
     if (!std::isfinite(dt) || dt < 0) {
         throw Error("update: dt must be a finite, non-negative number of seconds, got " + number(dt));
     }
@@ -99,6 +108,7 @@ void Space::update(Real dt) {
 
 void Space::update() {
     World& w = *m_world;
+    check_not_holding_motion_state_lock(w, "update");
     w.stats = UpdateStats{};
     run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
     step(w, w.settings.time_step.duration);
@@ -108,6 +118,7 @@ void Space::update() {
 
 void Space::flush() {
     World& w = *m_world;
+    check_not_holding_motion_state_lock(w, "flush");
     w.stats = UpdateStats{};
     run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
     run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });

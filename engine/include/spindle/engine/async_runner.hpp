@@ -5,12 +5,15 @@
 
 #include <atomic>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <future>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace spindle {
@@ -35,52 +38,89 @@ struct AsyncStats {
     double lock_us_p50 = 0, lock_us_p99 = 0, lock_us_max = 0;        // flip's hold of the motion-state lock
 };
 
+// Failures. Nothing a posted function or Space::update throws ends the process:
+//  - a posted function's exception goes to the future post() returned; the loop goes on;
+//  - an exception from Space::update ends the loop (running() turns false). Writes made
+//    before it stay in the write buffer or the live state; none is dropped. Until stop(),
+//    stats() and post() throw it; stop() finishes the stop (runs what was posted,
+//    flushes) and then throws it, once. The destructor never throws (it drops a failure
+//    nobody asked for; call stop() to see it).
 class AsyncRunner {
 public:
     // The space must outlive the runner. Nothing runs until start().
     explicit AsyncRunner(Space& space, AsyncRunnerOptions options = {});
-    // Stops (as stop()) if running.
+    // Stops (as stop()) if started, swallowing what stop() would throw. Who may call:
+    // the owner thread, not holding the motion-state lock (stopping would wait for the
+    // loop's flip, which waits for that lock: it aborts with a message instead).
     ~AsyncRunner();
     AsyncRunner(const AsyncRunner&) = delete;
     AsyncRunner& operator=(const AsyncRunner&) = delete;
 
     // Starts the physics loop thread. Who may call: the owner thread. Throws
-    // spindle::Error if already running or the PU cannot be pinned (reported from the
-    // new thread before start() returns).
+    // spindle::Error if already started (after a failure too: stop() first) or the PU
+    // cannot be pinned (reported from the new thread before start() returns).
     void start();
-    // Ends the loop, joins the thread, then applies and publishes every buffered write
-    // made before the call (Space::flush), so none is lost; writes to destroyed bodies
-    // are counted in Space::last_update().writes_rejected. Who may call: the owner
-    // thread. Deadlock: calling it from a function passed to post() (the loop thread).
+    // Ends the loop, joins the thread, runs what was posted and not yet run (on this
+    // thread), then applies and publishes every buffered write made before the call
+    // (Space::flush), so none is lost; writes to destroyed bodies are counted in
+    // Space::last_update().writes_rejected. Then throws the loop's failure, if any.
+    // Who may call: the owner thread. Waits for: the loop's current iteration (an
+    // update, posted functions). Throws spindle::Error instead of deadlocking when
+    // called from the loop thread (a posted function) or by a thread holding the
+    // motion-state lock (the loop's flip waits for it); the runner keeps running then.
     void stop();
     bool running() const noexcept { return m_running.load(std::memory_order_acquire); }
 
-    // Runs fn on the physics loop thread before its next update (structural changes
-    // such as create_body while running). Any thread. fn must not call stop().
-    void post(std::function<void(Space&)> fn);
+    // Runs fn(space) on the physics loop thread before its next update (structural
+    // changes such as create_body while running) and returns a future of its result or
+    // of the exception it threw. Any thread, the loop thread included (fn runs at the
+    // next iteration). Functions posted before start() run at the first iteration;
+    // those still queued at stop() run in stop() on the stopping thread; those posted
+    // after stop() wait for the next start() (destroying the runner breaks their
+    // futures: std::future_error, broken_promise). Throws the loop's failure until
+    // stop(). Deadlock: waiting on the future on the loop thread (fn runs only after
+    // the caller returns), or while holding the motion-state lock (the loop may be in
+    // its flip, waiting for that lock, before it gets to fn).
+    template <typename F>
+    auto post(F&& fn) -> std::future<std::invoke_result_t<F&, Space&>> {
+        using Result = std::invoke_result_t<F&, Space&>;
+        auto task = std::make_shared<std::packaged_task<Result(Space&)>>(std::forward<F>(fn));
+        std::future<Result> result = task->get_future();
+        enqueue([task](Space& space) { (*task)(space); });  // the task keeps fn's exception
+        return result;
+    }
 
-    // Any thread.
+    // Totals and latencies so far. Any thread; reads only the runner's own copies, taken
+    // by the loop under its stats lock (never the space, which the loop is changing).
+    // Throws the loop's failure until stop().
     AsyncStats stats() const;
 
 private:
+    void enqueue(std::function<void(Space&)> fn);
+    void run_posted(std::vector<std::function<void(Space&)>>& posted);
+    void rethrow_failure() const;
     void loop(std::promise<void>* started);
-    void record(double update_seconds, double lock_seconds, int steps, double dropped_seconds);
+    void record(double update_seconds, double lock_seconds, int steps, double dropped_steps);
 
     Space& m_space;
     AsyncRunnerOptions m_options;
     std::thread m_thread;
+    std::atomic<std::thread::id> m_loop_thread{};  // while the loop runs
     std::atomic<bool> m_running{false};
     std::atomic<bool> m_stop{false};
 
-    std::mutex m_posted_lock;
+    // Posted functions (each wraps a packaged_task, so running one never throws), and
+    // the exception that ended the loop, under one lock.
+    mutable std::mutex m_posted_lock;
     std::vector<std::function<void(Space&)>> m_posted;
+    std::exception_ptr m_failure;
 
     mutable std::mutex m_stats_lock;
     AsyncStats m_totals;
     std::vector<float> m_update_samples;  // ms, ring of the last kSamples
     std::vector<float> m_lock_samples;    // us
     std::size_t m_next_sample = 0;
-    double m_dropped_seconds = 0;
+    double m_dropped_steps = 0;  // each update's dropped time over the step duration it ran with
 };
 
 }  // namespace spindle

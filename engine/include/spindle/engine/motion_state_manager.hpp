@@ -4,9 +4,11 @@
 // half of the next (the seed, section 2.A).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <span>
+#include <thread>
 #include <vector>
 
 #include <spindle/engine/body.hpp>
@@ -23,13 +25,68 @@ struct PublishedBody {
     Vec3 previous_center_of_mass = Vec3::Zero();
 };
 
+// The motion-state lock: a mutex that knows which thread holds it, so that a thread
+// taking it a second time gets a spindle::Error instead of waiting for itself forever.
+// Use it as any mutex (std::scoped_lock, std::unique_lock<MotionStateLock>).
+class MotionStateLock {
+public:
+    // Any thread. Waits for the holder (a game thread's read, or the physics thread's
+    // flip). Throws spindle::Error if this thread holds it already.
+    void lock();
+    // As lock(), without waiting: false if another thread holds it.
+    bool try_lock();
+    // The holder only.
+    void unlock() noexcept;
+    // Whether the calling thread holds it; exact for the calling thread, lock-free.
+    bool held_by_this_thread() const noexcept;
+
+    // Holds the lock for a scope, or nothing if this thread holds it already (then the
+    // published step cannot change under the caller either way).
+    class Hold {
+    public:
+        explicit Hold(MotionStateLock& lock) : m_lock(lock), m_took(!lock.held_by_this_thread()) {
+            if (m_took) m_lock.lock();
+        }
+        ~Hold() {
+            if (m_took) m_lock.unlock();
+        }
+        Hold(const Hold&) = delete;
+        Hold& operator=(const Hold&) = delete;
+
+    private:
+        MotionStateLock& m_lock;
+        bool m_took;
+    };
+
+private:
+    std::mutex m_mutex;
+    std::atomic<std::thread::id> m_owner{};  // written only by the holder, under m_mutex
+};
+
 class MotionStateManager {
 public:
-    // The lock FlipReadBuffers takes. Hold it to make several reads of one published
-    // step (then use the *_locked reads). Any thread may take it; hold it briefly, it
-    // delays the physics thread's flip. Deadlock: calling update() or any non-locked
-    // read of this manager while holding it.
-    std::mutex& lock() const noexcept { return m_lock; }
+    MotionStateManager() = default;
+    ~MotionStateManager();
+    MotionStateManager(const MotionStateManager&) = delete;
+    MotionStateManager& operator=(const MotionStateManager&) = delete;
+
+    // The lock FlipReadBuffers takes: hold it to make several reads of one published
+    // step. Who may call: any thread; hold it briefly, it delays the physics thread's flip.
+    // While a thread holds it:
+    //  - that thread's reads of this manager and the space's buffered reads (position(),
+    //    motion_state(), get_motion_states(), ...) read the held step without locking
+    //    again, as the *_locked reads do; other threads' reads wait for it;
+    //  - buffered writes (set_position(), apply_impulse(), wake(), ...) from any thread
+    //    do not take it (their stale-handle check is lock-free);
+    //  - taking it again on the same thread throws spindle::Error;
+    //  - on the same thread, Space::update()/flush() and AsyncRunner::stop() throw
+    //    spindle::Error (each would wait for a flip that waits for this lock); create_body
+    //    and destroy_body publish under the held lock.
+    // Deadlock: waiting while holding it for anything that waits for a flip (another
+    // thread's update, an AsyncRunner's loop, a posted function's future); destroying a
+    // running AsyncRunner while holding it (the destructor cannot throw: it aborts with a
+    // message).
+    MotionStateLock& lock() const noexcept { return m_lock; }
 
     // Every live body, in handle order: handles and interpolated states, into the
     // caller's vectors (resized; no allocation once they are large enough). Returns the count.
@@ -40,7 +97,8 @@ public:
     // As above, the newest step without interpolation.
     void get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const;
 
-    // One body (interpolated where allowed); throws for a stale handle. Takes the lock.
+    // One body (interpolated where allowed); throws for a stale handle. Takes the lock
+    // unless this thread holds it.
     MotionState read(BodyHandle body) const;
     // The same, for a caller that already holds lock().
     MotionState read_locked(BodyHandle body) const;
@@ -49,6 +107,11 @@ public:
     std::uint32_t published_generation_locked(std::uint32_t slot) const noexcept {
         return slot < m_front->size() ? (*m_front)[slot].generation : 0;
     }
+    // The same without the lock: any thread, lock-free (buffered writes check handles
+    // with it, so a thread holding lock() can still write). Equal to the locked value:
+    // a slot's generation changes only when a body is created or destroyed, and both
+    // publish it to both buffers at once (publish_now), so a flip never changes it.
+    std::uint32_t published_generation(std::uint32_t slot) const noexcept { return m_generations.load(slot); }
 
     // Steps published so far and the weight of the newest step in blended reads.
     std::uint64_t published_steps() const;
@@ -67,10 +130,32 @@ private:
     // Swaps back and front under the lock; returns seconds the lock was held.
     double flip(double alpha, std::uint64_t steps);
 
+    // Records a slot's published generation; the physics side, under lock().
+    void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
+        m_generations.store(slot, generation);
+    }
+
     static MotionState blend(const PublishedBody& body, double alpha);
     const PublishedBody& checked_locked(BodyHandle body) const;
 
-    mutable std::mutex m_lock;
+    // Per slot, an atomic copy of the published generation. Readers take no lock, so
+    // storage never moves: chunks of doubling size, allocated by the one writer and
+    // never freed before the manager.
+    class SlotGenerations {
+    public:
+        ~SlotGenerations();
+        std::uint32_t load(std::uint32_t slot) const noexcept;
+        void store(std::uint32_t slot, std::uint32_t generation);  // one writer at a time
+
+    private:
+        static constexpr std::uint32_t kFirstChunk = 1024;
+        static constexpr int kChunks = 23;  // enough for every 32-bit slot index
+        static int chunk_of(std::uint32_t slot, std::uint32_t& offset) noexcept;
+        std::atomic<std::atomic<std::uint32_t>*> m_chunks[kChunks] = {};
+    };
+
+    mutable MotionStateLock m_lock;
+    SlotGenerations m_generations;
     std::vector<PublishedBody> m_buffers[2];
     std::vector<PublishedBody>* m_front = &m_buffers[0];
     std::vector<PublishedBody>* m_back = &m_buffers[1];
