@@ -45,9 +45,9 @@ void GetMotionStates(benchmark::State& state) {
     auto space = make_space(n, interpolate);
     std::vector<BodyHandle> handles;
     std::vector<MotionState> states;
-    space->motion_states().get_motion_states(handles, states);
+    space->motion_states().get_all_motion_states(handles, states);
     for (auto _ : state) {
-        space->motion_states().get_motion_states(handles, states);
+        space->motion_states().get_all_motion_states(handles, states);
         benchmark::DoNotOptimize(states.data());
     }
     state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(n * sizeof(MotionState)));
@@ -89,12 +89,12 @@ void ReadLatencyWhilePhysicsRuns(benchmark::State& state) {
     runner.start();
     std::vector<BodyHandle> handles;
     std::vector<MotionState> states;
-    space->motion_states().get_motion_states(handles, states);
+    space->motion_states().get_all_motion_states(handles, states);
     std::vector<double> latencies;
     latencies.reserve(1 << 20);
     for (auto _ : state) {
         const std::int64_t t0 = now_nanoseconds();
-        space->motion_states().get_motion_states(handles, states);
+        space->motion_states().get_all_motion_states(handles, states);
         latencies.push_back(static_cast<double>(now_nanoseconds() - t0));
     }
     runner.stop();

@@ -3,6 +3,7 @@
 // only the update thread touches it, and stages split work through the JobSystem.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -17,6 +18,7 @@
 #include <spindle/platform/spin.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
+#include "api/access_gate.hpp"
 #include "api/joint_store.hpp"
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
@@ -193,8 +195,10 @@ struct World {
     Joints joints;
 
     // Buffering.
+    AccessGate gate;                         // structural calls and updates (api/access_gate.hpp)
+    std::atomic<std::size_t> body_count{0};  // bodies.live, for Space::body_count from any thread
     WriteBuffer writes;
-    std::vector<BufferedWrite> drained;  // reused by ApplyWrites
+    std::vector<PendingWrites> drained;  // reused by ApplyWrites
     MotionStateManager motion_states;
     std::vector<std::uint32_t> changed_now;   // slots whose published state changed outside a step
     std::vector<std::uint32_t> changed_last;  // the same, one flip ago (the back buffer is two flips old)

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "async_util.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -19,37 +21,9 @@
 #include <thread>
 
 using namespace spindle;
+using namespace spindle::test;
 
 namespace {
-
-SpaceSettings async_settings() {
-    SpaceSettings s;
-    s.gravity = Vec3::Zero();
-    s.sleep.enabled = false;
-    s.time_step.use_internal_time_stepping = true;
-    return s;
-}
-
-BodyDesc ball() {
-    BodyDesc d;
-    d.shape = Shape::sphere(0.25);
-    d.mass = 1;
-    return d;
-}
-
-// Runs fn on its own thread and fails the test if it has not finished in time. A
-// thread stuck on a lock cannot be recovered, so a deadlock ends the test program.
-template <typename F>
-void finishes_in_time(F fn) {
-    std::packaged_task<void()> task(std::move(fn));
-    std::future<void> done = task.get_future();
-    std::thread(std::move(task)).detach();
-    if (done.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
-        std::fprintf(stderr, "deadlock: not finished within 10 s\n");
-        std::_Exit(1);
-    }
-    done.get();  // rethrows what fn threw
-}
 
 // A single-threaded job system that shows what the update thread does: which thread
 // runs updates, a sleep in every step (a known lower bound on an update's time), and

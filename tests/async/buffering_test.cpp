@@ -6,35 +6,18 @@
 
 #include <gtest/gtest.h>
 
+#include "async_util.hpp"
+
 #include <atomic>
 #include <thread>
 #include <vector>
 
 using namespace spindle;
-
-namespace {
-
-SpaceSettings weightless() {
-    SpaceSettings s;
-    s.gravity = Vec3::Zero();
-    s.sleep.enabled = false;
-    return s;
-}
-
-BodyDesc body_at(const Vec3& p, MotionType type = MotionType::Dynamic) {
-    BodyDesc d;
-    d.type = type;
-    d.position = p;
-    d.shape = Shape::sphere(0.25);
-    d.mass = 1;
-    return d;
-}
-
-}  // namespace
+using namespace spindle::test;
 
 TEST(Buffering, WriteIsInvisibleUntilTheNextUpdate) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3(0, 0, 0)));
+    const BodyHandle body = space.create_body(ball(Vec3(0, 0, 0)));
     space.set_position(body, Vec3(5, 0, 0));
     EXPECT_EQ(space.internal_position(body), Vec3(0, 0, 0));
     EXPECT_EQ(space.position(body), Vec3(0, 0, 0));
@@ -45,7 +28,7 @@ TEST(Buffering, WriteIsInvisibleUntilTheNextUpdate) {
 
 TEST(Buffering, LastWriteToAPropertyWins) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3::Zero()));
+    const BodyHandle body = space.create_body(ball(Vec3::Zero()));
     space.set_linear_velocity(body, Vec3(1, 0, 0));
     space.set_linear_velocity(body, Vec3(2, 0, 0));
     space.set_position(body, Vec3(1, 1, 1));
@@ -62,7 +45,7 @@ TEST(Buffering, LastWriteToAPropertyWins) {
 
 TEST(Buffering, ReadsReturnThePublishedStepNotTheLiveOne) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3::Zero()));
+    const BodyHandle body = space.create_body(ball(Vec3::Zero()));
     space.set_internal_motion_state(body, MotionState{Vec3(3, 0, 0), Quat::Identity(), Vec3::Zero(), Vec3::Zero(), {}});
     EXPECT_EQ(space.internal_position(body).x(), 3.0);
     EXPECT_EQ(space.position(body).x(), 0.0);  // not published until the flip
@@ -72,10 +55,10 @@ TEST(Buffering, ReadsReturnThePublishedStepNotTheLiveOne) {
 
 TEST(Buffering, StaleHandlesAreReportedEverywhere) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3::Zero()));
+    const BodyHandle body = space.create_body(ball(Vec3::Zero()));
     space.update();
     space.destroy_body(body);
-    const BodyHandle reused = space.create_body(body_at(Vec3(1, 0, 0)));
+    const BodyHandle reused = space.create_body(ball(Vec3(1, 0, 0)));
     EXPECT_EQ(reused.index, body.index);
     EXPECT_NE(reused.generation, body.generation);
     space.update();
@@ -93,7 +76,7 @@ TEST(Buffering, StaleHandlesAreReportedEverywhere) {
 
 TEST(Buffering, WriteToABodyDestroyedBeforeTheUpdateIsReportedNotApplied) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3::Zero()));
+    const BodyHandle body = space.create_body(ball(Vec3::Zero()));
     space.set_position(body, Vec3(1, 2, 3));
     space.destroy_body(body);
     space.update();
@@ -103,7 +86,7 @@ TEST(Buffering, WriteToABodyDestroyedBeforeTheUpdateIsReportedNotApplied) {
 
 TEST(Buffering, NanWritesAreRejectedAtOnce) {
     Space space(weightless());
-    const BodyHandle body = space.create_body(body_at(Vec3::Zero()));
+    const BodyHandle body = space.create_body(ball(Vec3::Zero()));
     EXPECT_THROW(space.set_position(body, Vec3(std::nan(""), 0, 0)), Error);
     EXPECT_THROW(space.set_orientation(body, Quat(0, 0, 0, 0)), Error);
     space.update();
@@ -115,7 +98,7 @@ TEST(Buffering, FourThreadsWritingWhileThePhysicsThreadUpdatesLoseNothing) {
     settings.solver.max_linear_speed = 1e9;  // the velocity counts the writes: no speed limit in the way
     Space space(settings);
     std::vector<BodyHandle> bodies;
-    for (int i = 0; i < 8; ++i) bodies.push_back(space.create_body(body_at(Vec3(10.0 * i, 0, 0))));
+    for (int i = 0; i < 8; ++i) bodies.push_back(space.create_body(ball(Vec3(10.0 * i, 0, 0))));
     constexpr int kThreads = 4;
     constexpr int kWritesPerThread = 25000;  // 100k in all
     std::atomic<bool> writing{true};
@@ -146,7 +129,7 @@ TEST(Buffering, ReaderNeverSeesTwoStepsMixed) {
     Space space(weightless());
     std::vector<BodyHandle> bodies;
     for (int i = 0; i < 64; ++i) {
-        BodyDesc d = body_at(Vec3(0, 2.0 * i, 0), MotionType::Kinematic);
+        BodyDesc d = ball(Vec3(0, 2.0 * i, 0), MotionType::Kinematic);
         d.linear_velocity = Vec3(1, 0, 0);
         d.allow_interpolation = false;
         bodies.push_back(space.create_body(d));
@@ -157,7 +140,7 @@ TEST(Buffering, ReaderNeverSeesTwoStepsMixed) {
         std::vector<BodyHandle> handles;
         std::vector<MotionState> states;
         while (running.load()) {
-            space.motion_states().get_motion_states(handles, states);
+            space.motion_states().get_all_motion_states(handles, states);
             for (const MotionState& s : states) {
                 if (s.position.x() != states.front().position.x()) {
                     torn.fetch_add(1);
@@ -182,14 +165,14 @@ TEST(Buffering, ReaderNeverSeesTwoStepsMixed) {
 
 TEST(MotionStates, CopiesAllOrListedBodiesAndRejectsStaleHandles) {
     Space space(weightless());
-    const BodyHandle a = space.create_body(body_at(Vec3(1, 0, 0)));
-    const BodyHandle b = space.create_body(body_at(Vec3(2, 0, 0)));
-    const BodyHandle c = space.create_body(body_at(Vec3(3, 0, 0)));
+    const BodyHandle a = space.create_body(ball(Vec3(1, 0, 0)));
+    const BodyHandle b = space.create_body(ball(Vec3(2, 0, 0)));
+    const BodyHandle c = space.create_body(ball(Vec3(3, 0, 0)));
     space.destroy_body(b);
     space.update();
     std::vector<BodyHandle> handles;
     std::vector<MotionState> states;
-    EXPECT_EQ(space.motion_states().get_motion_states(handles, states), 2u);
+    EXPECT_EQ(space.motion_states().get_all_motion_states(handles, states), 2u);
     EXPECT_EQ(handles, (std::vector<BodyHandle>{a, c}));
     EXPECT_EQ(states[1].position.x(), 3.0);
     std::vector<MotionState> out(2);
@@ -205,7 +188,7 @@ TEST(MotionStates, CopiesAllOrListedBodiesAndRejectsStaleHandles) {
 
 TEST(MotionStates, HoldingTheLockKeepsThePhysicsThreadFromFlipping) {
     Space space(weightless());
-    BodyDesc d = body_at(Vec3::Zero(), MotionType::Kinematic);
+    BodyDesc d = ball(Vec3::Zero(), MotionType::Kinematic);
     d.linear_velocity = Vec3(1, 0, 0);
     const BodyHandle body = space.create_body(d);
     std::atomic<bool> running{true};
@@ -227,7 +210,7 @@ TEST(MotionStates, HoldingTheLockKeepsThePhysicsThreadFromFlipping) {
 }
 
 TEST(Buffering, AnEntityOutsideASpaceReadsAndWritesItsOwnValues) {
-    Entity body(body_at(Vec3(1, 0, 0)));
+    Entity body(ball(Vec3(1, 0, 0)));
     EXPECT_FALSE(body.in_space());
     body.set_position(Vec3(2, 0, 0));  // direct: visible at once
     EXPECT_EQ(body.position(), Vec3(2, 0, 0));

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "async_util.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,38 +18,7 @@
 #include <vector>
 
 using namespace spindle;
-
-namespace {
-
-SpaceSettings weightless() {
-    SpaceSettings s;
-    s.gravity = Vec3::Zero();
-    s.sleep.enabled = false;
-    return s;
-}
-
-BodyDesc ball() {
-    BodyDesc d;
-    d.shape = Shape::sphere(0.25);
-    d.mass = 1;
-    return d;
-}
-
-// Runs fn on its own thread and fails the test if it has not finished in time. A
-// thread stuck on a lock cannot be recovered, so a deadlock ends the test program.
-template <typename F>
-void finishes_in_time(F fn) {
-    std::packaged_task<void()> task(std::move(fn));
-    std::future<void> done = task.get_future();
-    std::thread(std::move(task)).detach();
-    if (done.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
-        std::fprintf(stderr, "deadlock: not finished within 10 s\n");
-        std::_Exit(1);
-    }
-    done.get();  // rethrows what fn threw
-}
-
-}  // namespace
+using namespace spindle::test;
 
 TEST(MotionStateLock, EveryBufferedWriteWorksUnderTheHeldLock) {
     Space space(weightless());
@@ -113,7 +84,7 @@ TEST(MotionStateLock, ReadsUnderTheHeldLockReadTheHeldStep) {
         EXPECT_EQ(states.published_steps(), steps);
         std::vector<BodyHandle> handles;
         std::vector<MotionState> all;
-        EXPECT_EQ(states.get_motion_states(handles, all), 1u);
+        EXPECT_EQ(states.get_all_motion_states(handles, all), 1u);
         EXPECT_EQ(all[0].position, held.position);
         MotionState one;
         states.get_raw_motion_states(std::span<const BodyHandle>(&body, 1), std::span<MotionState>(&one, 1));

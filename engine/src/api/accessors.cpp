@@ -12,12 +12,11 @@
 namespace spindle {
 namespace {
 
-// Lock-free, so a thread holding the motion-state lock can still write. Newer
-// generations than the published one may be bodies created since; ApplyWrites checks
-// those. Older ones are certainly stale.
+// Lock-free, so a thread holding the motion-state lock can still write. The published
+// generation of a slot is exact (creation and destruction publish at once), so a handle
+// that does not match it names no live body: stale, never made, or from another space.
 void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* what) {
-    const bool stale = body.generation == 0 || manager.published_generation(body.index) > body.generation;
-    if (stale)
+    if (body.generation == 0 || manager.published_generation(body.index) != body.generation)
         throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
 }
 
@@ -120,6 +119,7 @@ std::uint32_t live_slot(const World& w, BodyHandle body, const char* what) {
 }  // namespace
 
 MotionState Space::internal_motion_state(BodyHandle body) const {
+    const AccessGate::Structure access(m_world->gate, "internal_motion_state");
     const Bodies& b = m_world->bodies;
     const std::uint32_t i = live_slot(*m_world, body, "internal_motion_state");
     return MotionState{b.origin(i), b.q[i], b.v[i], b.w[i], b.x[i]};
@@ -130,6 +130,7 @@ Vec3 Space::internal_linear_velocity(BodyHandle body) const { return internal_mo
 Vec3 Space::internal_angular_velocity(BodyHandle body) const { return internal_motion_state(body).angular_velocity; }
 
 void Space::set_internal_motion_state(BodyHandle body, const MotionState& state) {
+    const AccessGate::Structure access(m_world->gate, "set_internal_motion_state");
     const std::uint32_t i = live_slot(*m_world, body, "set_internal_motion_state");
     validate(state, "set_internal_motion_state");
     Bodies& b = m_world->bodies;
@@ -146,10 +147,12 @@ void Space::set_internal_motion_state(BodyHandle body, const MotionState& state)
 }
 
 bool Space::internal_is_awake(BodyHandle body) const {
+    const AccessGate::Structure access(m_world->gate, "internal_is_awake");
     return m_world->bodies.awake_index[live_slot(*m_world, body, "internal_is_awake")] >= 0;
 }
 
-const BodyDesc& Space::internal_desc(BodyHandle body) const {
+BodyDesc Space::internal_desc(BodyHandle body) const {
+    const AccessGate::Structure access(m_world->gate, "internal_desc");
     return m_world->bodies.desc[live_slot(*m_world, body, "internal_desc")];
 }
 

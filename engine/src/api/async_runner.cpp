@@ -8,6 +8,8 @@
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/thread.hpp>
 
+#include "world.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -121,6 +123,8 @@ void AsyncRunner::loop(std::promise<void>* started) {
         return;
     }
     m_loop_thread.store(std::this_thread::get_id(), std::memory_order_release);
+    // From here to the loop's end, structural calls from other threads throw (post them).
+    m_space.m_world->gate.claim(std::this_thread::get_id());
     m_running.store(true, std::memory_order_release);
     started->set_value();
 
@@ -160,6 +164,7 @@ void AsyncRunner::loop(std::promise<void>* started) {
         std::scoped_lock guard(m_posted_lock);
         m_failure = std::current_exception();
     }
+    m_space.m_world->gate.claim(std::thread::id{});
     m_running.store(false, std::memory_order_release);
     m_loop_thread.store(std::thread::id{}, std::memory_order_release);
 }

@@ -240,6 +240,7 @@ void destroy_joints_of(World& world, std::uint32_t body_slot) {
 }
 
 JointHandle Space::create_joint(const JointDesc& desc) {
+    const AccessGate::Structure access(m_world->gate, "create_joint");
     World& w = *m_world;
     validate(w, desc);
     Joint joint = make_joint(w, desc);
@@ -271,6 +272,7 @@ JointHandle Space::create_joint(const JointDesc& desc) {
 }
 
 void Space::destroy_joint(JointHandle joint) {
+    const AccessGate::Structure access(m_world->gate, "destroy_joint");
     live_joint(*m_world, joint, "destroy_joint");
     remove_joint(*m_world, joint.index);
 }
@@ -278,12 +280,14 @@ void Space::destroy_joint(JointHandle joint) {
 bool Space::contains(JointHandle joint) const noexcept { return m_world->joints.is_live(joint); }
 std::size_t Space::joint_count() const noexcept { return m_world->joints.live; }
 
-const JointDesc& Space::joint_desc(JointHandle joint) const {
+JointDesc Space::joint_desc(JointHandle joint) const {
+    const AccessGate::Structure access(m_world->gate, "joint_desc");
     live_joint(*m_world, joint, "joint_desc");
     return m_world->joints.desc[joint.index];
 }
 
 void Space::set_hinge_motor(JointHandle handle, bool enable, Real speed, Real max_torque) {
+    const AccessGate::Structure access(m_world->gate, "set_hinge_motor");
     World& w = *m_world;
     live_joint(w, handle, "set_hinge_motor");
     Joint& j = w.joints.joint[handle.index];
@@ -301,6 +305,7 @@ void Space::set_hinge_motor(JointHandle handle, bool enable, Real speed, Real ma
 }
 
 JointError Space::internal_joint_error(JointHandle handle) const {
+    const AccessGate::Structure access(m_world->gate, "internal_joint_error");
     const World& w = *m_world;
     const Joint& j = live_joint(w, handle, "internal_joint_error");
     const Bodies& b = w.bodies;
@@ -336,6 +341,7 @@ JointError Space::internal_joint_error(JointHandle handle) const {
 }
 
 Real Space::internal_hinge_angle(JointHandle handle) const {
+    const AccessGate::Structure access(m_world->gate, "internal_hinge_angle");
     const World& w = *m_world;
     const Joint& j = live_joint(w, handle, "internal_hinge_angle");
     if (j.type != JointType::Hinge)

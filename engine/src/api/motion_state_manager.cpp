@@ -99,8 +99,8 @@ MotionState MotionStateManager::read(BodyHandle body) const {
     return read_locked(body);
 }
 
-std::size_t MotionStateManager::get_motion_states(std::vector<BodyHandle>& handles,
-                                                  std::vector<MotionState>& states) const {
+std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& handles,
+                                                      std::vector<MotionState>& states) const {
     const MotionStateLock::Hold guard(m_lock);
     const std::vector<PublishedBody>& front = *m_front;
     std::size_t count = 0;

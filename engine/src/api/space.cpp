@@ -50,6 +50,7 @@ Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make
 Space::~Space() = default;
 
 BodyHandle Space::create_body(const BodyDesc& input) {
+    const AccessGate::Structure access(m_world->gate, "create_body");
     validate(input);
     World& w = *m_world;
     Bodies& b = w.bodies;
@@ -130,11 +131,13 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
     w.changed_now.push_back(slot);
     w.body_set_version += 1;
+    w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
     return BodyHandle{slot, b.generation[slot]};
 }
 
 void Space::destroy_body(BodyHandle body) {
+    const AccessGate::Structure access(m_world->gate, "destroy_body");
     World& w = *m_world;
     if (!w.bodies.is_live(body))
         throw Error("destroy_body: " + to_string(body) + " is not a live body (stale or foreign handle)");
@@ -152,11 +155,16 @@ void Space::destroy_body(BodyHandle body) {
     w.bodies.free_slots.push_back(slot);
     w.changed_now.push_back(slot);
     w.body_set_version += 1;
+    w.body_count.store(w.bodies.live, std::memory_order_release);
     publish_now(w, slot);
 }
 
-bool Space::contains(BodyHandle body) const noexcept { return m_world->bodies.is_live(body); }
-std::size_t Space::body_count() const noexcept { return m_world->bodies.live; }
+// Lock-free: a slot's published generation is exact (creation and destruction publish
+// at once), so these are safe from any thread while the physics thread updates.
+bool Space::contains(BodyHandle body) const noexcept {
+    return body.generation != 0 && m_world->motion_states.published_generation(body.index) == body.generation;
+}
+std::size_t Space::body_count() const noexcept { return m_world->body_count.load(std::memory_order_acquire); }
 
 // ---- settings and reports ----
 
@@ -164,21 +172,25 @@ const SpaceSettings& Space::settings() const noexcept { return m_world->settings
 
 // Each setter checks with the constructor's function for its struct (api/validation.cpp).
 void Space::set_time_step(const TimeStepSettings& s) {
+    const AccessGate::Structure access(m_world->gate, "set_time_step");
     validate(s);
     m_world->settings.time_step = s;
 }
 
 void Space::set_solver(const SolverSettings& s) {
+    const AccessGate::Structure access(m_world->gate, "set_solver");
     validate(s);
     m_world->settings.solver = s;
 }
 
 void Space::set_sleep(const SleepSettings& s) {
+    const AccessGate::Structure access(m_world->gate, "set_sleep");
     validate(s);
     m_world->settings.sleep = s;
 }
 
 void Space::set_gravity(const Vec3& gravity) {
+    const AccessGate::Structure access(m_world->gate, "set_gravity");
     validate_gravity(gravity);
     m_world->settings.gravity = gravity;
 }
@@ -191,6 +203,7 @@ MotionStateManager& Space::motion_states() noexcept { return m_world->motion_sta
 const MotionStateManager& Space::motion_states() const noexcept { return m_world->motion_states; }
 
 std::uint64_t Space::state_hash() const {
+    const AccessGate::Structure access(m_world->gate, "state_hash");
     const Bodies& b = m_world->bodies;
     std::uint64_t hash = 1469598103934665603ull;
     auto mix = [&hash](const void* data, std::size_t size) {

@@ -1,41 +1,104 @@
-// WriteBuffer: sharded pending writes, drained in sequence order.
+// WriteBuffer: pending writes coalesced per body, striped by slot.
 #include "api/write_buffer.hpp"
 
 #include <algorithm>
 
+#include "solver/speed_limit.hpp"
+
 namespace spindle {
 namespace {
 
-unsigned shard_of_this_thread(unsigned shards) {
-    static std::atomic<unsigned> next{0};
-    thread_local const unsigned shard = next.fetch_add(1, std::memory_order_relaxed);
-    return shard % shards;
+void merge(PendingWrites& entry, const BufferedWrite& write) {
+    entry.writes += 1;
+    switch (write.kind) {
+        case WriteKind::Position:
+            entry.position = write.vector;
+            entry.bits |= kPendingPosition;
+            break;
+        case WriteKind::Orientation:
+            entry.orientation = write.rotation;
+            entry.bits |= kPendingOrientation;
+            break;
+        case WriteKind::LinearVelocity:
+            entry.linear_velocity = write.vector;
+            entry.impulse = Vec3::Zero();
+            entry.bits = (entry.bits | kPendingLinearVelocity) & ~kPendingImpulse;
+            break;
+        case WriteKind::AngularVelocity:
+            entry.angular_velocity = write.vector;
+            entry.angular_impulse = Vec3::Zero();
+            entry.bits = (entry.bits | kPendingAngularVelocity) & ~kPendingAngularImpulse;
+            break;
+        case WriteKind::MotionState:
+            entry.position = write.state.position;
+            entry.orientation = write.state.orientation;
+            entry.linear_velocity = write.state.linear_velocity;
+            entry.angular_velocity = write.state.angular_velocity;
+            entry.impulse = Vec3::Zero();
+            entry.angular_impulse = Vec3::Zero();
+            entry.bits = (entry.bits | kPendingPose | kPendingVelocity) & ~(kPendingImpulse | kPendingAngularImpulse);
+            break;
+        case WriteKind::Force:
+            entry.force = saturate(entry.force + write.vector);
+            entry.bits |= kPendingForce;
+            break;
+        case WriteKind::Torque:
+            entry.torque = saturate(entry.torque + write.vector);
+            entry.bits |= kPendingTorque;
+            break;
+        case WriteKind::Impulse:
+            entry.impulse = saturate(entry.impulse + write.vector);
+            entry.bits |= kPendingImpulse;
+            break;
+        case WriteKind::AngularImpulse:
+            entry.angular_impulse = saturate(entry.angular_impulse + write.vector);
+            entry.bits |= kPendingAngularImpulse;
+            break;
+        case WriteKind::Wake: entry.bits |= kPendingWake; break;
+    }
 }
 
 }  // namespace
 
-void WriteBuffer::push(BufferedWrite write) {
-    Shard& shard = m_shards[shard_of_this_thread(kShards)];
-    std::scoped_lock guard(shard.lock);
-    // Taking the number under the shard lock keeps each shard sorted by sequence.
-    write.sequence = m_sequence.value.fetch_add(1, std::memory_order_relaxed);
-    shard.writes.push_back(write);
+void WriteBuffer::push(const BufferedWrite& write) {
+    const std::uint32_t slot = write.body.index;
+    Stripe& stripe = m_stripes[slot % kStripes];
+    const std::uint32_t local = slot / kStripes;
+    std::scoped_lock guard(stripe.lock);
+    if (stripe.entry_of.size() <= local) stripe.entry_of.resize(local + 1, -1);
+    std::int32_t& at = stripe.entry_of[local];
+    if (at < 0) {
+        at = static_cast<std::int32_t>(stripe.entries.size());
+        stripe.entries.emplace_back().body = write.body;
+    }
+    PendingWrites& entry = stripe.entries[static_cast<std::size_t>(at)];
+    if (entry.body.generation != write.body.generation) {
+        // The slot holds another body than the entry's: the older one was destroyed, and
+        // its writes can never apply.
+        if (write.body.generation < entry.body.generation) {
+            stripe.superseded += 1;
+            return;
+        }
+        stripe.superseded += entry.writes;
+        entry = PendingWrites{};
+        entry.body = write.body;
+    }
+    merge(entry, write);
 }
 
-void WriteBuffer::drain(std::vector<BufferedWrite>& out) {
+void WriteBuffer::drain(std::vector<PendingWrites>& out, std::uint32_t& superseded) {
     out.clear();
-    for (Shard& shard : m_shards) {
-        {
-            std::scoped_lock guard(shard.lock);
-            std::swap(shard.writes, m_spare);  // m_spare is empty: the shard keeps a buffer
-        }
-        out.insert(out.end(), m_spare.begin(), m_spare.end());
-        m_spare.clear();
+    superseded = 0;
+    for (Stripe& stripe : m_stripes) {
+        std::scoped_lock guard(stripe.lock);
+        for (const PendingWrites& entry : stripe.entries) stripe.entry_of[entry.body.index / kStripes] = -1;
+        out.insert(out.end(), stripe.entries.begin(), stripe.entries.end());
+        stripe.entries.clear();
+        superseded += stripe.superseded;
+        stripe.superseded = 0;
     }
     std::sort(out.begin(), out.end(),
-              [](const BufferedWrite& a, const BufferedWrite& b) { return a.sequence < b.sequence; });
+              [](const PendingWrites& a, const PendingWrites& b) { return a.body.index < b.body.index; });
 }
-
-std::uint64_t WriteBuffer::pending_hint() const noexcept { return m_sequence.value.load(std::memory_order_relaxed); }
 
 }  // namespace spindle

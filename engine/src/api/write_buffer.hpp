@@ -1,9 +1,14 @@
-// The write side of buffering: writes from any number of threads accumulate here
-// until ApplyWrites. Sharded by thread so that writers rarely contend; a global
-// sequence number orders writes across shards so the last write to a property wins.
+// The write side of buffering: writes from any number of threads wait here until
+// ApplyWrites, coalesced per body as the seed says: one pending value per body and
+// property, the last write winning, and forces, torques and impulses summed. So
+// ApplyWrites costs in proportion to the bodies written, not to the writes made, and a
+// flood of writes cannot grow the buffer beyond one entry per body.
+//
+// The entries are striped by body slot, each stripe under its own mutex: writes to
+// different bodies rarely contend, and all writes to one body pass one lock, whose
+// order is the order the writes were made (the last one wins across threads too).
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <vector>
@@ -26,8 +31,8 @@ enum class WriteKind : std::uint8_t {
     Wake,
 };
 
+// One write as a caller makes it.
 struct BufferedWrite {
-    std::uint64_t sequence = 0;
     BodyHandle body;
     WriteKind kind = WriteKind::Wake;
     Vec3 vector = Vec3::Zero();        // position, velocity, force, impulse
@@ -35,25 +40,58 @@ struct BufferedWrite {
     MotionState state;                 // motion state
 };
 
+// Which properties a body's pending entry holds.
+enum PendingBits : std::uint16_t {
+    kPendingPosition = 1U << 0U,
+    kPendingOrientation = 1U << 1U,
+    kPendingLinearVelocity = 1U << 2U,
+    kPendingAngularVelocity = 1U << 3U,
+    kPendingForce = 1U << 4U,
+    kPendingTorque = 1U << 5U,
+    kPendingImpulse = 1U << 6U,
+    kPendingAngularImpulse = 1U << 7U,
+    kPendingWake = 1U << 8U,
+    kPendingPose = kPendingPosition | kPendingOrientation,
+    kPendingVelocity = kPendingLinearVelocity | kPendingAngularVelocity,
+};
+
+// One body's writes since the last ApplyWrites. A velocity written after an impulse
+// replaces it (the impulse was made to the velocity it overwrites); an impulse written
+// after a velocity adds to it. ApplyWrites applies pose, then velocities, then impulses,
+// then adds forces and torques for the next step.
+struct PendingWrites {
+    BodyHandle body;
+    std::uint32_t writes = 0;  // calls coalesced into this entry
+    std::uint16_t bits = 0;    // PendingBits
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 linear_velocity = Vec3::Zero();
+    Vec3 angular_velocity = Vec3::Zero();
+    Vec3 force = Vec3::Zero();  // sums, saturated so they stay finite
+    Vec3 torque = Vec3::Zero();
+    Vec3 impulse = Vec3::Zero();
+    Vec3 angular_impulse = Vec3::Zero();
+};
+
 class WriteBuffer {
 public:
-    // Any thread. Never blocks on the physics thread for long: a shard lock is held
-    // for one push_back.
-    void push(BufferedWrite write);
-    // The update thread: every pending write, in the order they were made. `out` is
-    // reused between updates (no allocation in steady state).
-    void drain(std::vector<BufferedWrite>& out);
-    std::uint64_t pending_hint() const noexcept;
+    // Any thread. Holds one stripe's lock for the merge of one write.
+    void push(const BufferedWrite& write);
+    // The update thread: every body's pending entry, in slot order (so what ApplyWrites
+    // does never depends on which thread wrote first). `out` is reused between updates.
+    // `superseded` gets the writes dropped because their body's slot was reused by a
+    // newer body before they were applied.
+    void drain(std::vector<PendingWrites>& out, std::uint32_t& superseded);
 
 private:
-    static constexpr unsigned kShards = 16;
-    struct alignas(cache_line_size) Shard {
+    static constexpr std::uint32_t kStripes = 64;
+    struct alignas(cache_line_size) Stripe {
         std::mutex lock;
-        std::vector<BufferedWrite> writes;
+        std::vector<std::int32_t> entry_of;  // by slot / kStripes: index into entries, -1 none
+        std::vector<PendingWrites> entries;
+        std::uint32_t superseded = 0;
     };
-    Shard m_shards[kShards];
-    CacheLinePadded<std::atomic<std::uint64_t>> m_sequence;
-    std::vector<BufferedWrite> m_spare;
+    Stripe m_stripes[kStripes];
 };
 
 }  // namespace spindle

@@ -39,70 +39,53 @@ void reset_history(Bodies& b, std::uint32_t i) {
 
 }  // namespace
 
+// Each written body once, whatever the number of writes made to it (WriteBuffer
+// coalesces them): pose, then velocities, then impulses, then forces for the next step.
 void apply_writes(World& world) {
-    world.writes.drain(world.drained);
+    std::uint32_t superseded = 0;
+    world.writes.drain(world.drained, superseded);
+    world.stats.writes_rejected += static_cast<int>(superseded);
     Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
-    for (const BufferedWrite& write : world.drained) {
+    for (const PendingWrites& write : world.drained) {
         if (!b.is_live(write.body)) {
-            world.stats.writes_rejected += 1;  // the body was destroyed after the write was made
+            world.stats.writes_rejected += static_cast<int>(write.writes);  // destroyed after the writes were made
             continue;
         }
         const std::uint32_t i = write.body.index;
         const bool moves = b.type[i] != MotionType::Static;
-        switch (write.kind) {
-            case WriteKind::Position:
-                b.x[i] = write.vector + b.q[i] * b.local_com[i];
-                reset_history(b, i);
-                break;
-            case WriteKind::Orientation: {
-                const Vec3 origin = b.origin(i);
-                b.q[i] = write.rotation.normalized();
-                b.x[i] = origin + b.q[i] * b.local_com[i];
-                reset_history(b, i);
-                break;
-            }
-            case WriteKind::LinearVelocity:
-                if (moves) b.v[i] = write.vector;
-                break;
-            case WriteKind::AngularVelocity:
-                if (moves) b.w[i] = write.vector;
-                break;
-            case WriteKind::MotionState:
-                b.q[i] = write.state.orientation.normalized();
-                b.x[i] = write.state.position + b.q[i] * b.local_com[i];
-                if (moves) {
-                    b.v[i] = write.state.linear_velocity;
-                    b.w[i] = write.state.angular_velocity;
-                }
-                reset_history(b, i);
-                break;
-            case WriteKind::Force: b.force[i] = saturate(b.force[i] + write.vector); break;
-            case WriteKind::Torque: b.torque[i] = saturate(b.torque[i] + write.vector); break;
-            case WriteKind::Impulse: b.v[i] += b.inv_mass[i] * write.vector; break;
-            case WriteKind::AngularImpulse:
-                b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), write.vector, max_angular);
-                break;
-            case WriteKind::Wake: break;
-        }
-        b.v[i] = limit_speed(b.v[i], max_linear);
-        b.w[i] = limit_speed(b.w[i], max_angular);
-        const bool pose = write.kind == WriteKind::Position || write.kind == WriteKind::Orientation ||
-                          write.kind == WriteKind::MotionState;
+        const bool pose = (write.bits & kPendingPose) != 0;
         if (pose) {
             // A static body too: what rests on it must not hang where it was. Before the
             // proxy moves, so the contacts are found where the body was.
             wake_touching(world, i);
+            const Vec3 origin = (write.bits & kPendingPosition) != 0 ? write.position : b.origin(i);
+            if ((write.bits & kPendingOrientation) != 0) b.q[i] = write.orientation.normalized();
+            b.x[i] = origin + b.q[i] * b.local_com[i];
+            reset_history(b, i);
         } else if (moves) {
             wake_body(world, i);
         }
-        if (write.kind <= WriteKind::MotionState) {
+        if (moves) {
+            if ((write.bits & kPendingLinearVelocity) != 0) b.v[i] = write.linear_velocity;
+            if ((write.bits & kPendingAngularVelocity) != 0) b.w[i] = write.angular_velocity;
+            if ((write.bits & kPendingImpulse) != 0) b.v[i] += b.inv_mass[i] * write.impulse;
+            if ((write.bits & kPendingAngularImpulse) != 0) {
+                b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), write.angular_impulse, max_angular);
+            }
+            if ((write.bits & kPendingForce) != 0) b.force[i] = saturate(b.force[i] + write.force);
+            if ((write.bits & kPendingTorque) != 0) b.torque[i] = saturate(b.torque[i] + write.torque);
+            b.v[i] = limit_speed(b.v[i], max_linear);
+            b.w[i] = limit_speed(b.w[i], max_angular);
+        }
+        if ((write.bits & (kPendingPose | kPendingVelocity)) != 0) {
             b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
-        world.stats.writes_applied += 1;
+        world.stats.writes_applied += static_cast<int>(write.writes);
+        world.stats.bodies_written += 1;
     }
     settle_awake(world);
 }

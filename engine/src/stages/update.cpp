@@ -74,6 +74,7 @@ void check_not_holding_motion_state_lock(const World& world, const char* what) {
 }  // namespace
 
 void Space::update(Real dt) {
+    const AccessGate::Update access(m_world->gate, "update");
     World& w = *m_world;
     check_not_holding_motion_state_lock(w, "update");
     if (!std::isfinite(dt) || dt < 0) {
@@ -107,6 +108,7 @@ void Space::update(Real dt) {
 }
 
 void Space::update() {
+    const AccessGate::Update access(m_world->gate, "update");
     World& w = *m_world;
     check_not_holding_motion_state_lock(w, "update");
     w.stats = UpdateStats{};
@@ -117,6 +119,7 @@ void Space::update() {
 }
 
 void Space::flush() {
+    const AccessGate::Update access(m_world->gate, "flush");
     World& w = *m_world;
     check_not_holding_motion_state_lock(w, "flush");
     w.stats = UpdateStats{};

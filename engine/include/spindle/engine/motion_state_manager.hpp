@@ -74,7 +74,7 @@ public:
     // step. Who may call: any thread; hold it briefly, it delays the physics thread's flip.
     // While a thread holds it:
     //  - that thread's reads of this manager and the space's buffered reads (position(),
-    //    motion_state(), get_motion_states(), ...) read the held step without locking
+    //    motion_state(), get_all_motion_states(), ...) read the held step without locking
     //    again, as the *_locked reads do; other threads' reads wait for it;
     //  - buffered writes (set_position(), apply_impulse(), wake(), ...) from any thread
     //    do not take it (their stale-handle check is lock-free);
@@ -90,7 +90,7 @@ public:
 
     // Every live body, in handle order: handles and interpolated states, into the
     // caller's vectors (resized; no allocation once they are large enough). Returns the count.
-    std::size_t get_motion_states(std::vector<BodyHandle>& handles, std::vector<MotionState>& states) const;
+    std::size_t get_all_motion_states(std::vector<BodyHandle>& handles, std::vector<MotionState>& states) const;
     // The listed bodies into out[0..bodies.size()). A stale handle throws spindle::Error
     // naming it, before anything is written.
     void get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const;

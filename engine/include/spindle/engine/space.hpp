@@ -8,8 +8,12 @@
 //    next update's ApplyWrites, the last write to a property winning.
 //  - internal accessors (internal_*): the live state. Only the thread that calls
 //    update(), and never during update().
-//  - structure (create_body, destroy_body, settings) and update(): one thread at a
-//    time, normally the physics loop thread (AsyncRunner::post runs a function there).
+//  - structure (create_body, destroy_body, joints, settings, internal_*) and update():
+//    one thread at a time, normally the physics loop thread (AsyncRunner::post runs a
+//    function there). A structural call from another thread while an update runs, or
+//    while an AsyncRunner's loop runs this space, throws spindle::Error instead of
+//    racing; structural calls from several threads outside updates take turns.
+//    contains(BodyHandle) and body_count() are any thread, any time.
 #pragma once
 
 #include <cstdint>
@@ -44,8 +48,8 @@ public:
     // spindle::Error names the field and value.
     BodyHandle create_body(const BodyDesc& desc);
     void destroy_body(BodyHandle body);
-    bool contains(BodyHandle body) const noexcept;
-    std::size_t body_count() const noexcept;
+    bool contains(BodyHandle body) const noexcept;  // any thread: as published
+    std::size_t body_count() const noexcept;        // any thread
 
     // Joints (same thread rule as bodies). create_joint validates first (bodies live
     // and different, at least one dynamic, finite anchors, non-zero axes, ordered
@@ -56,7 +60,7 @@ public:
     void destroy_joint(JointHandle joint);
     bool contains(JointHandle joint) const noexcept;
     std::size_t joint_count() const noexcept;
-    const JointDesc& joint_desc(JointHandle joint) const;  // as created
+    JointDesc joint_desc(JointHandle joint) const;  // as created (a copy)
     // Changes a hinge's motor (between updates); max_torque >= 0.
     void set_hinge_motor(JointHandle joint, bool enable, Real speed, Real max_torque);
 
@@ -100,7 +104,7 @@ public:
     Vec3 internal_angular_velocity(BodyHandle body) const;
     void set_internal_motion_state(BodyHandle body, const MotionState& state);
     bool internal_is_awake(BodyHandle body) const;
-    const BodyDesc& internal_desc(BodyHandle body) const;  // as created (shape, material, flags)
+    BodyDesc internal_desc(BodyHandle body) const;  // as created (shape, material, flags; a copy)
     // How far a joint is from satisfied now, from the live poses.
     JointError internal_joint_error(JointHandle joint) const;
     // A hinge's angle (rad): B's rotation relative to A about the axis since creation.
@@ -130,6 +134,7 @@ public:
     JobSystem& jobs() noexcept;
 
 private:
+    friend class AsyncRunner;      // claims the space for its loop thread (api/access_gate.hpp)
     friend struct SpaceInternals;  // engine/src/api/space_internals.hpp: the engine's own tests reach World
     std::unique_ptr<World> m_world;
 };

@@ -24,8 +24,9 @@ const char* to_string(Stage stage) noexcept;
 struct UpdateStats {
     int steps = 0;               // steps taken by this update
     double dropped_seconds = 0;  // time beyond the cap's worth, thrown away
-    int writes_applied = 0;
-    int writes_rejected = 0;  // buffered writes to bodies destroyed since (reported, not applied)
+    int writes_applied = 0;      // buffered writes (calls) that reached the live state
+    int writes_rejected = 0;     // buffered writes to bodies destroyed since (reported, not applied)
+    int bodies_written = 0;      // bodies ApplyWrites changed: its cost, however many writes each got
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};  // summed over the steps
     double flip_lock_seconds = 0;  // how long FlipReadBuffers held the motion-state lock
     std::uint32_t awake_bodies = 0;
