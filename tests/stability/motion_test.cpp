@@ -117,8 +117,12 @@ TEST(Dominoes, AllFallInOrder) {
 }
 
 // A 1 x 2 x 3 m box spun about its intermediate (y) axis, slightly perturbed, tumbles
-// (Dzhanibekov); implicit gyroscopic torque must not add energy over 10 s.
-TEST(Gyroscopic, IntermediateAxisSpinDoesNotGainEnergy) {
+// (Dzhanibekov). A free body keeps its angular momentum: over 20 s it must stay within
+// 1 % (as a vector, in the world) and the energy must not grow (it may wobble by a
+// thousandth of a percent; an explicit update would gain 500 % here). Main before issue 16
+// (an implicit Newton step on the gyroscopic torque) lost 22 % of the momentum and 39 %
+// of the energy in 20 s.
+TEST(Gyroscopic, IntermediateAxisSpinKeepsAngularMomentumAndGainsNoEnergy) {
     auto space = make_space();
     space->set_gravity(Vec3::Zero());
     BodyDesc d;
@@ -126,27 +130,36 @@ TEST(Gyroscopic, IntermediateAxisSpinDoesNotGainEnergy) {
     d.gyroscopic = true;
     d.angular_velocity = Vec3(0.01, 5, 0.01);
     const BodyHandle body = space->create_body(d);
+    auto momentum = [&] {
+        const Mat3 r = space->internal_orientation(body).toRotationMatrix();
+        return Vec3(r * mass_of(space->internal_desc(body)).inertia * r.transpose() *
+                    space->internal_angular_velocity(body));
+    };
     const double initial = rotational_energy(*space, body);
-    double highest = initial, lowest = initial;
+    const Vec3 initial_momentum = momentum();
+    double highest = initial, lowest = initial, worst_momentum = 0;
     int flips = 0;
     double last_sign = 1;
-    for (int step = 0; step < 600; ++step) {
+    for (int step = 0; step < 1200; ++step) {
         space->update();
         const double e = rotational_energy(*space, body);
         highest = std::max(highest, e);
         lowest = std::min(lowest, e);
+        worst_momentum = std::max(worst_momentum, (momentum() - initial_momentum).norm() / initial_momentum.norm());
         const Vec3 body_w = space->internal_orientation(body).conjugate() * space->internal_angular_velocity(body);
         const double sign = body_w.y() >= 0 ? 1 : -1;
         if (sign != last_sign) ++flips;
         last_sign = sign;
     }
     std::printf("[ measure  ] gyroscopic: energy initial %.6g J, highest %+.3g%%, lowest %+.3g%%, final %+.3g%%; "
-                "%d flips of the spin about the body's y axis\n",
+                "angular momentum off by up to %.3g%%; %d flips of the spin about the body's y axis\n",
                 initial, 100 * (highest / initial - 1), 100 * (lowest / initial - 1),
-                100 * (rotational_energy(*space, body) / initial - 1), flips);
+                100 * (rotational_energy(*space, body) / initial - 1), 100 * worst_momentum, flips);
     EXPECT_TRUE(all_finite(*space, {body}));
-    EXPECT_LT(highest, initial * 1.01);
-    EXPECT_GT(flips, 0);  // it tumbles, as a free body spinning about that axis must
+    EXPECT_LT(highest, initial * (1 + 1e-4));  // a bounded wobble of the midpoint rule, no growth
+    EXPECT_GT(lowest, initial * 0.99);
+    EXPECT_LT(worst_momentum, 0.01);
+    EXPECT_GT(flips, 2);  // it tumbles, as a free body spinning about that axis must
 }
 
 // Sixteen 0.1 m spheres at 100 to 300 m/s, at angles from head-on to 80 degrees off

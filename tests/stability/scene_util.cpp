@@ -12,7 +12,6 @@
 #include "collision/collide.hpp"
 
 namespace spindle::stability {
-namespace {
 
 MassProperties mass_of(const BodyDesc& d) {
     MassProperties mp = d.shape.mass_properties(d.density);
@@ -23,7 +22,7 @@ MassProperties mass_of(const BodyDesc& d) {
     return mp;
 }
 
-}  // namespace
+namespace {}  // namespace
 
 std::unique_ptr<Space> make_space(const SpaceSettings& settings, JobSystem* jobs) {
     SpaceSettings s = settings;

@@ -35,6 +35,8 @@ double max_displacement(const Space& space, const std::vector<BodyHandle>& bodie
 double max_speed(const Space& space, const std::vector<BodyHandle>& bodies);
 bool all_finite(const Space& space, const std::vector<BodyHandle>& bodies);
 
+// As create_body computes it: the shape's at the density, scaled to the mass if given.
+MassProperties mass_of(const BodyDesc& d);
 // Rotational kinetic energy of a dynamic body, from its shape's mass properties.
 double rotational_energy(const Space& space, BodyHandle body);
 

@@ -61,9 +61,8 @@ private:
 inline void AccessGate::check_claim(const char* what) const {
     const std::thread::id claimed = m_claimed_by.load(std::memory_order_acquire);
     if (claimed != std::thread::id{} && claimed != std::this_thread::get_id()) {
-        throw Error(std::string(what) +
-                    ": an AsyncRunner is running this space on its loop thread; "
-                    "call it there (AsyncRunner::post) or after stop()");
+        throw Error(std::string(what) + ": an AsyncRunner is running this space on its loop thread; "
+                                        "call it there (AsyncRunner::post) or after stop()");
     }
 }
 
@@ -74,9 +73,8 @@ inline AccessGate::Structure::Structure(AccessGate& gate, const char* what) : m_
     std::unique_lock turn(gate.m_structure);
     int expected = kFree;
     if (!gate.m_state.compare_exchange_strong(expected, kStructure, std::memory_order_acquire)) {
-        throw Error(std::string(what) +
-                    ": an update is running on another thread; call it between updates "
-                    "(or on the loop thread with AsyncRunner::post)");
+        throw Error(std::string(what) + ": an update is running on another thread; call it between updates "
+                                        "(or on the loop thread with AsyncRunner::post)");
     }
     gate.m_holder.store(self, std::memory_order_release);
     turn.release();  // held until the destructor

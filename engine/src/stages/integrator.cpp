@@ -1,6 +1,7 @@
 // Integration, once per substep over the awake bodies: velocities (gravity, user
-// forces, damping, gyroscopic torque -- each only for bodies that use it) and then
-// positions as deltas from the start of the step (semi-implicit Euler).
+// forces, damping -- each only for bodies that use it) and then positions as deltas
+// from the start of the step (semi-implicit Euler), turning gyroscopic bodies so that
+// they keep their angular momentum.
 #include <algorithm>
 #include <cmath>
 
@@ -11,21 +12,31 @@
 namespace spindle {
 namespace {
 
-Mat3 skew(const Vec3& v) {
-    Mat3 m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
+// A body's world inverse inertia at orientation q.
+Mat3 inverse_inertia_at(const Quat& q, const Mat3& inv_inertia_local) {
+    const Mat3 r = q.toRotationMatrix();
+    return r * inv_inertia_local * r.transpose();
 }
 
-// Implicit gyroscopic torque (one Newton step on I(w2 - w1) + h w2 x I w2 = 0, in
-// the body frame): a fast-spinning asymmetric body neither gains energy nor explodes.
-Vec3 solve_gyroscopic(const Quat& q, const Mat3& inertia_local, const Vec3& w_world, Real h) {
-    const Vec3 wb = q.conjugate() * w_world;
-    const Vec3 iw = inertia_local * wb;
-    const Vec3 f = h * wb.cross(iw);
-    const Mat3 jacobian = inertia_local + h * (skew(wb) * inertia_local - skew(iw));
-    const Vec3 corrected = wb - jacobian.inverse() * f;  // closed-form 3x3: far cheaper than a pivoting LU
-    return q * corrected;
+// Gyroscopic motion that keeps angular momentum. Without torque, a body's world angular
+// momentum L = I(q) w is constant while its spin w changes as it turns (the torque-free
+// precession and flips of an asymmetric body). So L is taken at the start of the
+// substep, the rotation is made with the spin at the substep's middle orientation (the
+// implicit midpoint: two fixed-point passes), and the new spin is L through the new
+// orientation's inertia. L is kept to rounding and the energy does not grow (it falls
+// by well under 1 % in 20 s at the defaults); the implicit Newton step this replaces
+// lost 22 % of L in 20 s.
+void rotate_keeping_momentum(SolverBody& sb, const Quat& start, const Mat3& inertia_local,
+                             const Mat3& inv_inertia_local, const Vec3& push_w, Real h) {
+    const Quat q0 = (sb.dq * start).normalized();
+    const Mat3 r0 = q0.toRotationMatrix();
+    const Vec3 momentum = r0 * (inertia_local * (r0.transpose() * sb.w));
+    Vec3 mid_spin = sb.w;
+    for (int pass = 0; pass < 2; ++pass) {
+        mid_spin = inverse_inertia_at(integrate_rotation(q0, mid_spin, h / 2), inv_inertia_local) * momentum;
+    }
+    sb.dq = integrate_rotation(sb.dq, mid_spin + push_w, h);
+    sb.w = inverse_inertia_at((sb.dq * start).normalized(), inv_inertia_local) * momentum;
 }
 
 }  // namespace
@@ -52,14 +63,8 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
         }
         sb.v += h * sb.inv_mass * b.force[i];  // at worst infinite components, which the limit turns back
         sb.w = add_angular(sb.w, h, sb.inv_inertia, b.torque[i], max_angular);
-        // Before the gyroscopic step, which needs a finite spin.
         sb.v = limit_speed(sb.v, max_linear);
         sb.w = limit_speed(sb.w, max_angular);
-        if (d.gyroscopic) {
-            const Quat q = (sb.dq * b.q[i]).normalized();
-            sb.w = solve_gyroscopic(q, b.inertia_local[i], sb.w, h);
-            ++c.gyro;
-        }
         if (d.linear_damping > 0 || d.angular_damping > 0) {
             // Implicit (Pade) damping: stable for any h.
             sb.v *= 1 / (1 + h * d.linear_damping);
@@ -69,7 +74,9 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
     }
 }
 
-void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi) {
+void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
+                         EffectCounts& c) {
+    const Bodies& b = world.bodies;
     const Real push_out = world.settings.solver.push_out_speed;
     for (std::uint32_t k = lo; k < hi; ++k) {
         SolverBody& sb = bodies[k];
@@ -80,7 +87,13 @@ void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t
         const Real moving_sq = moving.squaredNorm();
         if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
         sb.dp += h * (sb.v + sb.push_v);
-        sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
+        const std::uint32_t i = world.awake[k];
+        if (sb.dynamic && b.desc[i].gyroscopic) {
+            rotate_keeping_momentum(sb, b.q[i], b.inertia_local[i], b.inv_inertia_local[i], sb.push_w, h);
+            ++c.gyro;
+        } else {
+            sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
+        }
         sb.push_v = Vec3::Zero();
         sb.push_w = Vec3::Zero();
     }

@@ -305,7 +305,9 @@ void solve(World& world, Real dt) {
                 case Pass::IntegrateVelocities:
                     integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
                     break;
-                case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi); break;
+                case Pass::IntegratePositions:
+                    integrate_positions(world, bodies, h, lo, hi, world.scratch_counts[worker]);
+                    break;
                 case Pass::WarmStart:
                     for_colored<true>(
                         scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },

@@ -27,7 +27,8 @@ void sweep_fast_bodies(World& world);
 struct SolverBody;
 void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
                           EffectCounts& counts);
-void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi);
+void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
+                         EffectCounts& counts);
 // record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
 void record(World& world);
 
