@@ -50,7 +50,8 @@ struct BodyDesc {
     Real gravity_scale = 1;
     Real linear_damping = 0;   // 1/s; 0 costs nothing
     Real angular_damping = 0;  // 1/s; 0 costs nothing
-    bool gyroscopic = false;   // implicit gyroscopic torque (spinning asymmetric bodies)
+    bool gyroscopic =
+        false;  // gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its angular momentum
     bool allow_interpolation = true;
     bool allow_sleep = true;
     bool fast = false;  // also swept against static geometry (continuous collision)
