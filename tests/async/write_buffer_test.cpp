@@ -154,7 +154,7 @@ TEST(WriteBuffer, FourThreadsWritingFlatOutLeaveTheLoopAtItsStepRate) {
     double total = 0;
     for (BodyHandle b : bodies) total += space.linear_velocity(b).x();
     EXPECT_EQ(total, static_cast<double>(made.load()));
-    EXPECT_GT(made.load(), 100000u);  // flat out: far more writes than bodies per step
+    EXPECT_GT(made.load(), 10000u);  // flat out: far more writes than bodies (14 M in a plain build, 77 k under TSan)
 #if !defined(SPINDLE_TSAN) && !defined(__SANITIZE_ADDRESS__)
     // 60 steps a second is the loop's rate; 30 leaves room for a slow two-core VM (a
     // sequenced log of every write gave 1-12 here).
