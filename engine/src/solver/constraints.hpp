@@ -67,6 +67,9 @@ struct WideContact {
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{}, restitution{};
     Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
+    // Radius of each body's round part (sphere, capsule; else 0): its surface point along
+    // the normal does not turn with the body, so a rolling ball's contact stays below it.
+    Wide radius_a{}, radius_b{};
     WidePoint points[kMaxManifoldPoints];
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The

@@ -111,6 +111,12 @@ WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wid
     return narrow(select(k > splat(0), splat(1) / k, splat(0)));
 }
 
+// The radius of a shape's round part: its surface point along any direction is the core's
+// plus this much, so it does not move as the body turns about the core.
+Real round_radius(const Shape& shape) {
+    return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule ? shape.radius : 0;
+}
+
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
 void prepare_wide(const World& world, const SolverScratch& scratch, WideContact& wc) {
@@ -125,6 +131,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
+    wc.radius_a = wc.radius_b = Wide{};
     for (int l = 0; l < wc.lanes; ++l) {
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
@@ -142,6 +149,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         inv_inertia_b.set_lane(l, B.inv_inertia);
         wc.friction[l] = contact.friction;
         wc.restitution[l] = contact.restitution;
+        wc.radius_a[l] = round_radius(b.desc[contact.body_a].shape);
+        wc.radius_b[l] = round_radius(b.desc[contact.body_b].shape);
         wc.gravity_normal[l] = m.normal.dot((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g -
                                             (A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g);
         const Vec3 xa = b.x[contact.body_a];
@@ -248,10 +257,14 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         dqa.set_lane(l, A.dq);
         dqb.set_lane(l, B.dq);
     }
-    const Wide moved = dot(wc.normal, dpb - dpa);
     const Wide3 na = rotate_inverse(dqa, wc.normal);
     const Wide3 nb = rotate_inverse(dqb, wc.normal);
     const Wide zero = splat(0), one = splat(1);
+    // The anchors turn with their bodies, but a round part's surface point along the
+    // normal stays on the normal: a rolling ball's contact stays below its centre (with
+    // the anchor alone it would seem to lift away as the ball turns, and sink).
+    const Wide moved = dot(wc.normal, dpb - dpa) + wc.radius_a * (dot(na, wc.normal) - one) +
+                       wc.radius_b * (dot(nb, wc.normal) - one);
     const Wide inv_h = splat(params.inv_h);
     const Wide recovery = splat(params.recovery_depth);
     // Overlap deeper than the recovery depth, per lane: its depth-weighted excess and centre.
