@@ -136,11 +136,15 @@ inline std::uint32_t contact_summary(const Contact& contact) {
     return summary;
 }
 
-// Effect counts of one worker in the solver's integration, summed after the step (a
-// sum of counts, so the total does not depend on who counted what). A cache line
-// each: the workers bump theirs per body.
+// Effect counts of one worker in the solver, summed after the step (a sum of counts,
+// so the total does not depend on who counted what). Each is bumped in the code that
+// does the work, so a count shows what ran, not what a flag promised. A cache line
+// each: the workers bump theirs per body and per constraint.
 struct alignas(64) EffectCounts {
-    std::uint64_t gravity = 0, damping = 0, gyro = 0;
+    std::uint64_t gravity = 0, damping = 0, gyro = 0;  // body-substeps (integrator.cpp)
+    std::uint64_t contact_points = 0, friction = 0;    // point-passes of the normal and friction rows
+    std::uint64_t restitution = 0;                     // points checked for a bounce
+    std::uint64_t joints = 0;                          // joint-passes
 };
 
 // Contacts of one worker in the narrowphase, summed after the stage.
