@@ -75,6 +75,9 @@ struct Bodies {
     }
     Vec3 origin(std::uint32_t i) const { return x[i] - q[i] * local_com[i]; }
     Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
+    // Whether the Continuous stage sweeps the body: dynamic and flagged fast (neither
+    // changes while the body lives).
+    bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && desc[i].fast; }
     Mat3 inv_inertia_world(std::uint32_t i) const {
         const Mat3 r = q[i].toRotationMatrix();
         return r * inv_inertia_local[i] * r.transpose();
@@ -226,6 +229,9 @@ struct World {
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     std::vector<std::uint32_t> scratch_lost;
     std::vector<FastStart> fast_starts;  // continuous.cpp
+    // Live bodies that are fast (create_body, destroy_body): without any, a step skips
+    // the Continuous stage instead of walking the awake bodies to find none.
+    std::uint32_t fast_bodies = 0;
     std::vector<std::uint32_t> scratch_candidates;
 
     // Islands.
