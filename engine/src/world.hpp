@@ -75,6 +75,9 @@ struct Bodies {
     }
     Vec3 origin(std::uint32_t i) const { return x[i] - q[i] * local_com[i]; }
     Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
+    // Whether the Continuous stage sweeps the body: dynamic and flagged fast (neither
+    // changes while the body lives).
+    bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && desc[i].fast; }
     Mat3 inv_inertia_world(std::uint32_t i) const {
         const Mat3 r = q[i].toRotationMatrix();
         return r * inv_inertia_local[i] * r.transpose();
@@ -136,11 +139,15 @@ inline std::uint32_t contact_summary(const Contact& contact) {
     return summary;
 }
 
-// Effect counts of one worker in the solver's integration, summed after the step (a
-// sum of counts, so the total does not depend on who counted what). A cache line
-// each: the workers bump theirs per body.
+// Effect counts of one worker in the solver, summed after the step (a sum of counts,
+// so the total does not depend on who counted what). Each is bumped in the code that
+// does the work, so a count shows what ran, not what a flag promised. A cache line
+// each: the workers bump theirs per body and per constraint.
 struct alignas(64) EffectCounts {
-    std::uint64_t gravity = 0, damping = 0, gyro = 0;
+    std::uint64_t gravity = 0, damping = 0, gyro = 0;  // body-substeps (integrator.cpp)
+    std::uint64_t contact_points = 0, friction = 0;    // point-passes of the normal and friction rows
+    std::uint64_t restitution = 0;                     // points checked for a bounce
+    std::uint64_t joints = 0;                          // joint-passes
 };
 
 // Contacts of one worker in the narrowphase, summed after the stage.
@@ -222,6 +229,9 @@ struct World {
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     std::vector<std::uint32_t> scratch_lost;
     std::vector<FastStart> fast_starts;  // continuous.cpp
+    // Live bodies that are fast (create_body, destroy_body): without any, a step skips
+    // the Continuous stage instead of walking the awake bodies to find none.
+    std::uint32_t fast_bodies = 0;
     std::vector<std::uint32_t> scratch_candidates;
 
     // Islands.

@@ -198,20 +198,21 @@ TEST(WorkStealing, AnIdleWorkerGetsPartOfABusyWorkersRange) {
 }
 
 TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {
-    // Worker 1 runs `quick` (group first), then `blocker` (group second), which waits
-    // until the main thread saw `first` done: a worker must not hold back the count of
-    // a finished job while it runs a job of another group.
+    // Worker 1 runs `quick` (group first), which hands worker 1 `next` (group second), so
+    // `next` runs after `quick` on the same worker. A worker counts the finished jobs of a
+    // group down together, but must do so before it runs a job of another group: `first`
+    // is done while `next` runs. Holding the count back would keep a waiter on `first`
+    // waiting for an unrelated job (for ever, if that job waits for the waiter).
     auto jobs = make(2);
     JobGroup first;
     JobGroup second;
-    std::atomic<bool> first_seen_done{false};
-    jobs->submit_pinned(1, second, "blocker", [&] {
-        while (!first_seen_done.load()) std::this_thread::yield();
+    std::atomic<int> first_done_in_next{-1};  // -1: `next` did not run
+    jobs->submit_pinned(1, first, "quick", [&] {
+        jobs->submit_pinned(1, second, "next", [&] { first_done_in_next.store(first.done() ? 1 : 0); });
     });
-    jobs->submit_pinned(1, first, "quick", [] {});  // the mailbox runs the newest first
     jobs->wait(first);
-    first_seen_done.store(true);
     jobs->wait(second);
+    EXPECT_EQ(first_done_in_next.load(), 1) << "`first` was still pending while its worker ran `next`";
 }
 
 TEST(WorkStealing, ExceptionsReachTheWaiter) {

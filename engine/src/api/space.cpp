@@ -127,6 +127,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     }
     b.desc[slot] = std::move(desc);
     b.bounds[slot] = b.desc[slot].shape.bounds(b.transform(slot));
+    if (b.is_fast(slot)) w.fast_bodies += 1;
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
     w.changed_now.push_back(slot);
@@ -149,6 +150,7 @@ void Space::destroy_body(BodyHandle body) {
     remove_contacts_of(w, slot);
     remove_proxy(w, slot);
     if (w.bodies.awake_index[slot] >= 0) set_awake(w, slot, false);
+    if (w.bodies.is_fast(slot)) w.fast_bodies -= 1;
     w.bodies.alive[slot] = 0;
     w.bodies.live -= 1;
     w.bodies.desc[slot] = BodyDesc{};  // drop the shape's geometry now

@@ -60,9 +60,10 @@ struct ManifoldRef {
 // They share no dynamic body, so the lanes never write the same body. Lanes past the
 // colour's end hold no manifold: both bodies are the immovable one and nothing is written.
 struct WideContact {
-    std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
-    std::uint32_t ref[kLanes] = {};                // manifold ref per lane
-    int lanes = 0;                                 // lanes holding a manifold
+    std::uint32_t a[kLanes] = {}, b[kLanes] = {};       // solver bodies per lane
+    std::uint32_t ref[kLanes] = {};                     // manifold ref per lane
+    int lanes = 0;                                      // lanes holding a manifold
+    std::uint8_t slot_points[kMaxManifoldPoints] = {};  // lanes with a point in each slot: the work counters
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{}, restitution{};
@@ -188,8 +189,10 @@ void pack_contacts(SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);  // wide [lo, hi)
 // push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
 void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params);
-void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h);
+// The points whose rows ran are counted into `counts` (the worker's).
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+                   EffectCounts& counts);
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts);
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 // joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are
@@ -198,7 +201,7 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
 Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz, capped; 0: the cap
 void prepare_joints(World& world, SolverScratch& scratch, Real h);
 void warm_start_joint(JointConstraint& jc, SolverBody* bodies);
-void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params);
+void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts);
 void store_joint_impulses(World& world, SolverScratch& scratch);
 
 }  // namespace spindle

@@ -132,6 +132,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
+    for (std::uint8_t& points : wc.slot_points) points = 0;
     for (int l = 0; l < wc.lanes; ++l) {
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
@@ -163,6 +164,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
             normal_impulse[j][l] = src.normal_impulse;
             tangent_impulse[j][0][l] = src.tangent_impulse[0];
             tangent_impulse[j][1][l] = src.tangent_impulse[1];
+            ++wc.slot_points[j];
         }
     }
     const Wide inv_mass_sum = wc.inv_mass_a + wc.inv_mass_b;
@@ -242,7 +244,8 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
 }
 
 template <bool kBias>
-void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
+void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+                EffectCounts& counts) {
     WideVelocities s = gather(wc, bodies);
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
@@ -273,6 +276,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
     Wide gap[kMaxManifoldPoints];
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
+        counts.contact_points += wc.slot_points[j];
         const Wide separation = moved + dot(nb, p.rb) - dot(na, p.ra) + p.adjusted_separation;
         gap[j] = separation;
         const WideMask speculative = separation > zero;  // may close the gap, no more
@@ -318,6 +322,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         // fast sphere's, metres ahead) would spin it up through the lever arm.
         const WideMask touching = gap[j] <= slop;
         if (!any(touching)) continue;
+        counts.friction += wc.slot_points[j];
         WidePoint& p = wc.points[j];
         const Wide old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
         const Wide3 dv = point_velocity(s, p.ra, p.rb);
@@ -371,18 +376,20 @@ void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody
     }
 }
 
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params) {
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+                   EffectCounts& counts) {
     if (params.use_bias) {
-        solve_wide<true>(wc, push_rows, bodies, params);
+        solve_wide<true>(wc, push_rows, bodies, params, counts);
     } else {
-        solve_wide<false>(wc, push_rows, bodies, params);
+        solve_wide<false>(wc, push_rows, bodies, params, counts);
     }
 }
 
-void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h) {
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
     const Wide zero = splat(0);
     const WideMask bouncy = wc.restitution > zero;
     if (!any(bouncy)) return;
+    for (std::uint8_t points : wc.slot_points) counts.restitution += points;
     WideVelocities s = gather(wc, bodies);
     for (WidePoint& p : wc.points) {
         // Only points that approached fast enough and actually pushed bounce.

@@ -321,7 +321,8 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
     store(A, B, s);
 }
 
-void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params) {
+void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts) {
+    ++counts.joints;
     SolverBody& A = bodies[jc.a];
     SolverBody& B = bodies[jc.b];
     Velocities s = load(A, B);

@@ -5,6 +5,8 @@
 // farthest reach) finds the first time of impact and stops the body there.
 #include <algorithm>
 
+#include <spindle/platform/assert.hpp>
+
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -69,8 +71,9 @@ void record_fast_starts(World& world) {
     world.fast_starts.clear();
     const Bodies& b = world.bodies;
     for (std::uint32_t i : world.awake) {
-        if (b.type[i] == MotionType::Dynamic && b.desc[i].fast) world.fast_starts.push_back({i, b.x[i], b.q[i]});
+        if (b.is_fast(i)) world.fast_starts.push_back({i, b.x[i], b.q[i]});
     }
+    SPINDLE_ASSERT(world.fast_starts.size() <= world.fast_bodies, "continuous: more fast bodies awake than counted");
 }
 
 void sweep_fast_bodies(World& world) {
@@ -104,6 +107,8 @@ void sweep_fast_bodies(World& world) {
         b.q[i] = pose.q;
         b.x[i] = pose.p + pose.q * b.local_com[i];
     }
+    // Used up: a step that records none (no fast body left) must not sweep these.
+    world.fast_starts.clear();
 }
 
 }  // namespace spindle

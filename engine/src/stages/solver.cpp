@@ -61,21 +61,16 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
 }
 
-// Contact points of the step's manifolds, for the work counters.
-struct PointCounts {
-    std::uint64_t points = 0, friction = 0, restitution = 0;
-};
-
-// One ref per touching manifold of an awake contact, in contact order; counts their
-// points. Reads only the packed keys and summaries, never a contact.
-PointCounts list_manifolds(World& world, SolverScratch& scratch) {
+// One ref per touching manifold of an awake contact, in contact order; returns whether
+// any has restitution. Reads only the packed keys and summaries, never a contact.
+bool list_manifolds(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     auto solver_index = [&](std::uint32_t slot) {
         const std::int32_t k = b.awake_index[slot];
         return k >= 0 ? static_cast<std::uint32_t>(k) : n;
     };
-    PointCounts counts;
+    bool restitution = false;
     scratch.manifolds.clear();
     for (std::uint32_t c : awake_contacts(world)) {
         const std::uint32_t summary = world.contact_summaries[c];
@@ -83,19 +78,14 @@ PointCounts list_manifolds(World& world, SolverScratch& scratch) {
         const std::uint64_t key = world.contact_keys[c];
         const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
         const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
-        const bool friction = (summary & kSummaryFriction) != 0;
-        const bool restitution = (summary & kSummaryRestitution) != 0;
         std::uint32_t point_counts = summary & 0xffffu;  // 4 bits per manifold
         for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= 4) {
-            const std::uint32_t points = point_counts & 0xfu;
-            if (points == 0) continue;
+            if ((point_counts & 0xfu) == 0) continue;
             scratch.manifolds.push_back({c, m, a, bb});
-            counts.points += points;
-            if (friction) counts.friction += points;
-            if (restitution) counts.restitution += points;
+            restitution = restitution || (summary & kSummaryRestitution) != 0;
         }
     }
-    return counts;
+    return restitution;
 }
 
 // Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
@@ -262,7 +252,7 @@ void solve(World& world, Real dt) {
     const Real h = dt / substeps;
 
     prepare_bodies(world, scratch);
-    const PointCounts points = list_manifolds(world, scratch);
+    const bool restitution = list_manifolds(world, scratch);
     prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
@@ -289,7 +279,7 @@ void solve(World& world, Real dt) {
     // bodies in one run_phases: the workers meet at a barrier after each colour instead
     // of forking and joining about a hundred times per step. Effects are counted per
     // worker and summed (the sum does not depend on who counted what).
-    plan_step(world, scratch, points.restitution > 0);  // no pass at all over a scene without bouncy contacts
+    plan_step(world, scratch, restitution);  // no pass at all over a scene without bouncy contacts
     world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
     const Real restitution_threshold = settings.restitution_threshold;
     auto push_rows = [&](const WideContact& wc) {
@@ -298,16 +288,13 @@ void solve(World& world, Real dt) {
     world.jobs->run_phases(
         "Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
             const SolverPhase phase = scratch.plan[p];
+            EffectCounts& counts = world.scratch_counts[worker];
             switch (phase.pass) {
                 case Pass::PrepareContacts: prepare_contacts(world, scratch, lo, hi); break;
                 case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
-                case Pass::IntegrateVelocities:
-                    integrate_velocities(world, bodies, h, lo, hi, world.scratch_counts[worker]);
-                    break;
-                case Pass::IntegratePositions:
-                    integrate_positions(world, bodies, h, lo, hi, world.scratch_counts[worker]);
-                    break;
+                case Pass::IntegrateVelocities: integrate_velocities(world, bodies, h, lo, hi, counts); break;
+                case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi, counts); break;
                 case Pass::WarmStart:
                     for_colored<true>(
                         scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
@@ -316,19 +303,19 @@ void solve(World& world, Real dt) {
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
-                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve); },
-                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params); });
+                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
+                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params, counts); });
                     break;
                 case Pass::Relax:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
-                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax); },
-                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params); });
+                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
+                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params, counts); });
                     break;
                 case Pass::Restitution:
                     for_colored<false>(
                         scratch, phase.color, lo, hi, [](JointConstraint&) {},
-                        [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h); });
+                        [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
                     break;
             }
         });
@@ -336,15 +323,12 @@ void solve(World& world, Real dt) {
         world.counters.gravity_applied += c.gravity;
         world.counters.damping_applied += c.damping;
         world.counters.gyroscopic_applied += c.gyro;
+        world.counters.contact_points_solved += c.contact_points;
+        world.counters.friction_applied += c.friction;
+        world.counters.restitution_applied += c.restitution;
+        world.counters.joints_solved += c.joints;
     }
     if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
-
-    // Work counters, derived from the constraint set (no per-point counting in the hot loop).
-    const auto passes = static_cast<std::uint64_t>(substeps * (settings.iterations + settings.relax_iterations));
-    world.counters.contact_points_solved += points.points * passes;
-    world.counters.friction_applied += points.friction * passes;
-    world.counters.restitution_applied += points.restitution;
-    world.counters.joints_solved += static_cast<std::uint64_t>(scratch.joints.size()) * passes;
     world.counters.bodies_integrated += world.awake.size();
 }
 

@@ -19,7 +19,8 @@ void update_narrowphase(World& world);
 void update_islands(World& world, Real dt);
 // solver.cpp: substeps of integrate velocities, warm start, solve, integrate positions, relax.
 void solve(World& world, Real dt);
-// continuous.cpp: fast bodies swept against static geometry (poses recorded before the solver).
+// continuous.cpp: fast bodies swept against static geometry (poses recorded before the
+// solver; step() runs neither while World::fast_bodies is zero).
 void record_fast_starts(World& world);
 void sweep_fast_bodies(World& world);
 // integrator.cpp (called by the solver once per substep, in blocks of the awake

@@ -133,8 +133,9 @@ void step(World& w, Real dt) {
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
-    run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });  // poses before the solver moves them
-    run_stage(w, Stage::Solver, [&] { solve(w, dt); });               // substeps integrate velocities and positions
+    // Fast bodies' poses before the solver moves them; no stage at all in a scene without any.
+    if (w.fast_bodies > 0) run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });
+    run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
     if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;

@@ -1,10 +1,14 @@
-// A steady-state step allocates nothing: a counting global operator new proves it.
+// A steady-state step allocates nothing, on the single-threaded job system and on
+// work stealing: a counting global operator new (every thread's) proves it.
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/topology.hpp>
+#include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <new>
 
 namespace {
@@ -35,11 +39,30 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 
 using namespace spindle;
 
-TEST(Allocation, SteadyStateStepAllocatesNothing) {
+namespace {
+
+// Two work-stealing workers (on the first two PUs, unpinned: the machine may have one),
+// with worker 1's thread running: starting it allocates (its name), and a thread that
+// started only during the counted steps would be counted.
+std::unique_ptr<JobSystem> two_workers() {
+    const Topology machine = Topology::from_system();
+    WorkStealingJobSystem::Options options;
+    for (unsigned i = 0; i < 2; ++i) options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
+    options.pin = false;
+    auto jobs = std::make_unique<WorkStealingJobSystem>(options);
+    JobGroup started;
+    jobs->submit_pinned(1, started, "started", [] {});
+    jobs->wait(started);
+    return jobs;
+}
+
+// 100 boxes and spheres resting on a plane, awake; `jobs` null: the space's own
+// single-threaded job system. Returns the allocations of 120 steps after 120 to settle.
+long resting_scene_allocations(JobSystem* jobs) {
     SpaceSettings settings;
     settings.sleep.enabled = false;  // resting but awake: the full pipeline runs every step
     settings.time_step.use_internal_time_stepping = true;
-    Space space(settings);
+    Space space(settings, jobs);
     BodyDesc ground;
     ground.type = MotionType::Static;
     ground.shape = Shape::plane(Vec3::UnitY(), 0);
@@ -54,23 +77,25 @@ TEST(Allocation, SteadyStateStepAllocatesNothing) {
     }
     for (int i = 0; i < 120; ++i) space.update(1.0 / 60.0);  // settle: contacts made, buffers sized
     const long before = g_allocations.load();
-    ASSERT_GT(before, 100) << "the counter must see the engine's allocations (setup makes many)";
+    EXPECT_GT(before, 100) << "the counter must see the engine's allocations (setup makes many)";
     for (int i = 0; i < 120; ++i) space.update(1.0 / 60.0);
     const long during = g_allocations.load() - before;
     EXPECT_EQ(space.last_update().contacts, 100u);
-    EXPECT_EQ(during, 0) << "allocations in 120 steady-state steps";
+    return during;
 }
 
-TEST(Allocation, SteadyStateJointedStepAllocatesNothing) {
+// A hanging chain of ball-socket, hinge (with a motor), fixed and distance joints,
+// awake; returns the allocations of 120 steps after 60 to settle.
+long jointed_scene_allocations(JobSystem* jobs) {
     SpaceSettings settings;
     settings.sleep.enabled = false;  // hanging still but awake: the joints are solved every step
-    Space space(settings);
+    Space space(settings, jobs);
     BodyDesc anchor;
     anchor.type = MotionType::Static;
     anchor.shape = Shape::sphere(0.1);
     anchor.position = Vec3(0, 5, 0);
     BodyHandle previous = space.create_body(anchor);
-    for (int i = 0; i < 8; ++i) {  // a hanging chain of ball-socket, hinge (with a motor), fixed and distance joints
+    for (int i = 0; i < 8; ++i) {
         BodyDesc d;
         d.shape = Shape::box(Vec3(0.05, 0.25, 0.05));
         d.position = Vec3(0, 5 - 0.5 * i - 0.25, 0);
@@ -95,6 +120,27 @@ TEST(Allocation, SteadyStateJointedStepAllocatesNothing) {
     for (int i = 0; i < 60; ++i) space.update();
     const long before = g_allocations.load();
     for (int i = 0; i < 120; ++i) space.update();
+    const long during = g_allocations.load() - before;
     EXPECT_GT(space.counters().joints_solved, 0u);
-    EXPECT_EQ(g_allocations.load() - before, 0) << "allocations in 120 steps of a jointed scene";
+    return during;
+}
+
+}  // namespace
+
+TEST(Allocation, SteadyStateStepAllocatesNothing) {
+    EXPECT_EQ(resting_scene_allocations(nullptr), 0) << "allocations in 120 steady-state steps";
+}
+
+TEST(Allocation, SteadyStateStepOnTwoWorkersAllocatesNothing) {
+    const std::unique_ptr<JobSystem> jobs = two_workers();
+    EXPECT_EQ(resting_scene_allocations(jobs.get()), 0) << "allocations in 120 steady-state steps, 2 workers";
+}
+
+TEST(Allocation, SteadyStateJointedStepAllocatesNothing) {
+    EXPECT_EQ(jointed_scene_allocations(nullptr), 0) << "allocations in 120 steps of a jointed scene";
+}
+
+TEST(Allocation, SteadyStateJointedStepOnTwoWorkersAllocatesNothing) {
+    const std::unique_ptr<JobSystem> jobs = two_workers();
+    EXPECT_EQ(jointed_scene_allocations(jobs.get()), 0) << "allocations in 120 steps of a jointed scene, 2 workers";
 }

@@ -1,13 +1,13 @@
 // Same scene + same settings => bitwise identical states for 1, 2, 3 and 4 workers,
 // and from run to run (design.md section 5).
 #include <spindle/engine/space.hpp>
-#include <spindle/platform/topology.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
-#include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
 
 #include <memory>
+
+#include "work_stealing_jobs.hpp"
 
 using namespace spindle;
 
@@ -20,17 +20,6 @@ constexpr int kSteps = 120;
 #else
 constexpr int kSteps = 300;
 #endif
-
-// Work stealing for every count, one worker included: the reference is the
-// single-threaded job system, so "1 worker" is not the reference compared with itself.
-std::unique_ptr<JobSystem> jobs_for(unsigned workers) {
-    const Topology machine = Topology::from_system();
-    WorkStealingJobSystem::Options options;
-    for (unsigned i = 0; i < workers; ++i)
-        options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
-    options.pin = workers <= machine.pus().size();
-    return std::make_unique<WorkStealingJobSystem>(options);
-}
 
 // Boxes, spheres, capsules and hulls falling into a pile, a resting row that falls
 // asleep, on a static floor box.

@@ -3,10 +3,8 @@
 // or the worker count, fails here. A change of physics made on purpose updates the
 // table below in the same commit, and says why.
 #include <spindle/engine/space.hpp>
-#include <spindle/platform/topology.hpp>
 #include <spindle/scene/scene.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
-#include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
 
@@ -16,6 +14,7 @@
 
 #include "api/space_internals.hpp"
 #include "solver/constraints.hpp"
+#include "work_stealing_jobs.hpp"
 
 using namespace spindle;
 
@@ -49,15 +48,6 @@ std::uint64_t expected(const Golden& golden) {
     return 0;
 }
 
-std::unique_ptr<JobSystem> work_stealing(unsigned workers) {
-    const Topology machine = Topology::from_system();
-    WorkStealingJobSystem::Options options;
-    for (unsigned i = 0; i < workers; ++i)
-        options.worker_pus.push_back(machine.pus()[i % machine.pus().size()].os_index);
-    options.pin = workers <= machine.pus().size();
-    return std::make_unique<WorkStealingJobSystem>(options);
-}
-
 std::uint64_t run_scene(const std::string& name, int steps, JobSystem& jobs, bool reuse_colors = true,
                         std::uint64_t* colorings = nullptr, bool sleeping = true) {
     const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/" + name + ".toml");
@@ -85,7 +75,7 @@ TEST(GoldenHash, BuiltInScenesMatchTheStoredHashOnOneToFourWorkers) {
         EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, single)), hex(expected(golden)))
             << golden.scene << ", single-threaded job system";
         for (unsigned workers : {1u, 2u, 3u, 4u}) {
-            auto jobs = work_stealing(workers);
+            auto jobs = jobs_for(workers);
             EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, *jobs)), hex(expected(golden)))
                 << golden.scene << ", work stealing with " << workers << " workers";
         }
@@ -94,7 +84,7 @@ TEST(GoldenHash, BuiltInScenesMatchTheStoredHashOnOneToFourWorkers) {
 
 TEST(GoldenHash, RepeatedRunsOnOneJobSystemMatchTheStoredHash) {
     if (expected(kGolden[0]) == 0) GTEST_SKIP() << "no stored hashes for -march=" << SPINDLE_TARGET_ARCH;
-    auto jobs = work_stealing(2);
+    auto jobs = jobs_for(2);
     const Golden& golden = kGolden[1];
     for (int run = 0; run < 3; ++run)
         EXPECT_EQ(hex(run_scene(golden.scene, golden.steps, *jobs)), hex(expected(golden)));
@@ -104,7 +94,7 @@ TEST(GoldenHash, RepeatedRunsOnOneJobSystemMatchTheStoredHash) {
 // step's colours and packing; colouring afresh every step must give the same bits.
 TEST(GoldenHash, ReusedColoursGiveTheSameBitsAsFreshColouring) {
     for (unsigned workers : {1u, 2u}) {
-        auto jobs = work_stealing(workers);
+        auto jobs = jobs_for(workers);
         std::uint64_t reused_colorings = 0, fresh_colorings = 0;
         const std::uint64_t reused = run_scene("stack", 240, *jobs, true, &reused_colorings, false);
         const std::uint64_t fresh = run_scene("stack", 240, *jobs, false, &fresh_colorings, false);

@@ -25,6 +25,12 @@ void add_ground(Space& space, Real friction = 0.6, Real restitution = 0) {
     space.create_body(g);
 }
 
+// Solve and relax passes over the constraints per step.
+std::uint64_t solver_passes(const Space& space) {
+    const SolverSettings& s = space.settings().solver;
+    return static_cast<std::uint64_t>(s.substeps * (s.iterations + s.relax_iterations));
+}
+
 SpaceSettings awake() {
     SpaceSettings s;
     s.sleep.enabled = false;
@@ -74,13 +80,26 @@ TEST(Effects, FrictionAndRestitutionOnlyWhereContactsHaveThem) {
     EXPECT_EQ(space.counters().restitution_applied, 0u);
 }
 
+// A resting ball has one contact point, through every solve and relax pass of each step.
 TEST(Effects, FrictionCountsExactlyTheFrictionalPoints) {
     Space space(awake());
     add_ground(space);
     space.create_body(ball(Vec3(0, 0.5, 0)));
     for (int i = 0; i < 30; ++i) space.update();
-    EXPECT_GT(space.counters().friction_applied, 0u);
+    EXPECT_EQ(space.counters().contact_points_solved, 30u * solver_passes(space));
     EXPECT_EQ(space.counters().friction_applied, space.counters().contact_points_solved);
+    EXPECT_EQ(space.counters().restitution_applied, 0u);
+}
+
+// Restitution is one pass after the substeps: each point of a bouncy contact is
+// checked once per step.
+TEST(Effects, RestitutionChecksEachBouncyPointOncePerStep) {
+    Space space(awake());
+    add_ground(space, /*friction=*/0.6, /*restitution=*/0.5);
+    space.create_body(ball(Vec3(0, 0.5, 0)));
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_EQ(space.counters().contact_points_solved, 30u * solver_passes(space));
+    EXPECT_EQ(space.counters().restitution_applied, 30u);
 }
 
 TEST(Effects, NoContactsNoSolverWork) {

@@ -21,6 +21,22 @@ BodyDesc static_box(const Vec3& position, const Vec3& half_extents) {
     return d;
 }
 
+BodyDesc ground_plane() {
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    return d;
+}
+
+// A kinematic platform, its top at y = 0.25.
+BodyDesc platform(const Vec3& velocity) {
+    BodyDesc d;
+    d.type = MotionType::Kinematic;
+    d.shape = Shape::box(Vec3(3, 0.25, 3));
+    d.linear_velocity = velocity;
+    return d;
+}
+
 BodyDesc dynamic_box(const Vec3& position) {
     BodyDesc d;
     d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
@@ -28,105 +44,91 @@ BodyDesc dynamic_box(const Vec3& position) {
     return d;
 }
 
-bool any_awake(const Space& space, const std::vector<BodyHandle>& bodies) {
-    for (BodyHandle b : bodies) {
-        if (space.internal_is_awake(b)) return true;
-    }
-    return false;
-}
-
-// Steps until every body sleeps; the test fails if they never do.
-void settle(Space& space, const std::vector<BodyHandle>& bodies) {
-    for (int i = 0; i < kMaxSettleSteps && any_awake(space, bodies); ++i) space.update();
-    ASSERT_FALSE(any_awake(space, bodies)) << "the scene did not fall asleep";
-}
-
-// A stack of three boxes resting on a floor.
-struct Stack {
-    Space space;
-    BodyHandle floor;
-    std::vector<BodyHandle> boxes;
-};
-
-void build_stack(Stack& s, const BodyDesc& floor) {
-    s.floor = s.space.create_body(floor);
-    for (int i = 0; i < 3; ++i) s.boxes.push_back(s.space.create_body(dynamic_box(Vec3(0, 0.5 + i, 0))));
-}
-
-// A second of free fall takes a body 4.9 m down; each box started at 0.5 + its level.
-void expect_fell_a_second(const Stack& s) {
-    for (std::size_t i = 0; i < s.boxes.size(); ++i) {
-        EXPECT_LT(s.space.position(s.boxes[i]).y(), 0.5 + static_cast<Real>(i) - 4.5) << "box " << i;
-    }
-}
-
 }  // namespace
 
+// A stack of unit boxes resting on a support (a floor, a pedestal or a platform), which
+// the tests then take away, move or set moving.
+class Waking : public ::testing::Test {
+protected:
+    Space space;
+    BodyHandle support;
+    std::vector<BodyHandle> boxes;  // bottom first
+
+    // The support, then `count` boxes above each other, the lowest centred at height `bottom`.
+    void build_stack(const BodyDesc& support_desc, Real bottom, int count) {
+        support = space.create_body(support_desc);
+        for (int i = 0; i < count; ++i) boxes.push_back(space.create_body(dynamic_box(Vec3(0, bottom + i, 0))));
+    }
+
+    bool any_awake() const {
+        if (space.internal_is_awake(support)) return true;  // a kinematic support sleeps with its stack
+        for (BodyHandle b : boxes) {
+            if (space.internal_is_awake(b)) return true;
+        }
+        return false;
+    }
+
+    // Steps until the stack and its support sleep; the test fails if they never do.
+    void settle() {
+        for (int i = 0; i < kMaxSettleSteps && any_awake(); ++i) space.update();
+        ASSERT_FALSE(any_awake()) << "the stack did not fall asleep";
+    }
+
+    // A second of free fall takes a body 4.9 m down; each box started at 0.5 + its level.
+    void expect_fell_a_second() const {
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            EXPECT_LT(space.position(boxes[i]).y(), 0.5 + static_cast<Real>(i) - 4.5) << "box " << i;
+        }
+    }
+};
+
 // On main the stack stayed asleep at y = 2.5 (top box) two seconds after its floor went.
-TEST(Waking, DestroyingTheFloorDropsTheStackWithinASecond) {
-    Stack s;
-    BodyDesc plane;
-    plane.type = MotionType::Static;
-    plane.shape = Shape::plane(Vec3::UnitY(), 0);
-    build_stack(s, plane);
-    settle(s.space, s.boxes);
-    s.space.destroy_body(s.floor);
-    for (int i = 0; i < 60; ++i) s.space.update();
-    expect_fell_a_second(s);
+TEST_F(Waking, DestroyingTheFloorDropsTheStackWithinASecond) {
+    build_stack(ground_plane(), 0.5, 3);
+    settle();
+    space.destroy_body(support);
+    for (int i = 0; i < 60; ++i) space.update();
+    expect_fell_a_second();
 }
 
 // On main the stack stayed asleep at y = 2.5 (top box) while its floor was 49 m lower.
-TEST(Waking, MovingTheFloorBySetPositionDropsTheStack) {
-    Stack s;
-    build_stack(s, static_box(Vec3(0, -0.5, 0), Vec3(5, 0.5, 5)));
-    settle(s.space, s.boxes);
-    s.space.set_position(s.floor, Vec3(0, -49.5, 0));
-    for (int i = 0; i < 60; ++i) s.space.update();
-    expect_fell_a_second(s);
+TEST_F(Waking, MovingTheFloorBySetPositionDropsTheStack) {
+    build_stack(static_box(Vec3(0, -0.5, 0), Vec3(5, 0.5, 5)), 0.5, 3);
+    settle();
+    space.set_position(support, Vec3(0, -49.5, 0));
+    for (int i = 0; i < 60; ++i) space.update();
+    expect_fell_a_second();
 }
 
 // On main the box stayed asleep on nothing at y = 2.5, a metre above the ground.
-TEST(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
-    Space space;
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(ground);
-    const BodyHandle pedestal = space.create_body(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)));
-    const BodyHandle box = space.create_body(dynamic_box(Vec3(0, 2.5, 0)));
-    settle(space, {box});
-    space.destroy_body(pedestal);
+TEST_F(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
+    space.create_body(ground_plane());
+    build_stack(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)), 2.5, 1);
+    settle();
+    space.destroy_body(support);
     for (int i = 0; i < 120; ++i) space.update();
-    EXPECT_NEAR(space.position(box).y(), 0.5, 0.05);  // landed on the ground
+    EXPECT_NEAR(space.position(boxes[0]).y(), 0.5, 0.05);  // landed on the ground
 }
 
 // A static body teleported into a sleeping one makes a new contact that wakes it. On main
 // the box slept on, overlapped by the wall, at x = 0.
-TEST(Waking, MovingAStaticBodyIntoASleepingBodyWakesIt) {
-    Space space;
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(ground);
+TEST_F(Waking, MovingAStaticBodyIntoASleepingBodyWakesIt) {
     const BodyHandle wall = space.create_body(static_box(Vec3(10, 1, 0), Vec3(0.5, 1, 2)));
-    const BodyHandle box = space.create_body(dynamic_box(Vec3(0, 0.5, 0)));
-    settle(space, {box});
+    build_stack(ground_plane(), 0.5, 1);
+    settle();
     space.set_position(wall, Vec3(0.9, 1, 0));  // 0.1 m into the box
     space.update();
     space.update();
-    EXPECT_TRUE(space.internal_is_awake(box));
+    EXPECT_TRUE(space.internal_is_awake(boxes[0]));
 }
 
 // On main the top box stayed asleep at y = 2.5 with the pedestal moved 0.5 m lower.
-TEST(Waking, SetInternalMotionStateOfATouchingStaticBodyWakesTheIsland) {
-    Space space;
-    const BodyHandle pedestal = space.create_body(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)));
-    std::vector<BodyHandle> boxes;
-    for (int i = 0; i < 2; ++i) boxes.push_back(space.create_body(dynamic_box(Vec3(0, 2.5 + i, 0))));
-    settle(space, boxes);
-    MotionState lowered = space.internal_motion_state(pedestal);
+TEST_F(Waking, SetInternalMotionStateOfATouchingStaticBodyWakesTheIsland) {
+    build_stack(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)), 2.5, 2);
+    settle();
+    MotionState lowered = space.internal_motion_state(support);
     lowered.position.y() -= 0.5;
-    space.set_internal_motion_state(pedestal, lowered);
+    space.set_internal_motion_state(support, lowered);
     for (BodyHandle b : boxes) EXPECT_TRUE(space.internal_is_awake(b));
     for (int i = 0; i < 120; ++i) space.update();
     EXPECT_NEAR(space.position(boxes[0]).y(), 2.0, 0.05);  // landed on the lowered pedestal
@@ -136,40 +138,30 @@ TEST(Waking, SetInternalMotionStateOfATouchingStaticBodyWakesTheIsland) {
 // A slow kinematic platform (below the sleep threshold) carrying a box. On main the
 // platform fell asleep with its velocity zeroed after 0.5 s: it stopped at x = 0.015
 // instead of 0.15 after 5 s, and the box slept with it.
-TEST(Waking, ASlowKinematicPlatformKeepsMovingAndKeepsItsRiderAwake) {
-    Space space;
-    BodyDesc platform;
-    platform.type = MotionType::Kinematic;
-    platform.shape = Shape::box(Vec3(3, 0.25, 3));
-    platform.linear_velocity = Vec3(0.03, 0, 0);
-    const BodyHandle p = space.create_body(platform);
-    const BodyHandle rider = space.create_body(dynamic_box(Vec3(0, 0.75, 0)));
+TEST_F(Waking, ASlowKinematicPlatformKeepsMovingAndKeepsItsRiderAwake) {
+    build_stack(platform(Vec3(0.03, 0, 0)), 0.75, 1);
+    const BodyHandle rider = boxes[0];
     bool platform_slept = false, rider_slept = false;
     for (int i = 0; i < 300; ++i) {
         space.update();
-        platform_slept |= !space.internal_is_awake(p);
+        platform_slept |= !space.internal_is_awake(support);
         // The first steps the box lands: it may not ride yet.
         if (i > 30) rider_slept |= !space.internal_is_awake(rider);
     }
     EXPECT_FALSE(platform_slept);
     EXPECT_FALSE(rider_slept);
-    EXPECT_DOUBLE_EQ(space.internal_linear_velocity(p).x(), 0.03);
-    EXPECT_NEAR(space.position(p).x(), 0.15, 1e-9);
+    EXPECT_DOUBLE_EQ(space.internal_linear_velocity(support).x(), 0.03);
+    EXPECT_NEAR(space.position(support).x(), 0.15, 1e-9);
     EXPECT_NEAR(space.position(rider).x(), 0.15, 0.01);  // carried by friction
 }
 
 // A kinematic platform at rest may sleep with what rests on it; a velocity written to
 // it wakes it and its rider.
-TEST(Waking, AVelocityWrittenToASleepingPlatformWakesItsRider) {
-    Space space;
-    BodyDesc platform;
-    platform.type = MotionType::Kinematic;
-    platform.shape = Shape::box(Vec3(3, 0.25, 3));
-    const BodyHandle p = space.create_body(platform);
-    const BodyHandle rider = space.create_body(dynamic_box(Vec3(0, 0.75, 0)));
-    settle(space, {p, rider});
-    space.set_linear_velocity(p, Vec3(0.03, 0, 0));
+TEST_F(Waking, AVelocityWrittenToASleepingPlatformWakesItsRider) {
+    build_stack(platform(Vec3::Zero()), 0.75, 1);
+    settle();
+    space.set_linear_velocity(support, Vec3(0.03, 0, 0));
     space.update();
-    EXPECT_TRUE(space.internal_is_awake(p));
-    EXPECT_TRUE(space.internal_is_awake(rider));
+    EXPECT_TRUE(space.internal_is_awake(support));
+    EXPECT_TRUE(space.internal_is_awake(boxes[0]));
 }

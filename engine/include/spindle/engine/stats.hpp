@@ -37,16 +37,19 @@ struct UpdateStats {
 // can show an effect costs nothing where a scene does not use it.
 struct WorkCounters {
     std::uint64_t steps = 0;
-    std::uint64_t bodies_integrated = 0;      // body-steps of velocity integration
-    std::uint64_t gravity_applied = 0;        // body-substeps with gravity
-    std::uint64_t damping_applied = 0;        // body-substeps with damping
-    std::uint64_t gyroscopic_applied = 0;     // body-substeps with gyroscopic torque
-    std::uint64_t contacts_updated = 0;       // contact-steps through the narrowphase
-    std::uint64_t manifolds_reused = 0;       // of those, moved with the bodies instead of recomputed
-    std::uint64_t contact_points_solved = 0;  // point-iterations in the contact solver
-    std::uint64_t restitution_applied = 0;    // points with restitution > 0 checked
-    std::uint64_t friction_applied = 0;       // point-iterations with friction > 0
-    std::uint64_t joints_solved = 0;          // joint-iterations
+    std::uint64_t bodies_integrated = 0;   // body-steps of velocity integration
+    std::uint64_t gravity_applied = 0;     // body-substeps with gravity
+    std::uint64_t damping_applied = 0;     // body-substeps with damping
+    std::uint64_t gyroscopic_applied = 0;  // body-substeps with gyroscopic torque
+    std::uint64_t contacts_updated = 0;    // contact-steps through the narrowphase
+    std::uint64_t manifolds_reused = 0;    // of those, moved with the bodies instead of recomputed
+    // The solver's counts are taken where the rows run. Contacts are solved four
+    // manifolds at a time, so a point without friction or restitution is counted when
+    // one solved with it has them (its lane ran too).
+    std::uint64_t contact_points_solved = 0;  // point-iterations of the normal rows (solve and relax)
+    std::uint64_t restitution_applied = 0;    // points checked for a bounce by the restitution pass
+    std::uint64_t friction_applied = 0;       // point-iterations of the friction rows
+    std::uint64_t joints_solved = 0;          // joint-iterations (solve and relax)
     std::uint64_t constraint_colorings = 0;   // steps that coloured their constraints (the rest reused the last step's)
     std::uint64_t swept_tests = 0;            // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
