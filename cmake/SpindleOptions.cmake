@@ -42,6 +42,10 @@ function(spindle_add_layer name)
   spindle_target_defaults(spindle_${name})
   if(SPINDLE_PORTABLE_MATH)
     target_compile_options(spindle_${name} PRIVATE -ffp-contract=off)
+    # A fixed vector width: Eigen's own SIMD paths (quaternion products, small matrices)
+    # follow -march, and an AVX and an SSE2 build would round differently. Public: it also
+    # sets Eigen's alignment of the fixed-size types in our headers, which users must share.
+    target_compile_definitions(spindle_${name} PUBLIC EIGEN_DONT_VECTORIZE)
   endif()
   install(TARGETS spindle_${name} EXPORT SpindleTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -46,7 +46,11 @@ Vec3 Space::angular_velocity(BodyHandle body) const { return motion_state(body).
 namespace {
 
 void push_vector(World& world, BodyHandle body, WriteKind kind, const Vec3& value, const char* what) {
-    check_finite(value, what, field_of(kind));
+    if (kind == WriteKind::Position) {
+        check_position(value, what, field_of(kind));
+    } else {
+        check_finite(value, what, field_of(kind));
+    }
     check_handle_for_write(world.motion_states, body, what);
     BufferedWrite write;
     write.body = body;

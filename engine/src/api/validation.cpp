@@ -22,6 +22,15 @@ void check_finite(const Vec3& value, const char* who, const char* field) {
     if (!is_finite(value)) reject_field(who, field, "must be finite", vec(value));
 }
 
+// Positions stay within a billion metres of the origin: far enough for any game world,
+// and near enough that squared distances, bounds and the step's sums stay finite.
+void check_position(const Vec3& value, const char* who, const char* field) {
+    if (!is_finite(value) || value.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+        reject_field(who, field, ("must be finite and within " + number(kMaxCoordinate) + " m of the origin").c_str(),
+                     vec(value));
+    }
+}
+
 void check_non_negative(Real value, const char* who, const char* field) {
     if (!(std::isfinite(value) && value >= 0)) reject_field(who, field, "must be finite and >= 0", number(value));
 }
@@ -136,7 +145,7 @@ void validate(const BodyDesc& d) {
     if (d.shape.static_only() && d.type != MotionType::Static) {
         throw Error(std::string(who) + ": a " + to_string(d.shape.type) + " shape can only belong to a static body");
     }
-    check_finite(d.position, who, "position");
+    check_position(d.position, who, "position");
     check_orientation(d.orientation, who, "orientation");
     check_finite(d.linear_velocity, who, "linear_velocity");
     check_finite(d.angular_velocity, who, "angular_velocity");
@@ -154,7 +163,7 @@ void validate(const BodyDesc& d) {
 }
 
 void validate(const MotionState& s, const char* who) {
-    check_finite(s.position, who, "position");
+    check_position(s.position, who, "position");
     check_orientation(s.orientation, who, "orientation");
     check_finite(s.linear_velocity, who, "linear_velocity");
     check_finite(s.angular_velocity, who, "angular_velocity");

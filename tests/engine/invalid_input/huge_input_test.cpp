@@ -148,3 +148,33 @@ TEST(HugeInput, HugeDtWithoutInternalSteppingTakesOneStep) {
     scene.space->update(1e12);
     EXPECT_EQ(scene.space->last_update().steps, 1);
 }
+
+// Positions are finite and within a billion metres of the origin: a body made, moved or
+// set there is rejected naming the field, and the space is left as it was.
+TEST(HugeInput, PositionsBeyondTheWorldBoundAreRejected) {
+    Scene scene = make_scene();
+    Scene twin = make_scene();
+    Space& space = *scene.space;
+    for (const Real far : {1e10, 1e308, -1e15}) {
+        const std::string trial = std::to_string(far);
+        BodyDesc d;
+        d.shape = Shape::sphere(0.5);
+        d.position = Vec3(0, far, 0);
+        expect_rejected(
+            space, *twin.space, [&] { space.create_body(d); }, "position", trial);
+        expect_rejected(
+            space, *twin.space, [&] { space.set_position(scene.box, Vec3(far, 0, 0)); }, "position", trial);
+        expect_rejected(
+            space, *twin.space,
+            [&] {
+                space.set_motion_state(scene.box,
+                                       MotionState{Vec3(0, 0, far), Quat::Identity(), Vec3::Zero(), Vec3::Zero()});
+            },
+            "position", trial);
+    }
+    // At the bound itself, accepted.
+    BodyDesc edge;
+    edge.shape = Shape::sphere(0.5);
+    edge.position = Vec3(1e9, -1e9, 1e9);
+    expect_accepted([&] { space.create_body(edge); }, "position", "1e9");
+}
