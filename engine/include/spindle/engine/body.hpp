@@ -84,9 +84,10 @@ struct BodyDesc {
     Real gravity_scale = 1;
     Real linear_damping = 0;   // 1/s; 0 costs nothing
     Real angular_damping = 0;  // 1/s; 0 costs nothing
-    bool gyroscopic = false;   // gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its angular
-                              // momentum (not for a body with a rotation lock: it turns as any other)
-    MotionLocks locks;  // nothing locked by default; dynamic and kinematic bodies
+    // Gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its
+    // angular momentum (not for a body with a rotation lock: it turns as any other).
+    bool gyroscopic = false;
+    MotionLocks locks;  // nothing locked by default; for dynamic and kinematic bodies
     bool allow_interpolation = true;
     bool allow_sleep = true;
     bool fast = false;  // also swept against static geometry (continuous collision)
