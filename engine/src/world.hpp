@@ -22,6 +22,7 @@
 #include "api/joint_store.hpp"
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
+#include "solver/motion_locks.hpp"
 
 namespace spindle {
 
@@ -53,6 +54,7 @@ struct Bodies {
     std::vector<Mat3> inv_inertia_local;  // about the centre of mass, body frame
     std::vector<Mat3> inertia_local;      // the same, not inverted (gyroscopic bodies read it)
     std::vector<Vec3> local_com;          // centre of mass in the shape's frame
+    std::vector<std::uint8_t> locks;      // BodyDesc::locks as bits (solver/motion_locks.hpp)
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
     std::vector<Aabb> bounds;               // tight, world
@@ -80,6 +82,8 @@ struct Bodies {
     bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && desc[i].fast; }
     Mat3 inv_inertia_world(std::uint32_t i) const {
         const Mat3 r = q[i].toRotationMatrix();
+        if ((locks[i] & kLockRotation) != 0)
+            return locked_inverse_inertia(r * inertia_local[i] * r.transpose(), locks[i]);
         return r * inv_inertia_local[i] * r.transpose();
     }
 };

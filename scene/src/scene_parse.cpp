@@ -4,6 +4,7 @@
 #include <spindle/scene/scene.hpp>
 
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <sstream>
 
@@ -86,6 +87,21 @@ MotionType parse_type(const TomlReader& r, const toml::node& node, const std::st
     r.fail(node, what + ": expected \"dynamic\", \"static\" or \"kinematic\", got \"" + type + "\"");
 }
 
+// Locked world axes, ["x", "z"]: the three flags for x, y and z.
+std::array<bool, 3> parse_axes(const TomlReader& r, const toml::node& node, const std::string& what) {
+    std::array<bool, 3> locked{};
+    const toml::array& list = r.array(node, what, "of axis names (\"x\", \"y\", \"z\")");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+        const std::string item = what + "[" + std::to_string(k) + "]";
+        const std::string axis = r.string(list[k], item);
+        if (axis != "x" && axis != "y" && axis != "z") {
+            r.fail(list[k], item + ": expected \"x\", \"y\" or \"z\", got \"" + axis + "\"");
+        }
+        locked[static_cast<std::size_t>(axis[0] - 'x')] = true;
+    }
+    return locked;
+}
+
 // [w, x, y, z], or { axis = [x, y, z], degrees = a } / { axis, radians = a }.
 Quat parse_orientation(const TomlReader& r, const toml::node& node, const std::string& what) {
     if (node.is_array()) {
@@ -139,6 +155,8 @@ const std::vector<std::string_view>& body_property_keys() {
                                                        "linear_damping",
                                                        "angular_damping",
                                                        "gyroscopic",
+                                                       "lock_translation",
+                                                       "lock_rotation",
                                                        "allow_interpolation",
                                                        "allow_sleep",
                                                        "fast"};
@@ -178,6 +196,12 @@ bool apply_body_key(const TomlReader& r, std::string_view key, const toml::node&
         d.angular_damping = r.non_negative(value, what);
     } else if (key == "gyroscopic") {
         d.gyroscopic = r.boolean(value, what);
+    } else if (key == "lock_translation") {
+        const std::array<bool, 3> axes = parse_axes(r, value, what);
+        d.locks.translation_x = axes[0], d.locks.translation_y = axes[1], d.locks.translation_z = axes[2];
+    } else if (key == "lock_rotation") {
+        const std::array<bool, 3> axes = parse_axes(r, value, what);
+        d.locks.rotation_x = axes[0], d.locks.rotation_y = axes[1], d.locks.rotation_z = axes[2];
     } else if (key == "allow_interpolation") {
         d.allow_interpolation = r.boolean(value, what);
     } else if (key == "allow_sleep") {

@@ -142,8 +142,10 @@ void Space::set_internal_motion_state(BodyHandle body, const MotionState& state)
     b.q[i] = state.orientation.normalized();
     b.x[i] = state.position + b.q[i] * b.local_com[i];
     if (b.type[i] != MotionType::Static) {
-        b.v[i] = limit_speed(state.linear_velocity, m_world->settings.solver.max_linear_speed);
-        b.w[i] = limit_speed(state.angular_velocity, m_world->settings.solver.max_angular_speed);
+        b.v[i] = limit_speed(project_linear(state.linear_velocity, b.locks[i]),
+                             m_world->settings.solver.max_linear_speed);
+        b.w[i] = limit_speed(project_angular(state.angular_velocity, b.locks[i]),
+                             m_world->settings.solver.max_angular_speed);
     }
     b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
     refresh_proxy(*m_world, i);

@@ -93,8 +93,8 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         b.generation.push_back(0);
         b.alive.push_back(0);
         grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
-        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.force, n),
-            grow(b.torque, n), grow(b.bounds, n);
+        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.locks, n),
+            grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
         grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
         grow(b.history_position[0], n), grow(b.history_position[1], n);
         grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
@@ -108,10 +108,13 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.local_com[slot] = local_com;
     b.x[slot] = desc.position + desc.orientation * local_com;
     const SolverSettings& limits = w.settings.solver;
-    b.v[slot] = desc.type == MotionType::Static ? Vec3::Zero()
-                                                : limit_speed(desc.linear_velocity, limits.max_linear_speed);
-    b.w[slot] = desc.type == MotionType::Static ? Vec3::Zero()
-                                                : limit_speed(desc.angular_velocity, limits.max_angular_speed);
+    b.locks[slot] = desc.type == MotionType::Static ? 0 : lock_bits(desc.locks);
+    b.v[slot] = desc.type == MotionType::Static
+                    ? Vec3::Zero()
+                    : limit_speed(project_linear(desc.linear_velocity, b.locks[slot]), limits.max_linear_speed);
+    b.w[slot] = desc.type == MotionType::Static
+                    ? Vec3::Zero()
+                    : limit_speed(project_angular(desc.angular_velocity, b.locks[slot]), limits.max_angular_speed);
     b.inv_mass[slot] = inv_mass;
     b.inv_inertia_local[slot] = inv_inertia;
     b.inertia_local[slot] = inertia;

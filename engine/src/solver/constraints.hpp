@@ -64,6 +64,9 @@ struct WideContact {
     std::uint32_t ref[kLanes] = {};                     // manifold ref per lane
     int lanes = 0;                                      // lanes holding a manifold
     std::uint8_t slot_points[kMaxManifoldPoints] = {};  // lanes with a point in each slot: the work counters
+    // A lane's body has a translation lock: its passes take each body's inverse mass per
+    // world axis (contact_solver.cpp), the others the scalar below.
+    bool locked = false;
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{}, restitution{};

@@ -35,7 +35,8 @@ Real make_row(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Ve
     row.rb_x = rb.cross(dir);
     row.ia = A.inv_inertia * row.ra_x;
     row.ib = B.inv_inertia * row.rb_x;
-    const Real k = A.inv_mass + B.inv_mass + row.ra_x.dot(row.ia) + row.rb_x.dot(row.ib);
+    const Real k = inverse_mass_along(A.inv_mass, A.locks, dir) + inverse_mass_along(B.inv_mass, B.locks, dir) +
+                   row.ra_x.dot(row.ia) + row.rb_x.dot(row.ib);
     return k > 0 ? 1 / k : 0;
 }
 
@@ -45,9 +46,9 @@ inline Real row_speed(const Velocities& s, const Vec3& dir, const ContactRow& ro
 }
 inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& dir, const ContactRow& row,
                       Real L) {
-    s.va -= (A.inv_mass * L) * dir;
+    s.va -= project_linear((A.inv_mass * L) * dir, A.locks);
     s.wa -= L * row.ia;
-    s.vb += (B.inv_mass * L) * dir;
+    s.vb += project_linear((B.inv_mass * L) * dir, B.locks);
     s.wb += L * row.ib;
 }
 
@@ -92,10 +93,42 @@ inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide
     return s.vb + cross(s.wb, rb) - s.va - cross(s.wa, ra);
 }
 
-inline void apply_row(const WideContact& wc, WideVelocities& s, const Wide3& dir, const WideRow& row, Wide L) {
-    s.va -= (wc.inv_mass_a * L) * dir;
+// The lanes' inverse masses per world axis (zero along a locked one), for a wide
+// contact with a locked body; the unlocked passes never build them.
+struct WideAxisMasses {
+    Wide3 a, b;
+};
+
+inline WideAxisMasses axis_masses(const WideContact& wc, const SolverBody* bodies) {
+    WideAxisMasses m;
+    for (int l = 0; l < kLanes; ++l) {
+        const SolverBody& A = bodies[wc.a[l]];
+        const SolverBody& B = bodies[wc.b[l]];
+        m.a.set_lane(l, project_linear(Vec3::Constant(A.inv_mass), A.locks));
+        m.b.set_lane(l, project_linear(Vec3::Constant(B.inv_mass), B.locks));
+    }
+    return m;
+}
+
+// (m L) d per axis: for a body without locks the same bits as the scalar (m L) d.
+inline Wide3 scaled(const Wide3& m, Wide L, const Wide3& dir) {
+    return {(m.x * L) * dir.x, (m.y * L) * dir.y, (m.z * L) * dir.z};
+}
+
+template <bool kLocked>
+inline void apply_row(const WideContact& wc, const WideAxisMasses& m, WideVelocities& s, const Wide3& dir,
+                      const WideRow& row, Wide L) {
+    if constexpr (kLocked) {
+        s.va -= scaled(m.a, L, dir);
+    } else {
+        s.va -= (wc.inv_mass_a * L) * dir;
+    }
     s.wa -= L * widen(row.ia);
-    s.vb += (wc.inv_mass_b * L) * dir;
+    if constexpr (kLocked) {
+        s.vb += scaled(m.b, L, dir);
+    } else {
+        s.vb += (wc.inv_mass_b * L) * dir;
+    }
     s.wb += L * widen(row.ib);
 }
 
@@ -128,7 +161,11 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
     Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
     Wide tangent_impulse[kMaxManifoldPoints][2]{};
+    // Inverse mass sums of both bodies along the normal and the tangents: the share of
+    // the free axes for a locked body, inv_mass_a + inv_mass_b otherwise.
+    Wide linear_sum[3]{};
     for (Wide& s : separation) s = splat(kEmptySeparation);
+    wc.locked = false;
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
@@ -146,14 +183,21 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         wc.tangent[1].set_lane(l, tangent[1]);
         wc.inv_mass_a[l] = A.inv_mass;
         wc.inv_mass_b[l] = B.inv_mass;
+        wc.locked = wc.locked || ((A.locks | B.locks) & kLockTranslation) != 0;
+        const Vec3 dirs[3] = {m.normal, tangent[0], tangent[1]};
+        for (int d = 0; d < 3; ++d) {
+            linear_sum[d][l] = inverse_mass_along(A.inv_mass, A.locks, dirs[d]) +
+                               inverse_mass_along(B.inv_mass, B.locks, dirs[d]);
+        }
         inv_inertia_a.set_lane(l, A.inv_inertia);
         inv_inertia_b.set_lane(l, B.inv_inertia);
         wc.friction[l] = contact.friction;
         wc.restitution[l] = contact.restitution;
         wc.radius_a[l] = round_radius(b.desc[contact.body_a].shape);
         wc.radius_b[l] = round_radius(b.desc[contact.body_b].shape);
-        wc.gravity_normal[l] = m.normal.dot((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g -
-                                            (A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g);
+        wc.gravity_normal[l] =
+            m.normal.dot(project_linear((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g, B.locks) -
+                         project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
         const Vec3 xa = b.x[contact.body_a];
         const Vec3 xb = b.x[contact.body_b];
         for (int j = 0; j < m.point_count; ++j) {
@@ -167,7 +211,6 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
             ++wc.slot_points[j];
         }
     }
-    const Wide inv_mass_sum = wc.inv_mass_a + wc.inv_mass_b;
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
@@ -175,11 +218,12 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         p.rb = rb[j];
         p.adjusted_separation = separation[j] - dot(wc.normal, rb[j] - ra[j]);
         // A slot no manifold fills gets no mass: it can never push or rub.
-        const Wide point_inv_mass = select(separation[j] < splat(kEmptySeparation), inv_mass_sum, splat(0));
-        p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.normal, p.normal_row);
+        const WideMask filled = separation[j] < splat(kEmptySeparation);
+        p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum[0], splat(0)), ra[j], rb[j],
+                                 wc.normal, p.normal_row);
         for (int t = 0; t < 2; ++t) {
-            p.tangent_mass[t] = make_row(inv_inertia_a, inv_inertia_b, point_inv_mass, ra[j], rb[j], wc.tangent[t],
-                                         p.tangent_row[t]);
+            p.tangent_mass[t] = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum[1 + t], splat(0)),
+                                         ra[j], rb[j], wc.tangent[t], p.tangent_row[t]);
             p.tangent_impulse[t] = tangent_impulse[j][t];
         }
         p.normal_impulse = normal_impulse[j];
@@ -243,10 +287,12 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
     store_push(A, B, push);
 }
 
-template <bool kBias>
+template <bool kBias, bool kLocked>
 void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
                 EffectCounts& counts) {
     WideVelocities s = gather(wc, bodies);
+    WideAxisMasses masses;
+    if constexpr (kLocked) masses = axis_masses(wc, bodies);
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
     // rotation is applied once per lane rather than once per point.
@@ -307,7 +353,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         p.relative_velocity = select(first_push, wide_min(p.relative_velocity, vn), p.relative_velocity);
         p.normal_impulse = total;
         p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
-        apply_row(wc, s, wc.normal, p.normal_row, impulse);
+        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
     const Wide slop = splat(params.slop);
     // A lane without friction has an empty cone (its rows come out zero); when no lane
@@ -336,8 +382,8 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         new1 = select(touching, new1 * scale, old1);
         p.tangent_impulse[0] = new0;
         p.tangent_impulse[1] = new1;
-        apply_row(wc, s, wc.tangent[0], p.tangent_row[0], new0 - old0);
-        apply_row(wc, s, wc.tangent[1], p.tangent_row[1], new1 - old1);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[0], p.tangent_row[0], new0 - old0);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[1], p.tangent_row[1], new1 - old1);
     }
     scatter(wc, bodies, s);
     if constexpr (kBias) {
@@ -350,20 +396,17 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
     }
 }
 
-}  // namespace
-
-void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
-    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, scratch.wide[k]);
-}
-
-void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+template <bool kLocked>
+void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
     WideVelocities s = gather(wc, bodies);
+    WideAxisMasses masses;
+    if constexpr (kLocked) masses = axis_masses(wc, bodies);
     const bool friction = any(wc.friction > splat(0));  // else the tangent impulses are all zero
     for (const WidePoint& p : wc.points) {
-        apply_row(wc, s, wc.normal, p.normal_row, p.normal_impulse);
+        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, p.normal_impulse);
         if (!friction) continue;
-        apply_row(wc, s, wc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
-        apply_row(wc, s, wc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
     }
     scatter(wc, bodies, s);
     for (int l = 0; l < kLanes; ++l) {
@@ -376,21 +419,15 @@ void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody
     }
 }
 
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
-                   EffectCounts& counts) {
-    if (params.use_bias) {
-        solve_wide<true>(wc, push_rows, bodies, params, counts);
-    } else {
-        solve_wide<false>(wc, push_rows, bodies, params, counts);
-    }
-}
-
-void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
+template <bool kLocked>
+void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
     const Wide zero = splat(0);
     const WideMask bouncy = wc.restitution > zero;
     if (!any(bouncy)) return;
     for (std::uint8_t points : wc.slot_points) counts.restitution += points;
     WideVelocities s = gather(wc, bodies);
+    WideAxisMasses masses;
+    if constexpr (kLocked) masses = axis_masses(wc, bodies);
     for (WidePoint& p : wc.points) {
         // Only points that approached fast enough and actually pushed bounce.
         const WideMask bounce = bouncy & (p.relative_velocity <= splat(-threshold)) & (p.max_normal_impulse > zero);
@@ -404,9 +441,44 @@ void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real
         const Wide applied = select(bounce, total - p.normal_impulse, zero);
         p.normal_impulse += applied;
         p.max_normal_impulse = wide_max(p.max_normal_impulse, applied);
-        apply_row(wc, s, wc.normal, p.normal_row, applied);
+        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, applied);
     }
     scatter(wc, bodies, s);
+}
+
+}  // namespace
+
+void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, scratch.wide[k]);
+}
+
+// Each pass in two builds: with per-axis inverse masses where a lane's body has a
+// translation lock, with the scalar ones (no extra work) everywhere else.
+void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+    if (wc.locked) {
+        warm_start_wide<true>(wc, push_rows, bodies);
+    } else {
+        warm_start_wide<false>(wc, push_rows, bodies);
+    }
+}
+
+void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+                   EffectCounts& counts) {
+    if (wc.locked) {
+        params.use_bias ? solve_wide<true, true>(wc, push_rows, bodies, params, counts)
+                        : solve_wide<false, true>(wc, push_rows, bodies, params, counts);
+    } else {
+        params.use_bias ? solve_wide<true, false>(wc, push_rows, bodies, params, counts)
+                        : solve_wide<false, false>(wc, push_rows, bodies, params, counts);
+    }
+}
+
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
+    if (wc.locked) {
+        restitution_wide<true>(wc, bodies, threshold, h, counts);
+    } else {
+        restitution_wide<false>(wc, bodies, threshold, h, counts);
+    }
 }
 
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
+
 #include "solver/constraints.hpp"
 #include "stages/stages.hpp"
 
@@ -25,11 +27,33 @@ M inverse_or_zero(const M& k) {
     return k.isZero(0) ? M(M::Zero()) : M(k.inverse());
 }
 
+// The same for a joint of a body with motion locks, where K may be singular (a direction
+// along which neither body can move): the pseudo-inverse, which pushes only where
+// something can move and leaves the locked directions alone.
+template <typename M>
+M inverse_or_pseudo(const M& k, bool locked) {
+    if (!locked) return inverse_or_zero(k);
+    const Eigen::SelfAdjointEigenSolver<M> eigen(k);
+    const auto& values = eigen.eigenvalues();
+    const Real cutoff = 1e-12 * values.cwiseAbs().maxCoeff();
+    M inverse = M::Zero();
+    for (int i = 0; i < M::RowsAtCompileTime; ++i) {
+        if (values[i] > cutoff)
+            inverse += (1 / values[i]) * eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose();
+    }
+    return inverse;
+}
+
+bool has_locks(const SolverBody& A, const SolverBody& B) { return (A.locks | B.locks) != 0; }
+
 Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
     const Mat3 sa = skew(ra), sb = skew(rb);
-    const Mat3 k = (A.inv_mass + B.inv_mass) * Mat3::Identity() + sa * A.inv_inertia * sa.transpose() +
+    // Inverse masses per world axis: zero along a locked one.
+    const Vec3 linear = project_linear(Vec3::Constant(A.inv_mass), A.locks) +
+                        project_linear(Vec3::Constant(B.inv_mass), B.locks);
+    const Mat3 k = Mat3(linear.asDiagonal()) + sa * A.inv_inertia * sa.transpose() +
                    sb * B.inv_inertia * sb.transpose();
-    return inverse_or_zero(k);
+    return inverse_or_pseudo(k, has_locks(A, B));
 }
 
 // The hinge's two alignment rows: C = (a1.b2, a1.c2) with a1 A's axis and b2, c2
@@ -126,7 +150,8 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
         for (int r = 0; r < 2; ++r) {
             for (int c = 0; c < 2; ++c) k(r, c) = rows.u[r].dot(inv_inertia * rows.u[c]);
         }
-        const Vec2 impulse = -soft.mass_scale * (inverse_or_zero(k) * (cdot + soft.bias_rate * rows.c)) -
+        const Vec2 impulse = -soft.mass_scale *
+                                 (inverse_or_pseudo(k, has_locks(A, B)) * (cdot + soft.bias_rate * rows.c)) -
                              soft.impulse_scale * jc.align_impulse;
         jc.align_impulse += impulse;
         apply_angular(A, B, s, impulse.x() * rows.u[0] + impulse.y() * rows.u[1]);
@@ -230,7 +255,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
         }
         case JointType::Fixed:
             jc.rotation_error = qb * j.reference.conjugate() * qa.conjugate();
-            jc.rotation_mass = inverse_or_zero(Mat3(A.inv_inertia + B.inv_inertia));
+            jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
             jc.angular_impulse = j.angular_impulse;
             break;
         case JointType::Distance: {

@@ -6,6 +6,8 @@
 
 #include <spindle/engine/math.hpp>
 
+#include "solver/motion_locks.hpp"
+
 namespace spindle {
 
 struct SolverBody {
@@ -19,10 +21,16 @@ struct SolverBody {
     // body move faster than the push-out speed or its own speed, whichever is larger.
     Vec3 push_v = Vec3::Zero();
     Vec3 push_w = Vec3::Zero();
-    Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step
-    Real inv_mass = 0;
-    bool dynamic = false;  // only dynamic bodies are written by constraints
+    Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
+    Real inv_mass = 0;                // along the free axes: zero along a locked one (locks)
+    bool dynamic = false;             // only dynamic bodies are written by constraints
+    std::uint8_t locks = 0;           // motion lock bits (motion_locks.hpp), in the padding
 };
+
+// The velocity change of an impulse (inverse mass times it): none along a locked axis.
+inline Vec3 linear_response(const SolverBody& body, const Vec3& impulse) {
+    return project_linear(body.inv_mass * impulse, body.locks);
+}
 
 // The velocities of a constraint's two bodies while it is solved: loaded once, changed
 // by each row, stored once.
@@ -58,9 +66,9 @@ inline void store_push(SolverBody& A, SolverBody& B, const Velocities& s) {
 // An impulse at the anchors ra, rb (from each centre of mass): -impulse on A, +impulse on B.
 inline void apply(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& ra, const Vec3& rb,
                   const Vec3& impulse) {
-    s.va -= A.inv_mass * impulse;
+    s.va -= linear_response(A, impulse);
     s.wa -= A.inv_inertia * ra.cross(impulse);
-    s.vb += B.inv_mass * impulse;
+    s.vb += linear_response(B, impulse);
     s.wb += B.inv_inertia * rb.cross(impulse);
 }
 
@@ -74,7 +82,8 @@ inline void apply_angular(const SolverBody& A, const SolverBody& B, Velocities& 
 inline Real effective_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir) {
     const Vec3 rna = ra.cross(dir);
     const Vec3 rnb = rb.cross(dir);
-    const Real k = A.inv_mass + B.inv_mass + rna.dot(A.inv_inertia * rna) + rnb.dot(B.inv_inertia * rnb);
+    const Real k = inverse_mass_along(A.inv_mass, A.locks, dir) + inverse_mass_along(B.inv_mass, B.locks, dir) +
+                   rna.dot(A.inv_inertia * rna) + rnb.dot(B.inv_inertia * rnb);
     return k > 0 ? 1 / k : 0;
 }
 

@@ -76,6 +76,12 @@ void apply_writes(World& world) {
             }
             if ((write.bits & kPendingForce) != 0) b.force[i] = saturate(b.force[i] + write.force);
             if ((write.bits & kPendingTorque) != 0) b.torque[i] = saturate(b.torque[i] + write.torque);
+            if (b.locks[i] != 0) {
+                // Written velocities and impulses lose their locked components (the
+                // angular impulse already went through the locked inverse inertia).
+                b.v[i] = project_linear(b.v[i], b.locks[i]);
+                b.w[i] = project_angular(b.w[i], b.locks[i]);
+            }
             b.v[i] = limit_speed(b.v[i], max_linear);
             b.w[i] = limit_speed(b.w[i], max_angular);
         }

@@ -105,7 +105,13 @@ void sweep_fast_bodies(World& world) {
         // within reach) takes it out.
         const Transform pose = sweep.at(first);
         b.q[i] = pose.q;
-        b.x[i] = pose.p + pose.q * b.local_com[i];
+        Vec3 x = pose.p + pose.q * b.local_com[i];
+        // A locked coordinate is the same at both ends of the sweep: kept exactly, not
+        // rebuilt from the pose with its rounding.
+        for (int k = 0; k < 3; ++k) {
+            if ((b.locks[i] & (1u << k)) != 0) x[k] = b.x[i][k];
+        }
+        b.x[i] = x;
     }
     // Used up: a step that records none (no fast body left) must not sweep these.
     world.fast_starts.clear();

@@ -58,11 +58,12 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
         const std::uint32_t i = world.awake[k];
         const BodyDesc& d = b.desc[i];
         if (d.gravity_scale != 0) {
-            sb.v += h * d.gravity_scale * gravity;
+            sb.v += project_linear(h * d.gravity_scale * gravity, sb.locks);
             ++c.gravity;
         }
-        sb.v += h * sb.inv_mass * b.force[i];  // at worst infinite components, which the limit turns back
-        sb.w = add_angular(sb.w, h, sb.inv_inertia, b.torque[i], max_angular);
+        // At worst infinite components, which the limit turns back.
+        sb.v += project_linear(h * sb.inv_mass * b.force[i], sb.locks);
+        sb.w = add_angular(sb.w, h, sb.inv_inertia, b.torque[i], max_angular);  // locked axes: zero inertia rows
         sb.v = limit_speed(sb.v, max_linear);
         sb.w = limit_speed(sb.w, max_angular);
         if (d.linear_damping > 0 || d.angular_damping > 0) {
@@ -88,7 +89,9 @@ void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t
         if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
         sb.dp += h * (sb.v + sb.push_v);
         const std::uint32_t i = world.awake[k];
-        if (sb.dynamic && b.desc[i].gyroscopic) {
+        // The momentum-keeping turn knows nothing of the locks: a body with a rotation lock
+        // turns by its (projected) spin, which about a single free axis is exact anyway.
+        if (sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0) {
             rotate_keeping_momentum(sb, b.q[i], b.inertia_local[i], b.inv_inertia_local[i], sb.push_w, h);
             ++c.gyro;
         } else {

@@ -54,6 +54,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dp = Vec3::Zero();
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
+            sb.locks = b.locks[i];
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
         }

@@ -231,6 +231,8 @@ angular_damping = 0.2
 gyroscopic = true
 allow_interpolation = false
 fast = true
+lock_translation = ["z"]
+lock_rotation = ["y", "x"]
 
 [[body]]
 shape = { box = [1, 2, 3] }
@@ -255,6 +257,7 @@ orientation = [2, 0, 0, 0]
     EXPECT_TRUE(a.gyroscopic);
     EXPECT_FALSE(a.allow_interpolation);
     EXPECT_TRUE(a.fast);
+    EXPECT_EQ(a.locks, MotionLocks::plane_xy());
     EXPECT_EQ(scene.shapes[scene.bodies[0].shape].type, ShapeType::Sphere);
 
     const BodyDesc& b = scene.bodies[1].desc;
@@ -264,6 +267,7 @@ orientation = [2, 0, 0, 0]
     EXPECT_TRUE(b.orientation.isApprox(Quat::Identity()));  // normalised
     EXPECT_EQ(scene.shapes[scene.bodies[1].shape].type, ShapeType::Box);
     EXPECT_EQ(b.linear_velocity, Vec3::Zero());
+    EXPECT_FALSE(b.locks.any());
 }
 
 TEST(SceneParse, Settings_AreRead) {
@@ -403,6 +407,12 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
                     "expected at least 4 points, got 3");
     EXPECT_REJECTED("[body]\nshape = { sphere = 1 }\n", "1:1", "body: expected [[body]] entries");
     EXPECT_REJECTED("[defaults]\nposition = [0, 0, 0]\n", "2:1", "unknown key 'position' in [defaults]");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nlock_rotation = [\"x\", \"w\"]\n", "3:23",
+                    "body.lock_rotation[1]: expected \"x\", \"y\" or \"z\", got \"w\"");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nlock_translation = \"z\"\n", "3:20",
+                    "body.lock_translation: expected an array of axis names");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nlock_translation = [2]\n", "3:21",
+                    "body.lock_translation[0]: expected a string, got");
 }
 
 TEST(SceneParse, MissingFile_IsAClearError) {
@@ -412,6 +422,28 @@ TEST(SceneParse, MissingFile_IsAClearError) {
     } catch (const Error& e) {
         EXPECT_STREQ(e.what(), "/nonexistent/scene.toml: cannot open scene file");
     }
+}
+
+TEST(SceneBuild, LockedBody_KeepsItsLockedAxes) {
+    const SceneDesc scene = parse_scene(R"(
+[[body]]
+shape = { box = [0.5, 0.5, 0.5] }
+position = [0, 5, 0]
+velocity = [1, 0, 2]
+angular_velocity = [1, 2, 3]
+lock_translation = ["y", "z"]
+lock_rotation = ["x", "y", "z"]
+)",
+                                        "locks.toml");
+    Space space;
+    const std::vector<BodyHandle> handles = build(scene, space);
+    ASSERT_EQ(handles.size(), 1u);
+    for (int step = 0; step < 30; ++step) space.update();
+    const MotionState s = space.internal_motion_state(handles[0]);
+    EXPECT_NEAR(s.position.x(), 0.5, 1e-12);  // moved along x alone; gravity pulls on a locked axis
+    EXPECT_EQ(s.position.y(), 5.0);
+    EXPECT_EQ(s.position.z(), 0.0);
+    EXPECT_EQ(s.orientation.coeffs(), Quat::Identity().coeffs());
 }
 
 TEST(SceneBuild, AppliesSettings_KeepsTheSpacesTimeSteppingMode) {

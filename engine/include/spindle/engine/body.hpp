@@ -36,6 +36,40 @@ struct MotionState {
     Vec3 center_of_mass = Vec3::Zero();    // world; equals position for centred shapes
 };
 
+// Motion locks (Box2D v3's fixed rotation, Jolt's allowed degrees of freedom), in world
+// axes. A locked translation axis: the body's centre of mass never moves along it. A
+// locked rotation axis: the body never turns about it. Locking translation z and
+// rotation x and y keeps a body in the x-y plane (a 2D body in a 3D scene); locking all
+// three rotations keeps its orientation. The locks are exact, not springs: the body
+// has no mass to move along a locked axis (contacts and joints see it infinitely heavy
+// there) and every velocity it is given, at creation, by a write, a force or an
+// impulse, loses its locked components. A teleport (a written position or orientation)
+// puts it anywhere; it stays locked from there. Rotation locked about one axis alone
+// stops the spin about it, but turns about the other two still combine into a little
+// of it (as in Jolt); lock two or three for a rotation that stays exact. Bodies without
+// locks pay nothing for them.
+struct MotionLocks {
+    bool translation_x = false, translation_y = false, translation_z = false;
+    bool rotation_x = false, rotation_y = false, rotation_z = false;
+
+    // A 2D body in the x-y plane: translation z and rotation x and y locked.
+    static constexpr MotionLocks plane_xy() {
+        MotionLocks locks;
+        locks.translation_z = locks.rotation_x = locks.rotation_y = true;
+        return locks;
+    }
+    // No rotation at all (Box2D's fixed rotation).
+    static constexpr MotionLocks all_rotation() {
+        MotionLocks locks;
+        locks.rotation_x = locks.rotation_y = locks.rotation_z = true;
+        return locks;
+    }
+    bool any() const noexcept {
+        return translation_x || translation_y || translation_z || rotation_x || rotation_y || rotation_z;
+    }
+    friend bool operator==(const MotionLocks&, const MotionLocks&) = default;
+};
+
 struct BodyDesc {
     MotionType type = MotionType::Dynamic;
     Shape shape = Shape::sphere(0.5);
@@ -50,8 +84,10 @@ struct BodyDesc {
     Real gravity_scale = 1;
     Real linear_damping = 0;   // 1/s; 0 costs nothing
     Real angular_damping = 0;  // 1/s; 0 costs nothing
-    bool gyroscopic =
-        false;  // gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its angular momentum
+    // Gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its
+    // angular momentum (not for a body with a rotation lock: it turns as any other).
+    bool gyroscopic = false;
+    MotionLocks locks;  // nothing locked by default; for dynamic and kinematic bodies
     bool allow_interpolation = true;
     bool allow_sleep = true;
     bool fast = false;  // also swept against static geometry (continuous collision)
