@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <iterator>
 #include <stdexcept>
 
 namespace spindle::bench {
@@ -263,13 +264,21 @@ void write_gnuplot(const std::string& script_path, const std::string& data_path,
        << "set xlabel \"time per simulated second (ms, one thread)\"\n"
        << "set ylabel " << quoted(format("error (unit per case; below %.0e drawn at it)", kPlotFloor)) << "\n"
        << "plot \\\n";
+    // Every case its own colour and its own marker (gnuplot's default cycle repeats after
+    // eight colours): filled markers for the points, the same marker open on the front.
+    static constexpr const char* kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
+                                              "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#000080", "#800000",
+                                              "#008080", "#808000", "#ff1493", "#000000"};
+    static constexpr int kFilledMarkers[] = {7, 5, 9, 11, 13, 15};  // circle, square, triangles, diamond, pentagon
+    if (cases.size() > std::size(kColors)) throw std::runtime_error("accuracy plot: more cases than colours");
     for (std::size_t ci = 0; ci < cases.size(); ++ci) {
         const Case& c = cases[ci];
         const std::string title = format("%s (%s)", c.name, std::string(c.unit) == "rel" ? "relative" : c.unit);
-        gp << format("  %s index %zu using 1:2 with points pt 7 ps 0.7 lc %zu title %s, \\\n",
-                     quoted(data_path).c_str(), 2 * ci, ci + 1, quoted(title).c_str())
-           << format("  %s index %zu using 1:2 with linespoints pt 6 ps 2 lw 1.5 lc %zu notitle, \\\n",
-                     quoted(data_path).c_str(), 2 * ci + 1, ci + 1);
+        const int marker = kFilledMarkers[ci % std::size(kFilledMarkers)];
+        gp << format("  %s index %zu using 1:2 with points pt %d ps 0.9 lc rgb \"%s\" title %s, \\\n",
+                     quoted(data_path).c_str(), 2 * ci, marker, kColors[ci], quoted(title).c_str())
+           << format("  %s index %zu using 1:2 with linespoints pt %d ps 2 lw 1.5 lc rgb \"%s\" notitle, \\\n",
+                     quoted(data_path).c_str(), 2 * ci + 1, marker - 1, kColors[ci]);
     }
     gp << "  NaN with linespoints pt 6 ps 2 lc rgb \"black\" title \"Pareto front\"\n";
 }
