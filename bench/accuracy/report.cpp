@@ -8,9 +8,9 @@
 #include <cstdarg>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
-#include <iterator>
 #include <stdexcept>
 
 namespace spindle::bench {

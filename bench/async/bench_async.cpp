@@ -1,7 +1,8 @@
 // Buffering costs: get_motion_states for 1k/10k/100k bodies next to a plain memcpy of
 // the same bytes (the ratio is the price of the lock and the interpolation), the
 // FlipReadBuffers lock hold, and the game thread's read latency while an AsyncRunner
-// steps the space on another thread.
+// steps the space on another thread, and the writes per second several threads make
+// beside the steps per second the loop keeps.
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
@@ -10,8 +11,11 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <memory>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -105,8 +109,51 @@ void ReadLatencyWhilePhysicsRuns(benchmark::State& state) {
     state.counters["physics_steps"] = static_cast<double>(runner.stats().steps);
 }
 
+// Writer threads flat out (apply_impulse and set_angular_velocity on random bodies of n)
+// while an AsyncRunner steps the space at 60 Hz: the writes per second made, beside the
+// steps per second the loop kept (the write buffer coalesces per body, so ApplyWrites
+// costs per body written; a log of every write once left the loop 1-12 steps a second).
+void WritesWhilePhysicsRuns(benchmark::State& state) {
+    const int writers = static_cast<int>(state.range(0));
+    constexpr int kBodies = 1000;
+    auto space = make_space(kBodies, false);
+    std::vector<BodyHandle> handles;
+    std::vector<MotionState> states;
+    space->motion_states().get_all_motion_states(handles, states);
+    AsyncRunner runner(*space);
+    runner.start();
+    std::atomic<bool> writing{true};
+    std::atomic<std::uint64_t> made{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < writers; ++t) {
+        threads.emplace_back([&, t] {
+            std::uint64_t count = 0;
+            std::uint32_t k = 2654435761u * static_cast<std::uint32_t>(t + 1);
+            while (writing.load(std::memory_order_relaxed)) {
+                k = k * 1664525u + 1013904223u;
+                space->apply_impulse(handles[k % handles.size()], Vec3(0.001, 0, 0));
+                space->set_angular_velocity(handles[(k >> 8) % handles.size()], Vec3(0, 0, 0.1));
+                count += 2;
+            }
+            made.fetch_add(count);
+        });
+    }
+    const std::uint64_t steps_before = runner.stats().steps;
+    const std::int64_t t0 = now_nanoseconds();
+    for (auto _ : state) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const double seconds = static_cast<double>(now_nanoseconds() - t0) * 1e-9;
+    const AsyncStats stats = runner.stats();
+    writing.store(false);
+    for (std::thread& t : threads) t.join();
+    runner.stop();
+    state.counters["writes_per_s"] = static_cast<double>(made.load()) / seconds;
+    state.counters["steps_per_s"] = static_cast<double>(stats.steps - steps_before) / seconds;
+    state.counters["update_ms_p99"] = stats.update_ms_p99;
+}
+
 }  // namespace
 
+BENCHMARK(WritesWhilePhysicsRuns)->DenseRange(0, 4, 2)->ArgName("writers")->Iterations(20)->UseRealTime();
 BENCHMARK(GetMotionStates)->ArgsProduct({{1000, 10000, 100000}, {0, 1}})->ArgNames({"bodies", "interpolate"});
 BENCHMARK(Memcpy)->Arg(1000)->Arg(10000)->Arg(100000)->ArgName("bodies");
 BENCHMARK(FlipLockHold)->Arg(1000)->Arg(10000)->Arg(100000)->ArgName("bodies");
