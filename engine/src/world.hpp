@@ -97,7 +97,6 @@ struct ContactPoint {
     Vec3 local_a = Vec3::Zero();
     Vec3 local_b = Vec3::Zero();
     Real normal_impulse = 0;
-    Real tangent_impulse[2] = {0, 0};
     Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
     Real relative_velocity = 0;   // normal approach speed before solving (restitution)
 };
@@ -107,6 +106,11 @@ struct ContactManifold {
     Vec3 local_normal = Vec3::UnitY();  // in A's frame, from the last collide
     int point_count = 0;
     ContactPoint points[kMaxManifoldPoints];
+    // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
+    // central friction): the tangential impulse there (world, in the contact plane) and
+    // the twist impulse about the normal, kept for warm starting.
+    Vec3 friction_impulse = Vec3::Zero();
+    Real twist_impulse = 0;
 };
 
 // A pair of bodies whose fat bounds overlap.

@@ -42,9 +42,10 @@ struct WideRow {
 struct WidePoint {
     Wide3 ra, rb;                // anchors from each centre of mass, world, fixed for the step
     Wide adjusted_separation{};  // separation minus n.(rb - ra): current separation = n.d + this
-    WideRow normal_row, tangent_row[2];
-    WideF normal_mass{}, tangent_mass[2]{};
-    Wide normal_impulse{}, tangent_impulse[2]{};
+    WideRow normal_row;
+    WideF normal_mass{};
+    WideF lever_arm{};  // distance from the friction centre on A: the twist friction's reach
+    Wide normal_impulse{};
     Wide max_normal_impulse{};
     Wide relative_velocity{};  // approach speed at impact (restitution)
 };
@@ -75,6 +76,17 @@ struct WideContact {
     // the normal does not turn with the body, so a rolling ball's contact stays below it.
     Wide radius_a{}, radius_b{};
     WidePoint points[kMaxManifoldPoints];
+    // Central friction (Box3D's): two tangent rows at the manifold's friction centre,
+    // coupled by their 2x2 effective mass, and a twist row about the normal; their cones
+    // scale with the manifold's total normal impulse. Three rows per manifold instead of
+    // two per point, and no point's order favoured over another's.
+    Wide3 center_a, center_b;  // the friction centre from each centre of mass
+    WideRow friction_row[2];   // the tangents' angular terms at the centre
+    WideF friction_mass[3]{};  // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
+    Wide friction_impulse[2]{};
+    WideRow twist_row;  // Ia^-1 n, Ib^-1 n
+    WideF twist_mass{};
+    Wide twist_impulse{};
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The
     // rows themselves live apart (SolverScratch::push_rows): they are rarely used, and

@@ -4,8 +4,10 @@
 // WideContact share no dynamic body, so gathering their velocities, solving and
 // scattering them back is the same as solving the four one after another.
 //
-// Per point and pass: the normal row (soft push-out of resting overlap while biased,
-// speculative for a gap), then both friction rows inside Coulomb's cone. Overlap deeper
+// Per pass: each point's normal row (soft push-out of resting overlap while biased,
+// speculative for a gap), then the manifold's central friction (Box3D's): a twist row
+// about the normal and two coupled tangent rows at the points' centre, inside Coulomb's
+// cone of the manifold's total normal impulse. Overlap deeper
 // than the recovery depth is pushed out by a split impulse on separate push-out
 // velocities, per lane (rare: bodies created or teleported inside each other).
 #include <algorithm>
@@ -150,6 +152,80 @@ Real round_radius(const Shape& shape) {
     return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule ? shape.radius : 0;
 }
 
+// Central friction of one lane (Box3D's): the friction centre is the points' mean,
+// weighted down for points farther apart than friction_distance (up to twice that they
+// fade out, so the centre moves smoothly as points come and go); the two tangent rows at
+// the centre with their coupled 2x2 effective mass; the twist row about the normal.
+void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactManifold& m, const Vec3& xa,
+                      const Vec3& xb, const Vec3 (&tangent)[2], Real friction_distance, WideContact& wc, int l) {
+    constexpr Real kMinWeight = 1e-3;
+    Vec3 center_a = Vec3::Zero(), center_b = Vec3::Zero();
+    Real total = 0;
+    for (int j = 0; j < m.point_count; ++j) {
+        const ContactPoint& p = m.points[j];
+        const Real weight = std::clamp(2 - p.geometry.separation / friction_distance, kMinWeight, Real(1));
+        center_a += weight * (p.geometry.point - xa);
+        center_b += weight * (p.geometry.point - xb);
+        total += weight;
+    }
+    if (total > 0) {
+        center_a /= total;
+        center_b /= total;
+    }
+    for (int j = 0; j < m.point_count; ++j) {
+        wc.points[j].lever_arm[l] = static_cast<float>((m.points[j].geometry.point - xa - center_a).norm());
+    }
+    wc.center_a.set_lane(l, center_a);
+    wc.center_b.set_lane(l, center_b);
+    Vec3 ia[2], ib[2], ra_x[2], rb_x[2];
+    for (int t = 0; t < 2; ++t) {
+        ra_x[t] = center_a.cross(tangent[t]);
+        rb_x[t] = center_b.cross(tangent[t]);
+        ia[t] = A.inv_inertia * ra_x[t];
+        ib[t] = B.inv_inertia * rb_x[t];
+        wc.friction_row[t].ia.x[l] = static_cast<float>(ia[t].x());
+        wc.friction_row[t].ia.y[l] = static_cast<float>(ia[t].y());
+        wc.friction_row[t].ia.z[l] = static_cast<float>(ia[t].z());
+        wc.friction_row[t].ib.x[l] = static_cast<float>(ib[t].x());
+        wc.friction_row[t].ib.y[l] = static_cast<float>(ib[t].y());
+        wc.friction_row[t].ib.z[l] = static_cast<float>(ib[t].z());
+    }
+    // k(s, t) = ms (Ps ts).(Ps tt) summed over both bodies (P: the free axes) + the angular terms.
+    auto linear = [&](int s, int t) {
+        return A.inv_mass * project_linear(tangent[s], A.locks).dot(project_linear(tangent[t], A.locks)) +
+               B.inv_mass * project_linear(tangent[s], B.locks).dot(project_linear(tangent[t], B.locks));
+    };
+    const Real k00 = linear(0, 0) + ra_x[0].dot(ia[0]) + rb_x[0].dot(ib[0]);
+    const Real k11 = linear(1, 1) + ra_x[1].dot(ia[1]) + rb_x[1].dot(ib[1]);
+    const Real k01 = linear(0, 1) + ra_x[0].dot(ia[1]) + rb_x[0].dot(ib[1]);
+    // The inverse; where a motion lock leaves a tangent no give (K of rank one, K = t u u^T
+    // with t its trace), the pseudo-inverse u u^T / t = K / t^2, so the free tangent still rubs.
+    const Real det = k00 * k11 - k01 * k01;
+    const Real trace = k00 + k11;
+    Real m00 = 0, m01 = 0, m11 = 0;
+    if (det > Real(1e-9) * trace * trace) {
+        m00 = k11 / det, m01 = -k01 / det, m11 = k00 / det;
+    } else if (trace > 0) {
+        const Real inv_sq = 1 / (trace * trace);
+        m00 = k00 * inv_sq, m01 = k01 * inv_sq, m11 = k11 * inv_sq;
+    }
+    wc.friction_mass[0][l] = static_cast<float>(m00);
+    wc.friction_mass[1][l] = static_cast<float>(m01);
+    wc.friction_mass[2][l] = static_cast<float>(m11);
+    wc.friction_impulse[0][l] = tangent[0].dot(m.friction_impulse);
+    wc.friction_impulse[1][l] = tangent[1].dot(m.friction_impulse);
+    const Vec3 twist_a = A.inv_inertia * m.normal, twist_b = B.inv_inertia * m.normal;
+    wc.twist_row.ia.x[l] = static_cast<float>(twist_a.x());
+    wc.twist_row.ia.y[l] = static_cast<float>(twist_a.y());
+    wc.twist_row.ia.z[l] = static_cast<float>(twist_a.z());
+    wc.twist_row.ib.x[l] = static_cast<float>(twist_b.x());
+    wc.twist_row.ib.y[l] = static_cast<float>(twist_b.y());
+    wc.twist_row.ib.z[l] = static_cast<float>(twist_b.z());
+    const Real k_twist = m.normal.dot(twist_a + twist_b);
+    wc.twist_mass[l] = static_cast<float>(k_twist > 0 ? 1 / k_twist : 0);
+    wc.twist_impulse[l] = m.twist_impulse;
+}
+
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
 void prepare_wide(const World& world, const SolverScratch& scratch, WideContact& wc) {
@@ -160,16 +236,21 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     WideMat3 inv_inertia_a, inv_inertia_b;
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
     Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
-    Wide tangent_impulse[kMaxManifoldPoints][2]{};
-    // Inverse mass sums of both bodies along the normal and the tangents: the share of
-    // the free axes for a locked body, inv_mass_a + inv_mass_b otherwise.
-    Wide linear_sum[3]{};
+    // Inverse mass sum of both bodies along the normal: the share of the free axes for a
+    // locked body, inv_mass_a + inv_mass_b otherwise.
+    Wide linear_sum{};
     for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.locked = false;
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
+    wc.center_a = wc.center_b = Wide3{};
+    wc.friction_row[0] = wc.friction_row[1] = wc.twist_row = WideRow{};
+    wc.friction_mass[0] = wc.friction_mass[1] = wc.friction_mass[2] = wc.twist_mass = WideF{};
+    wc.friction_impulse[0] = wc.friction_impulse[1] = wc.twist_impulse = Wide{};
+    for (WidePoint& p : wc.points) p.lever_arm = WideF{};
     for (std::uint8_t& points : wc.slot_points) points = 0;
+    const Real friction_distance = std::max(world.settings.solver.speculative_distance, Real(1e-3));
     for (int l = 0; l < wc.lanes; ++l) {
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
@@ -184,11 +265,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         wc.inv_mass_a[l] = A.inv_mass;
         wc.inv_mass_b[l] = B.inv_mass;
         wc.locked = wc.locked || ((A.locks | B.locks) & kLockTranslation) != 0;
-        const Vec3 dirs[3] = {m.normal, tangent[0], tangent[1]};
-        for (int d = 0; d < 3; ++d) {
-            linear_sum[d][l] = inverse_mass_along(A.inv_mass, A.locks, dirs[d]) +
-                               inverse_mass_along(B.inv_mass, B.locks, dirs[d]);
-        }
+        linear_sum[l] = inverse_mass_along(A.inv_mass, A.locks, m.normal) +
+                        inverse_mass_along(B.inv_mass, B.locks, m.normal);
         inv_inertia_a.set_lane(l, A.inv_inertia);
         inv_inertia_b.set_lane(l, B.inv_inertia);
         wc.friction[l] = contact.friction;
@@ -206,10 +284,9 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
             rb[j].set_lane(l, src.geometry.point - xb);
             separation[j][l] = src.geometry.separation;
             normal_impulse[j][l] = src.normal_impulse;
-            tangent_impulse[j][0][l] = src.tangent_impulse[0];
-            tangent_impulse[j][1][l] = src.tangent_impulse[1];
             ++wc.slot_points[j];
         }
+        prepare_friction(A, B, m, xa, xb, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
@@ -219,13 +296,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         p.adjusted_separation = separation[j] - dot(wc.normal, rb[j] - ra[j]);
         // A slot no manifold fills gets no mass: it can never push or rub.
         const WideMask filled = separation[j] < splat(kEmptySeparation);
-        p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum[0], splat(0)), ra[j], rb[j],
+        p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum, splat(0)), ra[j], rb[j],
                                  wc.normal, p.normal_row);
-        for (int t = 0; t < 2; ++t) {
-            p.tangent_mass[t] = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum[1 + t], splat(0)),
-                                         ra[j], rb[j], wc.tangent[t], p.tangent_row[t]);
-            p.tangent_impulse[t] = tangent_impulse[j][t];
-        }
         p.normal_impulse = normal_impulse[j];
         p.max_normal_impulse = Wide{};
         p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
@@ -355,35 +427,47 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
-    const Wide slop = splat(params.slop);
-    // A lane without friction has an empty cone (its rows come out zero); when no lane
-    // has friction, the rows are skipped outright.
-    const int friction_points = any(wc.friction > zero) ? kMaxManifoldPoints : 0;
-    for (int k = 0; k < friction_points; ++k) {
-        // Friction points in one order when biased and the other when relaxing: Gauss-
-        // Seidel favours the point solved last, and in a resting pyramid a fixed order
-        // creeps the upper layers sideways (0.10 m over 1000 steps, 0.07 alternating).
-        const int j = kBias ? k : kMaxManifoldPoints - 1 - k;
-        // No friction across an open gap: a speculative point far from the body (a
-        // fast sphere's, metres ahead) would spin it up through the lever arm.
-        const WideMask touching = gap[j] <= slop;
-        if (!any(touching)) continue;
-        counts.friction += wc.slot_points[j];
-        WidePoint& p = wc.points[j];
-        const Wide old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
-        const Wide3 dv = point_velocity(s, p.ra, p.rb);
-        Wide new0 = old0 - widen(p.tangent_mass[0]) * dot(wc.tangent[0], dv);
-        Wide new1 = old1 - widen(p.tangent_mass[1]) * dot(wc.tangent[1], dv);
-        // Coulomb's cone: the friction impulse stays within friction x normal impulse.
-        const Wide limit = wc.friction * p.normal_impulse;
+    // Central friction, when any lane has friction (a lane without has an empty cone).
+    // Its cones scale with the normal impulses of the touching points only: a speculative
+    // point far from the body (a fast sphere's, metres ahead) would spin it up through
+    // the lever arm.
+    if (any(wc.friction > zero)) {
+        const Wide slop = splat(params.slop);
+        Wide pressed = zero, twist_reach = zero;
+        for (int j = 0; j < kMaxManifoldPoints; ++j) {
+            const Wide touching_impulse = select(gap[j] <= slop, wc.points[j].normal_impulse, zero);
+            pressed += touching_impulse;
+            twist_reach += widen(wc.points[j].lever_arm) * touching_impulse;
+        }
+        counts.friction += static_cast<std::uint64_t>(wc.lanes);
+        // Twist about the normal, within friction x the normal impulses' moments.
+        {
+            const Wide speed = dot(wc.normal, s.wb - s.wa);
+            const Wide limit = wc.friction * twist_reach;
+            const Wide old = wc.twist_impulse;
+            const Wide total = wide_min(wide_max(old - widen(wc.twist_mass) * speed, -limit), limit);
+            wc.twist_impulse = total;
+            const Wide delta = total - old;
+            s.wa -= delta * widen(wc.twist_row.ia);
+            s.wb += delta * widen(wc.twist_row.ib);
+        }
+        // The two tangent rows at the centre, solved together by their 2x2 mass, within
+        // Coulomb's cone of friction x the total normal impulse.
+        const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
+        const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
+        const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
+        const Wide m00 = widen(wc.friction_mass[0]), m01 = widen(wc.friction_mass[1]), m11 = widen(wc.friction_mass[2]);
+        Wide new0 = old0 - (m00 * v0 + m01 * v1);
+        Wide new1 = old1 - (m01 * v0 + m11 * v1);
+        const Wide limit = wc.friction * pressed;
         const Wide length_sq = new0 * new0 + new1 * new1;
         const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), one);
-        new0 = select(touching, new0 * scale, old0);
-        new1 = select(touching, new1 * scale, old1);
-        p.tangent_impulse[0] = new0;
-        p.tangent_impulse[1] = new1;
-        apply_row<kLocked>(wc, masses, s, wc.tangent[0], p.tangent_row[0], new0 - old0);
-        apply_row<kLocked>(wc, masses, s, wc.tangent[1], p.tangent_row[1], new1 - old1);
+        new0 *= scale;
+        new1 *= scale;
+        wc.friction_impulse[0] = new0;
+        wc.friction_impulse[1] = new1;
+        apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], new0 - old0);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], new1 - old1);
     }
     scatter(wc, bodies, s);
     if constexpr (kBias) {
@@ -401,12 +485,12 @@ void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* b
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
-    const bool friction = any(wc.friction > splat(0));  // else the tangent impulses are all zero
-    for (const WidePoint& p : wc.points) {
-        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, p.normal_impulse);
-        if (!friction) continue;
-        apply_row<kLocked>(wc, masses, s, wc.tangent[0], p.tangent_row[0], p.tangent_impulse[0]);
-        apply_row<kLocked>(wc, masses, s, wc.tangent[1], p.tangent_row[1], p.tangent_impulse[1]);
+    for (const WidePoint& p : wc.points) apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, p.normal_impulse);
+    if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
+        apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], wc.friction_impulse[0]);
+        apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], wc.friction_impulse[1]);
+        s.wa -= wc.twist_impulse * widen(wc.twist_row.ia);
+        s.wb += wc.twist_impulse * widen(wc.twist_row.ib);
     }
     scatter(wc, bodies, s);
     for (int l = 0; l < kLanes; ++l) {
@@ -487,12 +571,13 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
         for (int l = 0; l < wc.lanes; ++l) {
             const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
             ContactManifold& m = world.contacts[ref.contact].manifold_at(static_cast<int>(ref.manifold));
+            m.friction_impulse = wc.friction_impulse[0][l] * wc.tangent[0].lane(l) +
+                                 wc.friction_impulse[1][l] * wc.tangent[1].lane(l);
+            m.twist_impulse = wc.twist_impulse[l];
             for (int j = 0; j < m.point_count; ++j) {
                 const WidePoint& p = wc.points[j];
                 ContactPoint& dst = m.points[j];
                 dst.normal_impulse = p.normal_impulse[l];
-                dst.tangent_impulse[0] = p.tangent_impulse[0][l];
-                dst.tangent_impulse[1] = p.tangent_impulse[1][l];
                 dst.max_normal_impulse = p.max_normal_impulse[l];
                 dst.relative_velocity = p.relative_velocity[l];
             }

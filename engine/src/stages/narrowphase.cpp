@@ -61,11 +61,23 @@ void remember(Contact& contact, const Transform& ta, const Transform& tb, const 
     contact.cached_rotation = rotation;
 }
 
-// Each new point takes the impulses of the old point with the same feature id or, when
-// the id changed (two faces aligned exactly flip between reference features from step
-// to step), of the nearest old point within kCarryDistance: losing the warm start there
-// makes a tall stack jitter and walk.
+// Each new point takes the normal impulse of the old point with the same feature id or,
+// when the id changed (two faces aligned exactly flip between reference features from
+// step to step), of the nearest old point within kCarryDistance: losing the warm start
+// there makes a tall stack jitter and walk. The manifold takes the friction and twist
+// impulses of the old manifold facing the same way.
 void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
+    const ContactManifold* facing = nullptr;
+    Real best_alignment = 0.9;  // a different face of a mesh below this
+    for (int m = 0; m < old_contact.manifold_count; ++m) {
+        const ContactManifold& old = old_contact.manifold_at(m);
+        const Real alignment = old.normal.dot(fresh.normal);
+        if (alignment > best_alignment) best_alignment = alignment, facing = &old;
+    }
+    if (facing) {
+        fresh.friction_impulse = facing->friction_impulse - facing->friction_impulse.dot(fresh.normal) * fresh.normal;
+        fresh.twist_impulse = facing->twist_impulse;
+    }
     for (int j = 0; j < fresh.point_count; ++j) {
         ContactPoint& p = fresh.points[j];
         const ContactPoint* match = nullptr;
@@ -86,10 +98,7 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
                 }
             }
         }
-        if (!match) continue;
-        p.normal_impulse = match->normal_impulse;
-        p.tangent_impulse[0] = match->tangent_impulse[0];
-        p.tangent_impulse[1] = match->tangent_impulse[1];
+        if (match) p.normal_impulse = match->normal_impulse;
     }
 }
 

@@ -80,8 +80,10 @@ TEST(Effects, FrictionAndRestitutionOnlyWhereContactsHaveThem) {
     EXPECT_EQ(space.counters().restitution_applied, 0u);
 }
 
-// A resting ball has one contact point, through every solve and relax pass of each step.
-TEST(Effects, FrictionCountsExactlyTheFrictionalPoints) {
+// A resting ball has one contact point, through every solve and relax pass of each step;
+// friction is solved once per manifold (central friction), so a box resting on its face
+// (four points, one manifold) counts a quarter as many friction passes as point passes.
+TEST(Effects, FrictionCountsExactlyTheFrictionalManifolds) {
     Space space(awake());
     add_ground(space);
     space.create_body(ball(Vec3(0, 0.5, 0)));
@@ -89,6 +91,16 @@ TEST(Effects, FrictionCountsExactlyTheFrictionalPoints) {
     EXPECT_EQ(space.counters().contact_points_solved, 30u * solver_passes(space));
     EXPECT_EQ(space.counters().friction_applied, space.counters().contact_points_solved);
     EXPECT_EQ(space.counters().restitution_applied, 0u);
+
+    Space boxes(awake());
+    add_ground(boxes);
+    BodyDesc box;
+    box.shape = Shape::box(Vec3::Constant(0.5));
+    box.position = Vec3(0, 0.5, 0);
+    boxes.create_body(box);
+    for (int i = 0; i < 30; ++i) boxes.update();
+    EXPECT_EQ(boxes.counters().contact_points_solved, 4u * 30u * solver_passes(boxes));
+    EXPECT_EQ(boxes.counters().friction_applied, 30u * solver_passes(boxes));
 }
 
 // Restitution is one pass after the substeps: each point of a bouncy contact is
