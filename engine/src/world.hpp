@@ -134,13 +134,11 @@ struct Contact {
 };
 
 // A contact's manifolds packed for the solver's listing: the point count of manifold m
-// in bits [4m, 4m + 4), and whether the contact has friction and restitution.
-inline constexpr std::uint32_t kSummaryFriction = 1u << 16;
+// in bits [4m, 4m + 4), and whether the contact has restitution.
 inline constexpr std::uint32_t kSummaryRestitution = 1u << 17;
 inline std::uint32_t contact_summary(const Contact& contact) {
     static_assert(kMaxManifoldPoints < 16, "a point count in 4 bits");
-    std::uint32_t summary = (contact.friction > 0 ? kSummaryFriction : 0u) |
-                            (contact.restitution > 0 ? kSummaryRestitution : 0u);
+    std::uint32_t summary = contact.restitution > 0 ? kSummaryRestitution : 0u;
     for (int m = 0; m < contact.manifold_count; ++m) {
         summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (4 * m);
     }
@@ -153,7 +151,8 @@ inline std::uint32_t contact_summary(const Contact& contact) {
 // each: the workers bump theirs per body and per constraint.
 struct alignas(64) EffectCounts {
     std::uint64_t gravity = 0, damping = 0, gyro = 0;  // body-substeps (integrator.cpp)
-    std::uint64_t contact_points = 0, friction = 0;    // point-passes of the normal and friction rows
+    std::uint64_t contact_points = 0;                  // point-passes of the normal rows
+    std::uint64_t friction = 0;                        // manifold-passes of the central friction rows
     std::uint64_t restitution = 0;                     // points checked for a bounce
     std::uint64_t joints = 0;                          // joint-passes
 };

@@ -8,6 +8,13 @@
 namespace spindle {
 namespace {
 
+// Adds v to one of the entry's sums, which starts afresh when its bit is clear (never
+// written, or dropped by a velocity write since).
+void accumulate(PendingWrites& entry, Vec3& sum, std::uint16_t bit, const Vec3& v) {
+    sum = (entry.bits & bit) != 0 ? saturate(sum + v) : v;
+    entry.bits |= bit;
+}
+
 void merge(PendingWrites& entry, const BufferedWrite& write) {
     entry.writes += 1;
     switch (write.kind) {
@@ -21,12 +28,10 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             break;
         case WriteKind::LinearVelocity:
             entry.linear_velocity = write.vector;
-            entry.impulse = Vec3::Zero();
             entry.bits = (entry.bits | kPendingLinearVelocity) & ~kPendingImpulse;
             break;
         case WriteKind::AngularVelocity:
             entry.angular_velocity = write.vector;
-            entry.angular_impulse = Vec3::Zero();
             entry.bits = (entry.bits | kPendingAngularVelocity) & ~kPendingAngularImpulse;
             break;
         case WriteKind::MotionState:
@@ -34,25 +39,13 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             entry.orientation = write.state.orientation;
             entry.linear_velocity = write.state.linear_velocity;
             entry.angular_velocity = write.state.angular_velocity;
-            entry.impulse = Vec3::Zero();
-            entry.angular_impulse = Vec3::Zero();
             entry.bits = (entry.bits | kPendingPose | kPendingVelocity) & ~(kPendingImpulse | kPendingAngularImpulse);
             break;
-        case WriteKind::Force:
-            entry.force = saturate(entry.force + write.vector);
-            entry.bits |= kPendingForce;
-            break;
-        case WriteKind::Torque:
-            entry.torque = saturate(entry.torque + write.vector);
-            entry.bits |= kPendingTorque;
-            break;
-        case WriteKind::Impulse:
-            entry.impulse = saturate(entry.impulse + write.vector);
-            entry.bits |= kPendingImpulse;
-            break;
+        case WriteKind::Force: accumulate(entry, entry.force, kPendingForce, write.vector); break;
+        case WriteKind::Torque: accumulate(entry, entry.torque, kPendingTorque, write.vector); break;
+        case WriteKind::Impulse: accumulate(entry, entry.impulse, kPendingImpulse, write.vector); break;
         case WriteKind::AngularImpulse:
-            entry.angular_impulse = saturate(entry.angular_impulse + write.vector);
-            entry.bits |= kPendingAngularImpulse;
+            accumulate(entry, entry.angular_impulse, kPendingAngularImpulse, write.vector);
             break;
         case WriteKind::Wake: entry.bits |= kPendingWake; break;
     }

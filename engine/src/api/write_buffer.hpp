@@ -67,7 +67,7 @@ struct PendingWrites {
     Quat orientation = Quat::Identity();
     Vec3 linear_velocity = Vec3::Zero();
     Vec3 angular_velocity = Vec3::Zero();
-    Vec3 force = Vec3::Zero();  // sums, saturated so they stay finite
+    Vec3 force = Vec3::Zero();  // sums, saturated so they stay finite; valid where their bit is set
     Vec3 torque = Vec3::Zero();
     Vec3 impulse = Vec3::Zero();
     Vec3 angular_impulse = Vec3::Zero();

@@ -134,6 +134,12 @@ inline void apply_row(const WideContact& wc, const WideAxisMasses& m, WideVeloci
     s.wb += L * widen(row.ib);
 }
 
+// An angular impulse L about a row's axis (the twist row): no linear part.
+inline void apply_angular_row(WideVelocities& s, const WideRow& row, Wide L) {
+    s.wa -= L * widen(row.ia);
+    s.wb += L * widen(row.ib);
+}
+
 // A row's angular terms for four lanes; returns the effective masses (0 where nothing moves).
 WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
                const Wide3& rb, const Wide3& dir, WideRow& row) {
@@ -183,12 +189,8 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
         rb_x[t] = center_b.cross(tangent[t]);
         ia[t] = A.inv_inertia * ra_x[t];
         ib[t] = B.inv_inertia * rb_x[t];
-        wc.friction_row[t].ia.x[l] = static_cast<float>(ia[t].x());
-        wc.friction_row[t].ia.y[l] = static_cast<float>(ia[t].y());
-        wc.friction_row[t].ia.z[l] = static_cast<float>(ia[t].z());
-        wc.friction_row[t].ib.x[l] = static_cast<float>(ib[t].x());
-        wc.friction_row[t].ib.y[l] = static_cast<float>(ib[t].y());
-        wc.friction_row[t].ib.z[l] = static_cast<float>(ib[t].z());
+        wc.friction_row[t].ia.set_lane(l, ia[t]);
+        wc.friction_row[t].ib.set_lane(l, ib[t]);
     }
     // k(s, t) = ms (Ps ts).(Ps tt) summed over both bodies (P: the free axes) + the angular terms.
     auto linear = [&](int s, int t) {
@@ -215,12 +217,8 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
     wc.friction_impulse[0][l] = tangent[0].dot(m.friction_impulse);
     wc.friction_impulse[1][l] = tangent[1].dot(m.friction_impulse);
     const Vec3 twist_a = A.inv_inertia * m.normal, twist_b = B.inv_inertia * m.normal;
-    wc.twist_row.ia.x[l] = static_cast<float>(twist_a.x());
-    wc.twist_row.ia.y[l] = static_cast<float>(twist_a.y());
-    wc.twist_row.ia.z[l] = static_cast<float>(twist_a.z());
-    wc.twist_row.ib.x[l] = static_cast<float>(twist_b.x());
-    wc.twist_row.ib.y[l] = static_cast<float>(twist_b.y());
-    wc.twist_row.ib.z[l] = static_cast<float>(twist_b.z());
+    wc.twist_row.ia.set_lane(l, twist_a);
+    wc.twist_row.ib.set_lane(l, twist_b);
     const Real k_twist = m.normal.dot(twist_a + twist_b);
     wc.twist_mass[l] = static_cast<float>(k_twist > 0 ? 1 / k_twist : 0);
     wc.twist_impulse[l] = m.twist_impulse;
@@ -447,9 +445,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
             const Wide old = wc.twist_impulse;
             const Wide total = wide_min(wide_max(old - widen(wc.twist_mass) * speed, -limit), limit);
             wc.twist_impulse = total;
-            const Wide delta = total - old;
-            s.wa -= delta * widen(wc.twist_row.ia);
-            s.wb += delta * widen(wc.twist_row.ib);
+            apply_angular_row(s, wc.twist_row, total - old);
         }
         // The two tangent rows at the centre, solved together by their 2x2 mass, within
         // Coulomb's cone of friction x the total normal impulse.
@@ -489,8 +485,7 @@ void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* b
     if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
         apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], wc.friction_impulse[0]);
         apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], wc.friction_impulse[1]);
-        s.wa -= wc.twist_impulse * widen(wc.twist_row.ia);
-        s.wb += wc.twist_impulse * widen(wc.twist_row.ib);
+        apply_angular_row(s, wc.twist_row, wc.twist_impulse);
     }
     scatter(wc, bodies, s);
     for (int l = 0; l < kLanes; ++l) {

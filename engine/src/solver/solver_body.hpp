@@ -25,6 +25,9 @@ struct SolverBody {
     Real inv_mass = 0;                // along the free axes: zero along a locked one (locks)
     bool dynamic = false;             // only dynamic bodies are written by constraints
     std::uint8_t locks = 0;           // motion lock bits (motion_locks.hpp), in the padding
+    // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
+    // and no rotation lock. Kept here so integrate_positions reads no body description.
+    bool gyroscopic = false;
 };
 
 // The velocity change of an impulse (inverse mass times it): none along a locked axis.

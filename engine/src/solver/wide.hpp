@@ -44,6 +44,12 @@ struct Wide3 {
 // A Wide3 stored as floats.
 struct Wide3F {
     WideF x{}, y{}, z{};
+
+    void set_lane(int i, const Vec3& v) {
+        x[i] = static_cast<float>(v.x());
+        y[i] = static_cast<float>(v.y());
+        z[i] = static_cast<float>(v.z());
+    }
 };
 inline Wide3 widen(const Wide3F& v) { return {widen(v.x), widen(v.y), widen(v.z)}; }
 inline Wide3F narrow(const Wide3& v) { return {narrow(v.x), narrow(v.y), narrow(v.z)}; }

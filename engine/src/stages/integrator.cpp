@@ -88,10 +88,11 @@ void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t
         const Real moving_sq = moving.squaredNorm();
         if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
         sb.dp += h * (sb.v + sb.push_v);
-        const std::uint32_t i = world.awake[k];
         // The momentum-keeping turn knows nothing of the locks: a body with a rotation lock
-        // turns by its (projected) spin, which about a single free axis is exact anyway.
-        if (sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0) {
+        // turns by its (projected) spin, which about a single free axis is exact anyway
+        // (SolverBody::gyroscopic is false for it).
+        if (sb.gyroscopic) {
+            const std::uint32_t i = world.awake[k];
             rotate_keeping_momentum(sb, b.q[i], b.inertia_local[i], b.inv_inertia_local[i], sb.push_w, h);
             ++c.gyro;
         } else {

@@ -16,6 +16,10 @@ static_assert(kMaxManifolds <= 4, "contact_summary (world.hpp) packs the point c
 // Within this distance an old point stands for a new one whose feature id changed.
 constexpr Real kCarryDistance = 0.02;
 
+// Old and new manifolds whose normals are closer than this (cosine) are the same face;
+// below it, a different face of a mesh.
+constexpr Real kSameFace = 0.9;
+
 // A contact keeps its manifolds while B's pose in A's frame stays within 0.2 mm and half
 // a degree (|cos| of half the angle between the rotations) of the pose they were computed
 // at. Jolt's 1 mm and 2 degrees let a 20-cube stack at 4 substeps drift 5 cm.
@@ -68,7 +72,7 @@ void remember(Contact& contact, const Transform& ta, const Transform& tb, const 
 // impulses of the old manifold facing the same way.
 void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     const ContactManifold* facing = nullptr;
-    Real best_alignment = 0.9;  // a different face of a mesh below this
+    Real best_alignment = kSameFace;
     for (int m = 0; m < old_contact.manifold_count; ++m) {
         const ContactManifold& old = old_contact.manifold_at(m);
         const Real alignment = old.normal.dot(fresh.normal);
@@ -84,7 +88,7 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
         Real nearest = kCarryDistance * kCarryDistance;
         for (int m = 0; m < old_contact.manifold_count && !(match && match->geometry.id == p.geometry.id); ++m) {
             const ContactManifold& old = old_contact.manifold_at(m);
-            if (old.normal.dot(fresh.normal) < 0.9) continue;  // a different face of a mesh
+            if (old.normal.dot(fresh.normal) < kSameFace) continue;
             for (int k = 0; k < old.point_count; ++k) {
                 const ContactPoint& o = old.points[k];
                 if (o.geometry.id == p.geometry.id) {

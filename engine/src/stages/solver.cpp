@@ -55,6 +55,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
+            sb.gyroscopic = sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0;
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
         }
