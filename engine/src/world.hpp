@@ -91,19 +91,20 @@ struct Bodies {
 // One touching manifold with what the solver keeps between steps (impulses, for
 // warm starting, matched by feature id).
 struct ContactPoint {
-    ManifoldPoint geometry;
-    // The point on each surface in its body's frame (shape origin), kept from the last
-    // collide so a manifold can follow its bodies while they barely move (narrowphase.cpp).
-    Vec3 local_a = Vec3::Zero();
-    Vec3 local_b = Vec3::Zero();
+    ManifoldPoint geometry;  // as collided; a recycled manifold updates the separation only
+    // Anchors (Box3D's): the point from each body's centre of mass, world axes, as it was
+    // when collided. They stay attached to their bodies while the manifold is recycled
+    // (narrowphase.cpp), and the solver pushes each body at its own anchor.
+    Vec3 anchor_a = Vec3::Zero();
+    Vec3 anchor_b = Vec3::Zero();
+    Real base_separation = 0;  // the separation when collided
     Real normal_impulse = 0;
     Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
     Real relative_velocity = 0;   // normal approach speed before solving (restitution)
 };
 
 struct ContactManifold {
-    Vec3 normal = Vec3::UnitY();
-    Vec3 local_normal = Vec3::UnitY();  // in A's frame, from the last collide
+    Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
     int point_count = 0;
     ContactPoint points[kMaxManifoldPoints];
     // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
@@ -121,11 +122,13 @@ struct Contact {
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
     bool sleeping = false;
-    // B's pose in A's frame when the manifolds were last computed; while the bodies stay
-    // within 0.2 mm and half a degree of it, the manifolds are moved, not recomputed.
+    // The poses the manifolds were last collided at (B's centre of mass in A's frame, the
+    // relative and both absolute rotations): while the bodies stay close to them the
+    // manifolds are recycled, not collided again (narrowphase.cpp).
     bool cached = false;
     Vec3 cached_position = Vec3::Zero();
     Quat cached_rotation = Quat::Identity();
+    Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
     const ContactManifold& manifold_at(int i) const {

@@ -1,10 +1,12 @@
-// Pyramids: Jolt's 1240-box "Pyramid" standing for 1000 steps, and piles started with
-// 25% overlap pushing apart no faster than the push-out speed allows.
+// Pyramids: Jolt's 1240-box "Pyramid" standing for 1000 steps, Box3D's 5,050-box
+// "large_pyramid" standing for 800, and piles started with 25% overlap pushing apart no
+// faster than the push-out speed allows.
 #include "scene_util.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 using namespace spindle;
@@ -57,6 +59,40 @@ TEST(Pyramid, StandsFor1000Steps) {
     EXPECT_LT(worst_top_error, 0.02);
 }
 
+// Box3D's benchmark "large_pyramid" (issue 16): a flat pyramid of unit cubes of density
+// 100, base 100 (5,050 cubes), on a box floor, sleeping off, at the default settings.
+// Box3D's top settles at 98.81 m and stays there to step 800. Spindle's, before contact
+// recycling and friction in the relax passes, oscillated and collapsed: top at 99.52,
+// 79.5 and 5.5 m at steps 100, 500 and 800.
+TEST(Pyramid, LargeFlatPyramidStandsFor800Steps) {
+    auto jobs = two_workers();
+    auto space = make_space(SpaceSettings{}, jobs.get());
+    add_static_box(*space, Vec3(100, 1, 100), Vec3(0, -1, 0));
+    std::vector<BodyHandle> boxes;
+    constexpr int kBase = 100;
+    for (int row = 0; row < kBase; ++row) {
+        for (int j = 0; j < kBase - row; ++j) {
+            boxes.push_back(add_box(*space, Vec3::Constant(0.5), Vec3(-49.5 + 0.5 * row + j, 0.5 + row, 0), 100));
+        }
+    }
+    constexpr int kSettle = 100;
+    for (int step = 0; step < kSettle; ++step) space->update();
+    const std::vector<Vec3> settled = positions(*space, boxes);
+    double lowest_top = settled.back().y();
+    for (int step = kSettle; step < 800; ++step) {
+        space->update();
+        lowest_top = std::min(lowest_top, space->internal_position(boxes.back()).y());
+    }
+    const double worst = max_displacement(*space, boxes, settled);
+    std::printf(
+        "[ measure  ] large pyramid: top at step 100 %.3f m, lowest to step 800 %.3f m, final %.3f m; worst box "
+        "moved from step 100 %.3f m\n",
+        settled.back().y(), lowest_top, space->internal_position(boxes.back()).y(), worst);
+    EXPECT_TRUE(all_finite(*space, boxes));
+    EXPECT_GT(lowest_top, 98.5);
+    EXPECT_LT(worst, 0.3);
+}
+
 // A 10-layer pyramid of unit cubes (385 boxes, each on four below) whose layers
 // overlap by a quarter of a box: each layer 0.75 above the one below.
 TEST(OverlapRecovery, PyramidWithQuarterOverlapSeparatesAtThePushOutSpeed) {
@@ -78,15 +114,32 @@ TEST(OverlapRecovery, PyramidWithQuarterOverlapSeparatesAtThePushOutSpeed) {
     EXPECT_LT(run.final_overlap, 0.01);
 }
 
-// A column of 20 cubes, each 0.75 above the one below.
+// A column of 20 cubes, each 0.75 above the one below. It ends as deep as the same column
+// built touching rests (soft contacts carry a load by compressing: about 1 cm under 19
+// cubes at the default 30 Hz), and standing: every cube on the one below (the column
+// toppled, several metres, before overlap was pushed out by split impulse). It sways:
+// since the default contacts went from 60 to 30 Hz (issue 16) its top sways up to 0.8 m
+// over 800 steps (0.27 m at 60 Hz); Box3D launches the same column 28 m high.
 TEST(OverlapRecovery, StackWithQuarterOverlapSeparatesAtThePushOutSpeed) {
+    double resting = 0;
+    {
+        auto space = make_space();
+        const BodyHandle floor = add_static_box(*space, Vec3(20, 1, 20), Vec3(0, -1, 0));
+        std::vector<BodyHandle> all = add_cube_stack(*space, 20, Vec3::Zero());
+        for (int step = 0; step < 240; ++step) space->update();
+        all.push_back(floor);
+        resting = deepest_penetration(*space, all);
+    }
     auto space = make_space();
     const BodyHandle floor = add_static_box(*space, Vec3(20, 1, 20), Vec3(0, -1, 0));
     const std::vector<BodyHandle> boxes = add_cube_stack(*space, 20, Vec3::Zero(), 0.75);
     const OverlapRun run = run_overlap_recovery("overlapping stack", *space, boxes, floor, 240);
+    std::printf("[ measure  ] the same column built touching rests %.4f m deep\n", resting);
     EXPECT_LE(run.worst_speed_excess, 0.0);
-    EXPECT_LT(run.final_overlap, 0.01);
-    // Standing: no cube ends more than half its width from where it started (the
-    // column toppled, several metres, before overlap was pushed out by split impulse).
-    EXPECT_LT(run.final_sideways, 0.5) << "the column should end standing, not toppled";
+    EXPECT_LT(run.final_overlap, resting + 0.005);
+    for (std::size_t i = 1; i < boxes.size(); ++i) {
+        const Vec3 d = space->internal_position(boxes[i]) - space->internal_position(boxes[i - 1]);
+        EXPECT_LT(std::hypot(d.x(), d.z()), 0.25) << "cube " << i << " is not on the one below";
+        EXPECT_NEAR(d.y(), 1.0, 0.02) << "cube " << i;
+    }
 }

@@ -67,14 +67,24 @@ TEST(Stack, TwentyCubesAtDefaultSettingsStandFor1000Steps) {
     EXPECT_LT(run.worst_box_from_settled, 0.05);
 }
 
-// At the default 4 substeps (60 Hz contacts) 30 cubes buckle and fall (the top cube ends
-// 198 m away), as SolverSettings::contact_hertz warns; more substeps is how a user buys
-// the contact stiffness a taller stack needs.
-TEST(Stack, ThirtyCubesWithEightSubstepsStandFor1000Steps) {
-    const StackRun run = run_stack(30, 8, Vec3::Zero());
+// Taller stacks stand at the defaults because resting manifolds are recycled (issue 16):
+// each contact's points stay anchored to the boxes, so the support under a box does not
+// follow the overlap as it shifts on the one below. Before, with fresh manifolds every
+// step, a column of soft contacts buckled exactly as springs do (at the default 60 Hz a
+// 30-cube column leant exponentially, e-folding in 1.7 s, and fell: its top ended 198 m
+// away); Box3D's columns stand only through the same recycling.
+TEST(Stack, ThirtyCubesAtDefaultSettingsStandFor1000Steps) {
+    const StackRun run = run_stack(30, SolverSettings{}.substeps, Vec3::Zero());
     EXPECT_TRUE(run.finite);
-    EXPECT_LT(run.top_drift_from_settled, 0.05);
-    EXPECT_LT(run.worst_box_from_settled, 0.05);
+    EXPECT_LT(run.top_drift_from_settled, 0.1);
+    EXPECT_LT(run.worst_box_from_settled, 0.1);
+}
+
+TEST(Stack, FiftyCubesAtDefaultSettingsStandFor1000Steps) {
+    const StackRun run = run_stack(50, SolverSettings{}.substeps, Vec3::Zero());
+    EXPECT_TRUE(run.finite);
+    EXPECT_LT(run.top_drift_from_settled, 0.2);
+    EXPECT_LT(run.worst_box_from_settled, 0.2);
 }
 
 TEST(Stack, TwentyCubesTenKilometresAwayMatchTheStackAtTheOrigin) {

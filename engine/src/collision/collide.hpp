@@ -31,4 +31,11 @@ struct Manifold {
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
             Manifold* out, int capacity);
 
+// The radius of a shape's round part (sphere, capsule; else 0): its surface point along
+// any direction is the core's plus this much, so it does not move as the body turns
+// about the core (a rolling ball's contact stays below its centre).
+inline Real round_radius(const Shape& shape) {
+    return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule ? shape.radius : 0;
+}
+
 }  // namespace spindle

@@ -10,9 +10,6 @@
 namespace spindle::detail {
 namespace {
 
-// A clipped manifold shallower than the deepest corner by more than this gets that corner.
-constexpr Real kMissedDepth = 1e-6;
-
 struct BoxAxis {
     Real separation = -kHuge;
     int index = -1;  // face axis 0..2, or edge pair 3 * i + j
@@ -20,6 +17,9 @@ struct BoxAxis {
 
 // Reference box r (half extents hr) and incident box i (hi, rotation ri and centre ti in
 // r's frame). Writes the clipped points in r's frame; n is r's face normal pointing at i.
+// A corner that clipping drops lies beside the reference face, outside r: it touches
+// nothing, and is not kept (as a point it would prop the box up past r's edge), unless
+// no point survives at all.
 int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3& ti, int axis, Real speculative,
                      bool reference_is_b, Vec3& n, ContactCandidate* out) {
     const Real sign = ti[axis] < 0 ? -1 : 1;
@@ -61,10 +61,10 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
         out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
                         face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
     }
-    // The deepest corner sets the SAT depth; when clipping dropped it (it pokes in beside
-    // the reference face) it is kept anyway, so the depth never falls short.
-    Real shallowest_kept = kHuge;
-    for (int k = 0; k < n_out; ++k) shallowest_kept = std::min(shallowest_kept, out[k].separation);
+    if (n_out > 0) return n_out;
+    // Nothing over the reference face is within reach, yet the face axis says the boxes
+    // touch (it won over an edge pair by the bias towards faces): the incident corner
+    // deepest along the normal stands for the contact, so the pair is never left without one.
     const Vec3 down = ri.transpose() * -n;
     std::uint32_t corner = 0;
     Vec3 local;
@@ -74,11 +74,10 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     }
     const Vec3 deepest = ri * local + ti;
     const Real separation = n.dot(deepest) - hr[axis];
-    if (separation <= speculative && separation < shallowest_kept - kMissedDepth) {
-        out[n_out++] = {deepest - n * (Real(0.5) * separation), separation,
-                        face_contact_id(reference_is_b, reference_face, incident_face, clip_key(3, corner, 0))};
-    }
-    return n_out;
+    if (separation > speculative) return 0;
+    out[0] = {deepest - n * (Real(0.5) * separation), separation,
+              face_contact_id(reference_is_b, reference_face, incident_face, clip_key(3, corner, 0))};
+    return 1;
 }
 
 }  // namespace
@@ -151,7 +150,7 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         return 1;
     }
 
-    ContactCandidate candidates[9];
+    ContactCandidate candidates[8];  // a quad clipped by four planes
     int count = 0;
     if (clearly_greater(face_b.separation, face_a.separation)) {
         // Reference face on B: clip in B's frame, then bring the points back to A's.

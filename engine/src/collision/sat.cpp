@@ -12,8 +12,6 @@ namespace spindle::detail {
 namespace {
 
 constexpr std::size_t kInlineVertices = 64;
-// A clipped manifold shallower than the deepest vertex by more than this gets that vertex.
-constexpr Real kMissedDepth = 1e-6;
 
 // A polyhedron placed in the common frame: its vertices already there, its normals
 // rotated by r and its plane offsets shifted by t on demand.
@@ -116,7 +114,9 @@ EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
     return best;
 }
 
-// Clips the incident face of `inc` against reference face `face` of `ref`.
+// Clips the incident face of `inc` against reference face `face` of `ref`. A vertex that
+// clipping drops lies beside the reference face, outside `ref`, and is not kept, unless
+// no point survives at all.
 int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative, Vec3& n,
                  ContactCandidate* out) {
     n = ref.normal(face);
@@ -151,18 +151,16 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
         if (s > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
     }
-    // The deepest vertex along the reference normal sets the SAT depth. When clipping
-    // dropped it (it pokes in beside a small reference face), it is kept anyway, so the
-    // reported depth never falls short of the real one.
-    Real shallowest_kept = kHuge;
-    for (int k = 0; k < n_out; ++k) shallowest_kept = std::min(shallowest_kept, out[k].separation);
+    if (n_out > 0) return n_out;
+    // Nothing over the reference face is within reach, yet the face axis says the shapes
+    // touch (it won over an edge pair by the bias towards faces): the incident vertex
+    // deepest along the normal stands for the contact, so the pair is never left without one.
     const std::uint32_t v = inc.support(-n);
     const Real s = n.dot(inc.vertices[v]) - d;
-    if (s <= speculative && s < shallowest_kept - kMissedDepth) {
-        out[n_out++] = {inc.vertices[v] - n * (Real(0.5) * s), s,
-                        face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
-    }
-    return n_out;
+    if (s > speculative) return 0;
+    out[0] = {inc.vertices[v] - n * (Real(0.5) * s), s,
+              face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
+    return 1;
 }
 
 }  // namespace
@@ -201,8 +199,8 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     }
 
     const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-    // Clipping leaves at most (incident face + reference face) vertices, plus the deepest.
-    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(a.vertex_count + b.vertex_count + 1);
+    // Clipping leaves at most (incident face + reference face) vertices.
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(a.vertex_count + b.vertex_count);
     Vec3 n;
     const int count = reference_is_b ? face_contact(pb, face_b.face, pa, true, speculative, n, candidates.data())
                                      : face_contact(pa, face_a.face, pb, false, speculative, n, candidates.data());

@@ -71,6 +71,7 @@ struct WideContact {
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{}, restitution{};
+    Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
     Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
     // Radius of each body's round part (sphere, capsule; else 0): its surface point along
     // the normal does not turn with the body, so a rolling ball's contact stays below it.
@@ -189,11 +190,13 @@ struct SolverScratch {
 // none (relax) without.
 struct ContactSolveParams {
     Softness soft;
+    Softness static_soft;  // against a static body (Box3D's): twice the hertz, half the damping ratio
     Real inv_h = 0;
     Real push_out = 0;        // push-out speed
     Real slop = 0;            // gaps wider than this carry no friction
     Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
     bool use_bias = true;
+    bool friction = true;  // solve the friction rows in this pass
 };
 
 // contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide

@@ -5,9 +5,11 @@
 // scattering them back is the same as solving the four one after another.
 //
 // Per pass: each point's normal row (soft push-out of resting overlap while biased,
-// speculative for a gap), then the manifold's central friction (Box3D's): a twist row
-// about the normal and two coupled tangent rows at the points' centre, inside Coulomb's
-// cone of the manifold's total normal impulse. Overlap deeper
+// speculative for a gap), then in the relax passes the manifold's central friction
+// (Box3D's): a twist row about the normal and two coupled tangent rows at the points'
+// centre, inside Coulomb's cone of the manifold's total normal impulse. Each body is
+// pushed at its own anchor of a point (the manifold may be recycled, and the anchors
+// moved apart with their bodies: narrowphase.cpp). Overlap deeper
 // than the recovery depth is pushed out by a split impulse on separate push-out
 // velocities, per lane (rare: bodies created or teleported inside each other).
 #include <algorithm>
@@ -152,26 +154,20 @@ WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wid
     return narrow(select(k > splat(0), splat(1) / k, splat(0)));
 }
 
-// The radius of a shape's round part: its surface point along any direction is the core's
-// plus this much, so it does not move as the body turns about the core.
-Real round_radius(const Shape& shape) {
-    return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule ? shape.radius : 0;
-}
-
 // Central friction of one lane (Box3D's): the friction centre is the points' mean,
 // weighted down for points farther apart than friction_distance (up to twice that they
 // fade out, so the centre moves smoothly as points come and go); the two tangent rows at
 // the centre with their coupled 2x2 effective mass; the twist row about the normal.
-void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactManifold& m, const Vec3& xa,
-                      const Vec3& xb, const Vec3 (&tangent)[2], Real friction_distance, WideContact& wc, int l) {
+void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactManifold& m, const Vec3 (&tangent)[2],
+                      Real friction_distance, WideContact& wc, int l) {
     constexpr Real kMinWeight = 1e-3;
     Vec3 center_a = Vec3::Zero(), center_b = Vec3::Zero();
     Real total = 0;
     for (int j = 0; j < m.point_count; ++j) {
         const ContactPoint& p = m.points[j];
         const Real weight = std::clamp(2 - p.geometry.separation / friction_distance, kMinWeight, Real(1));
-        center_a += weight * (p.geometry.point - xa);
-        center_b += weight * (p.geometry.point - xb);
+        center_a += weight * p.anchor_a;
+        center_b += weight * p.anchor_b;
         total += weight;
     }
     if (total > 0) {
@@ -179,7 +175,7 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
         center_b /= total;
     }
     for (int j = 0; j < m.point_count; ++j) {
-        wc.points[j].lever_arm[l] = static_cast<float>((m.points[j].geometry.point - xa - center_a).norm());
+        wc.points[j].lever_arm[l] = static_cast<float>((m.points[j].anchor_a - center_a).norm());
     }
     wc.center_a.set_lane(l, center_a);
     wc.center_b.set_lane(l, center_b);
@@ -240,7 +236,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
     for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.locked = false;
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
-    wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = Wide{};
+    wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
     wc.center_a = wc.center_b = Wide3{};
     wc.friction_row[0] = wc.friction_row[1] = wc.twist_row = WideRow{};
@@ -268,23 +264,23 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         inv_inertia_a.set_lane(l, A.inv_inertia);
         inv_inertia_b.set_lane(l, B.inv_inertia);
         wc.friction[l] = contact.friction;
+        wc.against_static[l] =
+            b.type[contact.body_a] == MotionType::Static || b.type[contact.body_b] == MotionType::Static ? 1 : 0;
         wc.restitution[l] = contact.restitution;
         wc.radius_a[l] = round_radius(b.desc[contact.body_a].shape);
         wc.radius_b[l] = round_radius(b.desc[contact.body_b].shape);
         wc.gravity_normal[l] =
             m.normal.dot(project_linear((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g, B.locks) -
                          project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
-        const Vec3 xa = b.x[contact.body_a];
-        const Vec3 xb = b.x[contact.body_b];
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
-            ra[j].set_lane(l, src.geometry.point - xa);
-            rb[j].set_lane(l, src.geometry.point - xb);
+            ra[j].set_lane(l, src.anchor_a);
+            rb[j].set_lane(l, src.anchor_b);
             separation[j][l] = src.geometry.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
-        prepare_friction(A, B, m, xa, xb, tangent, friction_distance, wc, l);
+        prepare_friction(A, B, m, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
@@ -386,6 +382,11 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
                        wc.radius_b * (dot(nb, wc.normal) - one);
     const Wide inv_h = splat(params.inv_h);
     const Wide recovery = splat(params.recovery_depth);
+    // Each lane's contact softness: stiffer against a static body.
+    const WideMask stiff = wc.against_static > zero;
+    const Wide bias_rate = select(stiff, splat(params.static_soft.bias_rate), splat(params.soft.bias_rate));
+    const Wide soft_mass = select(stiff, splat(params.static_soft.mass_scale), splat(params.soft.mass_scale));
+    const Wide soft_impulse = select(stiff, splat(params.static_soft.impulse_scale), splat(params.soft.impulse_scale));
     // Overlap deeper than the recovery depth, per lane: its depth-weighted excess and centre.
     Wide deep_weight = zero, deep_excess = zero;
     Wide3 deep_ra, deep_rb;
@@ -406,11 +407,10 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
             deep_rb += depth * p.rb;
             // Resting overlap is corrected by the contact's own soft bias (soft step);
             // deeper overlap is left to push_out.
-            const Wide soft_bias = wide_max(splat(params.soft.bias_rate) * wide_max(separation, -recovery),
-                                            splat(-params.push_out));
+            const Wide soft_bias = wide_max(bias_rate * wide_max(separation, -recovery), splat(-params.push_out));
             const Wide bias = select(speculative, separation * inv_h, soft_bias);
-            const Wide mass_scale = select(speculative, one, splat(params.soft.mass_scale));
-            const Wide impulse_scale = select(speculative, zero, splat(params.soft.impulse_scale));
+            const Wide mass_scale = select(speculative, one, soft_mass);
+            const Wide impulse_scale = select(speculative, zero, soft_impulse);
             impulse = -widen(p.normal_mass) * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         } else {
             impulse = -widen(p.normal_mass) * (vn + select(speculative, separation * inv_h, zero));
@@ -425,11 +425,13 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
-    // Central friction, when any lane has friction (a lane without has an empty cone).
-    // Its cones scale with the normal impulses of the touching points only: a speculative
-    // point far from the body (a fast sphere's, metres ahead) would spin it up through
-    // the lever arm.
-    if (any(wc.friction > zero)) {
+    // Central friction, when any lane has friction (a lane without has an empty cone), in
+    // the relax passes only (Box3D's; in the solve passes when there are none): friction
+    // solved against the biased velocities fights the push-out, and a tall pyramid walks
+    // apart and falls. Its cones scale with
+    // the normal impulses of the touching points only: a speculative point far from the
+    // body (a fast sphere's, metres ahead) would spin it up through the lever arm.
+    if (params.friction && any(wc.friction > zero)) {
         const Wide slop = splat(params.slop);
         Wide pressed = zero, twist_reach = zero;
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
