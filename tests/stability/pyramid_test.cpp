@@ -62,8 +62,9 @@ TEST(Pyramid, StandsFor1000Steps) {
 // Box3D's benchmark "large_pyramid" (issue 16): a flat pyramid of unit cubes of density
 // 100, base 100 (5,050 cubes), on a box floor, sleeping off, at the default settings.
 // Box3D's top settles at 98.81 m and stays there to step 800. Spindle's, before contact
-// recycling and friction in the relax passes, oscillated and collapsed: top at 99.52,
-// 79.5 and 5.5 m at steps 100, 500 and 800.
+// recycling, oscillated and collapsed: top at 99.52, 79.5 and 5.5 m at steps 100, 500
+// and 800. With recycling and friction solved in the relax passes only (Box3D's choice)
+// it stood, but its boxes crept up to 0.21 m between steps 100 and 800.
 TEST(Pyramid, LargeFlatPyramidStandsFor800Steps) {
     auto jobs = two_workers();
     auto space = make_space(SpaceSettings{}, jobs.get());
@@ -90,7 +91,7 @@ TEST(Pyramid, LargeFlatPyramidStandsFor800Steps) {
         settled.back().y(), lowest_top, space->internal_position(boxes.back()).y(), worst);
     EXPECT_TRUE(all_finite(*space, boxes));
     EXPECT_GT(lowest_top, 98.5);
-    EXPECT_LT(worst, 0.3);
+    EXPECT_LT(worst, 0.1);
 }
 
 // A 10-layer pyramid of unit cubes (385 boxes, each on four below) whose layers

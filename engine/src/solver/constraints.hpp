@@ -196,7 +196,6 @@ struct ContactSolveParams {
     Real slop = 0;            // gaps wider than this carry no friction
     Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
     bool use_bias = true;
-    bool friction = true;  // solve the friction rows in this pass
 };
 
 // contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide

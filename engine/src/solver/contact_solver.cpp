@@ -5,9 +5,9 @@
 // scattering them back is the same as solving the four one after another.
 //
 // Per pass: each point's normal row (soft push-out of resting overlap while biased,
-// speculative for a gap), then in the relax passes the manifold's central friction
-// (Box3D's): a twist row about the normal and two coupled tangent rows at the points'
-// centre, inside Coulomb's cone of the manifold's total normal impulse. Each body is
+// speculative for a gap), then the manifold's central friction (Box3D's): a twist row
+// about the normal and two coupled tangent rows at the points' centre, inside Coulomb's
+// cone of the manifold's total normal impulse. Each body is
 // pushed at its own anchor of a point (the manifold may be recycled, and the anchors
 // moved apart with their bodies: narrowphase.cpp). Overlap deeper
 // than the recovery depth is pushed out by a split impulse on separate push-out
@@ -425,13 +425,11 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
-    // Central friction, when any lane has friction (a lane without has an empty cone), in
-    // the relax passes only (Box3D's; in the solve passes when there are none): friction
-    // solved against the biased velocities fights the push-out, and a tall pyramid walks
-    // apart and falls. Its cones scale with
-    // the normal impulses of the touching points only: a speculative point far from the
-    // body (a fast sphere's, metres ahead) would spin it up through the lever arm.
-    if (params.friction && any(wc.friction > zero)) {
+    // Central friction, when any lane has friction (a lane without has an empty cone).
+    // Its cones scale with the normal impulses of the touching points only: a speculative
+    // point far from the body (a fast sphere's, metres ahead) would spin it up through
+    // the lever arm.
+    if (any(wc.friction > zero)) {
         const Wide slop = splat(params.slop);
         Wide pressed = zero, twist_reach = zero;
         for (int j = 0; j < kMaxManifoldPoints; ++j) {

@@ -277,7 +277,6 @@ void solve(World& world, Real dt) {
     solve_params.recovery_depth = settings.recovery_depth;
     ContactSolveParams relax_params = solve_params;
     relax_params.use_bias = false;
-    solve_params.friction = settings.relax_iterations == 0;  // friction relaxes (contact_solver.cpp)
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
     const JointSolveParams joint_relax{joint_solve.soft, joint_solve.inv_h, false};
 
