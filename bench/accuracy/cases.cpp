@@ -1,6 +1,7 @@
-// The accuracy cases: stacks, a mass ratio, free flight, a spinning box and a bounce, each
-// with its ideal answer written next to it. Sleeping is off everywhere, so every setting
-// pays for (and is judged on) every step it simulates.
+// The accuracy cases: stacks and a column, mass ratios, free flight, spinning boxes, a bounce,
+// joints, a rolling ball and a thin box at rest, each with its ideal answer written next to
+// it. Sleeping is off everywhere, so every setting pays for (and is judged on) every step it
+// simulates.
 #include "accuracy/cases.hpp"
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <spindle/engine/joint.hpp>
@@ -17,7 +19,11 @@ namespace spindle::bench {
 
 std::string Setting::label() const {
     char text[48];
-    std::snprintf(text, sizeof text, "%dx%d @1/%d", substeps, iterations, step_hz);
+    if (contact_hertz > 0) {
+        std::snprintf(text, sizeof text, "%dx%d @1/%d %g Hz", substeps, iterations, step_hz, contact_hertz);
+    } else {
+        std::snprintf(text, sizeof text, "%dx%d @1/%d", substeps, iterations, step_hz);
+    }
     return text;
 }
 
@@ -43,7 +49,10 @@ public:
     Real time() const { return m_steps * m_dt; }
     // Steps for `seconds` of simulation, rounded: every dt of the sweep divides the durations used.
     int steps_for(Real seconds) const { return static_cast<int>(std::lround(seconds / m_dt)); }
-    CaseRun result(double error) const { return {error, m_step_seconds, m_steps * m_dt}; }
+    // A run that blew up (NaN) reports kDiverged: off the chart, but plottable.
+    CaseRun result(double error) const {
+        return {std::isfinite(error) ? error : kDiverged, m_step_seconds, m_steps * m_dt};
+    }
 
 private:
     static SpaceSettings make_settings(const Setting& setting, const Vec3& gravity) {
@@ -52,6 +61,7 @@ private:
         s.time_step.duration = setting.dt();
         s.solver.substeps = setting.substeps;
         s.solver.iterations = setting.iterations;
+        s.solver.contact_hertz = setting.contact_hertz;
         s.sleep.enabled = false;  // a sleeping stack would stop drifting and stop costing
         return s;
     }
@@ -69,6 +79,14 @@ void add_floor(Space& space) {
     floor.shape = Shape::box(Vec3(20, 1, 20));
     floor.position = Vec3(0, -1, 0);
     space.create_body(floor);
+}
+
+// Static plane y = 0: the other kind of ground, with its own manifold code.
+void add_plane(Space& space) {
+    BodyDesc plane;
+    plane.type = MotionType::Static;
+    plane.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(plane);
 }
 
 BodyHandle add_body(Space& space, const Shape& shape, const Vec3& position) {
@@ -216,29 +234,44 @@ CaseRun projectile(const Setting& setting) {
     return t.result((t.space().internal_position(ball) - exact).norm());
 }
 
-// Energy drift: a box spun about its intermediate axis (the unstable one: it tumbles
-// over and back, the Dzhanibekov effect), no gravity, gyroscopic torque on. Free
-// rotation keeps its kinetic energy; the error is the worst relative change in 10 s.
+// A free box spun about its intermediate axis, y (the unstable one: it tumbles over and
+// back, the Dzhanibekov effect), no gravity, gyroscopic torque on; a small push off the
+// axis starts the tumble. Free rotation keeps both its kinetic energy and its world
+// angular momentum.
+class SpinningBox {
+public:
+    SpinningBox(Space& space, const Vec3& half_extents) {
+        BodyDesc desc;
+        desc.shape = Shape::box(half_extents);  // x < y < z, so y is the intermediate axis
+        desc.angular_velocity = Vec3(0.02, 6, 0.02);
+        desc.gyroscopic = true;
+        desc.allow_sleep = false;
+        desc.allow_interpolation = false;
+        m_box = space.create_body(desc);
+        m_inertia_local = desc.shape.mass_properties(desc.density).inertia;
+    }
+    Vec3 angular_velocity(const Space& space) const { return space.internal_angular_velocity(m_box); }
+    Vec3 angular_momentum(const Space& space) const {
+        const Mat3 r = space.internal_orientation(m_box).toRotationMatrix();
+        return r * m_inertia_local * r.transpose() * angular_velocity(space);
+    }
+    Real energy(const Space& space) const { return 0.5 * angular_velocity(space).dot(angular_momentum(space)); }
+
+private:
+    BodyHandle m_box;
+    Mat3 m_inertia_local;
+};
+
+// Energy drift: the worst relative change of a spinning 0.2 x 0.5 x 0.8 m box's kinetic
+// energy in 10 s.
 CaseRun spin_energy(const Setting& setting) {
     TimedSpace t(setting, Vec3::Zero());
-    BodyDesc desc;
-    desc.shape = Shape::box(Vec3(0.1, 0.25, 0.4));  // intermediate axis: y
-    desc.angular_velocity = Vec3(0.02, 6, 0.02);    // a small push off the axis starts the tumble
-    desc.gyroscopic = true;
-    desc.allow_sleep = false;
-    desc.allow_interpolation = false;
-    const BodyHandle box = t.space().create_body(desc);
-    const Mat3 inertia_local = desc.shape.mass_properties(desc.density).inertia;
-    auto energy = [&] {
-        const Mat3 r = t.space().internal_orientation(box).toRotationMatrix();
-        const Vec3 w = t.space().internal_angular_velocity(box);
-        return 0.5 * w.dot(r * inertia_local * r.transpose() * w);
-    };
-    const double initial = energy();
+    const SpinningBox box(t.space(), Vec3(0.1, 0.25, 0.4));
+    const double initial = box.energy(t.space());
     double worst = 0;
     for (int n = t.steps_for(10); n > 0; --n) {
         t.step();
-        worst = std::max(worst, std::abs(energy() - initial) / initial);
+        worst = std::max(worst, std::abs(box.energy(t.space()) - initial) / initial);
     }
     return t.result(worst);
 }
@@ -368,6 +401,141 @@ CaseRun chain_joint_error(const Setting& setting) {
     return t.result(worst);
 }
 
+// Rolling: a ball (radius 0.5) launched sliding at 6 m/s without spin. Friction slows it
+// and spins it up until it rolls at 5/7 of the launch speed (its angular momentum about the
+// contact point is kept), 2 v / (7 mu g) = 0.29 s after launch; then nothing slows it.
+// Measured over 2 s: the final speed, or the deepest it sinks into the floor while rolling.
+enum class RollMetric { Speed, Sink };
+
+CaseRun roll(const Setting& setting, RollMetric metric) {
+    constexpr Real kRadius = 0.5, kLaunch = 6;
+    TimedSpace t(setting, Vec3(0, -kGravity, 0));
+    add_floor(t.space());
+    BodyDesc desc;
+    desc.shape = Shape::sphere(kRadius);
+    desc.position = Vec3(-6, kRadius, 0);  // ends about 9 m further, well on the floor
+    desc.linear_velocity = Vec3(kLaunch, 0, 0);
+    desc.allow_sleep = false;
+    desc.allow_interpolation = false;
+    const BodyHandle ball = t.space().create_body(desc);
+    Real deepest = 0;
+    for (int n = t.steps_for(2); n > 0; --n) {
+        t.step();
+        deepest = std::max(deepest, kRadius - t.space().internal_position(ball).y());
+    }
+    if (metric == RollMetric::Sink) return t.result(1000 * deepest);
+    const Vec3 v = t.space().internal_linear_velocity(ball);
+    return t.result(std::abs(std::hypot(v.x(), v.z()) - kLaunch * 5 / 7));
+}
+
+CaseRun rolling_speed(const Setting& setting) { return roll(setting, RollMetric::Speed); }
+CaseRun rolling_sink(const Setting& setting) { return roll(setting, RollMetric::Sink); }
+
+// Thin box at rest: a 7.5 x 1.5 x 2.5 cm block of pine (700 kg/m^3) set flat on a plane. It
+// is thinner than the speculative distance, so its top corners are within reach of the
+// plane too; a manifold that takes one of them tilts the block. At rest it neither moves
+// nor sinks: the error is its horizontal creep plus its height error after 2 s, in mm.
+CaseRun thin_box(const Setting& setting) {
+    const Vec3 half(0.0375, 0.0075, 0.0125);
+    TimedSpace t(setting, Vec3(0, -kGravity, 0));
+    add_plane(t.space());
+    BodyDesc desc;
+    desc.shape = Shape::box(half);
+    desc.position = Vec3(0, half.y(), 0);
+    desc.density = 700;
+    desc.allow_sleep = false;
+    desc.allow_interpolation = false;
+    const BodyHandle box = t.space().create_body(desc);
+    for (int n = t.steps_for(2); n > 0; --n) t.step();
+    const Vec3 moved = t.space().internal_position(box) - desc.position;
+    return t.result(1000 * (std::hypot(moved.x(), moved.z()) + std::abs(moved.y())));
+}
+
+// Creep: static friction keeps a body at rest where it settled, so none of `bodies` (all
+// built resting, unit cubes or 1 m thick) moves sideways after `settle` seconds. Steps to
+// `seconds` and returns the furthest any strays horizontally from its position at `settle`,
+// or, when further, how far one ends below where it was built once that passes half its
+// height: it went through what held it, maybe before `settle`, and a fallen stack lies still.
+double worst_creep(TimedSpace& t, std::span<const BodyHandle> bodies, Real settle, Real seconds) {
+    constexpr Real kHalfHeight = 0.5;
+    std::vector<Vec3> built, settled;
+    for (BodyHandle b : bodies) built.push_back(t.space().internal_position(b));
+    for (int n = t.steps_for(settle); n > 0; --n) t.step();
+    for (BodyHandle b : bodies) settled.push_back(t.space().internal_position(b));
+    double worst = 0;
+    for (int n = t.steps_for(seconds) - t.steps_for(settle); n > 0; --n) {
+        t.step();
+        for (std::size_t i = 0; i < bodies.size(); ++i) {
+            const Vec3 moved = t.space().internal_position(bodies[i]) - settled[i];
+            const double drift = std::hypot(moved.x(), moved.z());
+            if (!std::isfinite(drift)) return kDiverged;
+            worst = std::max(worst, drift);
+        }
+    }
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const double fall = built[i].y() - t.space().internal_position(bodies[i]).y();
+        if (fall > kHalfHeight) worst = std::max(worst, fall);
+    }
+    return worst;
+}
+
+// Creep under a heavy body: the mass_ratio scene's 1000 kg slab (6 x 1 x 6 m) on four 1 kg
+// unit cubes at its corners, on a plane. Error: the furthest any of the five drifts
+// horizontally between 1 s and 10 s (or falls: worst_creep).
+CaseRun slab_creep(const Setting& setting) {
+    TimedSpace t(setting, Vec3(0, -kGravity, 0));
+    Space& space = t.space();
+    add_plane(space);
+    std::vector<BodyHandle> bodies;
+    for (Real x : {-2, 2}) {
+        for (Real z : {-2, 2}) {
+            BodyDesc cube;
+            cube.shape = Shape::box(Vec3::Constant(0.5));
+            cube.position = Vec3(x, 0.5, z);
+            cube.mass = 1;
+            cube.allow_sleep = false;
+            cube.allow_interpolation = false;
+            bodies.push_back(space.create_body(cube));
+        }
+    }
+    BodyDesc slab;
+    slab.shape = Shape::box(Vec3(3, 0.5, 3));
+    slab.position = Vec3(0, 1.5, 0);
+    slab.mass = 1000;
+    slab.allow_sleep = false;
+    slab.allow_interpolation = false;
+    bodies.push_back(space.create_body(slab));
+    return t.result(worst_creep(t, bodies, 1, 10));
+}
+
+// Angular momentum: a spinning 2 x 1 x 0.5 m box for 20 s. It flips over and back every
+// few seconds while its world angular momentum R I R^T w stays what it was. Error: the worst
+// relative change of that vector (which bounds the change of its magnitude), in percent.
+CaseRun spin_momentum(const Setting& setting) {
+    TimedSpace t(setting, Vec3::Zero());
+    const SpinningBox box(t.space(), Vec3(1, 0.5, 0.25));
+    const Vec3 initial = box.angular_momentum(t.space());
+    double worst = 0;
+    for (int n = t.steps_for(20); n > 0; --n) {
+        t.step();
+        worst = std::max(worst, (box.angular_momentum(t.space()) - initial).norm() / initial.norm());
+    }
+    return t.result(100 * worst);
+}
+
+// A column of 30 unit cubes standing touching on the floor: the taller the column, the less
+// it takes to lean it over, so the contacts must hold each cube where it stands on the one
+// below. Error: the top cube's furthest horizontal drift between 1 s and 15 s (or its fall:
+// worst_creep).
+CaseRun column_drift(const Setting& setting) {
+    constexpr int kCubes = 30;
+    TimedSpace t(setting, Vec3(0, -kGravity, 0));
+    add_floor(t.space());
+    BodyHandle top;
+    for (int i = 0; i < kCubes; ++i) top = add_body(t.space(), Shape::box(Vec3::Constant(0.5)), Vec3(0, 0.5 + i, 0));
+    return t.result(worst_creep(t, std::span(&top, 1), 1, 15));
+}
+
 constexpr Case kCases[] = {
     {"stack_drift", "10-box stack, 5 s: worst distance of the top box from its ideal position", "m", stack_drift},
     {"stack_sink", "10-box stack at rest: top box below its ideal height (last 1 s of 5)", "m", stack_sink},
@@ -385,6 +553,25 @@ constexpr Case kCases[] = {
      "ten 1 kg bars and a 100 kg ball on ball-socket joints, released horizontally, 3 s: worst anchor separation", "m",
      chain_joint_error},
     {"bounce", "sphere, restitution 1, dropped 5 m: relative error of the 5th apex height", "rel", bounce},
+    {"rolling_speed",
+     "ball of radius 0.5 launched sliding at 6 m/s without spin on a box floor: speed after 2 s against 5/7 of 6 m/s",
+     "m/s", rolling_speed},
+    {"rolling_sink", "the same ball, 2 s: deepest it sinks below the floor while sliding and rolling", "mm",
+     rolling_sink},
+    {"thin_box", "7.5 x 1.5 x 2.5 cm box (700 kg/m³) set flat on a plane: horizontal creep plus height error after 2 s",
+     "mm", thin_box},
+    {"slab_creep",
+     "1000 kg slab on four 1 kg cubes on a plane: furthest any body drifts horizontally from its place at 1 s, to 10 s "
+     "(or how far one fell, if it ends more than 0.5 m below where it was built)",
+     "m", slab_creep},
+    {"spin_momentum",
+     "free 2 x 1 x 0.5 m box spun about its intermediate axis, gyroscopic, 20 s: worst change of its angular "
+     "momentum vector, relative",
+     "%", spin_momentum},
+    {"column_drift",
+     "30 unit cubes in a column on a box floor: top cube's furthest horizontal drift from its place at 1 s, to 15 s "
+     "(or how far it fell, if it ends more than 0.5 m below where it was built)",
+     "m", column_drift},
 };
 
 }  // namespace

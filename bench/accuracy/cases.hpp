@@ -13,9 +13,10 @@ namespace spindle::bench {
 struct Setting {
     int substeps = 4;
     int iterations = 1;
-    int step_hz = 60;  // step duration is 1 / step_hz seconds
+    int step_hz = 60;        // step duration is 1 / step_hz seconds
+    Real contact_hertz = 0;  // 0: the solver's automatic stiffness, as the sweep runs
     Real dt() const { return 1.0 / step_hz; }
-    std::string label() const;  // "4x1 @1/60"
+    std::string label() const;  // "4x1 @1/60", or "4x1 @1/60 60 Hz" with a stiffness set
 };
 
 // What one run of a case gives back. Only the steps are timed: building the scene and

@@ -39,7 +39,8 @@ std::ofstream open(const std::string& path) {
 }
 
 bool same(const Setting& a, const Setting& b) {
-    return a.substeps == b.substeps && a.iterations == b.iterations && a.step_hz == b.step_hz;
+    return a.substeps == b.substeps && a.iterations == b.iterations && a.step_hz == b.step_hz &&
+           a.contact_hertz == b.contact_hertz;
 }
 
 std::vector<const Row*> rows_of(std::span<const Row> rows, int case_index) {
@@ -169,6 +170,65 @@ std::string knob_table(std::span<const Case> cases, std::span<const Row> rows) {
 // The sweep's dt as the users set it: "1/60".
 std::string dt_label(const Setting& s) { return format("1/%d", s.step_hz); }
 
+// Why contacts default to an eighth of the substep rate, and what that costs: the large
+// pyramid as measured when the default changed (too slow to run with every sweep), then
+// every case of this sweep at the default setting against the same with 60 Hz contacts.
+std::string stiffness_section(std::span<const Case> cases, std::span<const Row> rows, std::span<const Row> stiffer) {
+    std::string text =
+        "## Contact stiffness: why an eighth of the substep rate\n\n"
+        "A contact is a damped spring solved once per substep, its stiffness a frequency. Before 2ed0b27 "
+        "(2026-12-02) it defaulted to a quarter of the substep rate (60 Hz at 4 substeps of 1/60 s), the stiffest "
+        "the solver keeps stable; now it is Box3D's default, an eighth (30 Hz), and twice that against static "
+        "bodies (60 Hz; like any value set, the doubled one is capped at a quarter of the substep rate).\n\n"
+        "**Why.** With one iteration per substep a stiff contact settles slowly, and a tall structure keeps "
+        "ringing. Box3D's `large_pyramid` (`configs/scenes/large_pyramid.toml`: 5,050 cubes in a flat pyramid of "
+        "base 100, sleeping off, its top built at 99.5 m) at 60 Hz stands but never comes to rest: at every "
+        "hundredth step to step 800 some box still moves at 0.76-1.25 m/s, and the upper rows lean out of the "
+        "pyramid's plane, the furthest box by 0.18 m at step 200 and 1.23 m at step 800. At 30 Hz the fastest box "
+        "is down to 0.06 m/s by step 200 and 0.02 m/s at step 800, and the top stays within 0.5 mm of 98.837 m "
+        "from step 200 on (Box3D's settles at 98.81 m); the upper rows still creep out of plane, 1.5 cm at step "
+        "200 and 4.1 cm at step 800.\n\n"
+        "**What it costs.** Under a load a spring compresses as one over its frequency squared, so a contact "
+        "between two dynamic bodies compresses 4 times as far at 30 Hz as at 60 Hz (against static bodies nothing "
+        "changes at 4 substeps: 60 Hz either way). The pyramid's top stands 0.66 m below where it was built, "
+        "against 0.16 m at 60 Hz (99.34 m at step 800). (Pyramid numbers: release build of 2ed0b27, "
+        "`spindle bench configs/scenes/large_pyramid.toml --steps 800` prints the top, and the same scene with "
+        "`contact_hertz = 60` under `[settings]`; box speeds and out-of-plane offsets read from the space every "
+        "100 steps. They are not part of this sweep.)\n\n"
+        "Every case of this sweep at the default `" +
+        kDefault.label() + "` (30 Hz) and at `" + kQuarterRateContacts.label() +
+        "` (`contact_hertz = 60`, the former default); an error ratio below 1 means the default is more "
+        "accurate.\n\n"
+        "| case | error at 30 Hz (default) | error at 60 Hz | error, 30 Hz / 60 Hz | time, 30 Hz / 60 Hz |\n"
+        "|---|---:|---:|---:|---:|\n";
+    std::string better, worse;
+    const Row* worst = nullptr;  // where the default loses most
+    double worst_ratio = 0;
+    for (const Row& stiff : stiffer) {
+        const Case& c = cases[static_cast<std::size_t>(stiff.case_index)];
+        const Row* d = find(rows_of(rows, stiff.case_index), kDefault);
+        if (!d) continue;
+        const double ratio = d->error / stiff.error;
+        text += format("| %s | %.3g %s | %.3g %s | %.3g | %.2g |\n", c.name, d->error, c.unit, stiff.error, c.unit,
+                       ratio, d->ms_per_second / stiff.ms_per_second);
+        // Ten percent either way is the same answer: a pass or two of rounding, not stiffness.
+        if (ratio < 0.9) better += (better.empty() ? "" : ", ") + std::string(c.name);
+        if (ratio > 1.1) worse += (worse.empty() ? "" : ", ") + std::string(c.name);
+        if (ratio > worst_ratio) {
+            worst = &stiff;
+            worst_ratio = ratio;
+        }
+    }
+    text += "\nThe 30 Hz default is more accurate (error at least 10 % lower) in: " +
+            (better.empty() ? std::string("none") : better) +
+            "; less accurate (at least 10 % higher) in: " + (worse.empty() ? std::string("none") : worse);
+    if (worst && worst_ratio > 1.1) {
+        text += format(", most in %s (%.3g times the error at 60 Hz)",
+                       cases[static_cast<std::size_t>(worst->case_index)].name, worst_ratio);
+    }
+    return text + ".\n\n";
+}
+
 }  // namespace
 
 void mark_pareto(std::vector<Row>& rows) {
@@ -184,23 +244,26 @@ void mark_pareto(std::vector<Row>& rows) {
 
 void write_csv(const std::string& path, std::span<const Case> cases, std::span<const Row> rows) {
     std::ofstream out = open(path);
-    out << "case,substeps,iterations,dt,ms_per_simulated_second,error,unit,pareto\n";
+    out << "case,substeps,iterations,dt,contact_hertz,ms_per_simulated_second,error,unit,pareto\n";
     for (const Row& r : rows) {
         const Case& c = cases[static_cast<std::size_t>(r.case_index)];
-        out << format("%s,%d,%d,%.9g,%.6g,%.6g,%s,%d\n", c.name, r.setting.substeps, r.setting.iterations,
-                      r.setting.dt(), r.ms_per_second, r.error, c.unit, r.pareto ? 1 : 0);
+        out << format("%s,%d,%d,%.9g,%g,%.6g,%.6g,%s,%d\n", c.name, r.setting.substeps, r.setting.iterations,
+                      r.setting.dt(), r.setting.contact_hertz, r.ms_per_second, r.error, c.unit, r.pareto ? 1 : 0);
     }
 }
 
 void write_markdown(const std::string& path, std::span<const Case> cases, std::span<const Row> rows,
-                    const ReportInfo& info) {
+                    std::span<const Row> stiffer, const ReportInfo& info) {
     std::ofstream out = open(path);
     out << "# Accuracy and its cost\n\n"
         << "<!-- Generated by `make accuracy` (bench/accuracy); edits are overwritten. -->\n\n"
         << "Measured " << info.date << " on " << info.machine << ".\n\n"
         << "Each hard case is run under every setting of the sweep: substeps {1, 2, 4, 8} × solve iterations {1, 2} "
-           "× step duration {1/30, 1/60, 1/120, 1/240} s. Other solver settings are the defaults (contact stiffness "
-           "automatic: a quarter of the substep rate; one relax iteration). **Time** is the wall time spent in "
+           "× step duration {1/30, 1/60, 1/120, 1/240} s. Other solver settings are the defaults: contact stiffness "
+           "automatic, an eighth of the substep rate (30 Hz at 4 substeps of 1/60 s, 3.75 Hz at 1 substep of 1/30 "
+           "s, 240 Hz at 8 of 1/240 s) and twice that against static bodies, never above a quarter of the substep "
+           "rate (why, and what it costs: [Contact stiffness](#contact-stiffness-why-an-eighth-of-the-substep-rate)); "
+           "one relax iteration. **Time** is the wall time spent in "
            "`Space::update()` per simulated second, single-threaded (no job system), the fastest of up to "
         << info.runs
         << " runs; building the scene and measuring are not timed. Sleeping is off, so a resting stack keeps costing "
@@ -217,6 +280,7 @@ void write_markdown(const std::string& path, std::span<const Case> cases, std::s
         << knob_table(cases, rows) << "\n";
     out << "Joints are soft by default (`joint_hertz` 60, capped at a quarter of the substep rate), as they run "
            "here.\n\n";
+    out << stiffness_section(cases, rows, stiffer);
     out << "## Cases\n\n";
     for (std::size_t ci = 0; ci < cases.size(); ++ci) {
         const Case& c = cases[ci];
@@ -264,21 +328,30 @@ void write_gnuplot(const std::string& script_path, const std::string& data_path,
        << "set xlabel \"time per simulated second (ms, one thread)\"\n"
        << "set ylabel " << quoted(format("error (unit per case; below %.0e drawn at it)", kPlotFloor)) << "\n"
        << "plot \\\n";
-    // Every case its own colour and its own marker (gnuplot's default cycle repeats after
-    // eight colours): filled markers for the points, the same marker open on the front.
-    static constexpr const char* kColors[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
-                                              "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#000080", "#800000",
-                                              "#008080", "#808000", "#ff1493", "#000000"};
-    static constexpr int kFilledMarkers[] = {7, 5, 9, 11, 13, 15};  // circle, square, triangles, diamond, pentagon
-    if (cases.size() > std::size(kColors)) throw std::runtime_error("accuracy plot: more cases than colours");
+    // Every case its own colour and marker (gnuplot's default cycle repeats after eight
+    // colours): filled markers for the points, the same marker open on the front. Paired by
+    // hand so that colours that look alike (the browns, the olives, the pinks, navy and
+    // black, teal and cyan) never share a marker.
+    struct Style {
+        const char* color;
+        int marker;  // gnuplot pt, filled; pt - 1 is the same marker open
+    };
+    enum : int { kCircle = 7, kSquare = 5, kUp = 9, kDown = 11, kDiamond = 13, kPentagon = 15 };
+    static constexpr Style kStyles[] = {
+        {"#1f77b4", kCircle},   {"#ff7f0e", kSquare},   {"#2ca02c", kUp},       {"#d62728", kDown},
+        {"#9467bd", kDiamond},  {"#8c564b", kPentagon}, {"#e377c2", kCircle},   {"#7f7f7f", kSquare},
+        {"#bcbd22", kUp},       {"#17becf", kDown},     {"#000080", kSquare},   {"#800000", kUp},
+        {"#008080", kPentagon}, {"#808000", kDiamond},  {"#ff1493", kPentagon}, {"#000000", kDown},
+    };
+    if (cases.size() > std::size(kStyles)) throw std::runtime_error("accuracy plot: more cases than styles");
     for (std::size_t ci = 0; ci < cases.size(); ++ci) {
         const Case& c = cases[ci];
         const std::string title = format("%s (%s)", c.name, std::string(c.unit) == "rel" ? "relative" : c.unit);
-        const int marker = kFilledMarkers[ci % std::size(kFilledMarkers)];
+        const Style& style = kStyles[ci];
         gp << format("  %s index %zu using 1:2 with points pt %d ps 0.9 lc rgb \"%s\" title %s, \\\n",
-                     quoted(data_path).c_str(), 2 * ci, marker, kColors[ci], quoted(title).c_str())
+                     quoted(data_path).c_str(), 2 * ci, style.marker, style.color, quoted(title).c_str())
            << format("  %s index %zu using 1:2 with linespoints pt %d ps 2 lw 1.5 lc rgb \"%s\" notitle, \\\n",
-                     quoted(data_path).c_str(), 2 * ci + 1, marker - 1, kColors[ci]);
+                     quoted(data_path).c_str(), 2 * ci + 1, style.marker - 1, style.color);
     }
     gp << "  NaN with linespoints pt 6 ps 2 lc rgb \"black\" title \"Pareto front\"\n";
 }

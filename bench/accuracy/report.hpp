@@ -10,6 +10,11 @@
 
 namespace spindle::bench {
 
+// The default setting with contacts at 60 Hz, their default stiffness until 2ed0b27 (a
+// quarter of the substep rate; now an eighth). Run once per case beside the sweep, so the
+// report shows what the softer default buys and what it costs.
+inline constexpr Setting kQuarterRateContacts{4, 1, 60, 60};
+
 struct Row {
     int case_index = 0;
     Setting setting;
@@ -28,8 +33,9 @@ struct ReportInfo {
 void mark_pareto(std::vector<Row>& rows);
 
 void write_csv(const std::string& path, std::span<const Case> cases, std::span<const Row> rows);
+// stiffer: one row per case at kQuarterRateContacts.
 void write_markdown(const std::string& path, std::span<const Case> cases, std::span<const Row> rows,
-                    const ReportInfo& info);
+                    std::span<const Row> stiffer, const ReportInfo& info);
 // data_path: the points file this writes too; png_path: where gnuplot will draw.
 void write_gnuplot(const std::string& script_path, const std::string& data_path, const std::string& png_path,
                    std::span<const Case> cases, std::span<const Row> rows, const ReportInfo& info);
