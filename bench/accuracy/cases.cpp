@@ -262,18 +262,28 @@ private:
     Mat3 m_inertia_local;
 };
 
+// The size of a scalar's or a vector's change.
+double size_of(double x) { return std::abs(x); }
+double size_of(const Vec3& v) { return v.norm(); }
+
+// The worst relative change of a quantity from its initial value over `seconds` of steps.
+template <class Quantity>
+double worst_relative_change(TimedSpace& t, int seconds, Quantity quantity) {
+    const auto initial = quantity();
+    double worst = 0;
+    for (int n = t.steps_for(seconds); n > 0; --n) {
+        t.step();
+        worst = std::max(worst, size_of(quantity() - initial) / size_of(initial));
+    }
+    return worst;
+}
+
 // Energy drift: the worst relative change of a spinning 0.2 x 0.5 x 0.8 m box's kinetic
 // energy in 10 s.
 CaseRun spin_energy(const Setting& setting) {
     TimedSpace t(setting, Vec3::Zero());
     const SpinningBox box(t.space(), Vec3(0.1, 0.25, 0.4));
-    const double initial = box.energy(t.space());
-    double worst = 0;
-    for (int n = t.steps_for(10); n > 0; --n) {
-        t.step();
-        worst = std::max(worst, std::abs(box.energy(t.space()) - initial) / initial);
-    }
-    return t.result(worst);
+    return t.result(worst_relative_change(t, 10, [&] { return box.energy(t.space()); }));
 }
 
 // Bounce: a sphere with restitution 1 dropped from 5 m keeps bouncing back to 5 m. The
@@ -514,13 +524,7 @@ CaseRun slab_creep(const Setting& setting) {
 CaseRun spin_momentum(const Setting& setting) {
     TimedSpace t(setting, Vec3::Zero());
     const SpinningBox box(t.space(), Vec3(1, 0.5, 0.25));
-    const Vec3 initial = box.angular_momentum(t.space());
-    double worst = 0;
-    for (int n = t.steps_for(20); n > 0; --n) {
-        t.step();
-        worst = std::max(worst, (box.angular_momentum(t.space()) - initial).norm() / initial.norm());
-    }
-    return t.result(100 * worst);
+    return t.result(100 * worst_relative_change(t, 20, [&] { return box.angular_momentum(t.space()); }));
 }
 
 // A column of 30 unit cubes standing touching on the floor: the taller the column, the less

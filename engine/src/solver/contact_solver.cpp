@@ -7,11 +7,11 @@
 // Per pass: each point's normal row (soft push-out of resting overlap while biased,
 // speculative for a gap), then the manifold's central friction (Box3D's): a twist row
 // about the normal and two coupled tangent rows at the points' centre, inside Coulomb's
-// cone of the manifold's total normal impulse. Each body is
-// pushed at its own anchor of a point (the manifold may be recycled, and the anchors
-// moved apart with their bodies: narrowphase.cpp). Overlap deeper
-// than the recovery depth is pushed out by a split impulse on separate push-out
-// velocities, per lane (rare: bodies created or teleported inside each other).
+// cone of the manifold's total normal impulse. Each body is pushed at its own anchor of
+// a point (the manifold may be recycled, and the anchors moved apart with their bodies:
+// narrowphase.cpp). Overlap deeper than the recovery depth is pushed out by a split
+// impulse on separate push-out velocities, per lane (rare: bodies created or teleported
+// inside each other).
 #include <algorithm>
 
 #include "solver/constraints.hpp"
