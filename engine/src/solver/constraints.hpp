@@ -45,6 +45,10 @@ struct WidePoint {
     WideRow normal_row;
     WideF normal_mass{};
     WideF lever_arm{};  // distance from the friction centre on A: the twist friction's reach
+    // Overlap the soft row corrects itself; deeper overlap is pushed out. The recovery
+    // depth, or deeper where the point's load (its last impulse) compresses the soft
+    // contact further: a heavy body rests where its spring holds it.
+    WideF recovery{};
     Wide normal_impulse{};
     Wide max_normal_impulse{};
     Wide relative_velocity{};  // approach speed at impact (restitution)
@@ -203,7 +207,8 @@ struct ContactSolveParams {
 // the manifolds and bodies of the step; the others run per wide contact from the
 // colour loops.
 void pack_contacts(SolverScratch& scratch);
-void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);  // wide [lo, hi)
+void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
+                      std::uint32_t hi);  // wide [lo, hi)
 // push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
 void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
 // The points whose rows ran are counted into `counts` (the worker's).

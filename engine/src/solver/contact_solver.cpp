@@ -5,13 +5,13 @@
 // scattering them back is the same as solving the four one after another.
 //
 // Per pass: each point's normal row (soft push-out of resting overlap while biased,
-// speculative for a gap), then the manifold's central friction (Box3D's): a twist row
-// about the normal and two coupled tangent rows at the points' centre, inside Coulomb's
-// cone of the manifold's total normal impulse. Each body is pushed at its own anchor of
+// speculative for a gap); in the relax passes then the manifold's central friction
+// (Box3D's): a twist row about the normal and two coupled tangent rows at the points'
+// centre, inside Coulomb's cone of the manifold's total normal impulse. Each body is pushed at its own anchor of
 // a point (the manifold may be recycled, and the anchors moved apart with their bodies:
-// narrowphase.cpp). Overlap deeper than the recovery depth is pushed out by a split
-// impulse on separate push-out velocities, per lane (rare: bodies created or teleported
-// inside each other).
+// narrowphase.cpp). Overlap deeper than the recovery depth (or than the point's load
+// holds it) is pushed out by a split impulse on separate push-out velocities, per lane
+// (rare: bodies created or teleported inside each other).
 #include <algorithm>
 
 #include "solver/constraints.hpp"
@@ -222,7 +222,7 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
 
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
-void prepare_wide(const World& world, const SolverScratch& scratch, WideContact& wc) {
+void prepare_wide(const World& world, const SolverScratch& scratch, const ContactSolveParams& params, WideContact& wc) {
     const Bodies& b = world.bodies;
     const Vec3 g = world.settings.gravity;
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
@@ -283,6 +283,14 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         prepare_friction(A, B, m, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
+    // Each lane's softness (stiffer against a static body) and how deep a point's last
+    // impulse holds its soft row at rest: impulse_scale x impulse = mass x mass_scale x
+    // bias_rate x depth.
+    const WideMask stiff = wc.against_static > splat(0);
+    const Wide held_per_impulse =
+        select(stiff,
+               splat(params.static_soft.impulse_scale / (params.static_soft.mass_scale * params.static_soft.bias_rate)),
+               splat(params.soft.impulse_scale / (params.soft.mass_scale * params.soft.bias_rate)));
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
         p.ra = ra[j];
@@ -293,6 +301,9 @@ void prepare_wide(const World& world, const SolverScratch& scratch, WideContact&
         p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum, splat(0)), ra[j], rb[j],
                                  wc.normal, p.normal_row);
         p.normal_impulse = normal_impulse[j];
+        const Wide mass = widen(p.normal_mass);
+        const Wide held = select(mass > splat(0), held_per_impulse * normal_impulse[j] / mass, splat(0));
+        p.recovery = narrow(wide_max(splat(params.recovery_depth), held));
         p.max_normal_impulse = Wide{};
         p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
     }
@@ -381,7 +392,6 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
     const Wide moved = dot(wc.normal, dpb - dpa) + wc.radius_a * (dot(na, wc.normal) - one) +
                        wc.radius_b * (dot(nb, wc.normal) - one);
     const Wide inv_h = splat(params.inv_h);
-    const Wide recovery = splat(params.recovery_depth);
     // Each lane's contact softness: stiffer against a static body.
     const WideMask stiff = wc.against_static > zero;
     const Wide bias_rate = select(stiff, splat(params.static_soft.bias_rate), splat(params.soft.bias_rate));
@@ -400,6 +410,7 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
         if constexpr (kBias) {
+            const Wide recovery = widen(p.recovery);
             const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
             deep_weight += depth;
             deep_excess -= depth * depth;
@@ -425,11 +436,14 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
-    // Central friction, when any lane has friction (a lane without has an empty cone).
+    // Central friction, in the relax passes only (Box3D's), when any lane has friction (a
+    // lane without has an empty cone). In the biased pass the normal rows carry the soft
+    // push of the overlap; friction there ties a light body sideways to a heavy one it is
+    // pushed against, and a 100 kg box on a 1 kg cube rocked for ever instead of resting.
     // Its cones scale with the normal impulses of the touching points only: a speculative
     // point far from the body (a fast sphere's, metres ahead) would spin it up through
     // the lever arm.
-    if (any(wc.friction > zero)) {
+    if (!kBias && any(wc.friction > zero)) {
         const Wide slop = splat(params.slop);
         Wide pressed = zero, twist_reach = zero;
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
@@ -527,8 +541,9 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
 
 }  // namespace
 
-void prepare_contacts(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
-    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, scratch.wide[k]);
+void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
+                      std::uint32_t hi) {
+    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, params, scratch.wide[k]);
 }
 
 // Each pass in two builds: with per-axis inverse masses where a lane's body has a

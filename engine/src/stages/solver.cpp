@@ -295,7 +295,7 @@ void solve(World& world, Real dt) {
             const SolverPhase phase = scratch.plan[p];
             EffectCounts& counts = world.scratch_counts[worker];
             switch (phase.pass) {
-                case Pass::PrepareContacts: prepare_contacts(world, scratch, lo, hi); break;
+                case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
                 case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
                 case Pass::IntegrateVelocities: integrate_velocities(world, bodies, h, lo, hi, counts); break;

@@ -33,10 +33,11 @@ struct SolverSettings {
     Real joint_hertz = 60;
     Real joint_damping_ratio = 2;
     Real push_out_speed = 3;  // m/s: most speed used to push overlapping bodies apart
-    // m: overlap up to this depth is corrected by the soft contact itself (it carries
-    // the load: a heavy body compresses soft contacts by a few cm); deeper overlap is
-    // pushed out by a split impulse that moves bodies without giving them speed, at most
-    // push_out_speed per body, so a chain of overlapping bodies separates without launching.
+    // m: overlap up to this depth, or as deep as a point's load compresses its soft
+    // contact (a heavy body on a light one: several cm), is corrected by the soft contact
+    // itself, which carries the load; deeper overlap is pushed out by a split impulse
+    // that moves bodies without giving them speed, at most push_out_speed per body, so a
+    // chain of overlapping bodies separates without launching.
     Real recovery_depth = 0.03;
     Real restitution_threshold = 1;    // m/s: slower approaches do not bounce
     Real speculative_distance = 0.04;  // m: contacts are made this far before touching
