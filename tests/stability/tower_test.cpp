@@ -71,7 +71,7 @@ TEST(Tower, JengaOfEighteenLevelsStands) {
         "moved from 2 s to 10 s %.3f mm; fastest at the end %.2g m/s\n",
         kLevels, run.built_top, 1000 * run.sag, 1000 * run.aside, 1000 * run.creep, run.speed);
     EXPECT_TRUE(run.finite);
-    EXPECT_LT(run.sag, 0.05);  // a sixth of the tower's 27 cm: soft contacts, not a fall
+    EXPECT_LT(run.sag, 0.05);      // a sixth of the tower's 27 cm: soft contacts, not a fall
     EXPECT_LT(run.aside, 0.0125);  // less than half a block's width
     EXPECT_LT(run.creep, 0.002);
     EXPECT_LT(run.speed, 0.001);
