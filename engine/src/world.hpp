@@ -118,16 +118,18 @@ struct ContactManifold {
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
+    // Each body's round part (sphere, capsule radius; else 0), copied from the shapes at
+    // creation so that recycling and the solver stay off the cold descriptions.
+    Real radius_a = 0, radius_b = 0;
     int manifold_count = 0;
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
     bool sleeping = false;
-    // The poses the manifolds were last collided at (B's centre of mass in A's frame, the
-    // relative and both absolute rotations): while the bodies stay close to them the
-    // manifolds are recycled, not collided again (narrowphase.cpp).
+    // The poses the manifolds were last collided at (B's centre of mass in A's frame and
+    // both rotations): while the bodies stay close to them the manifolds are recycled,
+    // not collided again (narrowphase.cpp).
     bool cached = false;
     Vec3 cached_position = Vec3::Zero();
-    Quat cached_rotation = Quat::Identity();
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }

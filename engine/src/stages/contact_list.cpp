@@ -2,6 +2,7 @@
 // remaining contacts (so the solver's order, and so its result, is deterministic).
 #include <algorithm>
 
+#include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -34,6 +35,8 @@ void create_contact(World& world, std::uint64_t key) {
     // Mixing rules as most engines: geometric mean friction, largest restitution.
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
+    contact.radius_a = round_radius(bodies.desc[a].shape);
+    contact.radius_b = round_radius(bodies.desc[b].shape);
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contact_summaries.push_back(contact_summary(contact));
     world.contacts.push_back(std::move(contact));

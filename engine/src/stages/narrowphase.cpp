@@ -34,21 +34,6 @@ constexpr Real kSameFace = 0.9;
 constexpr Real kRecycleSlops = 8;
 constexpr Real kRecycleCosHalfAngleSq = 0.99240388;  // cos(5 degrees)^2: a 10 degree turn
 
-struct Pose {
-    Vec3 position;  // B's centre of mass in A's frame
-    Quat rotation;  // B's orientation in A's frame
-};
-
-bool recycles(const Contact& contact, const Pose& pose, const Quat& qa, const Quat& qb, Real extent, Real tolerance) {
-    if (!contact.cached) return false;
-    const Real turn_a = qa.dot(contact.cached_qa), turn_b = qb.dot(contact.cached_qb);
-    if (std::min(turn_a * turn_a, turn_b * turn_b) <= kRecycleCosHalfAngleSq) return false;
-    const Real distance = (pose.position - contact.cached_position).norm();
-    // 2 |sin(angle / 2)| ~ the relative angle: how far a point at the extent has swung.
-    const Real swing = 2 * (contact.cached_rotation.conjugate() * pose.rotation).vec().norm() * extent;
-    return distance + swing < tolerance;
-}
-
 // How far a point of the body can be from its centre of mass (0 for a static body: only
 // the other body's turn moves the contact).
 Real reach(const Bodies& b, std::uint32_t i) {
@@ -57,16 +42,37 @@ Real reach(const Bodies& b, std::uint32_t i) {
     return far.norm();
 }
 
+// How each body has turned since the manifolds were collided.
+struct Turns {
+    Quat dqa, dqb;
+};
+
+// Whether the contact's manifolds can be recycled; its bodies' turns in `turns` if so.
+// The cheap checks first: the reach of both bodies only for a pair that passes them.
+bool recycles(const Contact& contact, const Bodies& b, const Vec3& position, Real tolerance, Turns& turns) {
+    if (!contact.cached) return false;
+    const std::uint32_t a = contact.body_a, bb = contact.body_b;
+    const Real turn_a = b.q[a].dot(contact.cached_qa), turn_b = b.q[bb].dot(contact.cached_qb);
+    if (std::min(turn_a * turn_a, turn_b * turn_b) <= kRecycleCosHalfAngleSq) return false;
+    const Real distance = (position - contact.cached_position).norm();
+    if (distance >= tolerance) return false;
+    turns.dqa = b.q[a] * contact.cached_qa.conjugate();
+    turns.dqb = b.q[bb] * contact.cached_qb.conjugate();
+    // The relative turn dqa^-1 dqb (the same angle as the turn of B in A's frame):
+    // 2 |sin(angle / 2)| ~ the angle, so this is how far a point at the reach has swung.
+    const Real swing = 2 * (turns.dqa.conjugate() * turns.dqb).vec().norm() * std::max(reach(b, a), reach(b, bb));
+    return distance + swing < tolerance;
+}
+
 // A recycled manifold keeps its points, normal and impulses; each point's separation is
 // the one it was collided with plus how far its anchors, each moved and turned with its
 // body, have since come apart along the normal. Round parts keep their surface point on
 // the normal as they turn (as in the solver's substeps), so a rolling ball does not sink.
-void recycle(Contact& contact, const Bodies& b) {
-    const std::uint32_t a = contact.body_a, bb = contact.body_b;
-    const Quat dqa = b.q[a] * contact.cached_qa.conjugate();
-    const Quat dqb = b.q[bb] * contact.cached_qb.conjugate();
-    const Vec3 moved = b.x[bb] - b.x[a];
-    const Real radius_a = round_radius(b.desc[a].shape), radius_b = round_radius(b.desc[bb].shape);
+void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
+    const Quat& dqa = turns.dqa;
+    const Quat& dqb = turns.dqb;
+    const Vec3 moved = b.x[contact.body_b] - b.x[contact.body_a];
+    const Real radius_a = contact.radius_a, radius_b = contact.radius_b;
     for (int m = 0; m < contact.manifold_count; ++m) {
         ContactManifold& manifold = contact.manifold_at(m);
         const Vec3& n = manifold.normal;
@@ -81,7 +87,7 @@ void recycle(Contact& contact, const Bodies& b) {
 }
 
 // Anchors the fresh manifolds to their bodies and keeps the poses they were collided at.
-void remember(Contact& contact, const Bodies& b, const Pose& pose) {
+void remember(Contact& contact, const Bodies& b, const Vec3& position) {
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
     const Vec3 xa = b.x[a], xb = b.x[bb];
     for (int m = 0; m < contact.manifold_count; ++m) {
@@ -94,8 +100,7 @@ void remember(Contact& contact, const Bodies& b, const Pose& pose) {
         }
     }
     contact.cached = true;
-    contact.cached_position = pose.position;
-    contact.cached_rotation = pose.rotation;
+    contact.cached_position = position;
     contact.cached_qa = b.q[a];
     contact.cached_qb = b.q[bb];
 }
@@ -162,12 +167,12 @@ void update_narrowphase(World& world) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             Contact& contact = world.contacts[awake[k]];
             const std::uint32_t a = contact.body_a, bb = contact.body_b;
-            const Pose pose{b.q[a].conjugate() * (b.x[bb] - b.x[a]), b.q[a].conjugate() * b.q[bb]};
+            const Vec3 position = b.q[a].conjugate() * (b.x[bb] - b.x[a]);  // B's centre in A's frame
             // Not for a swept body: its contacts must see where it went.
             const bool recyclable = !b.is_fast(a) && !b.is_fast(bb);
-            if (recyclable &&
-                recycles(contact, pose, b.q[a], b.q[bb], std::max(reach(b, a), reach(b, bb)), recycle_distance)) {
-                recycle(contact, b);
+            Turns turns;
+            if (recyclable && recycles(contact, b, position, recycle_distance, turns)) {
+                recycle(contact, b, turns);
                 counts.reused += 1;
                 counts.touching += contact.manifold_count > 0 ? 1u : 0u;
                 continue;
@@ -187,7 +192,7 @@ void update_narrowphase(World& world) {
             contact.manifold_count = n;
             if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
-            remember(contact, b, pose);
+            remember(contact, b, position);
             // New manifolds, new summary (a cached pair, above, keeps both).
             world.contact_summaries[awake[k]] = contact_summary(contact);
             counts.touching += n > 0 ? 1u : 0u;
