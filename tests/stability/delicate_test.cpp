@@ -89,20 +89,23 @@ double house_top(const Space& space, const CardHouse& house) {
 // of the trapezoid between radii inner and outer over angles i pi / n to (i + 1) pi / n,
 // depth deep along z, its origin at the middle of that trapezoid (radius and angle). The
 // stones touch along their radial faces; the two springers are built kGap above the floor.
-constexpr int kStones = 11;
-constexpr double kInner = 2, kOuter = 2.5, kDeep = 1;
+struct Arch {
+    int stones = 11;
+    double inner = 2, outer = 2.5;  // radii, m
+};
+constexpr double kDeep = 1;
 constexpr double kStoneDensity = 2500;
 constexpr double kStoneFriction = 0.6;
 
-std::vector<BodyHandle> build_arch(Space& space) {
+std::vector<BodyHandle> build_arch(Space& space, const Arch& arch) {
     add_static_box(space, Vec3(5, 0.5, 2), Vec3(0, -0.5, 0), Quat::Identity(), kStoneFriction);
     std::vector<BodyHandle> stones;
-    for (int i = 0; i < kStones; ++i) {
-        const double from = i * kPi / kStones, to = (i + 1) * kPi / kStones, mid = 0.5 * (from + to);
-        const double r_mid = 0.5 * (kInner + kOuter);
+    for (int i = 0; i < arch.stones; ++i) {
+        const double from = i * kPi / arch.stones, to = (i + 1) * kPi / arch.stones, mid = 0.5 * (from + to);
+        const double r_mid = 0.5 * (arch.inner + arch.outer);
         const Vec3 origin(r_mid * std::cos(mid), r_mid * std::sin(mid), 0);
         std::vector<Vec3> points;
-        for (double r : {kInner, kOuter}) {
+        for (double r : {arch.inner, arch.outer}) {
             for (double angle : {from, to}) {
                 for (double z : {-0.5 * kDeep, 0.5 * kDeep}) {
                     points.push_back(Vec3(r * std::cos(angle), r * std::sin(angle), z) - origin);
@@ -173,33 +176,63 @@ TEST(Delicate, CardHouseOfFiveLevelsStands) {
 // more in 9 s); 4.2 mm at 8 substeps. This arch stood on main when the issue was filed
 // too (2321258: 7 mm of sag, with stiffer 60 Hz contacts), so it guards against a
 // regression but is not the arch the issue saw fall; that one is unknown.
-TEST(Delicate, ArchOfVoussoirsStands) {
+namespace {
+
+struct ArchRun {
+    double worst_sag = 0;  // m, the keystone's, over 10 s
+    double worst = 0;      // m, the most any stone moved after the first second
+    double speed = 0;      // m/s, the fastest stone at the end
+    bool finite = true;
+};
+
+ArchRun run_arch(const Arch& arch) {
     auto space = make_space();  // sleep off: any creep shows
-    const std::vector<BodyHandle> stones = build_arch(*space);
-    const BodyHandle keystone = stones[kStones / 2];
+    const std::vector<BodyHandle> stones = build_arch(*space, arch);
+    const BodyHandle keystone = stones[static_cast<std::size_t>(arch.stones / 2)];
     const double built_y = space->internal_position(keystone).y();
-    double worst_sag = 0;
+    ArchRun run;
     for (int step = 0; step < 60; ++step) {  // 1 s to settle
         space->update();
-        worst_sag = std::max(worst_sag, built_y - space->internal_position(keystone).y());
+        run.worst_sag = std::max(run.worst_sag, built_y - space->internal_position(keystone).y());
     }
     const std::vector<Vec3> settled = positions(*space, stones);
-    double worst = 0;
     for (int step = 0; step < 540; ++step) {
         space->update();
-        worst_sag = std::max(worst_sag, built_y - space->internal_position(keystone).y());
-        worst = std::max(worst, max_displacement(*space, stones, settled));
+        run.worst_sag = std::max(run.worst_sag, built_y - space->internal_position(keystone).y());
+        run.worst = std::max(run.worst, max_displacement(*space, stones, settled));
     }
-    const double end_sag = built_y - space->internal_position(keystone).y();
-    const double speed = max_speed(*space, stones);
+    run.speed = max_speed(*space, stones);
+    run.finite = all_finite(*space, stones);
     std::printf(
-        "[ measure  ] arch of %d voussoirs: keystone sagged %.2f mm at worst, %.2f mm at the end; worst stone moved "
+        "[ measure  ] arch of %d voussoirs, radii %.2f-%.2f m: keystone sagged %.2f mm at worst; worst stone moved "
         "%.3f mm from its pose at 1 s in 9 s; fastest at the end %.2g m/s\n",
-        kStones, 1000 * worst_sag, 1000 * end_sag, 1000 * worst, speed);
-    EXPECT_TRUE(all_finite(*space, stones));
-    EXPECT_LT(worst_sag, 0.02);
-    EXPECT_LT(worst, 0.02);
-    EXPECT_LT(speed, 0.001);
+        arch.stones, arch.inner, arch.outer, 1000 * run.worst_sag, 1000 * run.worst, run.speed);
+    return run;
+}
+
+}  // namespace
+
+TEST(Delicate, ArchOfVoussoirsStands) {
+    const ArchRun run = run_arch(Arch{});
+    EXPECT_TRUE(run.finite);
+    EXPECT_LT(run.worst_sag, 0.02);
+    EXPECT_LT(run.worst, 0.02);
+    EXPECT_LT(run.speed, 0.001);
+}
+
+// A thinner arch of more stones: 21 voussoirs between radii 2 and 2.3 m (thickness over
+// mean radius 0.14, above Heyman's 0.11), friction 0.6. On main when issue 16 was filed
+// (2321258, this test built there) it fell: the keystone 1.99 m down. Measured at
+// 1302f3d: it stands and rests (2.6 mm of movement after the first second, 2e-4 m/s at
+// the end), but the keystone sags 101 mm while the soft joints (30 Hz) compress and the
+// stones hinge: a defect left open (issue 16's notes). Asserted here: it does not fall
+// (keystone less than a quarter metre down, a fall drops it 2 m) and it comes to rest.
+TEST(Delicate, ThinArchOfManyVoussoirsDoesNotFall) {
+    const ArchRun run = run_arch(Arch{21, 2, 2.3});
+    EXPECT_TRUE(run.finite);
+    EXPECT_LT(run.worst_sag, 0.25);
+    EXPECT_LT(run.worst, 0.02);
+    EXPECT_LT(run.speed, 0.001);
 }
 
 }  // namespace spindle::stability
