@@ -3,6 +3,7 @@
 // only the update thread touches it, and stages split work through the JobSystem.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
@@ -61,6 +62,10 @@ struct Bodies {
     std::vector<std::int32_t> awake_index;  // position in World::awake, kAwakePending, or -1 if static or asleep
     std::vector<Real> sleep_time;
     std::vector<std::int32_t> island;  // sleeping island id, -1 when awake
+    // Collision filter (BodyDesc::layer, group), here so that the broadphase's test of
+    // every new pair reads two small arrays, not the descriptions.
+    std::vector<std::uint8_t> layer;
+    std::vector<std::uint32_t> group;
 
     // Interpolation history (the last two recorded steps), origin pose.
     std::vector<Vec3> history_position[2];
@@ -209,6 +214,14 @@ struct World {
     std::vector<std::uint32_t> awake_contact_list;
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
+
+    // The layer table: bit b of layer_masks[a] is set when layers a and b collide
+    // (symmetric; all set by default, so filtering changes nothing until asked).
+    std::array<std::uint32_t, kLayerCount> layer_masks = [] {
+        std::array<std::uint32_t, kLayerCount> all{};
+        all.fill(~std::uint32_t{0});
+        return all;
+    }();
 
     // Joints (api/joint_api.cpp); solved with the contacts, coloured first.
     Joints joints;

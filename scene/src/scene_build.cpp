@@ -4,6 +4,10 @@
 #include <spindle/platform/error.hpp>
 #include <spindle/scene/scene.hpp>
 
+#include <array>
+#include <utility>
+#include <vector>
+
 namespace spindle {
 namespace {
 
@@ -31,12 +35,27 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
     }
 
     const SpaceSettings before = space.settings();
+    // The layer pairs the scene turns off, with whether each collided before, to restore.
+    std::vector<std::pair<std::array<std::uint32_t, 2>, bool>> layers_before;
+    for (const auto& pair : scene.ignore_layers) {
+        layers_before.emplace_back(pair, space.layers_collide(pair[0], pair[1]));
+    }
+    auto restore = [&] {
+        space.set_time_step(before.time_step);
+        space.set_solver(before.solver);
+        space.set_sleep(before.sleep);
+        space.set_gravity(before.gravity);
+        for (auto it = layers_before.rbegin(); it != layers_before.rend(); ++it) {
+            space.set_layers_collide(it->first[0], it->first[1], it->second);
+        }
+    };
     TimeStepSettings time_step = scene.settings.time_step;
     time_step.use_internal_time_stepping = space.settings().time_step.use_internal_time_stepping;
     space.set_time_step(time_step);
     space.set_solver(scene.settings.solver);
     space.set_sleep(scene.settings.sleep);
     space.set_gravity(scene.settings.gravity);
+    for (const auto& pair : scene.ignore_layers) space.set_layers_collide(pair[0], pair[1], false);
 
     std::vector<BodyHandle> handles;
     handles.reserve(scene.bodies.size());
@@ -47,10 +66,7 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
             handles.push_back(space.create_body(desc));
         } catch (const Error& e) {
             for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
-            space.set_time_step(before.time_step);
-            space.set_solver(before.solver);
-            space.set_sleep(before.sleep);
-            space.set_gravity(before.gravity);
+            restore();
             fail_at(scene, body, "body", e);
         }
     }
@@ -63,10 +79,7 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
         } catch (const Error& e) {
             // Destroying the bodies destroys the joints made so far with them.
             for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
-            space.set_time_step(before.time_step);
-            space.set_solver(before.solver);
-            space.set_sleep(before.sleep);
-            space.set_gravity(before.gravity);
+            restore();
             throw Error(scene.source + ":" + std::to_string(joint.line) + ":" + std::to_string(joint.column) +
                         ": joint: " + e.what());
         }

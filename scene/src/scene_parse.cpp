@@ -14,7 +14,28 @@ namespace spindle {
 namespace scene_detail {
 namespace {
 
-SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
+// ignore_layers = [[a, b], ...]: pairs of layers whose bodies do not collide.
+std::vector<std::array<std::uint32_t, 2>> parse_layer_pairs(const TomlReader& r, const toml::node& node,
+                                                            const std::string& what) {
+    std::vector<std::array<std::uint32_t, 2>> pairs;
+    const toml::array& list = r.array(node, what, "of [a, b] layer pairs");
+    for (std::size_t k = 0; k < list.size(); ++k) {
+        const std::string item = what + "[" + std::to_string(k) + "]";
+        const toml::array& pair = r.array(list[k], item, "[a, b] of two layers");
+        if (pair.size() != 2) {
+            r.fail(list[k], item + ": expected two layers [a, b], got " + std::to_string(pair.size()) + " items");
+        }
+        std::array<std::uint32_t, 2> layers{};
+        for (std::size_t m = 0; m < 2; ++m) {
+            layers[m] = static_cast<std::uint32_t>(
+                r.integer(pair[m], item + "[" + std::to_string(m) + "]", 0, std::int64_t{kLayerCount} - 1));
+        }
+        pairs.push_back(layers);
+    }
+    return pairs;
+}
+
+void parse_settings(const TomlReader& r, const toml::node& node, SceneDesc& scene) {
     const toml::table& t = r.table(node, "settings", "([settings])");
     r.check_keys(t, "[settings]",
                  {"gravity",
@@ -36,8 +57,9 @@ SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
                   "sleep",
                   "time_to_sleep",
                   "sleep_linear_threshold",
-                  "sleep_angular_threshold"});
-    SpaceSettings s;
+                  "sleep_angular_threshold",
+                  "ignore_layers"});
+    SpaceSettings& s = scene.settings;
     TimeStepSettings& ts = s.time_step;
     SolverSettings& solver = s.solver;
     auto name = [](const char* key) { return std::string("settings.") + key; };
@@ -76,7 +98,8 @@ SpaceSettings parse_settings(const TomlReader& r, const toml::node& node) {
     non_negative("time_to_sleep", s.sleep.time_to_sleep);
     non_negative("sleep_linear_threshold", s.sleep.linear_threshold);
     non_negative("sleep_angular_threshold", s.sleep.angular_threshold);
-    return s;
+    if (const toml::node* n = t.get("ignore_layers"))
+        scene.ignore_layers = parse_layer_pairs(r, *n, name("ignore_layers"));
 }
 
 MotionType parse_type(const TomlReader& r, const toml::node& node, const std::string& what) {
@@ -159,7 +182,9 @@ const std::vector<std::string_view>& body_property_keys() {
                                                        "lock_rotation",
                                                        "allow_interpolation",
                                                        "allow_sleep",
-                                                       "fast"};
+                                                       "fast",
+                                                       "layer",
+                                                       "group"};
     return keys;
 }
 
@@ -208,6 +233,10 @@ bool apply_body_key(const TomlReader& r, std::string_view key, const toml::node&
         d.allow_sleep = r.boolean(value, what);
     } else if (key == "fast") {
         d.fast = r.boolean(value, what);
+    } else if (key == "layer") {
+        d.layer = static_cast<std::uint32_t>(r.integer(value, what, 0, std::int64_t{kLayerCount} - 1));
+    } else if (key == "group") {
+        d.group = static_cast<std::uint32_t>(r.integer(value, what, 0, std::int64_t{UINT32_MAX}));
     } else {
         return false;
     }
@@ -245,7 +274,7 @@ SceneDesc parse_scene(std::string_view toml_text, std::string_view source_name) 
     scene.name = root.get("name") ? r.string(*root.get("name"), "name") : stem(source_name);
     if (scene.name.empty()) r.fail(*root.get("name"), "name: expected a non-empty string");
     if (const toml::node* d = root.get("description")) scene.description = r.string(*d, "description");
-    if (const toml::node* s = root.get("settings")) scene.settings = parse_settings(r, *s);
+    if (const toml::node* s = root.get("settings")) parse_settings(r, *s, scene);
 
     BodyTemplate defaults;
     if (const toml::node* node = root.get("defaults")) {

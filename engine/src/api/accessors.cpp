@@ -109,6 +109,17 @@ void Space::wake(BodyHandle body) {
     m_world->writes.push(write);
 }
 
+void Space::set_collision_filter(BodyHandle body, std::uint32_t layer, std::uint32_t group) {
+    check_layer(layer, "set_collision_filter", "layer");
+    check_handle_for_write(m_world->motion_states, body, "set_collision_filter");
+    BufferedWrite write;
+    write.body = body;
+    write.kind = WriteKind::Filter;
+    write.layer = layer;
+    write.group = group;
+    m_world->writes.push(write);
+}
+
 // ---- internal ----
 
 namespace {

@@ -28,6 +28,8 @@ World::~World() = default;
 
 namespace {
 
+bool layers_collide_in(const World& w, std::uint32_t a, std::uint32_t b) { return ((w.layer_masks[a] >> b) & 1u) != 0; }
+
 template <typename T>
 void grow(std::vector<T>& v, std::size_t n) {
     if (v.size() < n) v.resize(n);
@@ -96,6 +98,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.locks, n),
             grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
         grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
+        grow(b.layer, n), grow(b.group, n);
         grow(b.history_position[0], n), grow(b.history_position[1], n);
         grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
     }
@@ -124,6 +127,8 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.sleep_time[slot] = 0;
     b.island[slot] = -1;
     b.interpolate[slot] = desc.allow_interpolation ? 1 : 0;
+    b.layer[slot] = static_cast<std::uint8_t>(desc.layer);
+    b.group[slot] = desc.group;
     for (int k = 0; k < 2; ++k) {
         b.history_position[k][slot] = desc.position;
         b.history_orientation[k][slot] = desc.orientation;
@@ -198,6 +203,25 @@ void Space::set_gravity(const Vec3& gravity) {
     const AccessGate::Structure access(m_world->gate, "set_gravity");
     validate_gravity(gravity);
     m_world->settings.gravity = gravity;
+}
+
+void Space::set_layers_collide(std::uint32_t a, std::uint32_t b, bool collide) {
+    const AccessGate::Structure access(m_world->gate, "set_layers_collide");
+    check_layer(a, "set_layers_collide", "a");
+    check_layer(b, "set_layers_collide", "b");
+    World& w = *m_world;
+    if (layers_collide_in(w, a, b) == collide) return;
+    const std::uint32_t bit_a = 1u << a, bit_b = 1u << b;
+    w.layer_masks[a] = collide ? (w.layer_masks[a] | bit_b) : (w.layer_masks[a] & ~bit_b);
+    w.layer_masks[b] = collide ? (w.layer_masks[b] | bit_a) : (w.layer_masks[b] & ~bit_a);
+    refilter_all(w);
+}
+
+bool Space::layers_collide(std::uint32_t a, std::uint32_t b) const {
+    const AccessGate::Structure access(m_world->gate, "layers_collide");
+    check_layer(a, "layers_collide", "a");
+    check_layer(b, "layers_collide", "b");
+    return layers_collide_in(*m_world, a, b);
 }
 
 const UpdateStats& Space::last_update() const noexcept { return m_world->stats; }

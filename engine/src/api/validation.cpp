@@ -57,6 +57,12 @@ void check_orientation(const Quat& value, const char* who, const char* field) {
     }
 }
 
+void check_layer(std::uint32_t value, const char* who, const char* field) {
+    if (value >= kLayerCount) {
+        reject_field(who, field, ("must be < " + std::to_string(kLayerCount)).c_str(), std::to_string(value));
+    }
+}
+
 // ---- settings ----
 
 void validate(const TimeStepSettings& s) {
@@ -160,6 +166,7 @@ void validate(const BodyDesc& d) {
     check_finite(d.gravity_scale, who, "gravity_scale");
     check_non_negative(d.linear_damping, who, "linear_damping");
     check_non_negative(d.angular_damping, who, "angular_damping");
+    check_layer(d.layer, who, "layer");
 }
 
 void validate(const MotionState& s, const char* who) {

@@ -24,6 +24,7 @@ void check_positive(Real value, const char* who, const char* field);      // fin
 void check_at_least(int value, int least, const char* who, const char* field);
 void check_direction(const Vec3& value, const char* who, const char* field);    // finite and non-zero
 void check_orientation(const Quat& value, const char* who, const char* field);  // finite and non-zero
+void check_layer(std::uint32_t value, const char* who, const char* field);      // < kLayerCount
 
 // Settings, the same for the Space constructor and each setter (who: "time_step",
 // "solver", "sleep"; gravity says "gravity must be finite").

@@ -48,6 +48,11 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             accumulate(entry, entry.angular_impulse, kPendingAngularImpulse, write.vector);
             break;
         case WriteKind::Wake: entry.bits |= kPendingWake; break;
+        case WriteKind::Filter:
+            entry.layer = write.layer;
+            entry.group = write.group;
+            entry.bits |= kPendingFilter;
+            break;
     }
 }
 

@@ -29,15 +29,17 @@ enum class WriteKind : std::uint8_t {
     Impulse,
     AngularImpulse,
     Wake,
+    Filter,  // layer and group
 };
 
 // One write as a caller makes it.
 struct BufferedWrite {
     BodyHandle body;
     WriteKind kind = WriteKind::Wake;
-    Vec3 vector = Vec3::Zero();        // position, velocity, force, impulse
-    Quat rotation = Quat::Identity();  // orientation
-    MotionState state;                 // motion state
+    Vec3 vector = Vec3::Zero();          // position, velocity, force, impulse
+    Quat rotation = Quat::Identity();    // orientation
+    MotionState state;                   // motion state
+    std::uint32_t layer = 0, group = 0;  // collision filter
 };
 
 // Which properties a body's pending entry holds.
@@ -51,6 +53,7 @@ enum PendingBits : std::uint16_t {
     kPendingImpulse = 1U << 6U,
     kPendingAngularImpulse = 1U << 7U,
     kPendingWake = 1U << 8U,
+    kPendingFilter = 1U << 9U,
     kPendingPose = kPendingPosition | kPendingOrientation,
     kPendingVelocity = kPendingLinearVelocity | kPendingAngularVelocity,
 };
@@ -71,6 +74,7 @@ struct PendingWrites {
     Vec3 torque = Vec3::Zero();
     Vec3 impulse = Vec3::Zero();
     Vec3 angular_impulse = Vec3::Zero();
+    std::uint32_t layer = 0, group = 0;  // valid where kPendingFilter is set
 };
 
 class WriteBuffer {

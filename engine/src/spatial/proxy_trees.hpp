@@ -65,6 +65,9 @@ public:
     // so its pairs are found at the next update_pairs.
     ProxyId create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static);
     void destroy_proxy(ProxyId id);
+    // Marks a proxy enlarged without moving it, so that the next update_pairs reports
+    // every pair it overlaps again (its collision filter changed).
+    void touch(ProxyId id) { mark_enlarged(id); }
     // Updates the proxy's tight box; `displacement` is its motion this step (stretches the
     // fat box ahead). Returns true and marks the proxy enlarged when the fat box grew.
     bool move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement);

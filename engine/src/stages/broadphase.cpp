@@ -59,6 +59,47 @@ void refresh_proxy(World& world, std::uint32_t slot) {
     move_proxy(*world.broadphase, slot, world.bodies.bounds[slot], Vec3::Zero());
 }
 
+namespace {
+
+// Removes the contacts (positions ascending) that the filter rejects, among those
+// `involves` accepts, waking both bodies of each first: what rested on the other may fall.
+template <typename Involves>
+void remove_filtered_contacts(World& world, Involves&& involves) {
+    std::vector<std::uint32_t>& filtered = world.scratch_lost;
+    filtered.clear();
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const std::uint64_t key = world.contact_keys[c];
+        const auto i = static_cast<std::uint32_t>(key >> 32);
+        const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
+        if (involves(i, j) && filter_blocks_pair(world, i, j)) filtered.push_back(c);
+    }
+    for (std::uint32_t c : filtered) {
+        wake_body(world, world.contacts[c].body_a);
+        wake_body(world, world.contacts[c].body_b);
+    }
+    remove_contacts(world, filtered);
+    filtered.clear();
+}
+
+}  // namespace
+
+void refilter_body(World& world, std::uint32_t slot) {
+    remove_filtered_contacts(world, [slot](std::uint32_t i, std::uint32_t j) { return i == slot || j == slot; });
+    wake_body(world, slot);
+    world.broadphase->tree.touch(world.broadphase->proxy[slot]);
+}
+
+void refilter_all(World& world) {
+    remove_filtered_contacts(world, [](std::uint32_t, std::uint32_t) { return true; });
+    // Every pair has a moving proxy (static pairs are never reported): touching those finds them all.
+    const Bodies& b = world.bodies;
+    for (std::uint32_t slot = 0; slot < b.capacity(); ++slot) {
+        if (!b.alive[slot] || b.type[slot] == MotionType::Static) continue;
+        wake_body(world, slot);
+        world.broadphase->tree.touch(world.broadphase->proxy[slot]);
+    }
+}
+
 void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
@@ -88,6 +129,10 @@ void update_broadphase(World& world, Real dt) {
         const auto i = static_cast<std::uint32_t>(pair.user_a);
         const auto j = static_cast<std::uint32_t>(pair.user_b);
         if (!can_collide(b, i, j)) continue;
+        if (filter_blocks_pair(world, i, j)) {
+            world.counters.pairs_filtered += 1;  // no contact: the narrowphase never sees the pair
+            continue;
+        }
         if (joint_blocks_pair(world, i, j)) continue;  // jointed bodies do not collide unless asked
         create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
     }

@@ -20,6 +20,22 @@ struct BroadphaseState {
     std::vector<std::uint8_t> moving;        // scratch, per awake body: its proxy must move this step
 };
 
+// Whether the collision filter keeps two bodies apart: their layers do not collide, or
+// they share a non-zero group. Reads the hot filter arrays only.
+inline bool filter_blocks_pair(const World& world, std::uint32_t i, std::uint32_t j) {
+    const Bodies& b = world.bodies;
+    if (b.group[i] != 0 && b.group[i] == b.group[j]) return true;
+    return ((world.layer_masks[b.layer[i]] >> b.layer[j]) & 1u) == 0;
+}
+// A body's filter changed (its layer and group are already set): its contacts the filter
+// now rejects are removed, waking both bodies, and the body is woken and its proxy
+// marked so that the next broadphase reports its overlaps again (pairs the filter now
+// allows become contacts).
+void refilter_body(World& world, std::uint32_t slot);
+// The layer table changed: the same for every body. Wakes every moving body (a newly
+// allowed pair of two sleepers must not start as an awake contact between sleepers).
+void refilter_all(World& world);
+
 void add_proxy(World& world, std::uint32_t slot);
 void remove_proxy(World& world, std::uint32_t slot);
 // Re-fits a proxy to the body's current bounds (a teleport, or a static body moved).

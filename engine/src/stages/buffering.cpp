@@ -90,6 +90,13 @@ void apply_writes(World& world) {
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
+        if ((write.bits & kPendingFilter) != 0 && (b.layer[i] != write.layer || b.group[i] != write.group)) {
+            b.layer[i] = static_cast<std::uint8_t>(write.layer);
+            b.group[i] = write.group;
+            b.desc[i].layer = write.layer;
+            b.desc[i].group = write.group;
+            refilter_body(world, i);
+        }
         world.stats.writes_applied += static_cast<int>(write.writes);
         world.stats.bodies_written += 1;
     }

@@ -10,6 +10,9 @@
 
 namespace spindle {
 
+// Collision layers per space: BodyDesc::layer is below this.
+inline constexpr std::uint32_t kLayerCount = 32;
+
 // A body's name in its space. index is its slot; generation changes every time the
 // slot is reused, so a handle to a destroyed body is detected, never aliased.
 struct BodyHandle {
@@ -91,6 +94,11 @@ struct BodyDesc {
     bool allow_interpolation = true;
     bool allow_sleep = true;
     bool fast = false;  // also swept against static geometry (continuous collision)
+    // Collision filter. layer: 0..kLayerCount-1; whether two layers collide is the
+    // space's layer table (Space::set_layers_collide; all pairs collide by default).
+    // group: 0 is none; bodies sharing a non-zero group never collide (a ragdoll's limbs).
+    std::uint32_t layer = 0;
+    std::uint32_t group = 0;
     std::uint64_t user_data = 0;
 };
 

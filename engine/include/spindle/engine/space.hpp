@@ -64,6 +64,13 @@ public:
     // Changes a hinge's motor (between updates); max_torque >= 0.
     void set_hinge_motor(JointHandle joint, bool enable, Real speed, Real max_torque);
 
+    // Collision filtering: the layer table. Whether bodies on layers a and b collide
+    // (symmetric; every pair collides by default). a, b < kLayerCount, else spindle::Error
+    // naming the value. A change re-checks every pair at the next step: contacts it
+    // filters out are removed (waking their bodies), overlaps it allows are found again.
+    void set_layers_collide(std::uint32_t a, std::uint32_t b, bool collide);
+    bool layers_collide(std::uint32_t a, std::uint32_t b) const;
+
     // ---- update (one thread at a time) ----
     // With internal time stepping: adds dt to the accumulator and takes the steps it
     // holds (at least min, at most max_steps_per_frame). Without: exactly one step of
@@ -95,6 +102,10 @@ public:
     void apply_impulse(BodyHandle body, const Vec3& impulse);
     void apply_angular_impulse(BodyHandle body, const Vec3& impulse);
     void wake(BodyHandle body);
+    // A body's collision layer and group (BodyDesc::layer, group); layer < kLayerCount,
+    // checked here. At the next update's ApplyWrites its contacts that the filter now
+    // rejects are removed (waking what they touched) and its overlaps are found again.
+    void set_collision_filter(BodyHandle body, std::uint32_t layer, std::uint32_t group);
 
     // ---- internal accessors (update thread, between updates) ----
     MotionState internal_motion_state(BodyHandle body) const;
@@ -104,7 +115,7 @@ public:
     Vec3 internal_angular_velocity(BodyHandle body) const;
     void set_internal_motion_state(BodyHandle body, const MotionState& state);
     bool internal_is_awake(BodyHandle body) const;
-    BodyDesc internal_desc(BodyHandle body) const;  // as created (shape, material, flags; a copy)
+    BodyDesc internal_desc(BodyHandle body) const;  // as created (shape, material, flags; a copy), filter as last set
     // How far a joint is from satisfied now, from the live poses.
     JointError internal_joint_error(JointHandle joint) const;
     // A hinge's angle (rad): B's rotation relative to A about the axis since creation.

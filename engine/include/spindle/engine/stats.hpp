@@ -41,6 +41,7 @@ struct WorkCounters {
     std::uint64_t gravity_applied = 0;     // body-substeps with gravity
     std::uint64_t damping_applied = 0;     // body-substeps with damping
     std::uint64_t gyroscopic_applied = 0;  // body-substeps with gyroscopic torque
+    std::uint64_t pairs_filtered = 0;      // new broadphase pairs dropped by layer or group (no contact made)
     std::uint64_t contacts_updated = 0;    // contact-steps through the narrowphase
     std::uint64_t manifolds_reused = 0;    // of those, moved with the bodies instead of recomputed
     // The solver's counts are taken where the rows run. Contacts are solved four

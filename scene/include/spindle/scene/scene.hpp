@@ -2,6 +2,7 @@
 // a SceneDesc, then built into a Space. Every error names file:line:column.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -58,6 +59,8 @@ struct SceneDesc {
     std::string description;
     std::string source;      // file name (or the name it was parsed under)
     SpaceSettings settings;  // time_step.use_internal_time_stepping is left to the program
+    // [settings] ignore_layers: pairs of layers that do not collide (the rest do).
+    std::vector<std::array<std::uint32_t, 2>> ignore_layers;
     std::vector<ShapeSpec> shapes;
     std::vector<SceneBody> bodies;   // generators expanded, in file order
     std::vector<SceneJoint> joints;  // made by [[chain]]; created after the bodies
@@ -71,8 +74,8 @@ SceneDesc parse_scene(std::string_view toml_text, std::string_view source_name);
 // Reads and parses a file; "path: cannot open scene file" when it cannot be read.
 SceneDesc load_scene(const std::string& path);
 
-// Applies the scene's settings (gravity, time step duration and caps, solver, sleep;
-// the space's use_internal_time_stepping is kept) and creates its bodies, in scene
+// Applies the scene's settings (gravity, time step duration and caps, solver, sleep, the
+// ignored layer pairs; the space's use_internal_time_stepping is kept) and creates its bodies, in scene
 // order, then its joints. Returns the bodies' handles, one per SceneDesc::bodies entry. Every shape is made
 // before any body is created; if anything is rejected the bodies created so far are
 // destroyed again, the settings restored, and the spindle::Error names the entry's
