@@ -85,7 +85,7 @@ void remove_filtered_contacts(World& world, Involves&& involves) {
 
 void refilter_body(World& world, std::uint32_t slot) {
     remove_filtered_contacts(world, [slot](std::uint32_t i, std::uint32_t j) { return i == slot || j == slot; });
-    wake_body(world, slot);
+    wake_body(world, slot);  // ApplyWrites has woken it already (as any write); kept for other callers
     world.broadphase->tree.touch(world.broadphase->proxy[slot]);
 }
 

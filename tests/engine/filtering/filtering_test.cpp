@@ -175,6 +175,8 @@ TEST(Filtering, GroupChangedAfterCreation_StopsPassingThroughAtTheNextStep) {
     space.set_collision_filter(a, 0, 0);
     space.update();
     EXPECT_GT(space.last_update().contacts, 0u);
+    EXPECT_TRUE(space.internal_is_awake(a));
+    EXPECT_TRUE(space.internal_is_awake(b));
     run(space, 60);
     EXPECT_GT(space.internal_position(b).x() - space.internal_position(a).x(), 0.95);
 }
@@ -198,6 +200,30 @@ TEST(Filtering, LayerTableChanged_ReappliesToExistingBodiesBothWays) {
     EXPECT_GT(space.last_update().contacts, 0u);
     run(space, 120);
     EXPECT_NEAR(space.internal_position(b).y(), 0.5, 0.05);
+}
+
+// Two sleeping boxes overlap on layers that ignore each other; allowing the pair wakes
+// them and pushes them apart.
+TEST(Filtering, LayerTableChanged_WakesSleepersWhosePairItAllows) {
+    Space space(weightless());
+    space.set_layers_collide(1, 2, false);
+    BodyDesc d = box(Vec3(0, 0, 0), 0);
+    d.layer = 1;
+    const BodyHandle a = space.create_body(d);
+    d.position = Vec3(0.6, 0, 0);
+    d.layer = 2;
+    const BodyHandle b = space.create_body(d);
+    run(space, 60);
+    ASSERT_FALSE(space.internal_is_awake(a));
+    ASSERT_FALSE(space.internal_is_awake(b));
+
+    space.set_layers_collide(2, 1, true);
+    space.update();
+    EXPECT_TRUE(space.internal_is_awake(a));
+    EXPECT_TRUE(space.internal_is_awake(b));
+    EXPECT_GT(space.last_update().contacts, 0u);
+    run(space, 60);
+    EXPECT_GT(space.internal_position(b).x() - space.internal_position(a).x(), 0.95);
 }
 
 TEST(Filtering, LastFilterWriteWins) {

@@ -98,6 +98,17 @@ TEST(InvalidBody, RealFieldsFollowTheirRules) {
     }
 }
 
+TEST(InvalidBody, LayerMustBeBelowTheLayerCount) {
+    for (MotionType type : kMotionTypes) {
+        for (std::uint32_t layer : {0u, kLayerCount - 1, kLayerCount, 1000u, ~0u}) {
+            BodyDesc d = body_of(type);
+            d.layer = layer;
+            d.group = ~0u;  // any group is valid
+            try_body(d, layer < kLayerCount, "layer", std::to_string(layer));
+        }
+    }
+}
+
 TEST(InvalidBody, MotionTypeOutOfRangeIsRejected) {
     BodyDesc d = body_of(MotionType::Dynamic);
     d.type = static_cast<MotionType>(7);

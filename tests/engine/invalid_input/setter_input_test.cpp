@@ -117,6 +117,22 @@ TEST(InvalidWrite, InternalMotionStateFieldsMustBeFinite) {
     try_motion_states([](Space& s, BodyHandle b, const MotionState& m) { s.set_internal_motion_state(b, m); });
 }
 
+TEST(InvalidWrite, CollisionFilterLayerMustBeBelowTheLayerCount) {
+    for (std::uint32_t layer : {0u, kLayerCount - 1, kLayerCount, ~0u}) {
+        try_write([&](Space& s, BodyHandle b) { s.set_collision_filter(b, layer, 7); }, layer < kLayerCount, "layer",
+                  std::to_string(layer));
+    }
+}
+
+TEST(InvalidWrite, LayerTableLayersMustBeBelowTheLayerCount) {
+    for (std::uint32_t layer : {kLayerCount, ~0u}) {
+        try_write([&](Space& s, BodyHandle) { s.set_layers_collide(layer, 0, false); }, false, "a must be < 32",
+                  std::to_string(layer));
+        try_write([&](Space& s, BodyHandle) { s.set_layers_collide(0, layer, false); }, false, "b must be < 32",
+                  std::to_string(layer));
+    }
+}
+
 TEST(InvalidWrite, MessageNamesTheFieldAndValue) {
     Scene scene = make_scene();
     MotionState state;
