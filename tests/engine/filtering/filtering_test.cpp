@@ -162,6 +162,22 @@ TEST(Filtering, LayerChangedAfterCreation_StartsPassingThroughAtTheNextStep) {
     EXPECT_LT(space.internal_position(b).y(), -2.0);
 }
 
+// The ground, not the ball, changes layer: the sleeping ball it held is woken and falls.
+TEST(Filtering, GroundLayerChangedAfterCreation_WakesWhatRestedOnIt) {
+    Space space;
+    const BodyHandle ground = add_ground(space);
+    space.set_layers_collide(kGhostLayer, 0, false);
+    const BodyHandle b = space.create_body(ball(Vec3(0, 0.5, 0)));
+    run(space, 90);
+    ASSERT_FALSE(space.internal_is_awake(b));
+
+    space.set_collision_filter(ground, kGhostLayer, 0);
+    space.update();
+    EXPECT_TRUE(space.internal_is_awake(b));
+    run(space, 60);
+    EXPECT_LT(space.internal_position(b).y(), -2.0);
+}
+
 // Two boxes of one group overlap at rest and sleep; moving one out of the group makes the
 // pair appear at the next step (though neither proxy moved) and pushes them apart.
 TEST(Filtering, GroupChangedAfterCreation_StopsPassingThroughAtTheNextStep) {
