@@ -41,9 +41,11 @@ struct WorkCounters {
     std::uint64_t gravity_applied = 0;     // body-substeps with gravity
     std::uint64_t damping_applied = 0;     // body-substeps with damping
     std::uint64_t gyroscopic_applied = 0;  // body-substeps with gyroscopic torque
-    std::uint64_t pairs_filtered = 0;      // new broadphase pairs dropped by layer or group (no contact made)
     std::uint64_t contacts_updated = 0;    // contact-steps through the narrowphase
     std::uint64_t manifolds_reused = 0;    // of those, moved with the bodies instead of recomputed
+    // Pairs the broadphase reported and the collision filter dropped (layers or group): no
+    // contact, no narrowphase work. A pair is reported again when one of its fat boxes grows.
+    std::uint64_t pairs_filtered = 0;
     // The solver's counts are taken where the rows run. Contacts are solved four
     // manifolds at a time, so a point without friction or restitution is counted when
     // one solved with it has them (its lane ran too).
