@@ -285,7 +285,7 @@ TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {
     }
     // name, dynamic bodies, other bodies, description
     for (const auto& [scene, dynamic] : std::vector<std::pair<std::string, std::string>>{
-             {"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}}) {
+             {"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}, {"convex_pile", "5120"}}) {
         const std::vector<std::string> w = line_starting_with(r.output, scene);
         ASSERT_GE(w.size(), 3u) << scene << " not listed in\n" << r.output;
         EXPECT_EQ(w[1], dynamic) << scene;

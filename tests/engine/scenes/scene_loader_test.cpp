@@ -164,6 +164,17 @@ TEST(SceneFiles, OtherScenes_HaveWhatTheyPromise) {
     EXPECT_GE(heaviest / lightest, 100);
 }
 
+TEST(SceneFiles, Box3DBenchmarkScenes_HaveBox3DsDynamicBodies) {
+    // Box3D's benchmark program (shared/benchmarks.c at 30c67b5, its Release sizes).
+    EXPECT_EQ(load("large_pyramid").dynamic_body_count(), 5050u);
+    EXPECT_EQ(load("convex_pile").dynamic_body_count(), 5120u);
+    EXPECT_EQ(load("washer").dynamic_body_count(), 8000u);
+    EXPECT_EQ(load("junkyard").dynamic_body_count(), 10584u);
+    const SceneDesc joint_grid = load("joint_grid");
+    EXPECT_EQ(joint_grid.dynamic_body_count(), 9900u);
+    EXPECT_EQ(joint_grid.joints.size(), 9900u);  // the columns' joints; Box3D's net has 19,800
+}
+
 TEST(SceneParse, EveryShape_IsRead) {
     const SceneDesc scene = parse_scene(R"(
 [[body]]
