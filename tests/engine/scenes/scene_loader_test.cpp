@@ -83,7 +83,10 @@ TEST(SceneFiles, EveryConfigScene_BuildsAndSteps) {
         ASSERT_EQ(handles.size(), scene.bodies.size());
         EXPECT_EQ(space.body_count(), scene.bodies.size());
         for (std::size_t i = 0; i < handles.size(); i += 97) {
-            EXPECT_EQ(space.internal_position(handles[i]), scene.bodies[i].desc.position);
+            // A hull whose centre of mass is off its origin is stored by that centre: the
+            // origin read back is within rounding of the one given.
+            const Vec3& given = scene.bodies[i].desc.position;
+            EXPECT_LE((space.internal_position(handles[i]) - given).norm(), 1e-12 * (1 + given.norm()));
         }
         if (scene.bodies.size() < 1000) {  // the big ones are stepped by the program's tests and bench
             for (int i = 0; i < 3; ++i) space.update();
