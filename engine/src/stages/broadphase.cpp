@@ -83,10 +83,10 @@ void remove_filtered_contacts(World& world, Involves&& involves) {
 
 }  // namespace
 
-void refilter_body(World& world, std::uint32_t slot) {
-    remove_filtered_contacts(world, [slot](std::uint32_t i, std::uint32_t j) { return i == slot || j == slot; });
-    wake_body(world, slot);  // ApplyWrites has woken it already (as any write); kept for other callers
-    world.broadphase->tree.touch(world.broadphase->proxy[slot]);
+void refilter_bodies(World& world, std::span<const std::uint32_t> slots) {
+    const auto changed = [slots](std::uint32_t i) { return std::binary_search(slots.begin(), slots.end(), i); };
+    remove_filtered_contacts(world, [&](std::uint32_t i, std::uint32_t j) { return changed(i) || changed(j); });
+    for (std::uint32_t slot : slots) world.broadphase->tree.touch(world.broadphase->proxy[slot]);
 }
 
 void refilter_all(World& world) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "spatial/proxy_trees.hpp"
@@ -27,11 +28,11 @@ inline bool filter_blocks_pair(const World& world, std::uint32_t i, std::uint32_
     if (b.group[i] != 0 && b.group[i] == b.group[j]) return true;
     return ((world.layer_masks[b.layer[i]] >> b.layer[j]) & 1u) == 0;
 }
-// A body's filter changed (its layer and group are already set): its contacts the filter
-// now rejects are removed, waking both bodies, and the body is woken and its proxy
-// marked so that the next broadphase reports its overlaps again (pairs the filter now
-// allows become contacts).
-void refilter_body(World& world, std::uint32_t slot);
+// These bodies' filters changed (their layers and groups are already set; slots
+// ascending): their contacts the filters now reject are removed, waking both bodies, and
+// their proxies marked so that the next broadphase reports their overlaps again (pairs
+// the filters now allow become contacts). One pass over the contacts for all of them.
+void refilter_bodies(World& world, std::span<const std::uint32_t> slots);
 // The layer table changed: the same for every body. Wakes every moving body (a newly
 // allowed pair of two sleepers must not start as an awake contact between sleepers).
 void refilter_all(World& world);

@@ -48,6 +48,7 @@ void apply_writes(World& world) {
     Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
+    std::vector<std::uint32_t> refiltered;  // bodies whose filter changed (rare: no allocation otherwise)
     for (const PendingWrites& write : world.drained) {
         if (!b.is_live(write.body)) {
             world.stats.writes_rejected += static_cast<int>(write.writes);  // destroyed after the writes were made
@@ -95,10 +96,14 @@ void apply_writes(World& world) {
             b.group[i] = write.group;
             b.desc[i].layer = write.layer;
             b.desc[i].group = write.group;
-            refilter_body(world, i);
+            refiltered.push_back(i);
         }
         world.stats.writes_applied += static_cast<int>(write.writes);
         world.stats.bodies_written += 1;
+    }
+    if (!refiltered.empty()) {
+        std::sort(refiltered.begin(), refiltered.end());
+        refilter_bodies(world, refiltered);
     }
     settle_awake(world);
 }
