@@ -29,6 +29,7 @@ namespace spindle {
 
 struct BroadphaseState;  // stages/broadphase_state.hpp
 struct SolverScratch;    // solver/constraints.hpp
+class QueryScene;        // query/query_scene.hpp
 
 // awake_index of a body woken since World::awake was last settled (settle_awake, islands.cpp):
 // awake, but not yet at a position in the list.
@@ -234,6 +235,10 @@ struct World {
     MotionStateManager motion_states;
     std::vector<std::uint32_t> changed_now;   // slots whose published state changed outside a step
     std::vector<std::uint32_t> changed_last;  // the same, one flip ago (the back buffer is two flips old)
+    // The query scene that goes with published buffer k, updated with it (buffering.cpp);
+    // null until the first body is published. Replaced by a copy while a query holds it.
+    std::shared_ptr<QueryScene> query_scenes[2];
+    std::vector<Aabb> scratch_query_bounds;  // per awake body, the flip's tight query boxes
 
     // Time stepping.
     Real accumulator = 0;

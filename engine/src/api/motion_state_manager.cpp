@@ -141,12 +141,13 @@ double MotionStateManager::alpha() const {
     return m_alpha;
 }
 
-double MotionStateManager::flip(double alpha, std::uint64_t steps) {
+double MotionStateManager::flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries) {
     std::scoped_lock guard(m_lock);
     const std::int64_t acquired = now_nanoseconds();
     std::swap(m_front, m_back);
     m_alpha = alpha;
     m_steps = steps;
+    m_query_scene = std::move(queries);
     return static_cast<double>(now_nanoseconds() - acquired) * 1e-9;  // hold time, not wait time
 }
 

@@ -2,6 +2,7 @@
 // (live state -> published buffer, swapped under the motion-state lock).
 #include <algorithm>
 
+#include "query/query_scene.hpp"
 #include "solver/speed_limit.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
@@ -19,7 +20,12 @@ public:
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_manager.set_published_generation(slot, generation);
     }
-    double flip(double alpha, std::uint64_t steps) { return m_manager.flip(alpha, steps); }
+    double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries) {
+        return m_manager.flip(alpha, steps, std::move(queries));
+    }
+    void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) {
+        m_manager.set_query_scene_locked(std::move(queries));
+    }
 
 private:
     MotionStateManager& m_manager;
@@ -97,6 +103,7 @@ void apply_writes(World& world) {
             b.desc[i].layer = write.layer;
             b.desc[i].group = write.group;
             refiltered.push_back(i);
+            world.changed_now.push_back(i);  // the query scenes publish the filter
         }
         world.stats.writes_applied += static_cast<int>(write.writes);
         world.stats.bodies_written += 1;
@@ -144,6 +151,10 @@ void publish_now(World& world, std::uint32_t slot) {
     // Creation and destruction are the only changes of a slot's generation, and both
     // publish here, so the lock-free copy buffered writes check stays exact.
     manager.set_published_generation(slot, manager.buffer_locked(0)[slot].generation);
+    // Queries see the body at once too, as reads do: both scenes (no query walks either
+    // while the lock is held; one that holds a scene from before keeps its copy).
+    for (int k = 0; k < 2; ++k) writable_query_scene(world, k).refresh(world, slot, interpolating);
+    manager.set_query_scene_locked(world.query_scenes[1 - manager.back_index()]);
 }
 
 void flip_read_buffers(World& world) {
@@ -169,31 +180,40 @@ void flip_read_buffers(World& world) {
         world.awake_version += 1;
     }
     const int k = manager.back_index();
+    // The query scene that goes with the back buffer gets the same bodies refreshed.
+    QueryScene& queries = writable_query_scene(world, k);
+    queries.reserve(b.capacity());
     const bool awake_stale = world.published_version[k] != world.awake_version ||
                              world.published_interpolating[k] != interpolating;
     if (awake_stale) {
         std::vector<CacheLinePadded<std::uint64_t>>& interpolated = world.publish_counts;
         interpolated.assign(world.jobs->worker_count(), {});
         const auto n = static_cast<std::uint32_t>(world.awake.size());
+        std::vector<Aabb>& query_bounds = world.scratch_query_bounds;
+        query_bounds.resize(n);
         world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
             std::uint64_t count = 0;
             for (std::uint32_t a = lo; a < hi; ++a) {
                 const std::uint32_t i = world.awake[a];
                 fill(world, i, back[i], interpolating);
                 count += back[i].interpolate ? 1 : 0;
+                queries.refresh_pose(world, i, interpolating, query_bounds[a]);
             }
             interpolated[worker].value += count;
         });
+        // The tree by one thread: most proxies are still inside their fat boxes.
+        for (std::uint32_t a = 0; a < n; ++a) queries.move(world.awake[a], query_bounds[a]);
         for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
         world.counters.awake_publishes += n;
         world.published_version[k] = world.awake_version;
         world.published_interpolating[k] = interpolating;
     }
-    for (std::uint32_t i : world.changed_now) {
-        if (!b.alive[i] || b.awake_index[i] < 0) publish(i);  // awake ones were published above
-    }
-    for (std::uint32_t i : world.changed_last) {
-        if (!b.alive[i] || b.awake_index[i] < 0) publish(i);
+    for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
+        for (std::uint32_t i : *changed) {
+            if (b.alive[i] && b.awake_index[i] >= 0) continue;  // awake ones were published above
+            publish(i);
+            queries.refresh(world, i, interpolating);
+        }
     }
     std::swap(world.changed_last, world.changed_now);
     world.changed_now.clear();
@@ -201,7 +221,7 @@ void flip_read_buffers(World& world) {
     // islands stage, so nothing is missed.
 
     const double alpha = interpolating ? world.accumulator / world.settings.time_step.duration : 1.0;
-    world.stats.flip_lock_seconds = manager.flip(alpha, world.steps);
+    world.stats.flip_lock_seconds = manager.flip(alpha, world.steps, world.query_scenes[k]);
     // After the swap the new back buffer may be shorter than the body slots.
     if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());

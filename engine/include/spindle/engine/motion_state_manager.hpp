@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <span>
 #include <thread>
@@ -14,6 +15,8 @@
 #include <spindle/engine/body.hpp>
 
 namespace spindle {
+
+class QueryScene;  // engine/src/query/query_scene.hpp: what scene queries read
 
 // One body as published at a flip: the newest step, and the one before for blending.
 struct PublishedBody {
@@ -122,13 +125,19 @@ private:
     // The physics side (the update thread): only the buffering stages reach it, through
     // MotionStatePublisher (engine/src/stages/buffering.cpp); a game never does.
     friend class MotionStatePublisher;
+    friend class QueryLease;  // takes the published query scene under the lock
     // The buffer being filled for the next flip; never read by other threads.
     std::vector<PublishedBody>& back() noexcept { return *m_back; }
     int back_index() const noexcept { return m_back == &m_buffers[0] ? 0 : 1; }  // which buffer back() is
     // Both buffers, for a caller that holds lock() (publishing a created body at once).
     std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_buffers[k]; }
-    // Swaps back and front under the lock; returns seconds the lock was held.
-    double flip(double alpha, std::uint64_t steps);
+    // Swaps back and front under the lock and publishes the query scene that goes with
+    // the new front; returns seconds the lock was held.
+    double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries);
+    // Replaces the published query scene, for a caller that holds lock().
+    void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) noexcept {
+        m_query_scene = std::move(queries);
+    }
 
     // Records a slot's published generation; the physics side, under lock().
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
@@ -161,6 +170,7 @@ private:
     std::vector<PublishedBody>* m_back = &m_buffers[1];
     double m_alpha = 1;
     std::uint64_t m_steps = 0;
+    std::shared_ptr<const QueryScene> m_query_scene;  // null until a body is published
 };
 
 }  // namespace spindle

@@ -19,11 +19,13 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <spindle/engine/body.hpp>
 #include <spindle/engine/joint.hpp>
+#include <spindle/engine/query.hpp>
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/stats.hpp>
 
@@ -106,6 +108,40 @@ public:
     // checked here. At the next update's ApplyWrites its contacts that the filter now
     // rejects are removed (waking what they touched) and its overlaps are found again.
     void set_collision_filter(BodyHandle body, std::uint32_t layer, std::uint32_t group);
+
+    // ---- scene queries (any thread, any time, concurrently with update) ----
+    // Each meets the bodies where the published step puts them: where motion_state() and
+    // get_motion_states() say they are (blended where those are), so a ray hits what the
+    // game renders; exact against the shapes (sphere, capsule, box, hull, plane, mesh).
+    // Bodies created since are met, destroyed ones are not (both publish at once). A query
+    // takes the motion-state lock only to pick up the published scene (a few loads; a
+    // thread that holds the lock queries the step it holds) and walks it unlocked: it
+    // never waits for a step, and a step never waits for it (the physics thread copies a
+    // scene a query still holds, WorkCounters::query_scene_copies). It may deadlock only
+    // through filter.accept (which must not wait for an update). Non-finite arguments, or
+    // a plane or mesh as the query's own shape, throw spindle::Error naming the argument.
+    //
+    // The nearest body the segment from -> to enters (a segment starting inside a solid
+    // does not hit it); none for a zero-length segment.
+    std::optional<QueryHit> cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter = {}) const;
+    // Whether the segment enters any body (stops at the first found: cheaper).
+    bool ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilter& filter = {}) const;
+    // Every body the segment enters, nearest first (equal fractions by slot), into `hits`
+    // (cleared first). Returns the count.
+    std::size_t cast_ray_all(const Vec3& from, const Vec3& to, std::vector<QueryHit>& hits,
+                             const QueryFilter& filter = {}) const;
+    // The first body met by `shape` (sphere, capsule, box or hull) at `start`, moved
+    // (not turned) by `translation`: fraction of the translation, point on the body,
+    // normal toward the caster. Overlapping at the start: fraction 0.
+    std::optional<QueryHit> cast_shape(const Shape& shape, const Transform& start, const Vec3& translation,
+                                       const QueryFilter& filter = {}) const;
+    // Every body that `shape` (sphere, capsule, box or hull) at `pose` touches or
+    // overlaps, by slot, into `bodies` (cleared first). Returns the count.
+    std::size_t overlap_shape(const Shape& shape, const Transform& pose, std::vector<BodyHandle>& bodies,
+                              const QueryFilter& filter = {}) const;
+    // Every body whose shape (not only its bounds) meets the box, by slot, into `bodies`
+    // (cleared first); box.min <= box.max. Returns the count.
+    std::size_t overlap_box(const Aabb& box, std::vector<BodyHandle>& bodies, const QueryFilter& filter = {}) const;
 
     // ---- internal accessors (update thread, between updates) ----
     MotionState internal_motion_state(BodyHandle body) const;

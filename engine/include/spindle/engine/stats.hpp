@@ -57,6 +57,9 @@ struct WorkCounters {
     std::uint64_t swept_tests = 0;            // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
     std::uint64_t awake_publishes = 0;         // awake bodies' entries refilled by FlipReadBuffers
+    // Query scenes the physics thread copied because a query still held the one it was
+    // about to update (query/query_scene.hpp): a query never holds up a step.
+    std::uint64_t query_scene_copies = 0;
 };
 
 }  // namespace spindle

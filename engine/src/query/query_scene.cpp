@@ -1,0 +1,242 @@
+// The published query structure: keeping it in step with the live bodies (the physics
+// thread, at publication) and walking it (any thread, under a QueryLease).
+#include "query/query_scene.hpp"
+
+#include <spindle/engine/motion_state_manager.hpp>
+
+#include <algorithm>
+#include <numbers>
+
+#include "collision/cast.hpp"
+#include "world.hpp"
+
+namespace spindle {
+
+namespace {
+
+// Queries never validate the tree per operation (a scene of 10k bodies would pay O(n)
+// per moved proxy in debug builds); tests call validate() themselves.
+AabbTreeSettings query_tree_settings() {
+    AabbTreeSettings settings;
+    settings.validate_each_operation = false;
+    return settings;
+}
+
+bool same_shape(const Shape& a, const Shape& b) {
+    return a.type == b.type && a.radius == b.radius && a.half_height == b.half_height &&
+           a.half_extents == b.half_extents && a.normal == b.normal && a.offset == b.offset && a.hull == b.hull &&
+           a.mesh == b.mesh;
+}
+
+}  // namespace
+
+// The same arithmetic as MotionStateManager::blend, so a ray meets a body where its
+// motion state puts it, to the bit.
+Transform QueryBody::pose(double alpha) const {
+    if (!interpolate || alpha >= 1) return current;
+    const Real t = alpha;
+    return {previous.p + (current.p - previous.p) * t, slerp_shortest(previous.q, current.q, t)};
+}
+
+QueryScene::QueryScene() : m_tree(query_tree_settings()) {}
+
+QueryScene::QueryScene(const QueryScene& other) : m_tree(other.m_tree), m_bodies(other.m_bodies) {}
+
+std::unique_ptr<QueryScene> QueryScene::clone() const { return std::unique_ptr<QueryScene>(new QueryScene(*this)); }
+
+void QueryScene::reserve(std::uint32_t slots) {
+    if (m_bodies.size() < slots) m_bodies.resize(slots);
+}
+
+// A blended pose lies within the shape's boxes at both poses but for the swing of the
+// turn: a point at distance r from the origin, turned through angle a by slerp while its
+// origin moves linearly, strays at most r a / 2 from the segment between its two end
+// positions (each end's distance from the slerped point is at most r a t, resp. r a (1-t)).
+Aabb QueryScene::tight_bounds(const QueryBody& body) {
+    const Aabb now = body.shape.bounds(body.current);
+    if (!body.interpolate) return now;
+    const Aabb both = now.merged(body.shape.bounds(body.previous));
+    // The angle a <= pi sin(a / 2) = pi |vec(q0^-1 q1)| on [0, pi]. Nothing to add for a
+    // body that has not turned (a plane's unbounded box would make its reach infinite).
+    const Real turn = std::numbers::pi_v<Real> * (body.previous.q.conjugate() * body.current.q).vec().norm();
+    if (turn == 0) return both;
+    const Vec3 far = (now.max - body.current.p).cwiseAbs().cwiseMax((now.min - body.current.p).cwiseAbs());
+    return both.fattened(far.norm() * turn / 2);
+}
+
+void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpolating, Aabb& tight) {
+    const Bodies& b = world.bodies;
+    QueryBody& body = m_bodies[i];
+    // Shapes change only with the body (creation, or a new shape): compared, not copied.
+    if (body.generation != b.generation[i] || !same_shape(body.shape, b.desc[i].shape)) body.shape = b.desc[i].shape;
+    body.generation = b.generation[i];
+    body.layer = b.layer[i];
+    body.group = b.group[i];
+    body.current = b.transform(i);
+    body.interpolate = interpolating && b.interpolate[i];
+    if (body.interpolate) body.previous = {b.history_position[0][i], b.history_orientation[0][i]};
+    tight = tight_bounds(body);
+}
+
+void QueryScene::move(std::uint32_t i, const Aabb& tight) {
+    QueryBody& body = m_bodies[i];
+    if (body.proxy == DynamicAabbTree::kNull) {
+        body.proxy = m_tree.create_proxy(tight, i);
+    } else {
+        m_tree.move_proxy(body.proxy, tight, Vec3::Zero());
+    }
+}
+
+void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating) {
+    reserve(world.bodies.capacity());
+    if (!world.bodies.alive[i]) {
+        QueryBody& body = m_bodies[i];
+        if (body.proxy != DynamicAabbTree::kNull) m_tree.destroy_proxy(body.proxy);
+        body = QueryBody{};
+        return;
+    }
+    Aabb tight;
+    refresh_pose(world, i, interpolating, tight);
+    move(i, tight);
+}
+
+bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFilter& filter) {
+    if (((filter.layer_mask >> body.layer) & 1u) == 0) return false;
+    if (filter.group != 0 && body.group == filter.group) return false;
+    if (handle == filter.ignore) return false;
+    return !filter.accept || filter.accept(handle);
+}
+
+// ---- queries ----
+
+bool QueryScene::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
+                          QueryHit& hit) const {
+    bool found = false;
+    m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real) -> Real {
+        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+        const QueryBody& body = m_bodies[i];
+        const BodyHandle handle{i, body.generation};
+        CastHit h;
+        if (!passes(body, handle, filter) || !ray_cast(body.shape, body.pose(alpha), from, to, h)) return -1;
+        // Equal fractions keep the first found (the tree's order, the same for every run).
+        if (found && h.fraction >= hit.fraction) return -1;
+        found = true;
+        hit = {handle, h.fraction, h.point, h.normal, h.part};
+        return h.fraction;  // 0 stops the walk: nothing is nearer
+    });
+    return found;
+}
+
+bool QueryScene::ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha) const {
+    bool found = false;
+    m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real) -> Real {
+        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+        const QueryBody& body = m_bodies[i];
+        CastHit h;
+        if (!passes(body, {i, body.generation}, filter) || !ray_cast(body.shape, body.pose(alpha), from, to, h)) {
+            return -1;
+        }
+        found = true;
+        return 0;
+    });
+    return found;
+}
+
+// Sorted by fraction, then by body slot, so the order never depends on the tree's shape.
+void QueryScene::cast_ray_all(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
+                              std::vector<QueryHit>& hits) const {
+    m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real max_fraction) -> Real {
+        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+        const QueryBody& body = m_bodies[i];
+        const BodyHandle handle{i, body.generation};
+        CastHit h;
+        if (passes(body, handle, filter) && ray_cast(body.shape, body.pose(alpha), from, to, h)) {
+            hits.push_back({handle, h.fraction, h.point, h.normal, h.part});
+        }
+        return max_fraction;  // keep walking the whole segment
+    });
+    std::sort(hits.begin(), hits.end(), [](const QueryHit& a, const QueryHit& b) {
+        return a.fraction != b.fraction ? a.fraction < b.fraction : a.body.index < b.body.index;
+    });
+}
+
+bool QueryScene::cast_shape(const Shape& shape, const Transform& start, const Vec3& translation,
+                            const QueryFilter& filter, double alpha, QueryHit& hit) const {
+    const Aabb swept = shape.bounds(start).merged(shape.bounds({start.p + translation, start.q}));
+    bool found = false;
+    m_tree.query(swept, [&](std::int32_t id) {
+        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+        const QueryBody& body = m_bodies[i];
+        const BodyHandle handle{i, body.generation};
+        CastHit h;
+        if (!passes(body, handle, filter) || !shape_cast(shape, start, translation, body.shape, body.pose(alpha), h)) {
+            return true;
+        }
+        // The nearer wins; equal fractions go to the lower slot, whatever the walk's order.
+        if (!found || h.fraction < hit.fraction || (h.fraction == hit.fraction && i < hit.body.index)) {
+            hit = {handle, h.fraction, h.point, h.normal, h.part};
+            found = true;
+        }
+        return true;
+    });
+    return found;
+}
+
+void QueryScene::overlap_shape(const Shape& shape, const Transform& pose, const QueryFilter& filter, double alpha,
+                               std::vector<BodyHandle>& bodies) const {
+    const std::size_t first = bodies.size();
+    m_tree.query(shape.bounds(pose), [&](std::int32_t id) {
+        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+        const QueryBody& body = m_bodies[i];
+        const BodyHandle handle{i, body.generation};
+        if (passes(body, handle, filter) && overlaps(shape, pose, body.shape, body.pose(alpha))) {
+            bodies.push_back(handle);
+        }
+        return true;
+    });
+    std::sort(bodies.begin() + static_cast<std::ptrdiff_t>(first), bodies.end(),
+              [](BodyHandle a, BodyHandle b) { return a.index < b.index; });
+}
+
+void QueryScene::overlap_box(const Aabb& box, const QueryFilter& filter, double alpha,
+                             std::vector<BodyHandle>& bodies) const {
+    // Exact against every shape: the box as a box shape (built directly: a flat box, or a
+    // point, is a fine query though not a fine body).
+    Shape shape;
+    shape.type = ShapeType::Box;
+    shape.half_extents = box.extents();
+    overlap_shape(shape, {box.center(), Quat::Identity()}, filter, alpha, bodies);
+}
+
+// ---- holding and updating ----
+
+QueryLease::QueryLease(const MotionStateManager& manager) {
+    const MotionStateLock::Hold guard(manager.m_lock);
+    m_scene = manager.m_query_scene;
+    m_alpha = manager.m_alpha;
+    if (m_scene) m_scene->holders.fetch_add(1, std::memory_order_relaxed);  // under the lock
+}
+
+QueryLease::~QueryLease() {
+    // Release: this query's reads happen before the physics thread's next writes.
+    if (m_scene) m_scene->holders.fetch_sub(1, std::memory_order_release);
+}
+
+QueryScene& writable_query_scene(World& world, int k) {
+    std::shared_ptr<QueryScene>& scene = world.query_scenes[k];
+    if (!scene) {
+        // The first publication: every body there is (creation publishes each at once).
+        scene = std::make_shared<QueryScene>();
+        const bool interpolating = world.settings.time_step.use_internal_time_stepping;
+        for (std::uint32_t i = 0; i < world.bodies.capacity(); ++i) {
+            if (world.bodies.alive[i]) scene->refresh(world, i, interpolating);
+        }
+    } else if (scene->holders.load(std::memory_order_acquire) != 0) {
+        // A query walks it still: it keeps the old one, which goes when it lets go.
+        scene = std::shared_ptr<QueryScene>(scene->clone());
+        world.counters.query_scene_copies += 1;
+    }
+    return *scene;
+}
+
+}  // namespace spindle

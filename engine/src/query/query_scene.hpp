@@ -1,0 +1,112 @@
+// The published query structure (design.md section 10): what scene queries read. Two
+// scenes go with the two published motion-state buffers; FlipReadBuffers brings the
+// back one up to date and publishes it with the buffer, under the motion-state lock, so
+// a query sees exactly the step buffered reads see. A query takes the published scene
+// (a shared pointer and a holder count) under the lock and walks it without the lock; a
+// scene the physics thread wants to update while a query still holds it is copied
+// first, so a query never waits for a step and a step never waits for a query.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <spindle/engine/body.hpp>
+#include <spindle/engine/query.hpp>
+#include <spindle/engine/shape.hpp>
+
+#include "spatial/aabb_tree.hpp"
+
+namespace spindle {
+
+class MotionStateManager;
+struct World;
+
+// One body as queries see it: its published pose (and the one before, for blending),
+// its filter and its shape. Written only by the physics thread, while no query holds
+// the scene.
+struct QueryBody {
+    std::uint32_t generation = 0;  // 0: no body in this slot
+    std::int32_t proxy = DynamicAabbTree::kNull;
+    bool interpolate = false;  // blended between previous and current, as its motion state
+    std::uint8_t layer = 0;
+    std::uint32_t group = 0;
+    Transform current;   // the shape's origin and orientation at the newest step
+    Transform previous;  // the step before (interpolate only)
+    Shape shape;
+
+    // The pose buffered reads return at blend weight alpha (MotionStateManager::blend).
+    Transform pose(double alpha) const;
+};
+
+class QueryScene {
+public:
+    QueryScene();
+    // A copy for the physics thread to update while a query holds this one.
+    std::unique_ptr<QueryScene> clone() const;
+
+    // Slot i from the live state (or empty if no body lives there); its proxy moved.
+    void refresh(const World& world, std::uint32_t i, bool interpolating);
+    // The pose and filter of slot i from the live state, and its tight box in `tight`;
+    // the proxy is left for move(). Distinct slots may run on many threads at once.
+    void refresh_pose(const World& world, std::uint32_t i, bool interpolating, Aabb& tight);
+    // Moves slot i's proxy if `tight` has left its fat box. One thread.
+    void move(std::uint32_t i, const Aabb& tight);
+    // The capacity of the body slots, at least.
+    void reserve(std::uint32_t slots);
+
+    // Whether the body passes the filter (layer, group, ignore, then accept).
+    static bool passes(const QueryBody& body, BodyHandle handle, const QueryFilter& filter);
+
+    // The queries, at blend weight alpha (see space.hpp for what each promises).
+    bool cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha, QueryHit& hit) const;
+    bool ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha) const;
+    void cast_ray_all(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
+                      std::vector<QueryHit>& hits) const;
+    bool cast_shape(const Shape& shape, const Transform& start, const Vec3& translation, const QueryFilter& filter,
+                    double alpha, QueryHit& hit) const;
+    void overlap_shape(const Shape& shape, const Transform& pose, const QueryFilter& filter, double alpha,
+                       std::vector<BodyHandle>& bodies) const;
+    void overlap_box(const Aabb& box, const QueryFilter& filter, double alpha, std::vector<BodyHandle>& bodies) const;
+
+    const DynamicAabbTree& tree() const noexcept { return m_tree; }
+    const std::vector<QueryBody>& bodies() const noexcept { return m_bodies; }
+
+    // Queries walking this scene now; the physics thread copies a held scene instead of
+    // writing it. Incremented under the motion-state lock, decremented with release.
+    mutable std::atomic<std::uint32_t> holders{0};
+
+private:
+    QueryScene(const QueryScene& other);
+    // The box a proxy must cover: the shape at both poses (and the swing between them).
+    static Aabb tight_bounds(const QueryBody& body);
+    void set_proxy(std::uint32_t i, const Aabb& tight);
+
+    DynamicAabbTree m_tree;
+    std::vector<QueryBody> m_bodies;
+};
+
+// A query's hold on the published scene: taken under the motion-state lock (briefly:
+// two loads and an increment), released on destruction. Any thread.
+class QueryLease {
+public:
+    explicit QueryLease(const MotionStateManager& manager);
+    ~QueryLease();
+    QueryLease(const QueryLease&) = delete;
+    QueryLease& operator=(const QueryLease&) = delete;
+
+    // Null before the space publishes its first body.
+    const QueryScene* scene() const noexcept { return m_scene.get(); }
+    double alpha() const noexcept { return m_alpha; }
+
+private:
+    std::shared_ptr<const QueryScene> m_scene;
+    double m_alpha = 1;
+};
+
+// The physics side: the scene that goes with published buffer k, ready to be written
+// (copied first if a query holds it).
+QueryScene& writable_query_scene(World& world, int k);
+
+}  // namespace spindle
