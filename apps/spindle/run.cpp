@@ -28,6 +28,7 @@
 #include "commands.hpp"
 #include "jobs.hpp"
 #include "physics_probe.hpp"
+#include "play.hpp"
 #include "progress.hpp"
 #include "recorder.hpp"
 #include "scenes.hpp"
@@ -50,6 +51,7 @@ struct RunOptions {
     std::string idle = "poll";
     std::optional<std::string> trace_file;
     std::optional<std::string> record_file;
+    bool play = false;
 };
 
 // What the game thread measured.
@@ -75,6 +77,17 @@ void print_smoothness(const char* name, const SmoothnessReport& r) {
     std::printf("    %-13s %10.3f mm %11.4f mm %9.3f %8llu of %llu\n", name, r.mean_step_m * 1e3, r.jerk_rms_m * 1e3,
                 r.relative_jerk, static_cast<unsigned long long>(r.frozen_frames),
                 static_cast<unsigned long long>(r.frames));
+}
+
+void print_play(const PlayStats& play, const WorkCounters& counters) {
+    const double frames = play.frames ? static_cast<double>(play.frames) : 1.0;
+    std::printf("  play           %llu queries (%.1f us each, %.3f ms per frame on the game thread), %llu picks, "
+                "%llu shots, %.1f bodies in the trigger box per frame, %llu query scenes copied\n",
+                static_cast<unsigned long long>(play.queries),
+                play.queries ? play.query_seconds * 1e6 / static_cast<double>(play.queries) : 0.0,
+                play.query_seconds * 1e3 / frames, static_cast<unsigned long long>(play.picks),
+                static_cast<unsigned long long>(play.shots), static_cast<double>(play.in_trigger) / frames,
+                static_cast<unsigned long long>(counters.query_scene_copies));
 }
 
 void print_summary(const SceneDesc& scene, const Layout& layout, const RunOptions& o, const GameStats& game,
@@ -178,6 +191,16 @@ int run(const RunOptions& o) {
     const MotionStateManager& states = space.motion_states();
     GameStats game;
 
+    std::optional<Player> player;
+    if (o.play) {
+        Aabb bounds;
+        for (const SceneBody& body : scene.bodies) {
+            if (body.desc.type != MotionType::Static) bounds.include(body.desc.position);
+        }
+        if (!bounds.valid()) bounds = {Vec3(-5, 0, -5), Vec3(5, 5, 5)};
+        player.emplace(space, runner, bounds);
+    }
+
     runner.start();
     const Stopwatch wall;
     const double period = 1.0 / o.render_hz;
@@ -196,6 +219,7 @@ int run(const RunOptions& o) {
         smooth_interpolated.add_frame(interpolated);
         smooth_raw.add_frame(raw);
         if (recorder) recorder->write_frame(game.frames, now, interpolated);
+        if (player) player->frame(now);
         const std::int64_t frame_end = now_nanoseconds();
         if (o.trace_file) frames.push_back({"Frame", frame_start, frame_end});
 
@@ -229,6 +253,7 @@ int run(const RunOptions& o) {
 
     print_summary(scene, layout, o, game, runner.stats(), probe.totals(), step_seconds, smooth_interpolated.report(),
                   smooth_raw.report());
+    if (player) print_play(player->stats(), space.counters());
     if (recorder) {
         recorder->close();
         std::printf("  record         %s (%llu frames x %zu bodies)\n", o.record_file->c_str(),
@@ -271,6 +296,10 @@ Command add_run_command(CLI::App& program) {
                     "next step is due: publishes only at steps, little to interpolate)")
         ->option_text("MODE")
         ->check(CLI::IsMember({"poll", "spin", "sleep"}));
+    cli->add_flag("--play", o->play,
+                  "play as a game would on the game thread: each frame a ray picks a target and\n"
+                  "checks the line of sight, an overlap counts the bodies in a trigger box; six\n"
+                  "times a second a ball is shot at the target (layer 1); the summary counts them");
     cli->add_option("--trace", o->trace_file, "write a Chrome trace-event JSON of the run (open in Perfetto)")
         ->option_text("FILE")
         ->check(not_an_option());
