@@ -28,8 +28,6 @@ World::~World() = default;
 
 namespace {
 
-bool layers_collide_in(const World& w, std::uint32_t a, std::uint32_t b) { return ((w.layer_masks[a] >> b) & 1u) != 0; }
-
 template <typename T>
 void grow(std::vector<T>& v, std::size_t n) {
     if (v.size() < n) v.resize(n);
@@ -210,7 +208,7 @@ void Space::set_layers_collide(std::uint32_t a, std::uint32_t b, bool collide) {
     check_layer(a, "set_layers_collide", "a");
     check_layer(b, "set_layers_collide", "b");
     World& w = *m_world;
-    if (layers_collide_in(w, a, b) == collide) return;
+    if (spindle::layers_collide(w, a, b) == collide) return;
     const std::uint32_t bit_a = 1u << a, bit_b = 1u << b;
     w.layer_masks[a] = collide ? (w.layer_masks[a] | bit_b) : (w.layer_masks[a] & ~bit_b);
     w.layer_masks[b] = collide ? (w.layer_masks[b] | bit_a) : (w.layer_masks[b] & ~bit_a);
@@ -221,7 +219,7 @@ bool Space::layers_collide(std::uint32_t a, std::uint32_t b) const {
     const AccessGate::Structure access(m_world->gate, "layers_collide");
     check_layer(a, "layers_collide", "a");
     check_layer(b, "layers_collide", "b");
-    return layers_collide_in(*m_world, a, b);
+    return spindle::layers_collide(*m_world, a, b);
 }
 
 const UpdateStats& Space::last_update() const noexcept { return m_world->stats; }

@@ -199,8 +199,14 @@ struct ContactSolveParams {
     Real push_out = 0;        // push-out speed
     Real slop = 0;            // gaps wider than this carry no friction
     Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
+    // How deep a point's last impulse holds its soft row at rest, per unit impulse over
+    // the effective mass (impulse_scale x impulse = mass x mass_scale x bias_rate x depth),
+    // for soft and static_soft; set with them (held_per_impulse()).
+    Real held_per_impulse = 0, static_held_per_impulse = 0;
     bool use_bias = true;
 };
+
+inline Real held_per_impulse(const Softness& soft) { return soft.impulse_scale / (soft.mass_scale * soft.bias_rate); }
 
 // contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide
 // (which manifold and bodies each lane holds); prepare_contacts fills in the rest from

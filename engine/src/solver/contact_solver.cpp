@@ -283,14 +283,10 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         prepare_friction(A, B, m, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
-    // Each lane's softness (stiffer against a static body) and how deep a point's last
-    // impulse holds its soft row at rest: impulse_scale x impulse = mass x mass_scale x
-    // bias_rate x depth.
+    // How deep a point's last impulse holds its soft row at rest, per lane (stiffer
+    // against a static body).
     const WideMask stiff = wc.against_static > splat(0);
-    const Wide held_per_impulse =
-        select(stiff,
-               splat(params.static_soft.impulse_scale / (params.static_soft.mass_scale * params.static_soft.bias_rate)),
-               splat(params.soft.impulse_scale / (params.soft.mass_scale * params.soft.bias_rate)));
+    const Wide held_per_impulse = select(stiff, splat(params.static_held_per_impulse), splat(params.held_per_impulse));
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
         p.ra = ra[j];

@@ -21,12 +21,16 @@ struct BroadphaseState {
     std::vector<std::uint8_t> moving;        // scratch, per awake body: its proxy must move this step
 };
 
+// Whether bodies on layers a and b collide, per the space's layer table.
+inline bool layers_collide(const World& world, std::uint32_t a, std::uint32_t b) {
+    return ((world.layer_masks[a] >> b) & 1u) != 0;
+}
 // Whether the collision filter keeps two bodies apart: their layers do not collide, or
 // they share a non-zero group. Reads the hot filter arrays only.
 inline bool filter_blocks_pair(const World& world, std::uint32_t i, std::uint32_t j) {
     const Bodies& b = world.bodies;
     if (b.group[i] != 0 && b.group[i] == b.group[j]) return true;
-    return ((world.layer_masks[b.layer[i]] >> b.layer[j]) & 1u) == 0;
+    return !layers_collide(world, b.layer[i], b.layer[j]);
 }
 // These bodies' filters changed (their layers and groups are already set; slots
 // ascending): their contacts the filters now reject are removed, waking both bodies, and

@@ -271,6 +271,8 @@ void solve(World& world, Real dt) {
     const Real hertz = settings.contact_hertz > 0 ? std::min(settings.contact_hertz, stiffest) : stiffest / 2;
     solve_params.soft = make_softness(hertz, settings.damping_ratio, h);
     solve_params.static_soft = make_softness(std::min(2 * hertz, stiffest), settings.damping_ratio / 2, h);
+    solve_params.held_per_impulse = held_per_impulse(solve_params.soft);
+    solve_params.static_held_per_impulse = held_per_impulse(solve_params.static_soft);
     solve_params.inv_h = 1 / h;
     solve_params.push_out = settings.push_out_speed;
     solve_params.slop = settings.linear_slop;

@@ -162,6 +162,25 @@ TEST(Filtering, LayerChangedAfterCreation_StartsPassingThroughAtTheNextStep) {
     EXPECT_LT(space.internal_position(b).y(), -2.0);
 }
 
+// Two of three resting balls change layer in one update: both fall, the third stays.
+TEST(Filtering, TwoFiltersChangedInOneUpdate_BothApplyAtTheNextStep) {
+    Space space;
+    add_ground(space);
+    space.set_layers_collide(kGroundLayer, kGhostLayer, false);
+    const BodyHandle kept = space.create_body(ball(Vec3(0, 0.5, 0)));
+    const BodyHandle first = space.create_body(ball(Vec3(3, 0.5, 0)));
+    const BodyHandle second = space.create_body(ball(Vec3(6, 0.5, 0)));
+    run(space, 90);
+    ASSERT_FALSE(space.internal_is_awake(second));
+
+    space.set_collision_filter(second, kGhostLayer, 0);
+    space.set_collision_filter(first, kGhostLayer, 0);
+    run(space, 60);
+    EXPECT_LT(space.internal_position(first).y(), -2.0);
+    EXPECT_LT(space.internal_position(second).y(), -2.0);
+    EXPECT_NEAR(space.internal_position(kept).y(), 0.5, 0.02);
+}
+
 // The ground, not the ball, changes layer: the sleeping ball it held is woken and falls.
 TEST(Filtering, GroundLayerChangedAfterCreation_WakesWhatRestedOnIt) {
     Space space;
