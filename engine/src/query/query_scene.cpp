@@ -40,42 +40,49 @@ Transform QueryBody::pose(double alpha) const {
 
 QueryScene::QueryScene() : m_tree(query_tree_settings()) {}
 
-QueryScene::QueryScene(const QueryScene& other) : m_tree(other.m_tree), m_bodies(other.m_bodies) {}
+QueryScene::QueryScene(const QueryScene& other)
+    : m_tree(other.m_tree), m_bodies(other.m_bodies), m_shapes(other.m_shapes) {}
 
 std::unique_ptr<QueryScene> QueryScene::clone() const { return std::unique_ptr<QueryScene>(new QueryScene(*this)); }
 
 void QueryScene::reserve(std::uint32_t slots) {
     if (m_bodies.size() < slots) m_bodies.resize(slots);
+    if (m_shapes.size() < slots) m_shapes.resize(slots);
 }
 
-// A blended pose lies within the shape's boxes at both poses but for the swing of the
-// turn: a point at distance r from the origin, turned through angle a by slerp while its
-// origin moves linearly, strays at most r a / 2 from the segment between its two end
-// positions (each end's distance from the slerped point is at most r a t, resp. r a (1-t)).
-Aabb QueryScene::tight_bounds(const QueryBody& body) {
-    const Aabb now = body.shape.bounds(body.current);
+Aabb box_of(const QueryBody& body, const Transform& pose) {
+    const Mat3 r = pose.q.toRotationMatrix();
+    return Aabb::from_center_extents(pose.apply(body.local_center), r.cwiseAbs() * body.local_extents);
+}
+
+// The shape's box turned with the body (an over-estimate for round shapes, cheap and
+// without reading the shape); a plane's or mesh's exact bounds (static: never blended).
+// A blended pose lies within the boxes at both poses but for the swing of the turn: a
+// point at distance r from the origin, turned through angle a by slerp while its origin
+// moves linearly, strays at most r a / 2 from the segment between its two end positions
+// (each end's distance from the slerped point is at most r a t, resp. r a (1 - t)).
+Aabb QueryScene::tight_bounds(std::uint32_t i) const {
+    const QueryBody& body = m_bodies[i];
+    if (body.exact_bounds) return m_shapes[i].bounds(body.current);
+    const Aabb now = box_of(body, body.current);
     if (!body.interpolate) return now;
-    const Aabb both = now.merged(body.shape.bounds(body.previous));
-    // The angle a <= pi sin(a / 2) = pi |vec(q0^-1 q1)| on [0, pi]. Nothing to add for a
-    // body that has not turned (a plane's unbounded box would make its reach infinite).
+    const Aabb both = now.merged(box_of(body, body.previous));
+    // The angle a <= pi sin(a / 2) = pi |vec(q0^-1 q1)| on [0, pi].
     const Real turn = std::numbers::pi_v<Real> * (body.previous.q.conjugate() * body.current.q).vec().norm();
     if (turn == 0) return both;
-    const Vec3 far = (now.max - body.current.p).cwiseAbs().cwiseMax((now.min - body.current.p).cwiseAbs());
-    return both.fattened(far.norm() * turn / 2);
+    const Real reach = body.local_center.norm() + body.local_extents.norm();
+    return both.fattened(reach * turn / 2);
 }
 
 void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpolating, Aabb& tight) {
     const Bodies& b = world.bodies;
     QueryBody& body = m_bodies[i];
-    // Shapes change only with the body (creation, or a new shape): compared, not copied.
-    if (body.generation != b.generation[i] || !same_shape(body.shape, b.desc[i].shape)) body.shape = b.desc[i].shape;
-    body.generation = b.generation[i];
     body.layer = b.layer[i];
     body.group = b.group[i];
     body.current = b.transform(i);
-    body.interpolate = interpolating && b.interpolate[i];
+    body.interpolate = interpolating && b.interpolate[i] && !body.exact_bounds;
     if (body.interpolate) body.previous = {b.history_position[0][i], b.history_orientation[0][i]};
-    tight = tight_bounds(body);
+    tight = tight_bounds(i);
 }
 
 void QueryScene::move(std::uint32_t i, const Aabb& tight) {
@@ -89,12 +96,23 @@ void QueryScene::move(std::uint32_t i, const Aabb& tight) {
 
 void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating) {
     reserve(world.bodies.capacity());
+    QueryBody& body = m_bodies[i];
     if (!world.bodies.alive[i]) {
-        QueryBody& body = m_bodies[i];
         if (body.proxy != DynamicAabbTree::kNull) m_tree.destroy_proxy(body.proxy);
         body = QueryBody{};
+        m_shapes[i] = Shape{};  // lets go of a hull or mesh
         return;
     }
+    // Shapes change only with the body (creation, a new shape): compared, not copied.
+    const Shape& shape = world.bodies.desc[i].shape;
+    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], shape)) {
+        m_shapes[i] = shape;
+        body.exact_bounds = shape.static_only();
+        const Aabb local = shape.bounds({});
+        body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
+        body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
+    }
+    body.generation = world.bodies.generation[i];
     Aabb tight;
     refresh_pose(world, i, interpolating, tight);
     move(i, tight);
@@ -117,7 +135,7 @@ bool QueryScene::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& f
         const QueryBody& body = m_bodies[i];
         const BodyHandle handle{i, body.generation};
         CastHit h;
-        if (!passes(body, handle, filter) || !ray_cast(body.shape, body.pose(alpha), from, to, h)) return -1;
+        if (!passes(body, handle, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) return -1;
         // Equal fractions keep the first found (the tree's order, the same for every run).
         if (found && h.fraction >= hit.fraction) return -1;
         found = true;
@@ -133,7 +151,7 @@ bool QueryScene::ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilte
         const auto i = static_cast<std::uint32_t>(m_tree.user(id));
         const QueryBody& body = m_bodies[i];
         CastHit h;
-        if (!passes(body, {i, body.generation}, filter) || !ray_cast(body.shape, body.pose(alpha), from, to, h)) {
+        if (!passes(body, {i, body.generation}, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) {
             return -1;
         }
         found = true;
@@ -150,7 +168,7 @@ void QueryScene::cast_ray_all(const Vec3& from, const Vec3& to, const QueryFilte
         const QueryBody& body = m_bodies[i];
         const BodyHandle handle{i, body.generation};
         CastHit h;
-        if (passes(body, handle, filter) && ray_cast(body.shape, body.pose(alpha), from, to, h)) {
+        if (passes(body, handle, filter) && ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) {
             hits.push_back({handle, h.fraction, h.point, h.normal, h.part});
         }
         return max_fraction;  // keep walking the whole segment
@@ -169,7 +187,7 @@ bool QueryScene::cast_shape(const Shape& shape, const Transform& start, const Ve
         const QueryBody& body = m_bodies[i];
         const BodyHandle handle{i, body.generation};
         CastHit h;
-        if (!passes(body, handle, filter) || !shape_cast(shape, start, translation, body.shape, body.pose(alpha), h)) {
+        if (!passes(body, handle, filter) || !shape_cast(shape, start, translation, m_shapes[i], body.pose(alpha), h)) {
             return true;
         }
         // The nearer wins; equal fractions go to the lower slot, whatever the walk's order.
@@ -189,7 +207,7 @@ void QueryScene::overlap_shape(const Shape& shape, const Transform& pose, const 
         const auto i = static_cast<std::uint32_t>(m_tree.user(id));
         const QueryBody& body = m_bodies[i];
         const BodyHandle handle{i, body.generation};
-        if (passes(body, handle, filter) && overlaps(shape, pose, body.shape, body.pose(alpha))) {
+        if (passes(body, handle, filter) && overlaps(shape, pose, m_shapes[i], body.pose(alpha))) {
             bodies.push_back(handle);
         }
         return true;

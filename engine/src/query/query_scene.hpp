@@ -24,17 +24,20 @@ class MotionStateManager;
 struct World;
 
 // One body as queries see it: its published pose (and the one before, for blending),
-// its filter and its shape. Written only by the physics thread, while no query holds
-// the scene.
+// its filter, and the box of its shape in its own frame (the tree's boxes come from it
+// without reading the shape). Written only by the physics thread, while no query holds
+// the scene. The shape itself is kept apart (QueryScene::shape), read by the exact tests.
 struct QueryBody {
     std::uint32_t generation = 0;  // 0: no body in this slot
     std::int32_t proxy = DynamicAabbTree::kNull;
-    bool interpolate = false;  // blended between previous and current, as its motion state
+    bool interpolate = false;   // blended between previous and current, as its motion state
+    bool exact_bounds = false;  // a plane or mesh: the tree takes Shape::bounds (static only)
     std::uint8_t layer = 0;
     std::uint32_t group = 0;
-    Transform current;   // the shape's origin and orientation at the newest step
-    Transform previous;  // the step before (interpolate only)
-    Shape shape;
+    Transform current;                 // the shape's origin and orientation at the newest step
+    Transform previous;                // the step before (interpolate only)
+    Vec3 local_center = Vec3::Zero();  // the shape's box in its own frame
+    Vec3 local_extents = Vec3::Zero();
 
     // The pose buffered reads return at blend weight alpha (MotionStateManager::blend).
     Transform pose(double alpha) const;
@@ -46,10 +49,12 @@ public:
     // A copy for the physics thread to update while a query holds this one.
     std::unique_ptr<QueryScene> clone() const;
 
-    // Slot i from the live state (or empty if no body lives there); its proxy moved.
+    // Slot i from the live state, shape included (or empty if no body lives there); its
+    // proxy moved. For bodies created, destroyed or changed by a write.
     void refresh(const World& world, std::uint32_t i, bool interpolating);
-    // The pose and filter of slot i from the live state, and its tight box in `tight`;
-    // the proxy is left for move(). Distinct slots may run on many threads at once.
+    // The pose and filter of slot i from the live state (its shape as last refreshed),
+    // and its tight box in `tight`; the proxy is left for move(). Distinct slots may run
+    // on many threads at once.
     void refresh_pose(const World& world, std::uint32_t i, bool interpolating, Aabb& tight);
     // Moves slot i's proxy if `tight` has left its fat box. One thread.
     void move(std::uint32_t i, const Aabb& tight);
@@ -72,6 +77,7 @@ public:
 
     const DynamicAabbTree& tree() const noexcept { return m_tree; }
     const std::vector<QueryBody>& bodies() const noexcept { return m_bodies; }
+    const Shape& shape(std::uint32_t i) const { return m_shapes[i]; }
 
     // Queries walking this scene now; the physics thread copies a held scene instead of
     // writing it. Incremented under the motion-state lock, decremented with release.
@@ -80,11 +86,12 @@ public:
 private:
     QueryScene(const QueryScene& other);
     // The box a proxy must cover: the shape at both poses (and the swing between them).
-    static Aabb tight_bounds(const QueryBody& body);
+    Aabb tight_bounds(std::uint32_t i) const;
     void set_proxy(std::uint32_t i, const Aabb& tight);
 
     DynamicAabbTree m_tree;
-    std::vector<QueryBody> m_bodies;
+    std::vector<QueryBody> m_bodies;  // per body slot; the flip's hot data
+    std::vector<Shape> m_shapes;      // per body slot; changed only with the body's shape
 };
 
 // A query's hold on the published scene: taken under the motion-state lock (briefly:

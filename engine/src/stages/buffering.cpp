@@ -183,6 +183,11 @@ void flip_read_buffers(World& world) {
     // The query scene that goes with the back buffer gets the same bodies refreshed.
     QueryScene& queries = writable_query_scene(world, k);
     queries.reserve(b.capacity());
+    // Bodies changed by writes, creation, destruction or sleep first, awake or not: a
+    // shape or filter changes here, and the awake poses below use the new shape's box.
+    for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
+        for (std::uint32_t i : *changed) queries.refresh(world, i, interpolating);
+    }
     const bool awake_stale = world.published_version[k] != world.awake_version ||
                              world.published_interpolating[k] != interpolating;
     if (awake_stale) {
@@ -212,7 +217,6 @@ void flip_read_buffers(World& world) {
         for (std::uint32_t i : *changed) {
             if (b.alive[i] && b.awake_index[i] >= 0) continue;  // awake ones were published above
             publish(i);
-            queries.refresh(world, i, interpolating);
         }
     }
     std::swap(world.changed_last, world.changed_now);
