@@ -234,3 +234,34 @@ TEST(Buffering, AnEntityOutsideASpaceReadsAndWritesItsOwnValues) {
     body.set_position(Vec3(4, 0, 0));
     EXPECT_EQ(body.position().x(), 4.0);
 }
+
+// get_all_motion_states copies runs of bodies that need no blending and blends the
+// rest: between steps, each body it returns equals that body's own read, interpolating
+// or not, across a hole where a body was destroyed; at a step boundary all are raw.
+TEST(MotionStates, CopyOfAllBlendsExactlyTheBodiesThatInterpolate) {
+    Space space(async_settings());
+    std::vector<BodyHandle> made;
+    for (int i = 0; i < 7; ++i) {
+        BodyDesc d = ball(Vec3(i, 0, 0));
+        d.linear_velocity = Vec3(1 + i, 0, 0);
+        d.angular_velocity = Vec3(0, 0, 2);
+        d.allow_interpolation = i % 3 != 1;  // runs of both kinds
+        made.push_back(space.create_body(d));
+    }
+    space.destroy_body(made[3]);
+    const Real dt = space.settings().time_step.duration;
+    space.update(2.5 * dt);  // alpha 0.5
+    std::vector<BodyHandle> handles;
+    std::vector<MotionState> states;
+    ASSERT_EQ(space.motion_states().get_all_motion_states(handles, states), 6u);
+    int blended = 0;
+    for (std::size_t k = 0; k < handles.size(); ++k) {
+        const MotionState own = space.motion_state(handles[k]);
+        EXPECT_EQ(states[k].position, own.position) << k;
+        EXPECT_EQ(states[k].orientation.coeffs(), own.orientation.coeffs()) << k;
+        EXPECT_EQ(states[k].linear_velocity, own.linear_velocity) << k;
+        blended += states[k].position != space.internal_position(handles[k]);
+    }
+    EXPECT_EQ(blended, 4);  // bodies 0, 2, 5, 6 interpolate (3 was destroyed)
+    EXPECT_EQ(handles[3], made[4]);
+}

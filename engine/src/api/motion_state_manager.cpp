@@ -4,6 +4,7 @@
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 
+#include <algorithm>
 #include <bit>
 
 namespace spindle {
@@ -71,48 +72,70 @@ void MotionStateManager::SlotGenerations::store(std::uint32_t slot, std::uint32_
 
 // ---- reads and the flip ----
 
-MotionState MotionStateManager::blend(const PublishedBody& body, double alpha) {
-    if (!body.interpolate || alpha >= 1) return body.current;
-    MotionState s = body.current;
-    const Real t = alpha;
-    s.position = body.previous_position + (body.current.position - body.previous_position) * t;
-    s.center_of_mass = body.previous_center_of_mass + (body.current.center_of_mass - body.previous_center_of_mass) * t;
-    s.orientation = slerp_shortest(body.previous_orientation, body.current.orientation, t);
+MotionState MotionStateManager::blend_locked(std::uint32_t i) const {
+    const PublishedBuffer& front = *m_front;
+    if (!front.interpolate[i] || m_alpha >= 1) return front.current[i];
+    const PublishedHistory& before = front.previous[i];
+    MotionState s = front.current[i];
+    const Real t = m_alpha;
+    s.position = before.position + (s.position - before.position) * t;
+    s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * t;
+    s.orientation = slerp_shortest(before.orientation, s.orientation, t);
     return s;
 }
 
-const PublishedBody& MotionStateManager::checked_locked(BodyHandle body) const {
+void MotionStateManager::check_locked(BodyHandle body) const {
     if (!is_published_locked(body)) {
         throw Error("motion state: " + to_string(body) + " is not a live body of this space (stale or foreign handle)");
     }
-    return (*m_front)[body.index];
 }
 
 bool MotionStateManager::is_published_locked(BodyHandle body) const noexcept {
-    return body.generation != 0 && body.index < m_front->size() && (*m_front)[body.index].generation == body.generation;
+    return body.generation != 0 && body.index < m_front->size() && m_front->generation[body.index] == body.generation;
 }
 
-MotionState MotionStateManager::read_locked(BodyHandle body) const { return blend(checked_locked(body), m_alpha); }
+MotionState MotionStateManager::read_locked(BodyHandle body) const {
+    check_locked(body);
+    return blend_locked(body.index);
+}
 
 MotionState MotionStateManager::read(BodyHandle body) const {
     const MotionStateLock::Hold guard(m_lock);
     return read_locked(body);
 }
 
+// Runs of live slots that need no blending (all of them at alpha 1, else those that do
+// not interpolate) are copied as runs, which streams like a memcpy; the others are
+// blended one by one.
 std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& handles,
                                                       std::vector<MotionState>& states) const {
     const MotionStateLock::Hold guard(m_lock);
-    const std::vector<PublishedBody>& front = *m_front;
+    const PublishedBuffer& front = *m_front;
+    const auto slots = static_cast<std::uint32_t>(front.size());
     std::size_t count = 0;
-    for (const PublishedBody& b : front) count += b.generation != 0;
+    for (std::uint32_t i = 0; i < slots; ++i) count += front.generation[i] != 0;
     handles.resize(count);
     states.resize(count);
+    const bool blending = m_alpha < 1;
+    auto copied = [&](std::uint32_t i) { return front.generation[i] != 0 && !(blending && front.interpolate[i]); };
     std::size_t k = 0;
-    for (std::uint32_t i = 0; i < front.size(); ++i) {
-        if (front[i].generation == 0) continue;
-        handles[k] = BodyHandle{i, front[i].generation};
-        states[k] = blend(front[i], m_alpha);
-        ++k;
+    for (std::uint32_t i = 0; i < slots;) {
+        if (front.generation[i] == 0) {
+            ++i;
+        } else if (!copied(i)) {
+            handles[k] = BodyHandle{i, front.generation[i]};
+            states[k++] = blend_locked(i++);
+        } else {
+            std::uint32_t end = i;
+            while (end < slots && copied(end)) {
+                handles[k + (end - i)] = BodyHandle{end, front.generation[end]};
+                ++end;
+            }
+            std::copy(front.current.begin() + i, front.current.begin() + end,
+                      states.begin() + static_cast<std::ptrdiff_t>(k));
+            k += end - i;
+            i = end;
+        }
     }
     return count;
 }
@@ -120,15 +143,15 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
 void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
     if (out.size() < bodies.size()) throw Error("get_motion_states: output span is shorter than the handle list");
     const MotionStateLock::Hold guard(m_lock);
-    for (BodyHandle b : bodies) checked_locked(b);
-    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend((*m_front)[bodies[i].index], m_alpha);
+    for (BodyHandle b : bodies) check_locked(b);
+    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend_locked(bodies[i].index);
 }
 
 void MotionStateManager::get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
     if (out.size() < bodies.size()) throw Error("get_raw_motion_states: output span is shorter than the handle list");
     const MotionStateLock::Hold guard(m_lock);
-    for (BodyHandle b : bodies) checked_locked(b);
-    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = (*m_front)[bodies[i].index].current;
+    for (BodyHandle b : bodies) check_locked(b);
+    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = m_front->current[bodies[i].index];
 }
 
 std::uint64_t MotionStateManager::published_steps() const {

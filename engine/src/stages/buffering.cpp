@@ -13,9 +13,9 @@ namespace spindle {
 class MotionStatePublisher {
 public:
     explicit MotionStatePublisher(MotionStateManager& manager) : m_manager(manager) {}
-    std::vector<PublishedBody>& back() noexcept { return m_manager.back(); }
+    PublishedBuffer& back() noexcept { return m_manager.back(); }
     int back_index() const noexcept { return m_manager.back_index(); }
-    std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_manager.buffer_locked(k); }
+    PublishedBuffer& buffer_locked(int k) noexcept { return m_manager.buffer_locked(k); }
     MotionStateLock& lock() const noexcept { return m_manager.lock(); }
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_manager.set_published_generation(slot, generation);
@@ -116,24 +116,27 @@ void apply_writes(World& world) {
 }
 
 // Fills one published entry from the live state.
-static void fill(const World& world, std::uint32_t i, PublishedBody& p, bool interpolating) {
+// Fills slot i of a published buffer from the live state.
+static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool interpolating) {
     const Bodies& b = world.bodies;
     if (!b.alive[i]) {
-        p.generation = 0;
+        p.generation[i] = 0;
         return;
     }
-    p.generation = b.generation[i];
-    p.current.orientation = b.q[i];
-    p.current.position = b.origin(i);
-    p.current.center_of_mass = b.x[i];
-    p.current.linear_velocity = b.v[i];
-    p.current.angular_velocity = b.w[i];
-    p.interpolate = interpolating && b.interpolate[i];
-    if (p.interpolate) {
+    p.generation[i] = b.generation[i];
+    MotionState& s = p.current[i];
+    s.orientation = b.q[i];
+    s.position = b.origin(i);
+    s.center_of_mass = b.x[i];
+    s.linear_velocity = b.v[i];
+    s.angular_velocity = b.w[i];
+    p.interpolate[i] = interpolating && b.interpolate[i];
+    if (p.interpolate[i]) {
         // Bodies without the flag skip this: interpolation costs them nothing.
-        p.previous_position = b.history_position[0][i];
-        p.previous_orientation = b.history_orientation[0][i];
-        p.previous_center_of_mass = p.previous_position + p.previous_orientation * b.local_com[i];
+        PublishedHistory& before = p.previous[i];
+        before.position = b.history_position[0][i];
+        before.orientation = b.history_orientation[0][i];
+        before.center_of_mass = before.position + before.orientation * b.local_com[i];
     }
 }
 
@@ -144,13 +147,13 @@ void publish_now(World& world, std::uint32_t slot) {
     // while it creates bodies); then publishing goes ahead under its hold.
     const MotionStateLock::Hold guard(manager.lock());
     for (int k = 0; k < 2; ++k) {
-        std::vector<PublishedBody>& buffer = manager.buffer_locked(k);
+        PublishedBuffer& buffer = manager.buffer_locked(k);
         if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
-        fill(world, slot, buffer[slot], interpolating);
+        fill(world, slot, buffer, interpolating);
     }
     // Creation and destruction are the only changes of a slot's generation, and both
     // publish here, so the lock-free copy buffered writes check stays exact.
-    manager.set_published_generation(slot, manager.buffer_locked(0)[slot].generation);
+    manager.set_published_generation(slot, manager.buffer_locked(0).generation[slot]);
     // Queries see the body at once too, as reads do: both scenes (no query walks either
     // while the lock is held; one that holds a scene from before keeps its copy).
     for (int k = 0; k < 2; ++k) writable_query_scene(world, k).refresh(world, slot, interpolating);
@@ -160,13 +163,13 @@ void publish_now(World& world, std::uint32_t slot) {
 void flip_read_buffers(World& world) {
     Bodies& b = world.bodies;
     MotionStatePublisher manager(world.motion_states);
-    std::vector<PublishedBody>& back = manager.back();
+    PublishedBuffer& back = manager.back();
     if (back.size() < b.capacity()) back.resize(b.capacity());
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
 
     auto publish = [&](std::uint32_t i) {
-        fill(world, i, back[i], interpolating);
-        world.counters.interpolated_publishes += back[i].interpolate ? 1 : 0;
+        fill(world, i, back, interpolating);
+        world.counters.interpolated_publishes += back.interpolate[i];
     };
     // The back buffer is two flips old: refresh what moved in either of the two
     // updates (awake bodies, and bodies changed by writes, creation or sleep). The
@@ -200,8 +203,8 @@ void flip_read_buffers(World& world) {
             std::uint64_t count = 0;
             for (std::uint32_t a = lo; a < hi; ++a) {
                 const std::uint32_t i = world.awake[a];
-                fill(world, i, back[i], interpolating);
-                count += back[i].interpolate ? 1 : 0;
+                fill(world, i, back, interpolating);
+                count += back.interpolate[i];
                 queries.refresh_pose(world, i, interpolating, query_bounds[a]);
             }
             interpolated[worker].value += count;

@@ -18,14 +18,29 @@ namespace spindle {
 
 class QueryScene;  // engine/src/query/query_scene.hpp: what scene queries read
 
-// One body as published at a flip: the newest step, and the one before for blending.
-struct PublishedBody {
-    std::uint32_t generation = 0;  // 0: no body in this slot
-    bool interpolate = false;      // allow_interpolation and internal time stepping
-    MotionState current;
-    Vec3 previous_position = Vec3::Zero();
-    Quat previous_orientation = Quat::Identity();
-    Vec3 previous_center_of_mass = Vec3::Zero();
+// The step before the newest, for blending a body that interpolates.
+struct PublishedHistory {
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+    Vec3 center_of_mass = Vec3::Zero();
+};
+
+// One published step, by body slot, as arrays: what every read copies (generation,
+// newest state) apart from what only blended reads need, so copying bodies that do not
+// interpolate streams like a memcpy of their states.
+struct PublishedBuffer {
+    std::vector<std::uint32_t> generation;  // 0: no body in this slot
+    std::vector<MotionState> current;
+    std::vector<std::uint8_t> interpolate;   // allow_interpolation and internal time stepping
+    std::vector<PublishedHistory> previous;  // meaningful where interpolate is set
+
+    std::size_t size() const noexcept { return generation.size(); }
+    void resize(std::size_t slots) {
+        generation.resize(slots);
+        current.resize(slots);
+        interpolate.resize(slots);
+        previous.resize(slots);
+    }
 };
 
 // The motion-state lock: a mutex that knows which thread holds it, so that a thread
@@ -108,7 +123,7 @@ public:
     bool is_published_locked(BodyHandle body) const noexcept;
     // The generation published for a slot (0: none), for a caller that holds lock().
     std::uint32_t published_generation_locked(std::uint32_t slot) const noexcept {
-        return slot < m_front->size() ? (*m_front)[slot].generation : 0;
+        return slot < m_front->size() ? m_front->generation[slot] : 0;
     }
     // The same without the lock: any thread, lock-free (buffered writes check handles
     // with it, so a thread holding lock() can still write). Equal to the locked value:
@@ -127,10 +142,10 @@ private:
     friend class MotionStatePublisher;
     friend class QueryLease;  // takes the published query scene under the lock
     // The buffer being filled for the next flip; never read by other threads.
-    std::vector<PublishedBody>& back() noexcept { return *m_back; }
+    PublishedBuffer& back() noexcept { return *m_back; }
     int back_index() const noexcept { return m_back == &m_buffers[0] ? 0 : 1; }  // which buffer back() is
     // Both buffers, for a caller that holds lock() (publishing a created body at once).
-    std::vector<PublishedBody>& buffer_locked(int k) noexcept { return m_buffers[k]; }
+    PublishedBuffer& buffer_locked(int k) noexcept { return m_buffers[k]; }
     // Swaps back and front under the lock and publishes the query scene that goes with
     // the new front; returns seconds the lock was held.
     double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries);
@@ -144,8 +159,9 @@ private:
         m_generations.store(slot, generation);
     }
 
-    static MotionState blend(const PublishedBody& body, double alpha);
-    const PublishedBody& checked_locked(BodyHandle body) const;
+    // Slot i of the front buffer as reads return it (blended where it interpolates).
+    MotionState blend_locked(std::uint32_t i) const;
+    void check_locked(BodyHandle body) const;
 
     // Per slot, an atomic copy of the published generation. Readers take no lock, so
     // storage never moves: chunks of doubling size, allocated by the one writer and
@@ -165,9 +181,9 @@ private:
 
     mutable MotionStateLock m_lock;
     SlotGenerations m_generations;
-    std::vector<PublishedBody> m_buffers[2];
-    std::vector<PublishedBody>* m_front = &m_buffers[0];
-    std::vector<PublishedBody>* m_back = &m_buffers[1];
+    PublishedBuffer m_buffers[2];
+    PublishedBuffer* m_front = &m_buffers[0];
+    PublishedBuffer* m_back = &m_buffers[1];
     double m_alpha = 1;
     std::uint64_t m_steps = 0;
     std::shared_ptr<const QueryScene> m_query_scene;  // null until a body is published
