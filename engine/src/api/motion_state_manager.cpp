@@ -99,6 +99,11 @@ MotionState MotionStateManager::read(BodyHandle body) const {
     return read_locked(body);
 }
 
+std::uint64_t MotionStateManager::read_user_data(BodyHandle body) const {
+    const MotionStateLock::Hold guard(m_lock);
+    return checked_locked(body).user_data;
+}
+
 std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& handles,
                                                       std::vector<MotionState>& states) const {
     const MotionStateLock::Hold guard(m_lock);

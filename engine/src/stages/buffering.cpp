@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "solver/speed_limit.hpp"
+#include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -18,6 +19,9 @@ public:
     MotionStateLock& lock() const noexcept { return m_manager.lock(); }
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_manager.set_published_generation(slot, generation);
+    }
+    void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
+        m_manager.set_published_kind(slot, type, static_only_shape);
     }
     double flip(double alpha, std::uint64_t steps) { return m_manager.flip(alpha, steps); }
 
@@ -48,13 +52,16 @@ void apply_writes(World& world) {
     Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
-    std::vector<std::uint32_t> refiltered;  // bodies whose filter changed (rare: no allocation otherwise)
+    std::vector<std::uint32_t> refiltered;    // bodies whose filter changed (rare: no allocation otherwise)
+    std::vector<std::uint32_t> rematerialed;  // bodies whose friction or restitution changed (as rare)
     for (const PendingWrites& write : world.drained) {
         if (!b.is_live(write.body)) {
             world.stats.writes_rejected += static_cast<int>(write.writes);  // destroyed after the writes were made
             continue;
         }
         const std::uint32_t i = write.body.index;
+        // Motion type, shape and material first: what follows is applied to the body as changed.
+        world.stats.writes_rejected += apply_body_changes(world, write, rematerialed);
         const bool moves = b.type[i] != MotionType::Static;
         const bool pose = (write.bits & kPendingPose) != 0;
         if (pose) {
@@ -77,6 +84,14 @@ void apply_writes(World& world) {
             }
             if ((write.bits & kPendingForce) != 0) b.force[i] = saturate(b.force[i] + write.force);
             if ((write.bits & kPendingTorque) != 0) b.torque[i] = saturate(b.torque[i] + write.torque);
+            // Forces and impulses at points turn the body about its centre of mass as it is now.
+            if ((write.bits & kPendingForceAt) != 0) {
+                b.torque[i] = saturate(b.torque[i] + write.force_moment - b.x[i].cross(write.force_at));
+            }
+            if ((write.bits & kPendingImpulseAt) != 0) {
+                const Vec3 angular = saturate(write.impulse_moment - b.x[i].cross(write.impulse_at));
+                b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), angular, max_angular);
+            }
             if (b.locks[i] != 0) {
                 // Written velocities and impulses lose their locked components (the
                 // angular impulse already went through the locked inverse inertia).
@@ -91,6 +106,13 @@ void apply_writes(World& world) {
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
+        if ((write.bits & kPendingKinematicMove) != 0) {
+            if (b.type[i] == MotionType::Kinematic) {
+                add_kinematic_move(world, i, write.target_position, write.target_orientation);
+            } else {
+                world.stats.writes_rejected += 1;  // made static or dynamic since the move was written
+            }
+        }
         if ((write.bits & kPendingFilter) != 0 && (b.layer[i] != write.layer || b.group[i] != write.group)) {
             b.layer[i] = static_cast<std::uint8_t>(write.layer);
             b.group[i] = write.group;
@@ -101,6 +123,7 @@ void apply_writes(World& world) {
         world.stats.writes_applied += static_cast<int>(write.writes);
         world.stats.bodies_written += 1;
     }
+    if (!rematerialed.empty()) recombine_materials(world, rematerialed);  // slots ascending, as drained
     if (!refiltered.empty()) {
         std::sort(refiltered.begin(), refiltered.end());
         refilter_bodies(world, refiltered);
@@ -121,6 +144,7 @@ static void fill(const World& world, std::uint32_t i, PublishedBody& p, bool int
     p.current.center_of_mass = b.x[i];
     p.current.linear_velocity = b.v[i];
     p.current.angular_velocity = b.w[i];
+    p.user_data = b.desc[i].user_data;
     p.interpolate = interpolating && b.interpolate[i];
     if (p.interpolate) {
         // Bodies without the flag skip this: interpolation costs them nothing.
@@ -144,6 +168,13 @@ void publish_now(World& world, std::uint32_t slot) {
     // Creation and destruction are the only changes of a slot's generation, and both
     // publish here, so the lock-free copy buffered writes check stays exact.
     manager.set_published_generation(slot, manager.buffer_locked(0)[slot].generation);
+    publish_kind(world, slot);
+}
+
+void publish_kind(World& world, std::uint32_t slot) {
+    const Bodies& b = world.bodies;
+    MotionStatePublisher(world.motion_states)
+        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.desc[slot].shape.static_only());
 }
 
 void flip_read_buffers(World& world) {

@@ -23,6 +23,7 @@ struct PublishedBody {
     Vec3 previous_position = Vec3::Zero();
     Quat previous_orientation = Quat::Identity();
     Vec3 previous_center_of_mass = Vec3::Zero();
+    std::uint64_t user_data = 0;  // BodyDesc::user_data, as last set (Space::set_user_data)
 };
 
 // The motion-state lock: a mutex that knows which thread holds it, so that a thread
@@ -112,6 +113,17 @@ public:
     // a slot's generation changes only when a body is created or destroyed, and both
     // publish it to both buffers at once (publish_now), so a flip never changes it.
     std::uint32_t published_generation(std::uint32_t slot) const noexcept { return m_generations.load(slot); }
+    // A slot's motion type, and whether its shape can only belong to a static body, as of
+    // the last creation or ApplyWrites that changed them: any thread, lock-free, for the
+    // checks of writes that depend on them (Space::move_kinematic, set_shape, set_motion_type).
+    MotionType published_motion_type(std::uint32_t slot) const noexcept {
+        return static_cast<MotionType>(m_kinds.load(slot) & 0xffu);
+    }
+    bool published_static_only_shape(std::uint32_t slot) const noexcept { return (m_kinds.load(slot) >> 8) != 0; }
+
+    // A body's user data (BodyDesc::user_data, Space::set_user_data) as published; throws
+    // for a stale handle. Takes the lock unless this thread holds it.
+    std::uint64_t read_user_data(BodyHandle body) const;
 
     // Steps published so far and the weight of the newest step in blended reads.
     std::uint64_t published_steps() const;
@@ -133,6 +145,9 @@ private:
     // Records a slot's published generation; the physics side, under lock().
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_generations.store(slot, generation);
+    }
+    void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
+        m_kinds.store(slot, static_cast<std::uint32_t>(type) | (static_only_shape ? 0x100u : 0u));
     }
 
     static MotionState blend(const PublishedBody& body, double alpha);
@@ -156,6 +171,7 @@ private:
 
     mutable MotionStateLock m_lock;
     SlotGenerations m_generations;
+    SlotGenerations m_kinds;  // the same storage for motion type | static-only shape << 8
     std::vector<PublishedBody> m_buffers[2];
     std::vector<PublishedBody>* m_front = &m_buffers[0];
     std::vector<PublishedBody>* m_back = &m_buffers[1];
