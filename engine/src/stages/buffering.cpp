@@ -72,8 +72,8 @@ void apply_writes(World& world) {
             if ((write.bits & kPendingOrientation) != 0) b.q[i] = write.orientation.normalized();
             b.x[i] = origin + b.q[i] * b.local_com[i];
             reset_history(b, i);
-        } else if (moves) {
-            wake_body(world, i);
+        } else if (moves && write.bits != kPendingUserData) {
+            wake_body(world, i);  // not for user data alone: a game may tag sleeping bodies every frame
         }
         if (moves) {
             if ((write.bits & kPendingLinearVelocity) != 0) b.v[i] = write.linear_velocity;

@@ -169,6 +169,7 @@ TEST(Setters, UserData_ReadFromAnotherThreadAfterTheNextUpdate) {
     d.user_data = 7;
     const BodyHandle b = space.create_body(d);
     EXPECT_EQ(space.user_data(b), 7u);
+    run(space, 2);  // both published buffers hold the body: only the write can republish it
     std::thread writer([&] { space.set_user_data(b, 0xfeedbeefcafeULL); });
     writer.join();
     std::uint64_t before = 0, after = 0;
@@ -180,6 +181,21 @@ TEST(Setters, UserData_ReadFromAnotherThreadAfterTheNextUpdate) {
     EXPECT_EQ(space.internal_desc(b).user_data, 0xfeedbeefcafeULL);
     space.update();  // the other published buffer has it too
     EXPECT_EQ(space.user_data(b), 0xfeedbeefcafeULL);
+}
+
+TEST(Setters, UserData_DoesNotWakeASleepingBody) {
+    Space space;
+    add_ground(space);
+    const BodyHandle b = space.create_body(box(Vec3(0, 0.5, 0)));
+    run(space, 120);
+    ASSERT_FALSE(space.internal_is_awake(b));
+    space.set_user_data(b, 3);
+    space.update();
+    EXPECT_FALSE(space.internal_is_awake(b));
+    EXPECT_EQ(space.user_data(b), 3u);
+    space.set_gravity_scale(b, 1);  // any other write does wake it
+    space.update();
+    EXPECT_TRUE(space.internal_is_awake(b));
 }
 
 // ---- forces and impulses at points ----
@@ -313,9 +329,45 @@ TEST(Setters, StaticBoxMadeDynamic_Falls) {
     run(space, 30);
     EXPECT_EQ(space.internal_position(b).y(), 5);
     space.set_motion_type(b, MotionType::Dynamic);
+    space.apply_impulse(b, Vec3(500, 0, 0));  // after the type: its new mass, 1000 kg, takes it
+    space.flush();
+    EXPECT_NEAR(space.internal_linear_velocity(b).x(), 0.5, 1e-12);
     run(space, 60);
     EXPECT_LT(space.internal_position(b).y(), 1);
     EXPECT_EQ(space.internal_desc(b).type, MotionType::Dynamic);
+}
+
+// A sleeping box made static must leave its sleeping island: waking the island later (the
+// box on it is pushed) must not put the static body in the awake list.
+TEST(Setters, SleepingBoxMadeStatic_NeverJoinsTheAwakeList) {
+    Space space;
+    add_ground(space);
+    const BodyHandle bottom = space.create_body(box(Vec3(0, 0.5, 0)));
+    const BodyHandle top = space.create_body(box(Vec3(0, 1.5, 0)));
+    run(space, 180);
+    ASSERT_FALSE(space.internal_is_awake(bottom));
+    space.set_motion_type(bottom, MotionType::Static);
+    const Vec3 held = space.internal_position(bottom);
+    space.apply_impulse(top, Vec3(0, 2000, 0));
+    for (int i = 0; i < 60; ++i) {
+        space.update();
+        ASSERT_FALSE(space.internal_is_awake(bottom)) << "step " << i;
+    }
+    EXPECT_EQ(space.internal_position(bottom), held);
+    run(space, 120);
+    EXPECT_NEAR(space.internal_position(top).y(), held.y() + 1, 0.02);
+}
+
+// With interpolation, a body made static reads where it is, not a blend with the step before.
+TEST(Setters, BodyMadeStaticWhileFalling_InterpolatedReadIsItsPose) {
+    SpaceSettings s;
+    s.time_step.use_internal_time_stepping = true;
+    Space space(s);
+    const BodyHandle b = space.create_body(box(Vec3(0, 5, 0)));
+    for (int i = 0; i < 10; ++i) space.update(1.0 / 60);
+    space.set_motion_type(b, MotionType::Static);
+    space.update(1.5 / 60);  // one step and half a step left over: alpha 0.5
+    EXPECT_EQ(space.position(b), space.internal_position(b));
 }
 
 TEST(Setters, DynamicBoxMadeStatic_StopsMidairAndHoldsABoxDroppedOnIt) {
@@ -375,6 +427,35 @@ TEST(Setters, RestingBoxMadeKinematic_LosesItsContactWithTheGround) {
     space.set_motion_type(b, MotionType::Dynamic);  // and back: found again
     run(space, 2);
     EXPECT_EQ(space.last_update().contacts, 1u);
+}
+
+// A body flagged fast that was static is swept once dynamic (World::fast_bodies counts
+// it): a bar spinning at 60 rad/s stops at a 4 cm wall (tests/engine/continuous).
+TEST(Setters, FastStaticBarMadeDynamic_IsSweptAndStopsAtAThinWall) {
+    Space space(weightless());
+    BodyDesc wall;
+    wall.type = MotionType::Static;
+    wall.shape = Shape::box(Vec3(0.02, 5, 5));
+    wall.position = Vec3(0.5, 0, 0);
+    space.create_body(wall);
+    BodyDesc bar;
+    bar.type = MotionType::Static;
+    bar.shape = Shape::box(Vec3(2, 0.05, 0.05));
+    bar.position = Vec3(-1, 0, 0);
+    bar.orientation = about_z(2.0);
+    bar.fast = true;
+    const BodyHandle b = space.create_body(bar);
+    space.set_motion_type(b, MotionType::Dynamic);
+    space.set_angular_velocity(b, Vec3(0, 0, -60));
+    Real max_tip_x = -1e9;
+    for (int i = 0; i < 30; ++i) {
+        space.update();
+        const MotionState s = space.internal_motion_state(b);
+        for (Real end : {2.0, -2.0})
+            max_tip_x = std::max(max_tip_x, (s.position + s.orientation * Vec3(end, 0, 0)).x());
+    }
+    EXPECT_LT(max_tip_x, 0.48 + 0.01);
+    EXPECT_GT(space.counters().swept_tests, 0u);
 }
 
 // ---- the buffer's rules ----

@@ -122,18 +122,20 @@ public:
     // contacts (found again at the next step, none between two bodies that are not
     // dynamic) and rebuilds its mass (none unless dynamic). A static body made moving
     // starts at rest; a kinematic one keeps its velocity. A body with a plane or mesh
-    // shape (as published) cannot be made moving: spindle::Error. A dynamic body whose
-    // density and mass are both 0 cannot be made dynamic: that write is dropped at
-    // ApplyWrites and counted in last_update().writes_rejected.
+    // shape cannot be made moving: spindle::Error. A body whose density and mass are both 0
+    // (allowed unless dynamic) cannot be made dynamic: that write is dropped at ApplyWrites
+    // and counted in last_update().writes_rejected. The motion type and shape these checks
+    // read are the body's as of the last ApplyWrites (lock-free).
     void set_motion_type(BodyHandle body, MotionType type);
     // A new shape (validated as create_body's). Unless keep_mass, mass, inertia and centre
     // of mass are rebuilt from it and the body's density or mass (its origin stays put).
     // Wakes what it touches; its contacts are found again at the next step. A plane or mesh
-    // only for a static body, and a shape with no volume not for a dynamic one (both as
-    // published): spindle::Error.
+    // only for a static body, and a shape with no volume not for a dynamic one (the type as
+    // of the last ApplyWrites): spindle::Error.
     void set_shape(BodyHandle body, const Shape& shape, bool keep_mass = false);
     // BodyDesc::user_data. user_data() reads it as published at the last FlipReadBuffers
-    // (any thread; takes the motion-state lock as motion_state() does).
+    // (any thread; takes the motion-state lock as motion_state() does). Unlike the other
+    // writes, setting it does not wake a sleeping body.
     void set_user_data(BodyHandle body, std::uint64_t user_data);
     std::uint64_t user_data(BodyHandle body) const;
     // A force (for one step) or an impulse at a world point: as add_force/apply_impulse,
@@ -144,8 +146,8 @@ public:
     // A kinematic body's next step takes it exactly to this pose (origin and orientation)
     // with the velocities that reach it in one step (contacts push with them); after that
     // step it is at rest unless moved again. Kept until a step takes it (an update that
-    // takes no step loses nothing). The body must be kinematic as published (else
-    // spindle::Error); if a set_motion_type made it otherwise before the move applies, the
+    // takes no step loses nothing). The body must be kinematic as of the last ApplyWrites
+    // (else spindle::Error); if a set_motion_type made it otherwise before the move applies, the
     // move is dropped and counted in last_update().writes_rejected.
     void move_kinematic(BodyHandle body, const Vec3& position, const Quat& orientation);
 
