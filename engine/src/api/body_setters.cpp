@@ -7,6 +7,7 @@
 #include <spindle/platform/error.hpp>
 
 #include "api/validation.hpp"
+#include "solver/speed_limit.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -114,7 +115,7 @@ void Space::add_force_at(BodyHandle body, const Vec3& force, const Vec3& point) 
     check_handle_for_write(m_world->motion_states, body, "add_force_at");
     BufferedWrite write = write_of(body, WriteKind::ForceAt);
     write.vector = force;
-    write.moment = point.cross(force);
+    write.moment = saturated_cross(point, force);
     m_world->writes.push(write);
 }
 
@@ -124,7 +125,7 @@ void Space::apply_impulse_at(BodyHandle body, const Vec3& impulse, const Vec3& p
     check_handle_for_write(m_world->motion_states, body, "apply_impulse_at");
     BufferedWrite write = write_of(body, WriteKind::ImpulseAt);
     write.vector = impulse;
-    write.moment = point.cross(impulse);
+    write.moment = saturated_cross(point, impulse);
     m_world->writes.push(write);
 }
 

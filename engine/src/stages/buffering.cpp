@@ -86,10 +86,10 @@ void apply_writes(World& world) {
             if ((write.bits & kPendingTorque) != 0) b.torque[i] = saturate(b.torque[i] + write.torque);
             // Forces and impulses at points turn the body about its centre of mass as it is now.
             if ((write.bits & kPendingForceAt) != 0) {
-                b.torque[i] = saturate(b.torque[i] + write.force_moment - b.x[i].cross(write.force_at));
+                b.torque[i] = saturate(b.torque[i] + write.force_moment - saturated_cross(b.x[i], write.force_at));
             }
             if ((write.bits & kPendingImpulseAt) != 0) {
-                const Vec3 angular = saturate(write.impulse_moment - b.x[i].cross(write.impulse_at));
+                const Vec3 angular = saturate(write.impulse_moment - saturated_cross(b.x[i], write.impulse_at));
                 b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), angular, max_angular);
             }
             if (b.locks[i] != 0) {

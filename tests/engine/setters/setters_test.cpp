@@ -531,6 +531,14 @@ TEST(Setters, BadValuesAndStaleHandles_ThrowNamingThemAndChangeNothing) {
          [&] { space.move_kinematic(gone, Vec3::Zero(), Quat::Identity()); }},
         {"body 1 (generation 1)", [&] { (void)space.user_data(gone); }},
     };
+    BodyDesc kd = box(Vec3(6, 1, 0));
+    kd.type = MotionType::Kinematic;
+    const BodyHandle k = space.create_body(kd);
+    const std::string target = error_of([&] { space.move_kinematic(k, Vec3(0, nan, 0), Quat::Identity()); });
+    EXPECT_NE(target.find("move_kinematic: position must be finite"), std::string::npos) << target;
+    const std::string turn = error_of([&] { space.move_kinematic(k, Vec3::Zero(), Quat(0, 0, 0, 0)); });
+    EXPECT_NE(turn.find("move_kinematic: orientation must be a finite, non-zero quaternion"), std::string::npos)
+        << turn;
     for (const Case& c : cases) {
         const std::string e = error_of(c.call);
         EXPECT_NE(e.find(c.expected), std::string::npos) << "expected \"" << c.expected << "\", got \"" << e << "\"";
@@ -543,6 +551,7 @@ TEST(Setters, BadValuesAndStaleHandles_ThrowNamingThemAndChangeNothing) {
     EXPECT_EQ(after.type, MotionType::Dynamic);
     EXPECT_EQ(after.shape.type, ShapeType::Sphere);
     EXPECT_EQ(space.internal_angular_velocity(b), Vec3::Zero());
+    EXPECT_EQ(space.internal_position(k), Vec3(6, 1, 0));
 }
 
 TEST(Setters, PlaneBodyMadeDynamic_Throws) {
