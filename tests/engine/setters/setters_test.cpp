@@ -319,6 +319,37 @@ TEST(Setters, SetShapeKeepingMass_KeepsTheMass) {
     EXPECT_NEAR(space.internal_linear_velocity(b).x(), 1, 1e-6);
 }
 
+// A hull whose centre of mass is off its origin: the joint's anchor must stay on the same
+// point of the body (joint frames are kept from the centre of mass, which moved).
+TEST(Setters, SetShapeMovingTheCentreOfMass_KeepsJointAnchorsInPlace) {
+    Space space(weightless());
+    BodyDesc anchor_desc = box(Vec3(0, 0, 0));
+    anchor_desc.type = MotionType::Static;
+    const BodyHandle anchor = space.create_body(anchor_desc);
+    const BodyHandle b = space.create_body(ball(Vec3(2, 0, 0)));
+    const JointHandle joint = space.create_joint(JointDesc::ball_socket_at(anchor, b, Vec3(1.5, 0, 0)));
+    const Vec3 corners[] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
+                            Vec3(1, 1, 0), Vec3(1, 0, 1), Vec3(0, 1, 1), Vec3(1, 1, 1)};
+    space.set_shape(b, Shape::convex_hull(corners));  // centre of mass at (0.5, 0.5, 0.5)
+    space.flush();
+    EXPECT_NEAR(space.internal_joint_error(joint).linear, 0, 1e-12);
+    EXPECT_TRUE(space.internal_motion_state(b).center_of_mass.isApprox(Vec3(2.5, 0.5, 0.5), 1e-12));
+    EXPECT_EQ(space.internal_position(b), Vec3(2, 0, 0)) << "the origin stays where it was";
+}
+
+// The floor's new shape no longer reaches under a sleeping box: no new contact wakes it,
+// so the change itself must, or the box hangs in the air.
+TEST(Setters, FloorShrunkFromUnderASleepingBox_TheBoxFalls) {
+    Space space;
+    const BodyHandle ground = add_ground(space);
+    const BodyHandle b = space.create_body(box(Vec3(5, 0.5, 0)));
+    run(space, 120);
+    ASSERT_FALSE(space.internal_is_awake(b));
+    space.set_shape(ground, Shape::box(Vec3(2, 0.5, 2)));
+    run(space, 60);
+    EXPECT_LT(space.internal_position(b).y(), -1);
+}
+
 // ---- motion type ----
 
 TEST(Setters, StaticBoxMadeDynamic_Falls) {
