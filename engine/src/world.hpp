@@ -187,6 +187,13 @@ struct FastStart {
     Quat q0 = Quat::Identity();
 };
 
+// A kinematic body's target pose (Space::move_kinematic), for the next step to reach.
+struct KinematicMove {
+    BodyHandle body;
+    Vec3 center_of_mass = Vec3::Zero();
+    Quat orientation = Quat::Identity();
+};
+
 struct World {
     SpaceSettings settings;
     JobSystem* jobs = nullptr;
@@ -263,6 +270,7 @@ struct World {
     // the Continuous stage instead of walking the awake bodies to find none.
     std::uint32_t fast_bodies = 0;
     std::vector<std::uint32_t> scratch_candidates;
+    std::vector<KinematicMove> kinematic_moves;  // taken by the next step (stages/body_changes.cpp)
 
     // Islands.
     std::vector<SleepingIsland> sleeping_islands;

@@ -12,14 +12,6 @@
 namespace spindle {
 namespace {
 
-// Lock-free, so a thread holding the motion-state lock can still write. The published
-// generation of a slot is exact (creation and destruction publish at once), so a handle
-// that does not match it names no live body: stale, never made, or from another space.
-void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* what) {
-    if (body.generation == 0 || manager.published_generation(body.index) != body.generation)
-        throw Error(std::string(what) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
-}
-
 // The field a vector write carries, for its error message.
 const char* field_of(WriteKind kind) {
     switch (kind) {

@@ -104,6 +104,12 @@ MotionState MotionStateManager::read(BodyHandle body) const {
     return read_locked(body);
 }
 
+std::uint64_t MotionStateManager::read_user_data(BodyHandle body) const {
+    const MotionStateLock::Hold guard(m_lock);
+    check_locked(body);
+    return m_front->user_data[body.index];
+}
+
 // Runs of live slots that need no blending (all of them at alpha 1, else those that do
 // not interpolate) are copied as runs, which streams like a memcpy; the others are
 // blended one by one.

@@ -14,6 +14,7 @@
 #include "api/validation.hpp"
 #include "solver/constraints.hpp"
 #include "solver/speed_limit.hpp"
+#include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -58,30 +59,11 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     desc.orientation.normalize();
 
     // Mass first: it may throw (e.g. a degenerate shape), and nothing has changed yet.
-    Real inv_mass = 0;
-    Mat3 inv_inertia = Mat3::Zero();
-    Mat3 inertia = Mat3::Zero();
-    Vec3 local_com = Vec3::Zero();
-    if (desc.type == MotionType::Dynamic) {
-        MassProperties mp = desc.shape.mass_properties(desc.density);
-        if (desc.mass > 0) {
-            mp.inertia *= desc.mass / mp.mass;
-            mp.mass = desc.mass;
-        }
-        if (!(mp.mass > 0) || !mp.inertia.allFinite()) {
-            throw Error("create_body: the shape has no volume (mass " + number(mp.mass) + ")");
-        }
-        inv_mass = 1 / mp.mass;
-        inv_inertia = mp.inertia.inverse();
-        // A mass so small that its inverse overflows would turn every impulse into NaN.
-        if (!std::isfinite(inv_mass) || !inv_inertia.allFinite()) {
-            throw Error("create_body: mass " + number(mp.mass) + " is too small: its inverse is not finite");
-        }
-        inertia = mp.inertia;
-        local_com = mp.center_of_mass;
-    } else if (desc.shape.type != ShapeType::Plane && desc.shape.type != ShapeType::TriangleMesh) {
-        local_com = Vec3::Zero();
-    }
+    const BodyMass mass = body_mass(desc, desc.type, desc.shape, "create_body");
+    const Real inv_mass = mass.inv_mass;
+    const Mat3& inv_inertia = mass.inv_inertia;
+    const Mat3& inertia = mass.inertia;
+    const Vec3& local_com = mass.local_com;
 
     std::uint32_t slot;
     if (!b.free_slots.empty()) {

@@ -2,6 +2,7 @@
 // descriptions and motion states.
 #include "api/validation.hpp"
 
+#include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/platform/error.hpp>
 
 #include <cmath>
@@ -167,6 +168,14 @@ void validate(const BodyDesc& d) {
     check_non_negative(d.linear_damping, who, "linear_damping");
     check_non_negative(d.angular_damping, who, "angular_damping");
     check_layer(d.layer, who, "layer");
+}
+
+// The published generation of a slot is exact (creation and destruction publish at once),
+// so a handle that does not match it names no live body: stale, never made, or from
+// another space.
+void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* who) {
+    if (body.generation == 0 || manager.published_generation(body.index) != body.generation)
+        throw Error(std::string(who) + ": " + to_string(body) + " is not a live body (stale or foreign handle)");
 }
 
 void validate(const MotionState& s, const char* who) {

@@ -11,6 +11,8 @@
 
 namespace spindle {
 
+class MotionStateManager;
+
 // Throws spindle::Error("<who>: <field> <rule>, got <got>").
 [[noreturn]] void reject_field(const char* who, const std::string& field, const char* rule, const std::string& got);
 
@@ -25,6 +27,9 @@ void check_at_least(int value, int least, const char* who, const char* field);
 void check_direction(const Vec3& value, const char* who, const char* field);    // finite and non-zero
 void check_orientation(const Quat& value, const char* who, const char* field);  // finite and non-zero
 void check_layer(std::uint32_t value, const char* who, const char* field);      // < kLayerCount
+// A buffered write's handle: "<who>: body 3 (generation 1) is not a live body ...". Lock-free
+// (published_generation), so a thread holding the motion-state lock can still write.
+void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* who);
 
 // Settings, the same for the Space constructor and each setter (who: "time_step",
 // "solver", "sleep"; gravity says "gravity must be finite").

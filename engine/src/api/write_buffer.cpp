@@ -10,7 +10,7 @@ namespace {
 
 // Adds v to one of the entry's sums, which starts afresh when its bit is clear (never
 // written, or dropped by a velocity write since).
-void accumulate(PendingWrites& entry, Vec3& sum, std::uint16_t bit, const Vec3& v) {
+void accumulate(PendingWrites& entry, Vec3& sum, std::uint32_t bit, const Vec3& v) {
     sum = (entry.bits & bit) != 0 ? saturate(sum + v) : v;
     entry.bits |= bit;
 }
@@ -32,14 +32,16 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             break;
         case WriteKind::AngularVelocity:
             entry.angular_velocity = write.vector;
-            entry.bits = (entry.bits | kPendingAngularVelocity) & ~kPendingAngularImpulse;
+            // The angular part of an impulse at a point goes too; its linear part is in `impulse`.
+            entry.bits = (entry.bits | kPendingAngularVelocity) & ~(kPendingAngularImpulse | kPendingImpulseAt);
             break;
         case WriteKind::MotionState:
             entry.position = write.state.position;
             entry.orientation = write.state.orientation;
             entry.linear_velocity = write.state.linear_velocity;
             entry.angular_velocity = write.state.angular_velocity;
-            entry.bits = (entry.bits | kPendingPose | kPendingVelocity) & ~(kPendingImpulse | kPendingAngularImpulse);
+            entry.bits = (entry.bits | kPendingPose | kPendingVelocity) &
+                         ~(kPendingImpulse | kPendingAngularImpulse | kPendingImpulseAt);
             break;
         case WriteKind::Force: accumulate(entry, entry.force, kPendingForce, write.vector); break;
         case WriteKind::Torque: accumulate(entry, entry.torque, kPendingTorque, write.vector); break;
@@ -52,6 +54,56 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             entry.layer = write.layer;
             entry.group = write.group;
             entry.bits |= kPendingFilter;
+            break;
+        case WriteKind::Friction:
+            entry.friction = write.scalar;
+            entry.bits |= kPendingFriction;
+            break;
+        case WriteKind::Restitution:
+            entry.restitution = write.scalar;
+            entry.bits |= kPendingRestitution;
+            break;
+        case WriteKind::GravityScale:
+            entry.gravity_scale = write.scalar;
+            entry.bits |= kPendingGravityScale;
+            break;
+        case WriteKind::Damping:
+            entry.linear_damping = write.scalar;
+            entry.angular_damping = write.scalar2;
+            entry.bits |= kPendingDamping;
+            break;
+        case WriteKind::MotionType:
+            entry.motion_type = write.motion_type;
+            entry.bits |= kPendingMotionType;
+            break;
+        case WriteKind::Shape:
+            entry.shape = write.shape;
+            entry.keep_mass = write.keep_mass;
+            entry.bits |= kPendingShape;
+            break;
+        case WriteKind::UserData:
+            entry.user_data = write.user_data;
+            entry.bits |= kPendingUserData;
+            break;
+        case WriteKind::KinematicMove:
+            entry.target_position = write.vector;
+            entry.target_orientation = write.rotation;
+            entry.bits |= kPendingKinematicMove;
+            break;
+        case WriteKind::ForceAt:
+            // The linear part is a force like any other; the moment waits for the centre of mass.
+            accumulate(entry, entry.force, kPendingForce, write.vector);
+            if ((entry.bits & kPendingForceAt) == 0) entry.force_at = entry.force_moment = Vec3::Zero();
+            entry.force_at = saturate(entry.force_at + write.vector);
+            entry.force_moment = saturate(entry.force_moment + write.moment);
+            entry.bits |= kPendingForceAt;
+            break;
+        case WriteKind::ImpulseAt:
+            accumulate(entry, entry.impulse, kPendingImpulse, write.vector);
+            if ((entry.bits & kPendingImpulseAt) == 0) entry.impulse_at = entry.impulse_moment = Vec3::Zero();
+            entry.impulse_at = saturate(entry.impulse_at + write.vector);
+            entry.impulse_moment = saturate(entry.impulse_moment + write.moment);
+            entry.bits |= kPendingImpulseAt;
             break;
     }
 }

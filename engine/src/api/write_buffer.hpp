@@ -30,20 +30,37 @@ enum class WriteKind : std::uint8_t {
     AngularImpulse,
     Wake,
     Filter,  // layer and group
+    // Changes after creation (api/body_setters.cpp): each replaces the last of its kind.
+    Friction,
+    Restitution,
+    GravityScale,
+    Damping,  // linear and angular
+    MotionType,
+    Shape,
+    UserData,
+    KinematicMove,  // target pose
+    ForceAt,        // force at a world point: the force, and its moment about the origin
+    ImpulseAt,      // the same for an impulse
 };
 
 // One write as a caller makes it.
 struct BufferedWrite {
     BodyHandle body;
     WriteKind kind = WriteKind::Wake;
-    Vec3 vector = Vec3::Zero();          // position, velocity, force, impulse
+    Vec3 vector = Vec3::Zero();          // position, velocity, force, impulse, kinematic target
+    Vec3 moment = Vec3::Zero();          // force or impulse at a point: p x vector
     Quat rotation = Quat::Identity();    // orientation
     MotionState state;                   // motion state
     std::uint32_t layer = 0, group = 0;  // collision filter
+    Real scalar = 0, scalar2 = 0;        // friction, restitution, gravity scale, damping (linear, angular)
+    std::uint64_t user_data = 0;
+    spindle::MotionType motion_type = spindle::MotionType::Dynamic;
+    bool keep_mass = false;
+    spindle::Shape shape;  // set_shape only (empty otherwise: no geometry is copied)
 };
 
 // Which properties a body's pending entry holds.
-enum PendingBits : std::uint16_t {
+enum PendingBits : std::uint32_t {
     kPendingPosition = 1U << 0U,
     kPendingOrientation = 1U << 1U,
     kPendingLinearVelocity = 1U << 2U,
@@ -54,6 +71,16 @@ enum PendingBits : std::uint16_t {
     kPendingAngularImpulse = 1U << 7U,
     kPendingWake = 1U << 8U,
     kPendingFilter = 1U << 9U,
+    kPendingFriction = 1U << 10U,
+    kPendingRestitution = 1U << 11U,
+    kPendingGravityScale = 1U << 12U,
+    kPendingDamping = 1U << 13U,
+    kPendingMotionType = 1U << 14U,
+    kPendingShape = 1U << 15U,
+    kPendingUserData = 1U << 16U,
+    kPendingKinematicMove = 1U << 17U,
+    kPendingForceAt = 1U << 18U,
+    kPendingImpulseAt = 1U << 19U,
     kPendingPose = kPendingPosition | kPendingOrientation,
     kPendingVelocity = kPendingLinearVelocity | kPendingAngularVelocity,
 };
@@ -65,7 +92,7 @@ enum PendingBits : std::uint16_t {
 struct PendingWrites {
     BodyHandle body;
     std::uint32_t writes = 0;  // calls coalesced into this entry
-    std::uint16_t bits = 0;    // PendingBits
+    std::uint32_t bits = 0;    // PendingBits
     Vec3 position = Vec3::Zero();
     Quat orientation = Quat::Identity();
     Vec3 linear_velocity = Vec3::Zero();
@@ -75,6 +102,20 @@ struct PendingWrites {
     Vec3 impulse = Vec3::Zero();
     Vec3 angular_impulse = Vec3::Zero();
     std::uint32_t layer = 0, group = 0;  // valid where kPendingFilter is set
+    // Changes after creation, each valid where its bit is set.
+    Real friction = 0, restitution = 0, gravity_scale = 1;
+    Real linear_damping = 0, angular_damping = 0;
+    spindle::MotionType motion_type = spindle::MotionType::Dynamic;
+    bool keep_mass = false;
+    spindle::Shape shape;
+    std::uint64_t user_data = 0;
+    Vec3 target_position = Vec3::Zero();  // kinematic move: the shape's origin
+    Quat target_orientation = Quat::Identity();
+    // Forces and impulses at points: their sums, and the sums of their moments about the
+    // world origin (p x f). ApplyWrites turns them into a torque about the centre of mass
+    // as it is then: sum(p x f) - c x sum(f).
+    Vec3 force_at = Vec3::Zero(), force_moment = Vec3::Zero();
+    Vec3 impulse_at = Vec3::Zero(), impulse_moment = Vec3::Zero();
 };
 
 class WriteBuffer {

@@ -3,6 +3,8 @@
 // finite input, however large, makes a velocity or a position infinite.
 #pragma once
 
+#include <algorithm>
+
 #include <cmath>
 
 #include <spindle/engine/math.hpp>
@@ -43,5 +45,13 @@ inline Vec3 add_angular(const Vec3& v, Real scale, const Mat3& m, const Vec3& j,
 
 // An accumulated force or torque stays finite however many huge ones are added.
 inline Vec3 saturate(const Vec3& v) { return v.cwiseMax(Vec3::Constant(-kHuge)).cwiseMin(Vec3::Constant(kHuge)); }
+
+// a x b with each product held to +-kHuge before the differences: huge finite inputs may
+// give an infinite component (which saturate() takes back) but never inf - inf, a NaN.
+inline Vec3 saturated_cross(const Vec3& a, const Vec3& b) {
+    auto product = [](Real x, Real y) { return std::clamp(x * y, -kHuge, kHuge); };
+    return Vec3(product(a.y(), b.z()) - product(a.z(), b.y()), product(a.z(), b.x()) - product(a.x(), b.z()),
+                product(a.x(), b.y()) - product(a.y(), b.x()));
+}
 
 }  // namespace spindle

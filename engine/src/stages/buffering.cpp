@@ -4,6 +4,7 @@
 
 #include "query/query_scene.hpp"
 #include "solver/speed_limit.hpp"
+#include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -19,6 +20,9 @@ public:
     MotionStateLock& lock() const noexcept { return m_manager.lock(); }
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_manager.set_published_generation(slot, generation);
+    }
+    void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
+        m_manager.set_published_kind(slot, type, static_only_shape);
     }
     double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries) {
         return m_manager.flip(alpha, steps, std::move(queries));
@@ -54,13 +58,16 @@ void apply_writes(World& world) {
     Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
-    std::vector<std::uint32_t> refiltered;  // bodies whose filter changed (rare: no allocation otherwise)
+    std::vector<std::uint32_t> refiltered;    // bodies whose filter changed (rare: no allocation otherwise)
+    std::vector<std::uint32_t> rematerialed;  // bodies whose friction or restitution changed (as rare)
     for (const PendingWrites& write : world.drained) {
         if (!b.is_live(write.body)) {
             world.stats.writes_rejected += static_cast<int>(write.writes);  // destroyed after the writes were made
             continue;
         }
         const std::uint32_t i = write.body.index;
+        // Motion type, shape and material first: what follows is applied to the body as changed.
+        world.stats.writes_rejected += apply_body_changes(world, write, rematerialed);
         const bool moves = b.type[i] != MotionType::Static;
         const bool pose = (write.bits & kPendingPose) != 0;
         if (pose) {
@@ -71,8 +78,8 @@ void apply_writes(World& world) {
             if ((write.bits & kPendingOrientation) != 0) b.q[i] = write.orientation.normalized();
             b.x[i] = origin + b.q[i] * b.local_com[i];
             reset_history(b, i);
-        } else if (moves) {
-            wake_body(world, i);
+        } else if (moves && write.bits != kPendingUserData) {
+            wake_body(world, i);  // not for user data alone: a game may tag sleeping bodies every frame
         }
         if (moves) {
             if ((write.bits & kPendingLinearVelocity) != 0) b.v[i] = write.linear_velocity;
@@ -83,6 +90,14 @@ void apply_writes(World& world) {
             }
             if ((write.bits & kPendingForce) != 0) b.force[i] = saturate(b.force[i] + write.force);
             if ((write.bits & kPendingTorque) != 0) b.torque[i] = saturate(b.torque[i] + write.torque);
+            // Forces and impulses at points turn the body about its centre of mass as it is now.
+            if ((write.bits & kPendingForceAt) != 0) {
+                b.torque[i] = saturate(b.torque[i] + write.force_moment - saturated_cross(b.x[i], write.force_at));
+            }
+            if ((write.bits & kPendingImpulseAt) != 0) {
+                const Vec3 angular = saturate(write.impulse_moment - saturated_cross(b.x[i], write.impulse_at));
+                b.w[i] = add_angular(b.w[i], 1, b.inv_inertia_world(i), angular, max_angular);
+            }
             if (b.locks[i] != 0) {
                 // Written velocities and impulses lose their locked components (the
                 // angular impulse already went through the locked inverse inertia).
@@ -97,6 +112,13 @@ void apply_writes(World& world) {
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
+        if ((write.bits & kPendingKinematicMove) != 0) {
+            if (b.type[i] == MotionType::Kinematic) {
+                add_kinematic_move(world, i, write.target_position, write.target_orientation);
+            } else {
+                world.stats.writes_rejected += 1;  // made static or dynamic since the move was written
+            }
+        }
         if ((write.bits & kPendingFilter) != 0 && (b.layer[i] != write.layer || b.group[i] != write.group)) {
             b.layer[i] = static_cast<std::uint8_t>(write.layer);
             b.group[i] = write.group;
@@ -108,6 +130,7 @@ void apply_writes(World& world) {
         world.stats.writes_applied += static_cast<int>(write.writes);
         world.stats.bodies_written += 1;
     }
+    if (!rematerialed.empty()) recombine_materials(world, rematerialed);  // slots ascending, as drained
     if (!refiltered.empty()) {
         std::sort(refiltered.begin(), refiltered.end());
         refilter_bodies(world, refiltered);
@@ -150,14 +173,22 @@ void publish_now(World& world, std::uint32_t slot) {
         PublishedBuffer& buffer = manager.buffer_locked(k);
         if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
         fill(world, slot, buffer, interpolating);
+        buffer.user_data[slot] = world.bodies.alive[slot] ? world.bodies.desc[slot].user_data : 0;
     }
     // Creation and destruction are the only changes of a slot's generation, and both
     // publish here, so the lock-free copy buffered writes check stays exact.
     manager.set_published_generation(slot, manager.buffer_locked(0).generation[slot]);
+    publish_kind(world, slot);
     // Queries see the body at once too, as reads do: both scenes (no query walks either
     // while the lock is held; one that holds a scene from before keeps its copy).
     for (int k = 0; k < 2; ++k) writable_query_scene(world, k).refresh(world, slot, interpolating);
     manager.set_query_scene_locked(world.query_scenes[1 - manager.back_index()]);
+}
+
+void publish_kind(World& world, std::uint32_t slot) {
+    const Bodies& b = world.bodies;
+    MotionStatePublisher(world.motion_states)
+        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.desc[slot].shape.static_only());
 }
 
 void flip_read_buffers(World& world) {
@@ -188,8 +219,13 @@ void flip_read_buffers(World& world) {
     queries.reserve(b.capacity());
     // Bodies changed by writes, creation, destruction or sleep first, awake or not: a
     // shape or filter changes here, and the awake poses below use the new shape's box.
+    // User data too: it changes only by creation or a write, both noted in changed_now (it
+    // lives in the cold description, which the awake refill below does not read).
     for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
-        for (std::uint32_t i : *changed) queries.refresh(world, i, interpolating);
+        for (std::uint32_t i : *changed) {
+            queries.refresh(world, i, interpolating);
+            back.user_data[i] = b.alive[i] ? b.desc[i].user_data : 0;
+        }
     }
     const bool awake_stale = world.published_version[k] != world.awake_version ||
                              world.published_interpolating[k] != interpolating;

@@ -55,5 +55,8 @@ void wake_touching(World& world, std::uint32_t slot);
 // Writes a body's current state into both published buffers at once (create/destroy
 // between updates), so buffered reads see it before the next flip (buffering.cpp).
 void publish_now(World& world, std::uint32_t slot);
+// Records a body's motion type and shape kind where buffered writes check them lock-free
+// (MotionStateManager::published_motion_type), at once (buffering.cpp).
+void publish_kind(World& world, std::uint32_t slot);
 
 }  // namespace spindle

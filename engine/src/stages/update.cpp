@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "api/describe.hpp"
+#include "stages/body_changes.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -130,6 +131,9 @@ void Space::flush() {
 void step(World& w, Real dt) {
     SPINDLE_ASSERT(w.awake_pending.empty() && w.awake_left_from == kNoPosition,
                    "step: the awake list has changes not settled (settle_awake after waking or sleeping)");
+    // Kinematic moves (Space::move_kinematic) set the velocities that reach their targets in
+    // this step, so the broadphase sweeps and the contacts push with them.
+    if (!w.kinematic_moves.empty()) start_kinematic_moves(w, dt);
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
@@ -137,6 +141,7 @@ void step(World& w, Real dt) {
     if (w.fast_bodies > 0) run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });
     run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
     if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
+    if (!w.kinematic_moves.empty()) finish_kinematic_moves(w);  // exactly on target, then at rest
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;
     w.counters.steps += 1;

@@ -63,6 +63,24 @@ TEST(HugeInput, ForcesAndTorquesNearTheLargestDoubleLeaveAFiniteState) {
     expect_finite_and_limited(space, {scene.sphere, scene.box});
 }
 
+// Forces and impulses at points far out: their moments overflow, and must not turn into
+// NaN (inf - inf) on the way to the torque.
+TEST(HugeInput, ForcesAndImpulsesAtFarPointsLeaveAFiniteState) {
+    Scene scene = make_scene();
+    Space& space = *scene.space;
+    const Vec3 far(1e9, 1e9, -1e9);
+    for (int k = 0; k < 3; ++k) {
+        space.add_force_at(scene.box, Vec3(kLargest, kLargest, -kLargest), far);
+        space.apply_impulse_at(scene.box, Vec3(kLargest, kLargest, kLargest), far);
+        space.apply_impulse_at(scene.sphere, Vec3(kLargest, -kLargest, kLargest), -far);
+    }
+    space.flush();
+    EXPECT_TRUE(is_finite(space.angular_velocity(scene.box)));
+    EXPECT_TRUE(is_finite(space.angular_velocity(scene.sphere)));
+    for (int i = 0; i < 30; ++i) space.update();
+    expect_finite_and_limited(space, {scene.sphere, scene.box});
+}
+
 TEST(HugeInput, HugeVelocitiesAreHeldToTheLimits) {
     Scene scene = make_scene();
     Space& space = *scene.space;

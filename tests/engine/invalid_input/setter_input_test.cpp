@@ -29,6 +29,10 @@ const std::vector<VectorWrite>& vector_writes() {
         {"torque", [](Space& s, BodyHandle b, const Vec3& v) { s.add_torque(b, v); }},
         {"impulse", [](Space& s, BodyHandle b, const Vec3& v) { s.apply_impulse(b, v); }},
         {"angular_impulse", [](Space& s, BodyHandle b, const Vec3& v) { s.apply_angular_impulse(b, v); }},
+        {"force", [](Space& s, BodyHandle b, const Vec3& v) { s.add_force_at(b, v, Vec3(2, 3.5, 0)); }},
+        {"point", [](Space& s, BodyHandle b, const Vec3& v) { s.add_force_at(b, Vec3(1, 0, 0), v); }},
+        {"impulse", [](Space& s, BodyHandle b, const Vec3& v) { s.apply_impulse_at(b, v, Vec3(2, 3.5, 0)); }},
+        {"point", [](Space& s, BodyHandle b, const Vec3& v) { s.apply_impulse_at(b, Vec3(1, 0, 0), v); }},
     };
     return writes;
 }
@@ -121,6 +125,27 @@ TEST(InvalidWrite, CollisionFilterLayerMustBeBelowTheLayerCount) {
     for (std::uint32_t layer : {0u, kLayerCount - 1, kLayerCount, ~0u}) {
         try_write([&](Space& s, BodyHandle b) { s.set_collision_filter(b, layer, 7); }, layer < kLayerCount, "layer",
                   std::to_string(layer));
+    }
+}
+
+// The real-valued changes after creation, each with BodyDesc's rule for its field.
+TEST(InvalidWrite, RealSettersFollowTheirRules) {
+    struct RealWrite {
+        const char* field;
+        Rule rule;
+        std::function<void(Space&, BodyHandle, Real)> set;
+    };
+    const std::vector<RealWrite> writes{
+        {"friction", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_friction(b, v); }},
+        {"restitution", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_restitution(b, v); }},
+        {"gravity_scale", Rule::Finite, [](Space& s, BodyHandle b, Real v) { s.set_gravity_scale(b, v); }},
+        {"linear_damping", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_damping(b, v, 0); }},
+        {"angular_damping", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_damping(b, 0, v); }},
+    };
+    for (const RealWrite& w : writes) {
+        for (const Trial& t : kTrials) {
+            try_write([&](Space& s, BodyHandle b) { w.set(s, b, t.value); }, accepts(w.rule, t.value), w.field, t.name);
+        }
     }
 }
 

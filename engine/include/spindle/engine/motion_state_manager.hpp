@@ -33,6 +33,7 @@ struct PublishedBuffer {
     std::vector<MotionState> current;
     std::vector<std::uint8_t> interpolate;   // allow_interpolation and internal time stepping
     std::vector<PublishedHistory> previous;  // meaningful where interpolate is set
+    std::vector<std::uint64_t> user_data;    // BodyDesc::user_data, as last set (Space::set_user_data)
 
     std::size_t size() const noexcept { return generation.size(); }
     void resize(std::size_t slots) {
@@ -40,6 +41,7 @@ struct PublishedBuffer {
         current.resize(slots);
         interpolate.resize(slots);
         previous.resize(slots);
+        user_data.resize(slots);
     }
 };
 
@@ -130,6 +132,17 @@ public:
     // a slot's generation changes only when a body is created or destroyed, and both
     // publish it to both buffers at once (publish_now), so a flip never changes it.
     std::uint32_t published_generation(std::uint32_t slot) const noexcept { return m_generations.load(slot); }
+    // A slot's motion type, and whether its shape can only belong to a static body, as of
+    // the last creation or ApplyWrites that changed them: any thread, lock-free, for the
+    // checks of writes that depend on them (Space::move_kinematic, set_shape, set_motion_type).
+    MotionType published_motion_type(std::uint32_t slot) const noexcept {
+        return static_cast<MotionType>(m_kinds.load(slot) & 0xffu);
+    }
+    bool published_static_only_shape(std::uint32_t slot) const noexcept { return (m_kinds.load(slot) >> 8) != 0; }
+
+    // A body's user data (BodyDesc::user_data, Space::set_user_data) as published; throws
+    // for a stale handle. Takes the lock unless this thread holds it.
+    std::uint64_t read_user_data(BodyHandle body) const;
 
     // Steps published so far and the weight of the newest step in blended reads.
     std::uint64_t published_steps() const;
@@ -158,6 +171,9 @@ private:
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_generations.store(slot, generation);
     }
+    void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
+        m_kinds.store(slot, static_cast<std::uint32_t>(type) | (static_only_shape ? 0x100u : 0u));
+    }
 
     // Slot i of the front buffer as reads return it (blended where it interpolates).
     MotionState blend_locked(std::uint32_t i) const;
@@ -181,6 +197,7 @@ private:
 
     mutable MotionStateLock m_lock;
     SlotGenerations m_generations;
+    SlotGenerations m_kinds;  // the same storage for motion type | static-only shape << 8
     PublishedBuffer m_buffers[2];
     PublishedBuffer* m_front = &m_buffers[0];
     PublishedBuffer* m_back = &m_buffers[1];

@@ -109,6 +109,50 @@ public:
     // rejects are removed (waking what they touched) and its overlaps are found again.
     void set_collision_filter(BodyHandle body, std::uint32_t layer, std::uint32_t group);
 
+    // Changes after creation (issue 17), buffered like the writes above: any thread, any
+    // time, concurrently with update(); the last write of each wins; live at the next
+    // update's ApplyWrites. Each checks its values first (spindle::Error naming the field
+    // and value: "set_friction: friction must be finite and >= 0, got nan"), then the
+    // handle, lock-free (a stale one is named); a rejected call changes nothing. None takes
+    // the motion-state lock, so none can deadlock with a flip.
+    // The body's contacts mix the new friction or restitution from the next step on.
+    void set_friction(BodyHandle body, Real friction);             // >= 0
+    void set_restitution(BodyHandle body, Real restitution);       // >= 0
+    void set_gravity_scale(BodyHandle body, Real scale);           // finite
+    void set_damping(BodyHandle body, Real linear, Real angular);  // 1/s, >= 0 each
+    // Static, kinematic or dynamic. Wakes the body and what it touches, removes its
+    // contacts (found again at the next step, none between two bodies that are not
+    // dynamic) and rebuilds its mass (none unless dynamic). A static body made moving
+    // starts at rest; a kinematic one keeps its velocity. A body with a plane or mesh
+    // shape cannot be made moving: spindle::Error. A body whose density and mass are both 0
+    // (allowed unless dynamic) cannot be made dynamic: that write is dropped at ApplyWrites
+    // and counted in last_update().writes_rejected. The motion type and shape these checks
+    // read are the body's as of the last ApplyWrites (lock-free).
+    void set_motion_type(BodyHandle body, MotionType type);
+    // A new shape (validated as create_body's). Unless keep_mass, mass, inertia and centre
+    // of mass are rebuilt from it and the body's density or mass (its origin stays put).
+    // Wakes what it touches; its contacts are found again at the next step. A plane or mesh
+    // only for a static body, and a shape with no volume not for a dynamic one (the type as
+    // of the last ApplyWrites): spindle::Error.
+    void set_shape(BodyHandle body, const Shape& shape, bool keep_mass = false);
+    // BodyDesc::user_data. user_data() reads it as published at the last FlipReadBuffers
+    // (any thread; takes the motion-state lock as motion_state() does). Unlike the other
+    // writes, setting it does not wake a sleeping body.
+    void set_user_data(BodyHandle body, std::uint64_t user_data);
+    std::uint64_t user_data(BodyHandle body) const;
+    // A force (for one step) or an impulse at a world point: as add_force/apply_impulse,
+    // plus the torque (point - centre of mass) x force about the centre of mass as it is
+    // at ApplyWrites. Accumulated like add_force and apply_impulse.
+    void add_force_at(BodyHandle body, const Vec3& force, const Vec3& point);
+    void apply_impulse_at(BodyHandle body, const Vec3& impulse, const Vec3& point);
+    // A kinematic body's next step takes it exactly to this pose (origin and orientation)
+    // with the velocities that reach it in one step (contacts push with them); after that
+    // step it is at rest unless moved again. Kept until a step takes it (an update that
+    // takes no step loses nothing). The body must be kinematic as of the last ApplyWrites
+    // (else spindle::Error); if a set_motion_type made it otherwise before the move applies, the
+    // move is dropped and counted in last_update().writes_rejected.
+    void move_kinematic(BodyHandle body, const Vec3& position, const Quat& orientation);
+
     // ---- scene queries (any thread, any time, concurrently with update) ----
     // Each meets the bodies where the published step puts them: where motion_state() and
     // get_motion_states() say they are (blended where those are), so a ray hits what the
@@ -151,7 +195,9 @@ public:
     Vec3 internal_angular_velocity(BodyHandle body) const;
     void set_internal_motion_state(BodyHandle body, const MotionState& state);
     bool internal_is_awake(BodyHandle body) const;
-    BodyDesc internal_desc(BodyHandle body) const;  // as created (shape, material, flags; a copy), filter as last set
+    // As created (shape, material, flags; a copy), with the changes made since (filter,
+    // material, gravity scale, damping, motion type, shape, user data) as last applied.
+    BodyDesc internal_desc(BodyHandle body) const;
     // How far a joint is from satisfied now, from the live poses.
     JointError internal_joint_error(JointHandle joint) const;
     // A hinge's angle (rad): B's rotation relative to A about the axis since creation.

@@ -25,7 +25,7 @@ struct UpdateStats {
     int steps = 0;               // steps taken by this update
     double dropped_seconds = 0;  // time beyond the cap's worth, thrown away
     int writes_applied = 0;      // buffered writes (calls) that reached the live state
-    int writes_rejected = 0;     // buffered writes to bodies destroyed since (reported, not applied)
+    int writes_rejected = 0;     // buffered writes to bodies destroyed since, or that could not apply (space.hpp)
     int bodies_written = 0;      // bodies ApplyWrites changed: its cost, however many writes each got
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};  // summed over the steps
     double flip_lock_seconds = 0;  // how long FlipReadBuffers held the motion-state lock
