@@ -15,6 +15,7 @@
 #include "solver/constraints.hpp"
 #include "solver/speed_limit.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -47,6 +48,7 @@ Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make
     m_world->jobs = jobs;
     m_world->broadphase = std::make_unique<BroadphaseState>();
     m_world->solver = std::make_unique<SolverScratch>();
+    m_world->events = std::make_unique<ContactEvents>();
 }
 
 Space::~Space() = default;

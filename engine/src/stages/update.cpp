@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "api/describe.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -136,6 +137,7 @@ void step(World& w, Real dt) {
     // Fast bodies' poses before the solver moves them; no stage at all in a scene without any.
     if (w.fast_bodies > 0) run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });
     run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
+    note_hits(w);  // from the impulses just solved; nothing to do unless a pair reports events
     if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;

@@ -57,6 +57,9 @@ struct WorkCounters {
     std::uint64_t swept_tests = 0;            // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
     std::uint64_t awake_publishes = 0;         // awake bodies' entries refilled by FlipReadBuffers
+    // Contact-steps checked for events (touch changes after the narrowphase, hits after
+    // the solver): only pairs with a body that asked for events or is a sensor.
+    std::uint64_t contact_event_checks = 0;
 };
 
 }  // namespace spindle
