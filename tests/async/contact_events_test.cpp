@@ -58,11 +58,13 @@ TEST(ContactEventsAsync, GameThreadReadsEveryEventOnceWhileTheRunnerSteps) {
     finishes_in_time([&] {
         runner.start();
         const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
-        while (std::chrono::steady_clock::now() < end) {
+        // Reads at once, and after pauses spanning none to several flips (a step is 4 ms).
+        constexpr int kPauseMicroseconds[] = {0, 300, 1000, 5000, 12000};
+        for (int i = 0; std::chrono::steady_clock::now() < end; ++i) {
             batch.clear();
             reads += space.read_contact_events(batch) > 0 ? 1 : 0;
             seen.insert(seen.end(), batch.begin(), batch.end());
-            std::this_thread::sleep_for(std::chrono::microseconds(500 * (reads % 4)));
+            std::this_thread::sleep_for(std::chrono::microseconds(kPauseMicroseconds[i % 5]));
         }
         runner.stop();
     });
