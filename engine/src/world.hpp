@@ -28,6 +28,7 @@
 namespace spindle {
 
 struct BroadphaseState;  // stages/broadphase_state.hpp
+struct ContactEvents;    // stages/contact_events.hpp
 struct SolverScratch;    // solver/constraints.hpp
 class QueryScene;        // query/query_scene.hpp
 
@@ -120,6 +121,11 @@ struct ContactManifold {
     Real twist_impulse = 0;
 };
 
+// Contact::events: the pair reports events (a body asked, or is a sensor); a body is a
+// sensor (the pair exerts no force: no solver rows, no island link).
+inline constexpr std::uint8_t kContactReports = 1u << 0;
+inline constexpr std::uint8_t kContactSensor = 1u << 1;
+
 // A pair of bodies whose fat bounds overlap.
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
@@ -131,6 +137,9 @@ struct Contact {
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
     bool sleeping = false;
+    std::uint8_t events = 0;      // kContactReports, kContactSensor (set at creation)
+    bool touch_reported = false;  // touching as last reported by a Begin (an End clears it)
+    bool pushed = false;          // a reporting contact pushed in its last solved step (a Hit starts a push)
     // The poses the manifolds were last collided at (B's centre of mass in A's frame and
     // both rotations): while the bodies stay close to them the manifolds are recycled,
     // not collided again (narrowphase.cpp).
@@ -149,6 +158,7 @@ struct Contact {
 inline constexpr std::uint32_t kSummaryRestitution = 1u << 17;
 inline std::uint32_t contact_summary(const Contact& contact) {
     static_assert(kMaxManifoldPoints < 16, "a point count in 4 bits");
+    if ((contact.events & kContactSensor) != 0) return 0;  // a sensor's manifolds push nothing
     std::uint32_t summary = contact.restitution > 0 ? kSummaryRestitution : 0u;
     for (int m = 0; m < contact.manifold_count; ++m) {
         summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (4 * m);
@@ -171,6 +181,7 @@ struct alignas(64) EffectCounts {
 // Contacts of one worker in the narrowphase, summed after the stage.
 struct alignas(64) ContactCounts {
     std::uint32_t touching = 0, reused = 0;
+    std::uint32_t event_checks = 0;  // reporting contacts checked for a touch change
 };
 
 // A sleeping island: its bodies, contacts and joints, kept so one touch wakes them together.
@@ -230,6 +241,10 @@ struct World {
         all.fill(~std::uint32_t{0});
         return all;
     }();
+
+    // Contact and sensor events: gathered by the steps, published at the flip, read by the
+    // game (stages/contact_events.cpp).
+    std::unique_ptr<ContactEvents> events;
 
     // Joints (api/joint_api.cpp); solved with the contacts, coloured first.
     Joints joints;

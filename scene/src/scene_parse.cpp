@@ -184,7 +184,9 @@ const std::vector<std::string_view>& body_property_keys() {
                                                        "allow_sleep",
                                                        "fast",
                                                        "layer",
-                                                       "group"};
+                                                       "group",
+                                                       "contact_events",
+                                                       "sensor"};
     return keys;
 }
 
@@ -237,6 +239,10 @@ bool apply_body_key(const TomlReader& r, std::string_view key, const toml::node&
         d.layer = static_cast<std::uint32_t>(r.integer(value, what, 0, std::int64_t{kLayerCount} - 1));
     } else if (key == "group") {
         d.group = static_cast<std::uint32_t>(r.integer(value, what, 0, std::int64_t{UINT32_MAX}));
+    } else if (key == "contact_events") {
+        d.contact_events = r.boolean(value, what);
+    } else if (key == "sensor") {
+        d.sensor = r.boolean(value, what);
     } else {
         return false;
     }

@@ -16,6 +16,7 @@
 #include "solver/speed_limit.hpp"
 #include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -46,6 +47,7 @@ Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make
     m_world->jobs = jobs;
     m_world->broadphase = std::make_unique<BroadphaseState>();
     m_world->solver = std::make_unique<SolverScratch>();
+    m_world->events = std::make_unique<ContactEvents>();
 }
 
 Space::~Space() = default;

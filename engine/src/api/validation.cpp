@@ -102,6 +102,12 @@ void validate(const SleepSettings& s) {
     check_non_negative(s.angular_threshold, who, "angular_threshold");
 }
 
+void validate(const EventSettings& s) {
+    const char* who = "events";
+    check_non_negative(s.hit_speed, who, "hit_speed");
+    if (s.max_queued < 1) reject_field(who, "max_queued", "must be >= 1", std::to_string(s.max_queued));
+}
+
 void validate_gravity(const Vec3& gravity) {
     if (!is_finite(gravity)) throw Error("gravity must be finite, got " + vec(gravity));
 }
@@ -111,6 +117,7 @@ void validate(const SpaceSettings& s) {
     validate(s.time_step);
     validate(s.solver);
     validate(s.sleep);
+    validate(s.events);
 }
 
 // ---- shapes and bodies ----

@@ -32,10 +32,11 @@ void check_layer(std::uint32_t value, const char* who, const char* field);      
 void check_handle_for_write(const MotionStateManager& manager, BodyHandle body, const char* who);
 
 // Settings, the same for the Space constructor and each setter (who: "time_step",
-// "solver", "sleep"; gravity says "gravity must be finite").
+// "solver", "sleep", "events"; gravity says "gravity must be finite").
 void validate(const TimeStepSettings& settings);
 void validate(const SolverSettings& settings);
 void validate(const SleepSettings& settings);
+void validate(const EventSettings& settings);
 void validate_gravity(const Vec3& gravity);
 void validate(const SpaceSettings& settings);
 

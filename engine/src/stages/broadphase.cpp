@@ -9,8 +9,9 @@ namespace spindle {
 namespace {
 
 bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
-    // Two bodies that cannot move each other make no contact.
-    return b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic;
+    // Two bodies that cannot move each other make no contact; two sensors do not sense each other.
+    return (b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic) &&
+           !(b.desc[i].sensor && b.desc[j].sensor);
 }
 
 void mark_refit(BroadphaseState& bp, std::uint32_t slot) {

@@ -6,6 +6,7 @@
 #include "solver/speed_limit.hpp"
 #include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -268,6 +269,7 @@ void flip_read_buffers(World& world) {
     // After the swap the new back buffer may be shorter than the body slots.
     if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());
+    publish_contact_events(world);  // under the events' own lock, not the motion-state lock
 }
 
 }  // namespace spindle

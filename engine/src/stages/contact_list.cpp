@@ -4,6 +4,7 @@
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -37,6 +38,7 @@ void create_contact(World& world, std::uint64_t key) {
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     contact.radius_a = round_radius(bodies.desc[a].shape);
     contact.radius_b = round_radius(bodies.desc[b].shape);
+    note_contact_created(world, contact);  // before the summary: a sensor's has no points
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contact_summaries.push_back(contact_summary(contact));
     world.contacts.push_back(std::move(contact));
@@ -57,7 +59,10 @@ const std::vector<std::uint32_t>& awake_contacts(World& world) {
 
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
     if (positions.empty()) return;
-    for (std::uint32_t p : positions) world.contact_index.erase(world.contact_keys[p]);
+    for (std::uint32_t p : positions) {
+        note_contact_removed(world, world.contacts[p]);  // a touching one ends its touch
+        world.contact_index.erase(world.contact_keys[p]);
+    }
     std::size_t next = 0, write = 0;
     for (std::size_t read = 0; read < world.contacts.size(); ++read) {
         if (next < positions.size() && positions[next] == read) {

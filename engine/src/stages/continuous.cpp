@@ -71,7 +71,7 @@ void record_fast_starts(World& world) {
     world.fast_starts.clear();
     const Bodies& b = world.bodies;
     for (std::uint32_t i : world.awake) {
-        if (b.is_fast(i)) world.fast_starts.push_back({i, b.x[i], b.q[i]});
+        if (b.is_fast(i) && !b.desc[i].sensor) world.fast_starts.push_back({i, b.x[i], b.q[i]});
     }
     SPINDLE_ASSERT(world.fast_starts.size() <= world.fast_bodies, "continuous: more fast bodies awake than counted");
 }
@@ -90,7 +90,9 @@ void sweep_fast_bodies(World& world) {
         const Aabb swept = shape.bounds(sweep.at(0)).merged(shape.bounds(sweep.at(1))).fattened(reach_radius);
         candidates.clear();
         bp.tree.query(swept, [&](ProxyId id) {
-            if (id.is_static()) candidates.push_back(static_cast<std::uint32_t>(bp.tree.user(id)));
+            // A static sensor stops nothing.
+            if (id.is_static() && !b.desc[bp.tree.user(id)].sensor)
+                candidates.push_back(static_cast<std::uint32_t>(bp.tree.user(id)));
             return true;
         });
         std::sort(candidates.begin(), candidates.end());  // the same order whatever the tree's shape

@@ -26,7 +26,8 @@ void unite(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b)
     if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
 }
 
-bool touching(const Contact& c) { return c.manifold_count > 0; }
+// A sensor's contact pushes nothing: it neither links bodies into an island nor wakes one.
+bool touching(const Contact& c) { return c.manifold_count > 0 && (c.events & kContactSensor) == 0; }
 
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -158,6 +159,16 @@ void update_narrowphase(World& world) {
     // Counted per worker while the contacts are at hand (a sum: it does not matter who
     // counted which), not in a second pass over every contact.
     world.contact_counts.assign(world.jobs->worker_count(), ContactCounts{});
+    // Reporting contacts whose touch changed or that may push, per worker; none while no
+    // contact reports events.
+    std::vector<std::vector<std::uint32_t>>& event_candidates = world.events->found;
+    if (world.events->reporting > 0) event_candidates.resize(world.jobs->worker_count());
+    auto note_events = [&](Contact& contact, std::uint32_t position, unsigned worker, ContactCounts& counts) {
+        if (contact.events == 0) return;
+        counts.event_checks += 1;
+        if (contact.manifold_count == 0) contact.pushed = false;  // apart: the next push is a new impact
+        if (contact_event_candidate(contact)) event_candidates[worker].push_back(position);
+    };
     // A parallel_for, not a run_phases phase: a mesh or hull pair costs a thousand times
     // a resting box pair, and parallel_for splits the busy worker's range on demand,
     // where a phase's first block (half a share) could hold all the expensive pairs.
@@ -175,6 +186,7 @@ void update_narrowphase(World& world) {
                 recycle(contact, b, turns);
                 counts.reused += 1;
                 counts.touching += contact.manifold_count > 0 ? 1u : 0u;
+                note_events(contact, awake[k], worker, counts);
                 continue;
             }
             const Transform ta = b.transform(a), tb = b.transform(bb);
@@ -196,13 +208,16 @@ void update_narrowphase(World& world) {
             // New manifolds, new summary (a cached pair, above, keeps both).
             world.contact_summaries[awake[k]] = contact_summary(contact);
             counts.touching += n > 0 ? 1u : 0u;
+            note_events(contact, awake[k], worker, counts);
         }
     });
     std::uint32_t touching = 0, reused = 0;
     for (const ContactCounts& c : world.contact_counts) {
         touching += c.touching;
         reused += c.reused;
+        world.counters.contact_event_checks += c.event_checks;
     }
+    note_touch_changes(world);  // Begin and End in contact order, whichever worker found them
     world.stats.contacts = touching;
     world.counters.contacts_updated += count;
     world.counters.manifolds_reused += reused;

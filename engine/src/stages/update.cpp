@@ -11,6 +11,7 @@
 
 #include "api/describe.hpp"
 #include "stages/body_changes.hpp"
+#include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -140,6 +141,7 @@ void step(World& w, Real dt) {
     // Fast bodies' poses before the solver moves them; no stage at all in a scene without any.
     if (w.fast_bodies > 0) run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });
     run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
+    note_hits(w);  // from the impulses just solved; nothing to do unless a pair reports events
     if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     if (!w.kinematic_moves.empty()) finish_kinematic_moves(w);  // exactly on target, then at rest
     run_stage(w, Stage::Record, [&] { record(w); });

@@ -607,6 +607,29 @@ TEST(SceneParse, BadFilterKeys_AreRejectedAtTheLine) {
     EXPECT_REJECTED("[settings]\nignore_layers = [1, 2]\n", "2:18", "settings.ignore_layers[0]: expected an array");
 }
 
+TEST(SceneParse, EventKeys_ContactEventsAndSensor) {
+    const SceneDesc scene = parse_scene("[defaults]\ncontact_events = true\n"
+                                        "[[body]]\nshape = { sphere = 1 }\nsensor = true\n"
+                                        "[[body]]\nshape = { sphere = 1 }\ncontact_events = false\n",
+                                        "events.toml");
+    ASSERT_EQ(scene.bodies.size(), 2u);
+    EXPECT_TRUE(scene.bodies[0].desc.contact_events);  // from [defaults]
+    EXPECT_TRUE(scene.bodies[0].desc.sensor);
+    EXPECT_FALSE(scene.bodies[1].desc.contact_events);
+    EXPECT_FALSE(scene.bodies[1].desc.sensor);
+    Space space;
+    const std::vector<BodyHandle> bodies = build(scene, space);
+    EXPECT_TRUE(space.internal_desc(bodies[0]).sensor);
+    EXPECT_TRUE(space.internal_desc(bodies[0]).contact_events);
+}
+
+TEST(SceneParse, BadEventKeys_AreRejectedAtTheLine) {
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nsensor = 1\n", "3:10",
+                    "body.sensor: expected true or false, got the integer 1");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncontact_events = \"yes\"\n", "3:18",
+                    "body.contact_events: expected true or false");
+}
+
 TEST(SceneBuild, ARejectedBody_RestoresTheLayerTable) {
     SceneDesc scene = parse_scene("[settings]\nignore_layers = [[1, 2]]\n[[body]]\nshape = { sphere = 1 }\n",
                                   "hand.toml");

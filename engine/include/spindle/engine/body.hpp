@@ -99,6 +99,13 @@ struct BodyDesc {
     // group: 0 is none; bodies sharing a non-zero group never collide (a ragdoll's limbs).
     std::uint32_t layer = 0;
     std::uint32_t group = 0;
+    // Contact events (Space::read_contact_events) for every pair this body is in: begin
+    // and end of touch, hits. Pairs where neither body asks cost nothing for events.
+    bool contact_events = false;
+    // A sensor detects overlaps (begin and end events with the other body, whatever either
+    // asked) and exerts no force: its contacts never reach the solver nor join islands. It
+    // detects bodies it could touch (one of the two dynamic), never another sensor.
+    bool sensor = false;
     std::uint64_t user_data = 0;
 };
 

@@ -1,6 +1,8 @@
 // Settings structs, with their defaults written in the struct.
 #pragma once
 
+#include <cstdint>
+
 #include <spindle/engine/math.hpp>
 
 namespace spindle {
@@ -60,11 +62,20 @@ struct SleepSettings {
     Real angular_threshold = 0.05;  // rad/s
 };
 
+// Contact and sensor events (events.hpp, Space::read_contact_events).
+struct EventSettings {
+    Real hit_speed = 1;  // m/s: a reporting pair's hit needs an approach faster than this (Box2D's default)
+    // Events kept for the game to read. Events beyond it are dropped, newest first, and
+    // counted (Space::dropped_contact_events): the queue's memory is bounded.
+    std::uint32_t max_queued = 1u << 16;
+};
+
 struct SpaceSettings {
     Vec3 gravity{0, -9.81, 0};
     TimeStepSettings time_step;
     SolverSettings solver;
     SleepSettings sleep;
+    EventSettings events;
 };
 
 }  // namespace spindle

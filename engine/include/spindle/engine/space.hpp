@@ -24,6 +24,7 @@
 #include <vector>
 
 #include <spindle/engine/body.hpp>
+#include <spindle/engine/events.hpp>
 #include <spindle/engine/joint.hpp>
 #include <spindle/engine/query.hpp>
 #include <spindle/engine/settings.hpp>
@@ -187,6 +188,18 @@ public:
     // (cleared first); box.min <= box.max. Returns the count.
     std::size_t overlap_box(const Aabb& box, std::vector<BodyHandle>& bodies, const QueryFilter& filter = {}) const;
 
+    // ---- contact and sensor events (any thread, any time, concurrently with update) ----
+    // Hands over every event published since the last read (FlipReadBuffers publishes
+    // each update's steps' events), appended to `out` in the order they happened, and
+    // returns how many: none lost however many steps ran or how seldom the game reads, none
+    // given twice. Holds the events' own small lock, which the physics thread takes only to
+    // append at the flip: a read never waits for a step. Readers on several threads each get
+    // a disjoint part of the sequence.
+    std::size_t read_contact_events(std::vector<ContactEvent>& out);
+    // Events thrown away since creation because EventSettings::max_queued were waiting
+    // unread (never silent). Any thread.
+    std::uint64_t dropped_contact_events() const;
+
     // ---- internal accessors (update thread, between updates) ----
     MotionState internal_motion_state(BodyHandle body) const;
     Vec3 internal_position(BodyHandle body) const;
@@ -214,6 +227,7 @@ public:
     void set_solver(const SolverSettings& settings);
     void set_sleep(const SleepSettings& settings);
     void set_gravity(const Vec3& gravity);
+    void set_events(const EventSettings& settings);  // "events: max_queued must be >= 1, got 0"
 
     // What the last update did (update thread).
     const UpdateStats& last_update() const noexcept;
