@@ -48,7 +48,26 @@ void Player::frame(double now) {
     m_stats.in_trigger += inside;
 
     if (pick && seen && m_stats.frames % kFramesPerShot == 0) shoot(camera, pick->point);
+    read_events();
     m_stats.frames += 1;
+}
+
+void Player::read_events() {
+    m_events.clear();
+    const std::int64_t t0 = now_nanoseconds();
+    m_space.read_contact_events(m_events);
+    m_stats.event_seconds += static_cast<double>(now_nanoseconds() - t0) * 1e-9;
+    for (const ContactEvent& e : m_events) {
+        const bool begin = e.kind == ContactEventKind::Begin, end = e.kind == ContactEventKind::End;
+        if (e.sensor) {
+            m_stats.sensor_begins += begin;
+            m_stats.sensor_ends += end;
+        } else {
+            m_stats.begins += begin;
+            m_stats.ends += end;
+            m_stats.hits += e.kind == ContactEventKind::Hit;
+        }
+    }
 }
 
 void Player::shoot(const Vec3& from, const Vec3& target) {
@@ -58,6 +77,7 @@ void Player::shoot(const Vec3& from, const Vec3& target) {
     ball.linear_velocity = (target - from).normalized() * kShotSpeed;
     ball.layer = kProjectileLayer;
     ball.fast = true;
+    ball.contact_events = true;  // its landings and hits are events
     m_pending.push_back(m_runner.post([ball](Space& space) { return space.create_body(ball); }));
     m_stats.shots += 1;
     if (m_balls.size() >= kMaxBalls) {

@@ -88,6 +88,11 @@ void print_play(const PlayStats& play, const WorkCounters& counters) {
                 play.query_seconds * 1e3 / frames, static_cast<unsigned long long>(play.picks),
                 static_cast<unsigned long long>(play.shots), static_cast<double>(play.in_trigger) / frames,
                 static_cast<unsigned long long>(counters.query_scene_copies));
+    std::printf("  events         %llu begin, %llu end, %llu hit; sensors %llu begin, %llu end; read in %.1f us per "
+                "frame on the game thread\n",
+                static_cast<unsigned long long>(play.begins), static_cast<unsigned long long>(play.ends),
+                static_cast<unsigned long long>(play.hits), static_cast<unsigned long long>(play.sensor_begins),
+                static_cast<unsigned long long>(play.sensor_ends), play.event_seconds * 1e6 / frames);
 }
 
 void print_summary(const SceneDesc& scene, const Layout& layout, const RunOptions& o, const GameStats& game,

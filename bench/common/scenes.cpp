@@ -93,6 +93,7 @@ std::vector<BodyHandle> add_to_space(Space& space, const BoxScene& scene, const 
     box.friction = scene.friction;
     box.density = scene.density;
     box.allow_sleep = options.allow_sleep;
+    box.contact_events = options.contact_events;
     box.allow_interpolation = false;  // benches read internal state; nothing to blend
     for (const BoxSpec& spec : scene.boxes) {
         box.shape = Shape::box(spec.half_extents);  // shapes are values: one per body, as a user would

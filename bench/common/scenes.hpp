@@ -44,6 +44,7 @@ enum class FloorShape {
 struct BuildOptions {
     FloorShape floor = FloorShape::Box;
     bool allow_sleep = true;
+    bool contact_events = false;  // every box asks for contact events
 };
 
 // Creates the scene's bodies; returns the dynamic boxes' handles in scene order.

@@ -306,7 +306,7 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
         {"run --help",
          "usage: spindle run [OPTIONS] [SCENE]",
          {"SCENE", "--layout FILE", "--seconds S", "--render-hz HZ", "--idle MODE", "--trace FILE", "--record FILE",
-          "poll", "spin", "sleep", "frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz"}},
+          "--play", "poll", "spin", "sleep", "frame,time,body,px,py,pz,qw,qx,qy,qz,vx,vy,vz"}},
         {"run -h", "usage: spindle run [OPTIONS] [SCENE]", {"--seconds S"}},
         {"bench --help",
          "usage: spindle bench [OPTIONS] SCENE",
@@ -335,6 +335,22 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
     const Result layout = spindle("layout '" + (kSource / "configs" / "layouts" / "xbox360.toml").string() + "'");
     EXPECT_EQ(layout.exit_code, 0) << layout.output;
     expect_contains(layout.output, "layout xbox360");
+}
+
+// --play: the game thread queries, shoots and reads events while the physics runs; in
+// the playground scene the shots and the falling target make contact and sensor events.
+TEST(SpindleProgram, RunPlay_QueriesShootsAndReadsEvents) {
+    const Result r = spindle("run playground --play --seconds 1.5");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto number_after = [&](const std::string& label) {
+        const std::size_t at = r.output.find(label);
+        EXPECT_NE(at, std::string::npos) << label << " not in\n" << r.output;
+        return at == std::string::npos ? 0.0 : std::stod(r.output.substr(at + label.size()));
+    };
+    EXPECT_GT(number_after("  play           "), 150);  // queries: three a frame at 60 Hz
+    EXPECT_GT(number_after("picks, "), 0);              // shots
+    EXPECT_GT(number_after("  events         "), 0);    // begins: the target's boxes and the balls land
+    EXPECT_GT(number_after("; sensors "), 0);           // the trigger volume saw something enter
 }
 
 // Every option of every command is taken, in both spellings (--name VALUE and

@@ -108,6 +108,7 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
     if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], shape)) {
         m_shapes[i] = shape;
         body.exact_bounds = shape.static_only();
+        body.sensor = world.bodies.desc[i].sensor;  // set at creation only
         const Aabb local = shape.bounds({});
         body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
         body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
@@ -122,6 +123,7 @@ bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFil
     if (((filter.layer_mask >> body.layer) & 1u) == 0) return false;
     if (filter.group != 0 && body.group == filter.group) return false;
     if (handle == filter.ignore) return false;
+    if (body.sensor && !filter.sensors) return false;
     return !filter.accept || filter.accept(handle);
 }
 

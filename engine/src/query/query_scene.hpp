@@ -32,6 +32,7 @@ struct QueryBody {
     std::int32_t proxy = DynamicAabbTree::kNull;
     bool interpolate = false;   // blended between previous and current, as its motion state
     bool exact_bounds = false;  // a plane or mesh: the tree takes Shape::bounds (static only)
+    bool sensor = false;        // BodyDesc::sensor: met only by filters that ask
     std::uint8_t layer = 0;
     std::uint32_t group = 0;
     Transform current;                 // the shape's origin and orientation at the newest step

@@ -199,6 +199,26 @@ TEST(SceneQueries, FiltersSkipLayersGroupsTheIgnoredBodyAndRejectedBodies) {
     EXPECT_EQ(touching[0], first);
 }
 
+// A trigger volume is passed through unless the filter asks for sensors.
+TEST(SceneQueries, SensorsAreMetOnlyWhenTheFilterAsks) {
+    Space space(weightless());
+    BodyDesc trigger = body(Shape::box({1, 1, 1}), {0, 0, 0}, MotionType::Static);
+    trigger.sensor = true;
+    const BodyHandle sensor = space.create_body(trigger);
+    const BodyHandle wall = space.create_body(body(Shape::box({0.5, 2, 2}), {4, 0, 0}, MotionType::Static));
+    const std::optional<QueryHit> through = space.cast_ray({-5, 0, 0}, {5, 0, 0});
+    ASSERT_TRUE(through);
+    EXPECT_EQ(through->body, wall);
+    QueryFilter with_sensors;
+    with_sensors.sensors = true;
+    const std::optional<QueryHit> stopped = space.cast_ray({-5, 0, 0}, {5, 0, 0}, with_sensors);
+    ASSERT_TRUE(stopped);
+    EXPECT_EQ(stopped->body, sensor);
+    std::vector<BodyHandle> inside;
+    EXPECT_EQ(space.overlap_box({{-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}}, inside), 0u);
+    EXPECT_EQ(space.overlap_box({{-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}}, inside, with_sensors), 1u);
+}
+
 TEST(SceneQueries, ShapeCastFindsTheFirstTimeOfImpact) {
     Space space(weightless());
     const BodyHandle target = space.create_body(body(Shape::box({1, 1, 1}), {0, 0, 0}));
