@@ -22,7 +22,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Four threads query while the runner steps balls bouncing in their own columns. Each
+// Four threads query (one also reads contact events) while the runner steps balls
+// bouncing in their own columns. Each
 // query is made with the motion-state lock held, beside a read of the ball's motion
 // state: the ray straight down its column must meet it exactly on top, at the pose read.
 TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
@@ -39,18 +40,24 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     for (int c = 0; c < kColumns; ++c) {
         BodyDesc d = test::ball({2.0 * c, 1 + 0.2 * c, 0});
         d.restitution = 0.9;
+        d.contact_events = true;         // bouncing: begins, ends and hits for the event reader
         d.angular_velocity = {0, 3, 0};  // spins in place: its top stays on the column's axis
         balls.push_back(space.create_body(d));
     }
     AsyncRunner runner(space);
     runner.start();
     std::atomic<bool> stop{false};
-    std::atomic<int> queries{0}, misses{0}, mismatches{0};
+    std::atomic<int> queries{0}, misses{0}, mismatches{0}, events{0};
     std::vector<std::thread> threads;
     for (int t = 0; t < 4; ++t) {
         threads.emplace_back([&, t] {
             int c = t;
+            std::vector<ContactEvent> read;
             while (!stop.load(std::memory_order_relaxed)) {
+                if (t == 0) {  // one thread also reads the events as they are published
+                    read.clear();
+                    events.fetch_add(static_cast<int>(space.read_contact_events(read)), std::memory_order_relaxed);
+                }
                 c = (c + 1) % kColumns;
                 std::scoped_lock hold(space.motion_states().lock());
                 const MotionState seen = space.motion_state(balls[static_cast<std::size_t>(c)]);
@@ -75,6 +82,7 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     EXPECT_EQ(misses.load(), 0);
     EXPECT_EQ(mismatches.load(), 0);
     EXPECT_GT(steps_after - steps_before, 20u);  // the physics loop kept stepping
+    EXPECT_GT(events.load(), kColumns);          // every ball landed at least once
 }
 
 // A query that stays inside its walk (its filter waits) while the game steps three

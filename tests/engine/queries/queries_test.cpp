@@ -73,7 +73,7 @@ TEST(SceneQueries, RayMissesTheBoundsOfARoundShape) {
     EXPECT_TRUE(space.cast_ray({-5, 0.3, 0.3}, {5, 0.3, 0.3}));
 }
 
-TEST(SceneQueries, RayHitsEveryKindOfShape) {
+TEST(SceneQueries, RaysSweepsAndOverlapsMeetEveryKindOfShape) {
     Space space(weightless());
     const std::vector<Vec3> corners = {{-0.5, -0.5, -0.5}, {0.5, -0.5, -0.5}, {0, 0.5, -0.5}, {0, 0, 0.5}};
     const std::vector<Vec3> tri = {{-1, 0, -1}, {1, 0, -1}, {0, 0, 1}};
@@ -97,6 +97,19 @@ TEST(SceneQueries, RayHitsEveryKindOfShape) {
         ASSERT_TRUE(hit) << "x " << c.x;
         EXPECT_EQ(hit->body, c.handle) << "x " << c.x;
         EXPECT_NEAR(hit->point.y(), c.top, 1e-9) << "x " << c.x;
+        // A small sphere dropped down the same line, and one resting just inside the top.
+        // (The hull's top face is slanted: the sphere meets it off the line, lower down.)
+        const Shape probe = Shape::sphere(0.05);
+        const std::optional<QueryHit> swept = space.cast_shape(probe, {{c.x, 20, 0}, Quat::Identity()}, {0, -40, 0});
+        ASSERT_TRUE(swept) << "x " << c.x;
+        EXPECT_EQ(swept->body, c.handle) << "x " << c.x;
+        if (c.x != 12) {
+            EXPECT_NEAR(swept->point.y(), c.top, 1e-4) << "x " << c.x;
+            EXPECT_NEAR(swept->fraction, (20 - 0.05 - c.top) / 40, 1e-5) << "x " << c.x;
+        }
+        std::vector<BodyHandle> touching;
+        EXPECT_EQ(space.overlap_shape(probe, {{c.x, c.top - 0.01, 0}, Quat::Identity()}, touching), 1u) << "x " << c.x;
+        EXPECT_EQ(space.overlap_shape(probe, {{c.x, c.top + 0.5, 0}, Quat::Identity()}, touching), 0u) << "x " << c.x;
     }
 }
 
