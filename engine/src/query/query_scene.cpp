@@ -85,12 +85,12 @@ void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpol
     tight = tight_bounds(i);
 }
 
-void QueryScene::move(std::uint32_t i, const Aabb& tight) {
+void QueryScene::move(std::uint32_t i, const Aabb& tight, const Vec3& displacement) {
     QueryBody& body = m_bodies[i];
     if (body.proxy == DynamicAabbTree::kNull) {
         body.proxy = m_tree.create_proxy(tight, i);
     } else {
-        m_tree.move_proxy(body.proxy, tight, Vec3::Zero());
+        m_tree.move_proxy(body.proxy, tight, displacement);
     }
 }
 
@@ -116,7 +116,8 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
     body.generation = world.bodies.generation[i];
     Aabb tight;
     refresh_pose(world, i, interpolating, tight);
-    move(i, tight);
+    const Bodies& b = world.bodies;
+    move(i, tight, b.type[i] == MotionType::Static ? Vec3::Zero() : Vec3(b.v[i] * world.settings.time_step.duration));
 }
 
 bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFilter& filter) {

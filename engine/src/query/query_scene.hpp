@@ -57,8 +57,10 @@ public:
     // and its tight box in `tight`; the proxy is left for move(). Distinct slots may run
     // on many threads at once.
     void refresh_pose(const World& world, std::uint32_t i, bool interpolating, Aabb& tight);
-    // Moves slot i's proxy if `tight` has left its fat box. One thread.
-    void move(std::uint32_t i, const Aabb& tight);
+    // Moves slot i's proxy if `tight` has left its fat box, the new fat box stretched
+    // along `displacement` (the body's travel in a step, as the broadphase does: a falling
+    // body is not re-inserted every step). One thread.
+    void move(std::uint32_t i, const Aabb& tight, const Vec3& displacement);
     // The capacity of the body slots, at least.
     void reserve(std::uint32_t slots);
 

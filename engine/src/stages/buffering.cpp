@@ -247,7 +247,11 @@ void flip_read_buffers(World& world) {
             interpolated[worker].value += count;
         });
         // The tree by one thread: most proxies are still inside their fat boxes.
-        for (std::uint32_t a = 0; a < n; ++a) queries.move(world.awake[a], query_bounds[a]);
+        const Real step = world.settings.time_step.duration;
+        for (std::uint32_t a = 0; a < n; ++a) {
+            const std::uint32_t i = world.awake[a];
+            queries.move(i, query_bounds[a], b.v[i] * step);
+        }
         for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
         world.counters.awake_publishes += n;
         world.published_version[k] = world.awake_version;
