@@ -120,5 +120,42 @@ TEST(AsyncQueries, AQueryHeldAcrossStepsDelaysNoneOfThem) {
     EXPECT_NEAR(held->point.y(), 0.25, 1e-12);
 }
 
+// Bodies made while a query walks the published scene: none is copied under the lock
+// (that would stall every reader once per body); queries meet them from the next update.
+TEST(AsyncQueries, BodiesMadeWhileAQueryHoldsTheSceneReachQueriesAtTheNextUpdate) {
+    Space space(test::weightless());
+    space.create_body(test::ball({0, 0, 0}));
+    space.update();
+    std::promise<void> inside, go;
+    std::shared_future<void> released = go.get_future().share();
+    std::future<bool> answer = std::async(std::launch::async, [&] {
+        QueryFilter filter;
+        filter.accept = [&, first = true](BodyHandle) mutable {
+            if (first) {
+                first = false;
+                inside.set_value();
+                released.wait();
+            }
+            return true;
+        };
+        return space.cast_ray({0, 5, 0}, {0, -5, 0}, filter).has_value();
+    });
+    inside.get_future().wait();
+    std::vector<BodyHandle> made;
+    for (int i = 1; i <= 20; ++i) made.push_back(space.create_body(test::ball({-2.0 * i, 0, 0})));
+    EXPECT_EQ(space.counters().query_scene_copies, 0u);
+    EXPECT_EQ(space.counters().query_publishes_deferred, 20u);
+    EXPECT_FALSE(space.cast_ray({-2, 5, 0}, {-2, -5, 0}));            // not yet: the held scene is published
+    EXPECT_EQ(space.motion_state(made[0]).position, Vec3(-2, 0, 0));  // reads see it at once
+    go.set_value();
+    EXPECT_TRUE(answer.get());
+    space.update();
+    for (int i = 1; i <= 20; ++i) {
+        const std::optional<QueryHit> hit = space.cast_ray({-2.0 * i, 5, 0}, {-2.0 * i, -5, 0});
+        ASSERT_TRUE(hit) << i;
+        EXPECT_EQ(hit->body, made[static_cast<std::size_t>(i - 1)]);
+    }
+}
+
 }  // namespace
 }  // namespace spindle

@@ -19,6 +19,7 @@ namespace {
 AabbTreeSettings query_tree_settings() {
     AabbTreeSettings settings;
     settings.validate_each_operation = false;
+    settings.margin = Real(0.3);
     return settings;
 }
 
@@ -50,10 +51,14 @@ void QueryScene::reserve(std::uint32_t slots) {
     if (m_shapes.size() < slots) m_shapes.resize(slots);
 }
 
+namespace {
+
 Aabb box_of(const QueryBody& body, const Transform& pose) {
     const Mat3 r = pose.q.toRotationMatrix();
     return Aabb::from_center_extents(pose.apply(body.local_center), r.cwiseAbs() * body.local_extents);
 }
+
+}  // namespace
 
 // The shape's box turned with the body (an over-estimate for round shapes, cheap and
 // without reading the shape); a plane's or mesh's exact bounds (static: never blended).
@@ -80,7 +85,7 @@ void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpol
     body.layer = b.layer[i];
     body.group = b.group[i];
     body.current = b.transform(i);
-    body.interpolate = interpolating && b.interpolate[i] && !body.exact_bounds;
+    body.interpolate = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;  // as fill()
     if (body.interpolate) body.previous = {b.history_position[0][i], b.history_orientation[0][i]};
     tight = tight_bounds(i);
 }
@@ -133,17 +138,20 @@ bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFil
 bool QueryScene::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
                           QueryHit& hit) const {
     bool found = false;
-    m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real) -> Real {
+    m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real max_fraction) -> Real {
         const auto i = static_cast<std::uint32_t>(m_tree.user(id));
         const QueryBody& body = m_bodies[i];
         const BodyHandle handle{i, body.generation};
         CastHit h;
         if (!passes(body, handle, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) return -1;
-        // Equal fractions keep the first found (the tree's order, the same for every run).
-        if (found && h.fraction >= hit.fraction) return -1;
+        // Equal fractions go to the lower slot: the two scenes' trees differ in shape, and
+        // a ray must not flip between two bodies from one flip to the next.
+        if (found && (h.fraction > hit.fraction || (h.fraction == hit.fraction && i > hit.body.index))) return -1;
         found = true;
         hit = {handle, h.fraction, h.point, h.normal, h.part};
-        return h.fraction;  // 0 stops the walk: nothing is nearer
+        // Clips the segment; at fraction 0 the walk goes on (0 would stop it) for a lower
+        // slot also hit at 0.
+        return h.fraction > 0 ? h.fraction : max_fraction;
     });
     return found;
 }

@@ -139,8 +139,8 @@ void apply_writes(World& world) {
     settle_awake(world);
 }
 
-// Fills one published entry from the live state.
-// Fills slot i of a published buffer from the live state.
+// Fills slot i of a published buffer from the live state. A static body never blends
+// (its history is its pose: a blend would only add rounding).
 static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool interpolating) {
     const Bodies& b = world.bodies;
     if (!b.alive[i]) {
@@ -154,7 +154,7 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
     s.center_of_mass = b.x[i];
     s.linear_velocity = b.v[i];
     s.angular_velocity = b.w[i];
-    p.interpolate[i] = interpolating && b.interpolate[i];
+    p.interpolate[i] = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;
     if (p.interpolate[i]) {
         // Bodies without the flag skip this: interpolation costs them nothing.
         PublishedHistory& before = p.previous[i];
@@ -167,6 +167,10 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
 void publish_now(World& world, std::uint32_t slot) {
     MotionStatePublisher manager(world.motion_states);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
+    // The back query scene first, outside the lock: no query can take it (it is not
+    // published), so a copy of one an old query still holds costs the lock nothing.
+    const int back = manager.back_index();
+    writable_query_scene(world, back).refresh(world, slot, interpolating);
     // The update thread may hold the lock itself (a posted function reading one step
     // while it creates bodies); then publishing goes ahead under its hold.
     const MotionStateLock::Hold guard(manager.lock());
@@ -180,10 +184,19 @@ void publish_now(World& world, std::uint32_t slot) {
     // publish here, so the lock-free copy buffered writes check stays exact.
     manager.set_published_generation(slot, manager.buffer_locked(0).generation[slot]);
     publish_kind(world, slot);
-    // Queries see the body at once too, as reads do: both scenes (no query walks either
-    // while the lock is held; one that holds a scene from before keeps its copy).
-    for (int k = 0; k < 2; ++k) writable_query_scene(world, k).refresh(world, slot, interpolating);
-    manager.set_query_scene_locked(world.query_scenes[1 - manager.back_index()]);
+    // Queries see the body at once too, as reads do, unless a query is walking the
+    // published scene now: copying a whole scene under the lock for each body made would
+    // stall every reader, so then the next flip brings the body to queries (the front
+    // scene is refreshed there for it, as a changed body; WorkCounters::query_publishes_deferred).
+    QueryScene* front = world.query_scenes[1 - back].get();
+    if (front && front->holders.load(std::memory_order_acquire) == 0) {
+        front->refresh(world, slot, interpolating);
+    } else if (front) {
+        world.counters.query_publishes_deferred += 1;
+    } else {
+        writable_query_scene(world, 1 - back).refresh(world, slot, interpolating);
+    }
+    manager.set_query_scene_locked(world.query_scenes[1 - back]);
 }
 
 void publish_kind(World& world, std::uint32_t slot) {

@@ -158,7 +158,9 @@ public:
     // Each meets the bodies where the published step puts them: where motion_state() and
     // get_motion_states() say they are (blended where those are), so a ray hits what the
     // game renders; exact against the shapes (sphere, capsule, box, hull, plane, mesh).
-    // Bodies created since are met, destroyed ones are not (both publish at once). A query
+    // Bodies created since are met, destroyed ones are not (both publish at once), except
+    // while a query walks the published scene: then from the next update (no copy of a
+    // whole scene under the lock per body; WorkCounters::query_publishes_deferred). A query
     // takes the motion-state lock only to pick up the published scene (a few loads; a
     // thread that holds the lock queries the step it holds) and walks it unlocked: it
     // never waits for a step, and a step never waits for it (the physics thread copies a
@@ -191,8 +193,10 @@ public:
     // ---- contact and sensor events (any thread, any time, concurrently with update) ----
     // Hands over every event published since the last read (FlipReadBuffers publishes
     // each update's steps' events), appended to `out` in the order they happened, and
-    // returns how many: none lost however many steps ran or how seldom the game reads, none
-    // given twice. Holds the events' own small lock, which the physics thread takes only to
+    // returns how many: none lost however many steps ran or how seldom the game reads (up
+    // to EventSettings::max_queued unread; beyond it they are dropped and counted), none
+    // given twice. An event's bodies may be destroyed by the time it is read: check
+    // contains() before reading their state. Holds the events' own small lock, which the physics thread takes only to
     // append at the flip: a read never waits for a step. Readers on several threads each get
     // a disjoint part of the sequence.
     std::size_t read_contact_events(std::vector<ContactEvent>& out);

@@ -60,6 +60,9 @@ struct WorkCounters {
     // Query scenes the physics thread copied because a query still held the one it was
     // about to update (query/query_scene.hpp): a query never holds up a step.
     std::uint64_t query_scene_copies = 0;
+    // Bodies created or destroyed while a query walked the published scene: queries meet
+    // (or stop meeting) them from the next update instead of at once (buffering.cpp).
+    std::uint64_t query_publishes_deferred = 0;
     // Contact-steps checked for events (touch changes after the narrowphase, hits after
     // the solver): only pairs with a body that asked for events or is a sensor.
     std::uint64_t contact_event_checks = 0;
