@@ -164,6 +164,12 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
     }
 }
 
+// A body's user data, published apart from its state: it lives in the cold description
+// and changes only by creation or a write, so only changed bodies are written.
+static void publish_user_data(const World& world, std::uint32_t i, PublishedBuffer& p) {
+    p.user_data[i] = world.bodies.alive[i] ? world.bodies.desc[i].user_data : 0;
+}
+
 void publish_now(World& world, std::uint32_t slot) {
     MotionStatePublisher manager(world.motion_states);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
@@ -178,7 +184,7 @@ void publish_now(World& world, std::uint32_t slot) {
         PublishedBuffer& buffer = manager.buffer_locked(k);
         if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
         fill(world, slot, buffer, interpolating);
-        buffer.user_data[slot] = world.bodies.alive[slot] ? world.bodies.desc[slot].user_data : 0;
+        publish_user_data(world, slot, buffer);
     }
     // Creation and destruction are the only changes of a slot's generation, and both
     // publish here, so the lock-free copy buffered writes check stays exact.
@@ -234,11 +240,13 @@ void flip_read_buffers(World& world) {
     // Bodies changed by writes, creation, destruction or sleep first, awake or not: a
     // shape or filter changes here, and the awake poses below use the new shape's box.
     // User data too: it changes only by creation or a write, both noted in changed_now (it
-    // lives in the cold description, which the awake refill below does not read).
+    // lives in the cold description, which the awake refill below does not read). The
+    // awake ones' states are refilled below with the rest of the awake bodies.
     for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
         for (std::uint32_t i : *changed) {
             queries.refresh(world, i, interpolating);
-            back.user_data[i] = b.alive[i] ? b.desc[i].user_data : 0;
+            publish_user_data(world, i, back);
+            if (!b.alive[i] || b.awake_index[i] < 0) publish(i);
         }
     }
     const bool awake_stale = world.published_version[k] != world.awake_version ||
@@ -269,12 +277,6 @@ void flip_read_buffers(World& world) {
         world.counters.awake_publishes += n;
         world.published_version[k] = world.awake_version;
         world.published_interpolating[k] = interpolating;
-    }
-    for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
-        for (std::uint32_t i : *changed) {
-            if (b.alive[i] && b.awake_index[i] >= 0) continue;  // awake ones were published above
-            publish(i);
-        }
     }
     std::swap(world.changed_last, world.changed_now);
     world.changed_now.clear();
