@@ -135,20 +135,31 @@ bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFil
 
 // ---- queries ----
 
+// The exact hit of the segment on the body behind tree proxy `id`, if it passes the filter.
+bool QueryScene::ray_hit(std::int32_t id, const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
+                         QueryHit& hit) const {
+    const auto i = static_cast<std::uint32_t>(m_tree.user(id));
+    const QueryBody& body = m_bodies[i];
+    const BodyHandle handle{i, body.generation};
+    CastHit h;
+    if (!passes(body, handle, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) return false;
+    hit = {handle, h.fraction, h.point, h.normal, h.part};
+    return true;
+}
+
 bool QueryScene::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
                           QueryHit& hit) const {
     bool found = false;
     m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real max_fraction) -> Real {
-        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
-        const QueryBody& body = m_bodies[i];
-        const BodyHandle handle{i, body.generation};
-        CastHit h;
-        if (!passes(body, handle, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) return -1;
+        QueryHit h;
+        if (!ray_hit(id, from, to, filter, alpha, h)) return -1;
         // Equal fractions go to the lower slot: the two scenes' trees differ in shape, and
         // a ray must not flip between two bodies from one flip to the next.
-        if (found && (h.fraction > hit.fraction || (h.fraction == hit.fraction && i > hit.body.index))) return -1;
+        if (found && (h.fraction > hit.fraction || (h.fraction == hit.fraction && h.body.index > hit.body.index))) {
+            return -1;
+        }
         found = true;
-        hit = {handle, h.fraction, h.point, h.normal, h.part};
+        hit = h;
         // Clips the segment; at fraction 0 the walk goes on (0 would stop it) for a lower
         // slot also hit at 0.
         return h.fraction > 0 ? h.fraction : max_fraction;
@@ -159,14 +170,9 @@ bool QueryScene::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& f
 bool QueryScene::ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha) const {
     bool found = false;
     m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real) -> Real {
-        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
-        const QueryBody& body = m_bodies[i];
-        CastHit h;
-        if (!passes(body, {i, body.generation}, filter) || !ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) {
-            return -1;
-        }
-        found = true;
-        return 0;
+        QueryHit h;
+        found = ray_hit(id, from, to, filter, alpha, h);
+        return found ? 0 : -1;  // 0 stops at the first
     });
     return found;
 }
@@ -175,13 +181,8 @@ bool QueryScene::ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilte
 void QueryScene::cast_ray_all(const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
                               std::vector<QueryHit>& hits) const {
     m_tree.ray_cast(from, to - from, 1, [&](std::int32_t id, Real max_fraction) -> Real {
-        const auto i = static_cast<std::uint32_t>(m_tree.user(id));
-        const QueryBody& body = m_bodies[i];
-        const BodyHandle handle{i, body.generation};
-        CastHit h;
-        if (passes(body, handle, filter) && ray_cast(m_shapes[i], body.pose(alpha), from, to, h)) {
-            hits.push_back({handle, h.fraction, h.point, h.normal, h.part});
-        }
+        QueryHit h;
+        if (ray_hit(id, from, to, filter, alpha, h)) hits.push_back(h);
         return max_fraction;  // keep walking the whole segment
     });
     std::sort(hits.begin(), hits.end(), [](const QueryHit& a, const QueryHit& b) {

@@ -88,6 +88,9 @@ public:
 
 private:
     QueryScene(const QueryScene& other);
+    // The exact hit of the segment on the body behind tree proxy id, if it passes the filter.
+    bool ray_hit(std::int32_t id, const Vec3& from, const Vec3& to, const QueryFilter& filter, double alpha,
+                 QueryHit& hit) const;
     // The box a proxy must cover: the shape at both poses (and the swing between them).
     Aabb tight_bounds(std::uint32_t i) const;
     void set_proxy(std::uint32_t i, const Aabb& tight);
