@@ -29,6 +29,18 @@ BufferedWrite write_of(BodyHandle body, WriteKind kind) {
     return write;
 }
 
+// A force or impulse at a world point: the vector and its moment about the origin.
+void push_at(World& world, BodyHandle body, WriteKind kind, const Vec3& vector, const Vec3& point, const char* who,
+             const char* field) {
+    check_finite(vector, who, field);
+    check_position(point, who, "point");
+    check_handle_for_write(world.motion_states, body, who);
+    BufferedWrite write = write_of(body, kind);
+    write.vector = vector;
+    write.moment = saturated_cross(point, vector);
+    world.writes.push(write);
+}
+
 void push_scalar(World& world, BodyHandle body, WriteKind kind, Real value, const char* who) {
     check_handle_for_write(world.motion_states, body, who);
     BufferedWrite write = write_of(body, kind);
@@ -110,23 +122,11 @@ void Space::set_user_data(BodyHandle body, std::uint64_t user_data) {
 std::uint64_t Space::user_data(BodyHandle body) const { return m_world->motion_states.read_user_data(body); }
 
 void Space::add_force_at(BodyHandle body, const Vec3& force, const Vec3& point) {
-    check_finite(force, "add_force_at", "force");
-    check_position(point, "add_force_at", "point");
-    check_handle_for_write(m_world->motion_states, body, "add_force_at");
-    BufferedWrite write = write_of(body, WriteKind::ForceAt);
-    write.vector = force;
-    write.moment = saturated_cross(point, force);
-    m_world->writes.push(write);
+    push_at(*m_world, body, WriteKind::ForceAt, force, point, "add_force_at", "force");
 }
 
 void Space::apply_impulse_at(BodyHandle body, const Vec3& impulse, const Vec3& point) {
-    check_finite(impulse, "apply_impulse_at", "impulse");
-    check_position(point, "apply_impulse_at", "point");
-    check_handle_for_write(m_world->motion_states, body, "apply_impulse_at");
-    BufferedWrite write = write_of(body, WriteKind::ImpulseAt);
-    write.vector = impulse;
-    write.moment = saturated_cross(point, impulse);
-    m_world->writes.push(write);
+    push_at(*m_world, body, WriteKind::ImpulseAt, impulse, point, "apply_impulse_at", "impulse");
 }
 
 void Space::move_kinematic(BodyHandle body, const Vec3& position, const Quat& orientation) {

@@ -15,6 +15,15 @@ void accumulate(PendingWrites& entry, Vec3& sum, std::uint32_t bit, const Vec3& 
     entry.bits |= bit;
 }
 
+// A force or impulse at a point: its sum and its moment about the origin, which start
+// afresh when the bit is clear (ApplyWrites takes the moment about the centre of mass).
+void accumulate_at(PendingWrites& entry, Vec3& sum, Vec3& moment, std::uint32_t bit, const BufferedWrite& write) {
+    if ((entry.bits & bit) == 0) sum = moment = Vec3::Zero();
+    sum = saturate(sum + write.vector);
+    moment = saturate(moment + write.moment);
+    entry.bits |= bit;
+}
+
 void merge(PendingWrites& entry, const BufferedWrite& write) {
     entry.writes += 1;
     switch (write.kind) {
@@ -93,17 +102,11 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
         case WriteKind::ForceAt:
             // The linear part is a force like any other; the moment waits for the centre of mass.
             accumulate(entry, entry.force, kPendingForce, write.vector);
-            if ((entry.bits & kPendingForceAt) == 0) entry.force_at = entry.force_moment = Vec3::Zero();
-            entry.force_at = saturate(entry.force_at + write.vector);
-            entry.force_moment = saturate(entry.force_moment + write.moment);
-            entry.bits |= kPendingForceAt;
+            accumulate_at(entry, entry.force_at, entry.force_moment, kPendingForceAt, write);
             break;
         case WriteKind::ImpulseAt:
             accumulate(entry, entry.impulse, kPendingImpulse, write.vector);
-            if ((entry.bits & kPendingImpulseAt) == 0) entry.impulse_at = entry.impulse_moment = Vec3::Zero();
-            entry.impulse_at = saturate(entry.impulse_at + write.vector);
-            entry.impulse_moment = saturate(entry.impulse_moment + write.moment);
-            entry.bits |= kPendingImpulseAt;
+            accumulate_at(entry, entry.impulse_at, entry.impulse_moment, kPendingImpulseAt, write);
             break;
     }
 }
