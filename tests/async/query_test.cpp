@@ -85,27 +85,44 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     EXPECT_GT(events.load(), kColumns);          // every ball landed at least once
 }
 
+// A ray cast down through the origin on its own thread whose filter waits, at its first
+// candidate, until release(): the query holds the scene it took for as long as a test wants.
+class HeldQuery {
+public:
+    explicit HeldQuery(Space& space) {
+        m_answer = std::async(std::launch::async, [this, &space] {
+            QueryFilter filter;
+            filter.accept = [this, first = true](BodyHandle) mutable {
+                if (first) {
+                    first = false;
+                    m_inside.set_value();
+                    m_released.wait();
+                }
+                return true;
+            };
+            return space.cast_ray({0, 5, 0}, {0, -5, 0}, filter);
+        });
+        m_inside.get_future().wait();
+    }
+    // Lets the query finish; its answer.
+    std::optional<QueryHit> release() {
+        m_go.set_value();
+        return m_answer.get();
+    }
+
+private:
+    std::promise<void> m_inside, m_go;
+    std::shared_future<void> m_released = m_go.get_future().share();
+    std::future<std::optional<QueryHit>> m_answer;
+};
+
 // A query that stays inside its walk (its filter waits) while the game steps three
 // times: every update finishes, the physics thread copies the scene the query holds,
 // and the query answers from the step it started on.
 TEST(AsyncQueries, AQueryHeldAcrossStepsDelaysNoneOfThem) {
     Space space(test::weightless());
     const BodyHandle target = space.create_body(test::ball({0, 0, 0}));
-    std::promise<void> inside, go;
-    std::shared_future<void> released = go.get_future().share();
-    std::future<std::optional<QueryHit>> answer = std::async(std::launch::async, [&] {
-        QueryFilter filter;
-        filter.accept = [&, first = true](BodyHandle) mutable {
-            if (first) {
-                first = false;
-                inside.set_value();
-                released.wait();
-            }
-            return true;
-        };
-        return space.cast_ray({0, 5, 0}, {0, -5, 0}, filter);
-    });
-    inside.get_future().wait();
+    HeldQuery query(space);
     const std::uint64_t copies_before = space.counters().query_scene_copies;
     test::finishes_in_time([&] {
         space.set_position(target, {5, 0, 0});
@@ -113,8 +130,7 @@ TEST(AsyncQueries, AQueryHeldAcrossStepsDelaysNoneOfThem) {
     });
     EXPECT_GE(space.counters().query_scene_copies, copies_before + 1);
     EXPECT_FALSE(space.cast_ray({0, 5, 0}, {0, -5, 0}));  // a new query sees the body moved
-    go.set_value();
-    const std::optional<QueryHit> held = answer.get();
+    const std::optional<QueryHit> held = query.release();
     ASSERT_TRUE(held);  // the held one answers from its own step
     EXPECT_EQ(held->body, target);
     EXPECT_NEAR(held->point.y(), 0.25, 1e-12);
@@ -126,29 +142,14 @@ TEST(AsyncQueries, BodiesMadeWhileAQueryHoldsTheSceneReachQueriesAtTheNextUpdate
     Space space(test::weightless());
     space.create_body(test::ball({0, 0, 0}));
     space.update();
-    std::promise<void> inside, go;
-    std::shared_future<void> released = go.get_future().share();
-    std::future<bool> answer = std::async(std::launch::async, [&] {
-        QueryFilter filter;
-        filter.accept = [&, first = true](BodyHandle) mutable {
-            if (first) {
-                first = false;
-                inside.set_value();
-                released.wait();
-            }
-            return true;
-        };
-        return space.cast_ray({0, 5, 0}, {0, -5, 0}, filter).has_value();
-    });
-    inside.get_future().wait();
+    HeldQuery query(space);
     std::vector<BodyHandle> made;
     for (int i = 1; i <= 20; ++i) made.push_back(space.create_body(test::ball({-2.0 * i, 0, 0})));
     EXPECT_EQ(space.counters().query_scene_copies, 0u);
     EXPECT_EQ(space.counters().query_publishes_deferred, 20u);
     EXPECT_FALSE(space.cast_ray({-2, 5, 0}, {-2, -5, 0}));            // not yet: the held scene is published
     EXPECT_EQ(space.motion_state(made[0]).position, Vec3(-2, 0, 0));  // reads see it at once
-    go.set_value();
-    EXPECT_TRUE(answer.get());
+    EXPECT_TRUE(query.release());
     space.update();
     for (int i = 1; i <= 20; ++i) {
         const std::optional<QueryHit> hit = space.cast_ray({-2.0 * i, 5, 0}, {-2.0 * i, -5, 0});
