@@ -27,12 +27,12 @@
 #include "checks.hpp"
 #include "commands.hpp"
 #include "jobs.hpp"
+#include "motion_truth.hpp"
 #include "physics_probe.hpp"
 #include "play.hpp"
 #include "progress.hpp"
 #include "recorder.hpp"
 #include "scenes.hpp"
-#include "smoothness.hpp"
 #include "trace.hpp"
 
 namespace spindle::app {
@@ -42,6 +42,8 @@ namespace {
 // 60 Hz then sees a publish at most 0.5 ms old (3% of the frame), for a few percent of
 // a hardware thread instead of all of it.
 constexpr double kPollInterval = 0.5e-3;
+// Moving bodies whose rendered motion is set beside the recorded steps (spread evenly).
+constexpr std::size_t kTruthBodies = 64;
 
 struct RunOptions {
     std::string scene{kDefaultScene};
@@ -73,10 +75,9 @@ void wait_until(const Stopwatch& wall, double deadline) {
     while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
 }
 
-void print_smoothness(const char* name, const SmoothnessReport& r) {
-    std::printf("    %-13s %10.3f mm %11.4f mm %9.3f %8llu of %llu\n", name, r.mean_step_m * 1e3, r.jerk_rms_m * 1e3,
-                r.relative_jerk, static_cast<unsigned long long>(r.frozen_frames),
-                static_cast<unsigned long long>(r.frames));
+void print_truth(ShownAs shown, const TruthReport& r) {
+    std::printf("    %-16s %8.3f mm %8.3f mm %10.2f ms %9.2f ms %8llu\n", to_string(shown), r.error_mean_m * 1e3,
+                r.error_p95_m * 1e3, r.lag_mean_ms, r.lag_jitter_ms, static_cast<unsigned long long>(r.frames));
 }
 
 void print_play(const PlayStats& play, const WorkCounters& counters) {
@@ -97,7 +98,7 @@ void print_play(const PlayStats& play, const WorkCounters& counters) {
 
 void print_summary(const SceneDesc& scene, const Layout& layout, const RunOptions& o, const GameStats& game,
                    const AsyncStats& physics, const ProbeTotals& probe, double step_seconds,
-                   const SmoothnessReport& interpolated, const SmoothnessReport& raw) {
+                   const MotionTruthMeter& truth) {
     std::printf("summary: scene %s, layout %s, %.2f s wall, idle %s\n", scene.name.c_str(), layout.name.c_str(),
                 game.wall_seconds, o.idle.c_str());
     std::printf("  simulated      %.3f s in %llu steps (%.1f steps/s) over %llu updates\n",
@@ -127,16 +128,15 @@ void print_summary(const SceneDesc& scene, const Layout& layout, const RunOption
         std::printf("                 %-20s %10.4f %12.4f %6.1f%%\n", to_string(static_cast<Stage>(i)), s,
                     probe.steps ? s * 1e3 / static_cast<double>(probe.steps) : 0.0, total > 0 ? 100 * s / total : 0.0);
     }
-    std::printf(
-        "  smoothness     motion per frame: mean, jerk (rms change frame to frame), jerk/mean, frozen frames\n");
-    print_smoothness("interpolated", interpolated);
-    print_smoothness("raw steps", raw);
-    if (interpolated.jerk_rms_m > 0 && raw.jerk_rms_m > 0) {
-        std::printf("  interpolated motion is %.1fx %s than the raw step states\n",
-                    raw.jerk_rms_m >= interpolated.jerk_rms_m ? raw.jerk_rms_m / interpolated.jerk_rms_m
-                                                              : interpolated.jerk_rms_m / raw.jerk_rms_m,
-                    raw.jerk_rms_m >= interpolated.jerk_rms_m ? "smoother" : "jerkier");
-    }
+    if (!truth.has_clock()) return;
+    // Each frame against where the bodies were at its own instant (motion_truth.hpp): the
+    // error is mostly the lag times the speed; the lag's jitter is what looks uneven.
+    std::printf("  smoothness     frames against the recorded steps at their instants (%llu steps recorded):\n",
+                static_cast<unsigned long long>(truth.steps_recorded()));
+    std::printf("    %-16s %11s %11s %13s %12s %8s\n", "shown", "error mean", "error p95", "lag mean", "lag jitter",
+                "frames");
+    for (ShownAs shown : {ShownAs::ReadClock, ShownAs::UpdateClock, ShownAs::Raw})
+        print_truth(shown, truth.report(shown));
 }
 
 int run(const RunOptions& o) {
@@ -189,8 +189,8 @@ int run(const RunOptions& o) {
     AsyncRunner runner(space, runner_options);
     probe.attach(runner, o.idle == "poll" ? kPollInterval : 0.0);
 
-    std::vector<MotionState> interpolated(handles.size()), raw(handles.size());
-    SmoothnessMeter smooth_interpolated(moving), smooth_raw(moving);
+    std::vector<MotionState> interpolated(handles.size()), by_update(handles.size()), raw(handles.size());
+    MotionTruthMeter truth(moving, kTruthBodies);
     Progress progress(stdout, isatty(fileno(stdout)) != 0);
     const double step_seconds = settings.time_step.duration;
     const MotionStateManager& states = space.motion_states();
@@ -217,12 +217,16 @@ int run(const RunOptions& o) {
         wait_until(wall, deadline);
         const std::int64_t frame_start = now_nanoseconds();
         const double now = wall.elapsed_seconds();
-        // Two calls, each a consistent copy under the motion-state lock; a flip may
-        // fall between them, which only makes the raw side (slightly) newer, never torn.
-        states.get_motion_states(handles, interpolated);
-        states.get_raw_motion_states(handles, raw);
-        smooth_interpolated.add_frame(interpolated);
-        smooth_raw.add_frame(raw);
+        {
+            // One hold: the frame as the game shows it (blended at the read), beside what
+            // the seed's blend and the newest step would have shown at the same instant.
+            const MotionStateLock::Hold hold(states.lock());
+            states.get_motion_states(handles, interpolated, BlendClock::Read);
+            states.get_motion_states(handles, by_update, BlendClock::Update);
+            states.get_raw_motion_states(handles, raw);
+            truth.add_frame(states.published_time(), states.lock().taken_at_ns(), states.alpha_locked(BlendClock::Read),
+                            {interpolated, by_update, raw});
+        }
         if (recorder) recorder->write_frame(game.frames, now, interpolated);
         if (player) player->frame(now);
         const std::int64_t frame_end = now_nanoseconds();
@@ -256,8 +260,7 @@ int run(const RunOptions& o) {
     runner.stop();
     progress.finish();
 
-    print_summary(scene, layout, o, game, runner.stats(), probe.totals(), step_seconds, smooth_interpolated.report(),
-                  smooth_raw.report());
+    print_summary(scene, layout, o, game, runner.stats(), probe.totals(), step_seconds, truth);
     if (player) print_play(player->stats(), space.counters());
     if (recorder) {
         recorder->close();

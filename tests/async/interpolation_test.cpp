@@ -1,6 +1,11 @@
 // Interpolation (the seed, section 2.B).
+#include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/clock.hpp>
+
+#include <chrono>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -29,7 +34,122 @@ BodyDesc moving(bool interpolate) {
     return d;
 }
 
+// Two reads of one published step by a game thread, some real time apart, each with the
+// instants just before taking the lock and just after the read.
+struct ReadPair {
+    MotionState first, second, first_update_clock, second_update_clock;
+    PublishedTime time;
+    std::int64_t before_first = 0, after_first = 0, before_second = 0, after_second = 0;
+};
+
+MotionState read_one(const Space& space, BodyHandle body, BlendClock clock) {
+    MotionState out;
+    space.motion_states().get_motion_states(std::span(&body, 1), std::span(&out, 1), clock);
+    return out;
+}
+
+// Retries until both reads fall within one published step and the second is still
+// blending (not capped at the newest step), as a slow machine may need.
+ReadPair read_twice_within_a_step(const Space& space, BodyHandle body, std::chrono::milliseconds apart) {
+    const MotionStateManager& states = space.motion_states();
+    for (int attempt = 0; attempt < 50; ++attempt) {
+        ReadPair r;
+        r.before_first = now_nanoseconds();
+        {
+            const MotionStateLock::Hold hold(states.lock());
+            r.first = space.motion_state(body);
+            r.first_update_clock = read_one(space, body, BlendClock::Update);
+            r.time = states.published_time();
+        }
+        r.after_first = now_nanoseconds();
+        std::this_thread::sleep_for(apart);
+        r.before_second = now_nanoseconds();
+        const MotionStateLock::Hold hold(states.lock());
+        r.second = space.motion_state(body);
+        r.second_update_clock = read_one(space, body, BlendClock::Update);
+        r.after_second = now_nanoseconds();
+        if (states.published_steps_locked() == r.time.steps && states.alpha_locked() < 1) return r;
+    }
+    ADD_FAILURE() << "no two reads fell within one published step";
+    return {};
+}
+
+Space runner_space(double step) {
+    SpaceSettings s;
+    s.gravity = Vec3::Zero();
+    s.sleep.enabled = false;
+    s.time_step.use_internal_time_stepping = true;
+    s.time_step.duration = step;
+    return Space(s);
+}
+
 }  // namespace
+
+// Under an AsyncRunner, reads blend by their own clock: between two flips interpolated
+// motion moves on at the real rate (one step behind), where the seed's blend stands still.
+TEST(Interpolation, ReadClockMovesReadsOnBetweenFlipsAtTheRealRate) {
+    constexpr double kLongStep = 0.1;  // s: room for two reads within one published step
+    Space space = runner_space(kLongStep);
+    const BodyHandle body = space.create_body(moving(true));  // 1 m/s along x from 0
+    AsyncRunner runner(space);
+    runner.start();
+    while (space.motion_states().published_steps() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const ReadPair r = read_twice_within_a_step(space, body, std::chrono::milliseconds(30));
+    runner.stop();
+    EXPECT_NE(r.time.clock_ns, 0);
+    EXPECT_EQ(r.time.reads, BlendClock::Read);
+    // The seed's blend: the same weight for both reads, from the update's banked time.
+    const double banked = (static_cast<double>(r.time.steps) - 1 + r.time.banked_alpha) * kLongStep;
+    EXPECT_NEAR(r.first_update_clock.position.x(), banked, 1e-9);
+    EXPECT_EQ(r.second_update_clock.position, r.first_update_clock.position);
+    // The reader's clock: the second read has moved on by the real time between them
+    // (the lock was taken somewhere between each pair of instants), at 1 m/s.
+    const double moved = r.second.position.x() - r.first.position.x();
+    EXPECT_GE(moved, static_cast<double>(r.before_second - r.after_first) * 1e-9 - 1e-9);
+    EXPECT_LE(moved, static_cast<double>(r.after_second - r.before_first) * 1e-9 + 1e-9);
+    // And each is the banked time grown by the time since the update measured it.
+    EXPECT_GE(r.first.position.x(), banked + static_cast<double>(r.before_first - r.time.clock_ns) * 1e-9 - 1e-9);
+    EXPECT_LE(r.first.position.x(), banked + static_cast<double>(r.after_first - r.time.clock_ns) * 1e-9 + 1e-9);
+}
+
+// Every read under one hold of the lock shows the instant the lock was taken, so reads
+// and scene queries made together agree, however long the hold.
+TEST(Interpolation, ReadsUnderOneHoldShowOneInstant) {
+    Space space = runner_space(0.1);
+    const BodyHandle body = space.create_body(moving(true));
+    AsyncRunner runner(space);
+    runner.start();
+    while (space.motion_states().published_steps() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    MotionState first, second;
+    double alpha_first = 0, alpha_second = 0;
+    {
+        const MotionStateLock::Hold hold(space.motion_states().lock());
+        first = space.motion_state(body);
+        alpha_first = space.motion_states().alpha_locked();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        second = space.motion_state(body);
+        alpha_second = space.motion_states().alpha_locked();
+    }
+    runner.stop();
+    EXPECT_EQ(first.position, second.position);
+    EXPECT_EQ(alpha_first, alpha_second);
+}
+
+// A runner asked for the seed's blend: reads stand still between flips.
+TEST(Interpolation, RunnerWithTheUpdateClockKeepsTheSeedsBlend) {
+    Space space = runner_space(0.1);
+    const BodyHandle body = space.create_body(moving(true));
+    AsyncRunnerOptions options;
+    options.blend_clock = BlendClock::Update;
+    AsyncRunner runner(space, options);
+    runner.start();
+    while (space.motion_states().published_steps() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    const ReadPair r = read_twice_within_a_step(space, body, std::chrono::milliseconds(30));
+    runner.stop();
+    EXPECT_EQ(r.time.reads, BlendClock::Update);
+    EXPECT_EQ(r.second.position, r.first.position);
+    EXPECT_NEAR(r.first.position.x(), (static_cast<double>(r.time.steps) - 1 + r.time.banked_alpha) * 0.1, 1e-9);
+}
 
 TEST(Interpolation, SeedExampleBlendsPointFourOfNewestAndPointSixOfPrevious) {
     Space space = make_space();

@@ -134,6 +134,9 @@ void AsyncRunner::loop(std::promise<void>* started) {
     try {
         while (!m_stop.load(std::memory_order_acquire)) {
             const double dt = since_last.lap();
+            // The instant dt runs to: the banked time's clock, for reads that blend by theirs.
+            m_space.m_world->update_clock_ns = since_last.started_nanoseconds();
+            m_space.m_world->read_blend = m_options.blend_clock;
             {
                 std::scoped_lock guard(m_posted_lock);
                 posted.swap(m_posted);
@@ -165,6 +168,9 @@ void AsyncRunner::loop(std::promise<void>* started) {
         m_failure = std::current_exception();
     }
     m_space.m_world->gate.claim(std::thread::id{});
+    // Later updates (stop's flush, the game's own) follow no clock.
+    m_space.m_world->update_clock_ns = 0;
+    m_space.m_world->read_blend = BlendClock::Update;
     m_running.store(false, std::memory_order_release);
     m_loop_thread.store(std::thread::id{}, std::memory_order_release);
 }

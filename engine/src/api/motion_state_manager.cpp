@@ -23,12 +23,14 @@ void MotionStateLock::lock() {
     }
     m_mutex.lock();
     m_owner.store(std::this_thread::get_id(), std::memory_order_relaxed);
+    m_taken_ns = now_nanoseconds();
 }
 
 bool MotionStateLock::try_lock() {
     if (held_by_this_thread()) throw Error("motion-state lock: this thread holds it already");
     if (!m_mutex.try_lock()) return false;
     m_owner.store(std::this_thread::get_id(), std::memory_order_relaxed);
+    m_taken_ns = now_nanoseconds();
     return true;
 }
 
@@ -72,12 +74,19 @@ void MotionStateManager::SlotGenerations::store(std::uint32_t slot, std::uint32_
 
 // ---- reads and the flip ----
 
-MotionState MotionStateManager::blend_locked(std::uint32_t i) const {
+double MotionStateManager::alpha_locked(BlendClock clock) const noexcept {
+    const PublishedTime& t = m_time;
+    if (clock == BlendClock::Update || t.clock_ns == 0 || t.banked_alpha >= 1) return t.banked_alpha;
+    const double grown = static_cast<double>(m_lock.taken_at_ns() - t.clock_ns) * 1e-9 / t.step_seconds;
+    return std::clamp(t.banked_alpha + grown, t.banked_alpha, 1.0);
+}
+
+MotionState MotionStateManager::blend_locked(std::uint32_t i, double alpha) const {
     const PublishedBuffer& front = *m_front;
-    if (!front.interpolate[i] || m_alpha >= 1) return front.current[i];
+    if (!front.interpolate[i] || alpha >= 1) return front.current[i];
     const PublishedHistory& before = front.previous[i];
     MotionState s = front.current[i];
-    const Real t = m_alpha;
+    const Real t = alpha;
     s.position = before.position + (s.position - before.position) * t;
     s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * t;
     s.orientation = slerp_shortest(before.orientation, s.orientation, t);
@@ -96,7 +105,7 @@ bool MotionStateManager::is_published_locked(BodyHandle body) const noexcept {
 
 MotionState MotionStateManager::read_locked(BodyHandle body) const {
     check_locked(body);
-    return blend_locked(body.index);
+    return blend_locked(body.index, alpha_locked());
 }
 
 MotionState MotionStateManager::read(BodyHandle body) const {
@@ -122,7 +131,8 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
     for (std::uint32_t i = 0; i < slots; ++i) count += front.generation[i] != 0;
     handles.resize(count);
     states.resize(count);
-    const bool blending = m_alpha < 1;
+    const double alpha = alpha_locked();
+    const bool blending = alpha < 1;
     auto copied = [&](std::uint32_t i) { return front.generation[i] != 0 && !(blending && front.interpolate[i]); };
     std::size_t k = 0;
     for (std::uint32_t i = 0; i < slots;) {
@@ -130,7 +140,7 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
             ++i;
         } else if (!copied(i)) {
             handles[k] = BodyHandle{i, front.generation[i]};
-            states[k++] = blend_locked(i++);
+            states[k++] = blend_locked(i++, alpha);
         } else {
             std::uint32_t end = i;
             while (end < slots && copied(end)) {
@@ -147,10 +157,16 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
 }
 
 void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
+    get_motion_states(bodies, out, m_time.reads);
+}
+
+void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out,
+                                           BlendClock clock) const {
     if (out.size() < bodies.size()) throw Error("get_motion_states: output span is shorter than the handle list");
     const MotionStateLock::Hold guard(m_lock);
     for (BodyHandle b : bodies) check_locked(b);
-    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend_locked(bodies[i].index);
+    const double alpha = alpha_locked(clock);
+    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend_locked(bodies[i].index, alpha);
 }
 
 void MotionStateManager::get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
@@ -162,20 +178,24 @@ void MotionStateManager::get_raw_motion_states(std::span<const BodyHandle> bodie
 
 std::uint64_t MotionStateManager::published_steps() const {
     const MotionStateLock::Hold guard(m_lock);
-    return m_steps;
+    return m_time.steps;
 }
 
 double MotionStateManager::alpha() const {
     const MotionStateLock::Hold guard(m_lock);
-    return m_alpha;
+    return alpha_locked();
 }
 
-double MotionStateManager::flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries) {
+PublishedTime MotionStateManager::published_time() const {
+    const MotionStateLock::Hold guard(m_lock);
+    return m_time;
+}
+
+double MotionStateManager::flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries) {
     std::scoped_lock guard(m_lock);
-    const std::int64_t acquired = now_nanoseconds();
+    const std::int64_t acquired = m_lock.taken_at_ns();
     std::swap(m_front, m_back);
-    m_alpha = alpha;
-    m_steps = steps;
+    m_time = time;
     m_query_scene = std::move(queries);
     return static_cast<double>(now_nanoseconds() - acquired) * 1e-9;  // hold time, not wait time
 }

@@ -243,7 +243,7 @@ void QueryScene::overlap_box(const Aabb& box, const QueryFilter& filter, double 
 QueryLease::QueryLease(const MotionStateManager& manager) {
     const MotionStateLock::Hold guard(manager.m_lock);
     m_scene = manager.m_query_scene;
-    m_alpha = manager.m_alpha;
+    m_alpha = manager.alpha_locked();
     if (m_scene) m_scene->holders.fetch_add(1, std::memory_order_relaxed);  // under the lock
 }
 

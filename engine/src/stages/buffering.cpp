@@ -25,8 +25,8 @@ public:
     void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
         m_manager.set_published_kind(slot, type, static_only_shape);
     }
-    double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries) {
-        return m_manager.flip(alpha, steps, std::move(queries));
+    double flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries) {
+        return m_manager.flip(time, std::move(queries));
     }
     void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) {
         m_manager.set_query_scene_locked(std::move(queries));
@@ -283,8 +283,10 @@ void flip_read_buffers(World& world) {
     // Bodies awake last update but asleep now were recorded in changed_now by the
     // islands stage, so nothing is missed.
 
-    const double alpha = interpolating ? world.accumulator / world.settings.time_step.duration : 1.0;
-    world.stats.flip_lock_seconds = manager.flip(alpha, world.steps, world.query_scenes[k]);
+    const Real step = world.settings.time_step.duration;
+    const PublishedTime time{world.steps, interpolating ? world.accumulator / step : 1.0, world.update_clock_ns, step,
+                             world.read_blend};
+    world.stats.flip_lock_seconds = manager.flip(time, world.query_scenes[k]);
     // After the swap the new back buffer may be shorter than the body slots.
     if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());

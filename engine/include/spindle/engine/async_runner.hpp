@@ -16,6 +16,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <spindle/engine/motion_state_manager.hpp>
+
 namespace spindle {
 
 class Space;
@@ -26,6 +28,10 @@ struct AsyncRunnerOptions {
     // With internal time stepping, sleep until the next step is due instead of
     // spinning through updates that take no step (they would only re-publish).
     bool sleep_when_idle = true;
+    // Where reads without a clock of their own take the blend from (motion_state_manager.hpp):
+    // Read lets interpolated motion move on between updates at the real rate; Update is
+    // the seed's blend, fixed from one flip to the next.
+    BlendClock blend_clock = BlendClock::Read;
 };
 
 struct AsyncStats {

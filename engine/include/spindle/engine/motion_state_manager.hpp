@@ -18,6 +18,27 @@ namespace spindle {
 
 class QueryScene;  // engine/src/query/query_scene.hpp: what scene queries read
 
+// Where a blended read takes the weight of the newest step from.
+enum class BlendClock : std::uint8_t {
+    // The seed's: the time the last update banked (its accumulator over the step), the
+    // same for every read until the next flip. Between flips the reads stand still.
+    Update,
+    // The banked time grown by the reader's clock since the update measured it, capped
+    // at the newest step: motion moves on between flips at the real rate, one step
+    // behind. Only updates that follow the real clock say when they measured it (an
+    // AsyncRunner's); for others this is Update.
+    Read,
+};
+
+// What the published step is: enough to say which instant a read shows.
+struct PublishedTime {
+    std::uint64_t steps = 0;                // steps taken when it was published
+    double banked_alpha = 1;                // the newest step's weight under BlendClock::Update (1: no blending)
+    std::int64_t clock_ns = 0;              // now_nanoseconds() when the update measured the banked time; 0: unknown
+    double step_seconds = 0;                // the fixed step
+    BlendClock reads = BlendClock::Update;  // the clock of reads that do not name one
+};
+
 // The step before the newest, for blending a body that interpolates.
 struct PublishedHistory {
     Vec3 position = Vec3::Zero();
@@ -59,6 +80,9 @@ public:
     void unlock() noexcept;
     // Whether the calling thread holds it; exact for the calling thread, lock-free.
     bool held_by_this_thread() const noexcept;
+    // now_nanoseconds() when the holder took it: the clock of every read made under one
+    // hold (BlendClock::Read), so they all show the same instant. The holder only.
+    std::int64_t taken_at_ns() const noexcept { return m_taken_ns; }
 
     // Holds the lock for a scope, or nothing if this thread holds it already (then the
     // published step cannot change under the caller either way).
@@ -81,6 +105,7 @@ public:
 private:
     std::mutex m_mutex;
     std::atomic<std::thread::id> m_owner{};  // written only by the holder, under m_mutex
+    std::int64_t m_taken_ns = 0;             // the same
 };
 
 class MotionStateManager {
@@ -114,6 +139,9 @@ public:
     // The listed bodies into out[0..bodies.size()). A stale handle throws spindle::Error
     // naming it, before anything is written.
     void get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const;
+    // The same with the blend's clock chosen for this read (the others use the one the
+    // updates ask for: PublishedTime::reads, AsyncRunnerOptions::blend_clock).
+    void get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out, BlendClock clock) const;
     // As above, the newest step without interpolation.
     void get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const;
 
@@ -144,10 +172,14 @@ public:
     // for a stale handle. Takes the lock unless this thread holds it.
     std::uint64_t read_user_data(BodyHandle body) const;
 
-    // Steps published so far and the weight of the newest step in blended reads.
+    // Steps published so far and the weight of the newest step in blended reads now.
     std::uint64_t published_steps() const;
-    std::uint64_t published_steps_locked() const noexcept { return m_steps; }
+    std::uint64_t published_steps_locked() const noexcept { return m_time.steps; }
     double alpha() const;
+    // The weight a blended read by the lock's holder gives the newest step.
+    double alpha_locked() const noexcept { return alpha_locked(m_time.reads); }
+    double alpha_locked(BlendClock clock) const noexcept;
+    PublishedTime published_time() const;
 
 private:
     // The physics side (the update thread): only the buffering stages reach it, through
@@ -161,7 +193,7 @@ private:
     PublishedBuffer& buffer_locked(int k) noexcept { return m_buffers[k]; }
     // Swaps back and front under the lock and publishes the query scene that goes with
     // the new front; returns seconds the lock was held.
-    double flip(double alpha, std::uint64_t steps, std::shared_ptr<const QueryScene> queries);
+    double flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries);
     // Replaces the published query scene, for a caller that holds lock().
     void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) noexcept {
         m_query_scene = std::move(queries);
@@ -175,8 +207,8 @@ private:
         m_kinds.store(slot, static_cast<std::uint32_t>(type) | (static_only_shape ? 0x100u : 0u));
     }
 
-    // Slot i of the front buffer as reads return it (blended where it interpolates).
-    MotionState blend_locked(std::uint32_t i) const;
+    // Slot i of the front buffer as reads return it: blended by `alpha` where it interpolates.
+    MotionState blend_locked(std::uint32_t i, double alpha) const;
     void check_locked(BodyHandle body) const;
 
     // Per slot, an atomic copy of the published generation. Readers take no lock, so
@@ -201,8 +233,7 @@ private:
     PublishedBuffer m_buffers[2];
     PublishedBuffer* m_front = &m_buffers[0];
     PublishedBuffer* m_back = &m_buffers[1];
-    double m_alpha = 1;
-    std::uint64_t m_steps = 0;
+    PublishedTime m_time;
     std::shared_ptr<const QueryScene> m_query_scene;  // null until a body is published
 };
 

@@ -24,6 +24,10 @@ public:
     std::int64_t elapsed_nanoseconds() const noexcept {
         return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - m_start).count();
     }
+    // When it started (or last restarted or lapped), on now_nanoseconds()'s scale.
+    std::int64_t started_nanoseconds() const noexcept {
+        return std::chrono::duration_cast<std::chrono::nanoseconds>(m_start.time_since_epoch()).count();
+    }
     // Elapsed seconds, and restart: the physics loop's "time since last iteration".
     double lap() noexcept {
         const auto now = Clock::now();
