@@ -54,6 +54,13 @@ JointDesc JointDesc::fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anch
     return d;
 }
 
+JointDesc JointDesc::prismatic_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::Prismatic;
+    d.prismatic.axis_a = world_axis;
+    return d;
+}
+
 JointDesc JointDesc::swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor,
                                     const Vec3& world_twist_axis) {
     JointDesc d = ball_socket_at(a, b, world_anchor);
@@ -104,7 +111,7 @@ void validate(const World& world, const JointDesc& d) {
         reject("at least one of body_a and body_b must be dynamic");
     }
     if (d.type != JointType::BallSocket && d.type != JointType::Hinge && d.type != JointType::Fixed &&
-        d.type != JointType::Distance && d.type != JointType::SwingTwist) {
+        d.type != JointType::Distance && d.type != JointType::SwingTwist && d.type != JointType::Prismatic) {
         reject("type is not a joint type (" + std::to_string(static_cast<int>(d.type)) + ")");
     }
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
@@ -139,6 +146,24 @@ void validate(const World& world, const JointDesc& d) {
         require_ordered(p.twist_min, p.twist_max, "swing_twist.twist_min", "swing_twist.twist_max");
         require_non_negative(p.max_friction_torque, "swing_twist.max_friction_torque");
     }
+    if (d.type == JointType::Prismatic) {
+        const PrismaticParams& p = d.prismatic;
+        require_axis(p.axis_a, "prismatic.axis_a");
+        require(std::isfinite(p.lower_translation), "prismatic.lower_translation", "must be finite",
+                number(p.lower_translation));
+        require(std::isfinite(p.upper_translation), "prismatic.upper_translation", "must be finite",
+                number(p.upper_translation));
+        if (p.enable_limit) {
+            require_ordered(p.lower_translation, p.upper_translation, "prismatic.lower_translation",
+                            "prismatic.upper_translation");
+        }
+        require_non_negative(p.spring_hertz, "prismatic.spring_hertz");
+        require_non_negative(p.spring_damping_ratio, "prismatic.spring_damping_ratio");
+        require(std::isfinite(p.target_translation), "prismatic.target_translation", "must be finite",
+                number(p.target_translation));
+        require(std::isfinite(p.motor_speed), "prismatic.motor_speed", "must be finite", number(p.motor_speed));
+        require_non_negative(p.max_motor_force, "prismatic.max_motor_force");
+    }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
         require(std::isfinite(p.rest_length), "distance.rest_length", "must be finite", number(p.rest_length));
@@ -162,6 +187,7 @@ Joint make_joint(const World& world, const JointDesc& d) {
     j.hinge = d.hinge;
     j.distance = d.distance;
     j.swing_twist = d.swing_twist;
+    j.prismatic = d.prismatic;
     j.collide_connected = d.collide_connected;
     const bool world_frame = d.anchors.frame == JointFrame::World;
     // Anchors are given in the shape's frame (local) or in world; kept relative to the centre of mass.
@@ -183,6 +209,13 @@ Joint make_joint(const World& world, const JointDesc& d) {
         j.ref_b = qb.conjugate() * rb;
     }
     j.reference = (qa.conjugate() * qb).normalized();
+    if (d.type == JointType::Prismatic) {
+        const Vec3 axis = world_frame ? d.prismatic.axis_a.normalized() : Vec3(qa * d.prismatic.axis_a.normalized());
+        j.axis_a = qa.conjugate() * axis;
+        j.ref_a = qa.conjugate() * perpendicular(axis);
+        const Vec3 pa = b.x[sa] + qa * j.local_a, pb = b.x[sb] + qb * j.local_b;
+        j.rest_length = axis.dot(pb - pa);
+    }
     if (d.type == JointType::Distance) {
         const Vec3 pa = b.x[sa] + qa * j.local_a, pb = b.x[sb] + qb * j.local_b;
         j.rest_length = d.distance.rest_length < 0 ? (pb - pa).norm() : d.distance.rest_length;
@@ -367,7 +400,18 @@ JointError Space::internal_joint_error(JointHandle handle) const {
             e.angular = swing_twist_violation(angles, j.swing_twist);
             break;
         }
-        case JointType::Prismatic:
+        case JointType::Prismatic: {
+            const PrismaticParams& p = j.prismatic;
+            const PrismaticOffset offset = prismatic_offset(j, qa * j.axis_a, pa, pb);
+            e.linear = offset.off_axis;
+            if (p.enable_limit) {
+                e.linear += std::max(
+                    {Real(0), p.lower_translation - offset.translation, offset.translation - p.upper_translation});
+            }
+            const Quat error = qb * j.reference.conjugate() * qa.conjugate();
+            e.angular = 2 * std::atan2(error.vec().norm(), std::abs(error.w()));
+            break;
+        }
         case JointType::Motor: break;
     }
     return e;

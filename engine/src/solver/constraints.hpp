@@ -115,31 +115,34 @@ struct JointConstraint {
 
     // Hinge: A's axis, two perpendiculars of B's axis (the alignment rows), angle references.
     // Swing-twist: each body's twist axis (axis_a, axis_b) and twist references.
+    // Prismatic: the slide axis (axis_a) and two perpendiculars of it (perp_a), on A.
     Vec3 axis_a = Vec3::UnitZ();
     Vec3 axis_b = Vec3::UnitZ();
     Vec3 perp_b[2] = {Vec3::UnitX(), Vec3::UnitY()};
     Vec3 ref_a = Vec3::UnitX(), ref_b = Vec3::UnitX();
+    Vec3 perp_a[2] = {Vec3::UnitY(), Vec3::UnitZ()};
     // Fixed: the rotation that takes B's target orientation to its actual one, world.
     Quat rotation_error = Quat::Identity();
     Mat3 rotation_mass = Mat3::Zero();  // fixed, swing-twist friction
     // Effective masses of the other rows are computed as they are solved, from the
     // frames then: a light body can turn far within one step.
     Vec3 axis = Vec3::UnitX();  // distance: direction at the step's start (if the anchors meet)
-    Softness spring;            // distance spring
+    Softness spring;            // distance, prismatic spring
 
     // Parameters, copied so the hot loop reads one struct.
     bool enable_limit = false, enable_motor = false, enable_spring = false;
     Real lower = 0, upper = 0;  // hinge angles, distance lengths or twist range
     Real cone = 0;              // swing-twist: the cone's half angle
     Real max_friction_impulse = 0;
-    Real rest_length = 0;
+    Real rest_length = 0;  // distance; prismatic: the anchors' offset along the axis at creation
+    Real target = 0;       // prismatic spring's translation
     Real motor_speed = 0, max_motor_impulse = 0;
     Real spring_hertz = 0;
 
     // Accumulated impulses.
     Vec3 linear_impulse = Vec3::Zero();
     Vec3 angular_impulse = Vec3::Zero();  // fixed; swing-twist friction
-    Vec2 align_impulse = Vec2::Zero();    // hinge, along the two alignment rows
+    Vec2 align_impulse = Vec2::Zero();    // hinge, along the two alignment rows; prismatic, perp_a
     Real axial_impulse = 0, motor_impulse = 0, lower_impulse = 0, upper_impulse = 0;
     Real swing_impulse = 0;
 };

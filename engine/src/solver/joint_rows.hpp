@@ -57,6 +57,14 @@ Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointS
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p);
 
+// Three angular rows that hold B's orientation relative to A's (fixed, prismatic), from
+// jc.rotation_error and jc.rotation_mass, accumulated in jc.angular_impulse.
+void solve_rotation_lock(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                         const JointSolveParams& p);
+// jc.rotation_error, rotation_mass and angular_impulse for the step.
+void prepare_rotation_lock(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb,
+                           JointConstraint& jc);
+
 // Some unit vector perpendicular to a unit vector.
 Vec3 perpendicular(const Vec3& n);
 
@@ -78,5 +86,21 @@ void prepare_swing_twist(const Joint& j, const SolverBody& A, const SolverBody& 
 void warm_start_swing_twist(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s);
 void solve_swing_twist(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                        const JointSolveParams& p);
+
+// Prismatic (joint_prismatic.cpp).
+void prepare_prismatic(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb, Real h,
+                       JointConstraint& jc);
+void warm_start_prismatic(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s);
+void solve_prismatic(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                     const JointSolveParams& p);
+// The translation and how far B's anchor is off the axis, from the anchors in world.
+struct PrismaticOffset {
+    Real translation = 0;  // along the axis, from the pose at creation
+    Real off_axis = 0;     // m
+};
+PrismaticOffset prismatic_offset(const Joint& j, const Vec3& axis, const Vec3& anchor_a, const Vec3& anchor_b);
+// The world impulse the two perpendicular rows carried, back to the rows (warm starting:
+// the rows turn between steps).
+Vec2 onto_rows(const Vec3 (&rows)[2], const Vec3& impulse);
 
 }  // namespace spindle

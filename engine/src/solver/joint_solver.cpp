@@ -97,6 +97,33 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     apply(A, B, s, ra, rb, impulse);
 }
 
+void solve_rotation_lock(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                         const JointSolveParams& p) {
+    const Softness soft = pass_softness(p);
+    const Vec3 c = rotation_error(jc, A.dq, B.dq);
+    const Vec3 cdot = s.wb - s.wa;
+    const Vec3 impulse = -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) -
+                         soft.impulse_scale * jc.angular_impulse;
+    jc.angular_impulse += impulse;
+    apply_angular(A, B, s, impulse);
+}
+
+void prepare_rotation_lock(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb,
+                           JointConstraint& jc) {
+    jc.rotation_error = qb * j.reference.conjugate() * qa.conjugate();
+    jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
+    jc.angular_impulse = j.angular_impulse;
+}
+
+Vec2 onto_rows(const Vec3 (&rows)[2], const Vec3& impulse) {
+    Vec2 r;
+    for (int k = 0; k < 2; ++k) {
+        const Real norm2 = rows[k].squaredNorm();
+        r[k] = norm2 > 1e-12 ? rows[k].dot(impulse) / norm2 : 0;
+    }
+    return r;
+}
+
 namespace {
 
 // Hinge: motor and limit about the axis, two alignment rows, then the point.
@@ -139,13 +166,7 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
 // Fixed: three angular rows that hold the relative rotation, then the point.
 void solve_fixed(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
-    const Softness soft = pass_softness(p);
-    const Vec3 c = rotation_error(jc, A.dq, B.dq);
-    const Vec3 cdot = s.wb - s.wa;
-    const Vec3 impulse = -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) -
-                         soft.impulse_scale * jc.angular_impulse;
-    jc.angular_impulse += impulse;
-    apply_angular(A, B, s, impulse);
+    solve_rotation_lock(jc, A, B, s, p);
     solve_point(jc, A, B, s, p);
 }
 
@@ -214,10 +235,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.ref_b = jc.perp_b[0];
             // The kept impulse is a world vector: the rows' directions move between steps.
             const AlignRows rows = align_rows(jc, Quat::Identity(), Quat::Identity());
-            for (int r = 0; r < 2; ++r) {
-                const Real norm2 = rows.u[r].squaredNorm();
-                jc.align_impulse[r] = norm2 > 1e-12 ? rows.u[r].dot(j.angular_impulse) / norm2 : 0;
-            }
+            jc.align_impulse = onto_rows(rows.u, j.angular_impulse);
             const HingeParams& hp = j.hinge;
             jc.enable_limit = hp.enable_limit;
             jc.lower = hp.lower_angle;
@@ -230,11 +248,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.upper_impulse = hp.enable_limit ? j.upper_impulse : 0;
             break;
         }
-        case JointType::Fixed:
-            jc.rotation_error = qb * j.reference.conjugate() * qa.conjugate();
-            jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
-            jc.angular_impulse = j.angular_impulse;
-            break;
+        case JointType::Fixed: prepare_rotation_lock(j, A, B, qa, qb, jc); break;
         case JointType::Distance: {
             const DistanceParams& dp = j.distance;
             const Vec3 d = jc.delta_center + jc.rb - jc.ra;
@@ -254,7 +268,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             break;
         }
         case JointType::SwingTwist: prepare_swing_twist(j, A, B, qa, qb, h, jc); break;
-        case JointType::Prismatic:
+        case JointType::Prismatic: prepare_prismatic(j, A, B, qa, qb, h, jc); break;
         case JointType::Motor: break;
     }
 }
@@ -326,7 +340,7 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
             warm_start_swing_twist(jc, A, B, s);
             apply(A, B, s, ra, rb, jc.linear_impulse);
             break;
-        case JointType::Prismatic:
+        case JointType::Prismatic: warm_start_prismatic(jc, A, B, s); break;
         case JointType::Motor: break;
     }
     store(A, B, s);
@@ -343,7 +357,7 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
         case JointType::Fixed: solve_fixed(jc, A, B, s, params); break;
         case JointType::Distance: solve_distance(jc, A, B, s, params); break;
         case JointType::SwingTwist: solve_swing_twist(jc, A, B, s, params); break;
-        case JointType::Prismatic:
+        case JointType::Prismatic: solve_prismatic(jc, A, B, s, params); break;
         case JointType::Motor: break;
     }
     store(A, B, s);
@@ -364,6 +378,11 @@ void store_joint_impulses(World& world, SolverScratch& scratch) {
         if (jc.type == JointType::Hinge) {
             const AlignRows rows = align_rows(jc, bodies[jc.a].dq, bodies[jc.b].dq);
             j.angular_impulse = jc.align_impulse.x() * rows.u[0] + jc.align_impulse.y() * rows.u[1];
+        }
+        if (jc.type == JointType::Prismatic) {
+            const Quat& dqa = bodies[jc.a].dq;
+            j.linear_impulse = jc.align_impulse.x() * (dqa * jc.perp_a[0]) +
+                               jc.align_impulse.y() * (dqa * jc.perp_a[1]);
         }
     }
 }

@@ -108,7 +108,8 @@ std::uint64_t run_jointed_scene(JobSystem& jobs) {
 }
 
 // The joints a ragdoll and a machine need: limbs of capsules on swing-twist joints
-// (cones, twist ranges, friction) swinging down onto a floor.
+// (cones, twist ranges, friction) swinging down onto a floor, and boxes on sliders
+// (limits, springs, motors) from the limbs' ends and the ground.
 std::uint64_t run_limb_scene(JobSystem& jobs) {
     Space space(SpaceSettings{}, &jobs);
     BodyDesc d;
@@ -135,6 +136,21 @@ std::uint64_t run_limb_scene(JobSystem& jobs) {
             space.create_joint(joint);
             previous = link;
         }
+        d.shape = Shape::box(Vec3(0.1, 0.1, 0.1));
+        d.orientation = Quat::Identity();
+        d.position = Vec3(1.5 * c + 2.6, 2, 0.1 * c);
+        const BodyHandle slider = space.create_body(d);
+        JointDesc joint = JointDesc::prismatic_at(previous, slider, d.position, Vec3(1, 1, c).normalized());
+        joint.prismatic.enable_limit = true;
+        joint.prismatic.lower_translation = -0.3;
+        joint.prismatic.upper_translation = 0.2;
+        joint.prismatic.enable_spring = c % 2 == 0;
+        joint.prismatic.spring_hertz = 3;
+        joint.prismatic.spring_damping_ratio = 0.3;
+        joint.prismatic.enable_motor = c % 2 == 1;
+        joint.prismatic.motor_speed = 1;
+        joint.prismatic.max_motor_force = 20;
+        space.create_joint(joint);
     }
     for (int i = 0; i < kSteps; ++i) space.update();
     EXPECT_GT(space.counters().joints_solved, 0u);

@@ -32,6 +32,17 @@ JointDesc joint_of(JointType type, const Scene& s) {
     d.swing_twist.twist_min = -0.25;
     d.swing_twist.twist_max = 0.25;
     d.swing_twist.max_friction_torque = 2;
+    d.prismatic.axis_a = Vec3(0, 1, 0);
+    d.prismatic.enable_limit = true;
+    d.prismatic.lower_translation = -0.5;
+    d.prismatic.upper_translation = 0.5;
+    d.prismatic.enable_spring = true;
+    d.prismatic.spring_hertz = 2;
+    d.prismatic.spring_damping_ratio = 0.5;
+    d.prismatic.target_translation = 0.1;
+    d.prismatic.enable_motor = true;
+    d.prismatic.motor_speed = 1;
+    d.prismatic.max_motor_force = 10;
     return d;
 }
 
@@ -194,6 +205,39 @@ TEST(InvalidJoint, SwingTwistFieldsFollowTheirRules) {
             d.swing_twist.twist_max = 0.1;
         },
         false, "swing_twist.twist_min", "above twist_max");
+}
+
+TEST(InvalidJoint, PrismaticFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Prismatic,
+                [&](JointDesc& d) {
+                    d.prismatic.axis_a = Vec3(1, 1, 1);
+                    d.prismatic.axis_a[axis] = t.value;
+                },
+                accepts(Rule::Finite, t.value), "prismatic.axis_a", t.name);
+        }
+    }
+    try_joint(
+        JointType::Prismatic, [](JointDesc& d) { d.prismatic.axis_a = Vec3::Zero(); }, false, "prismatic.axis_a",
+        "zero");
+    const std::vector<std::tuple<const char*, Real PrismaticParams::*, Rule>> fields{
+        {"prismatic.lower_translation", &PrismaticParams::lower_translation, Rule::Finite},       // <= upper (0.5)
+        {"prismatic.upper_translation", &PrismaticParams::upper_translation, Rule::NonNegative},  // -1 < lower
+        {"prismatic.spring_hertz", &PrismaticParams::spring_hertz, Rule::NonNegative},
+        {"prismatic.spring_damping_ratio", &PrismaticParams::spring_damping_ratio, Rule::NonNegative},
+        {"prismatic.target_translation", &PrismaticParams::target_translation, Rule::Finite},
+        {"prismatic.motor_speed", &PrismaticParams::motor_speed, Rule::Finite},
+        {"prismatic.max_motor_force", &PrismaticParams::max_motor_force, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Prismatic, [&](JointDesc& d) { d.prismatic.*member = t.value; }, accepts(rule, t.value),
+                field, t.name);
+        }
+    }
 }
 
 TEST(InvalidJoint, HingeMotorSetterChecksSpeedAndTorque) {

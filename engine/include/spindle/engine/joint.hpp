@@ -89,6 +89,23 @@ struct SwingTwistParams {
     Real max_friction_torque = 0;  // N m
 };
 
+// Prismatic (a slider): B keeps its orientation relative to A and its anchor moves only
+// along an axis fixed in A. The translation is B's anchor from A's along the axis,
+// measured from the pose at creation (0 there), in metres.
+struct PrismaticParams {
+    Vec3 axis_a = Vec3::UnitX();  // in anchors.frame (on A); normalised at creation
+    bool enable_limit = false;
+    Real lower_translation = 0;     // m, <= upper_translation
+    Real upper_translation = 0;     // m
+    bool enable_spring = false;     // toward target_translation
+    Real spring_hertz = 0;          // 0 with enable_spring: no spring force
+    Real spring_damping_ratio = 0;  // 1 = critical
+    Real target_translation = 0;    // m
+    bool enable_motor = false;
+    Real motor_speed = 0;      // m/s of B relative to A along the axis
+    Real max_motor_force = 0;  // N; the motor gives up beyond it
+};
+
 struct JointDesc {
     JointType type = JointType::BallSocket;
     BodyHandle body_a;
@@ -97,12 +114,14 @@ struct JointDesc {
     HingeParams hinge;               // used by Hinge
     DistanceParams distance;         // used by Distance
     SwingTwistParams swing_twist;    // used by SwingTwist
+    PrismaticParams prismatic;       // used by Prismatic
     bool collide_connected = false;  // false: the two bodies never make contacts with each other
     std::uint64_t user_data = 0;
 
     static JointDesc ball_socket_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
     static JointDesc hinge_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis);
     static JointDesc fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
+    static JointDesc prismatic_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis);
     static JointDesc swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_twist_axis);
     static JointDesc distance_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor_a,
                                       const Vec3& world_anchor_b);
@@ -110,8 +129,10 @@ struct JointDesc {
 
 // How far a joint is from satisfied, from the bodies' current poses.
 struct JointError {
-    Real linear = 0;  // m: anchor separation; distance joint: length outside what it allows
-    // rad: hinge axis misalignment, fixed joint rotation error; swing-twist: how far the
+    // m: anchor separation; distance joint: length outside what it allows; prismatic: B's
+    // anchor off the axis, plus how far the translation is outside its limits
+    Real linear = 0;
+    // rad: hinge axis misalignment, fixed and prismatic joint rotation error; swing-twist: how far the
     // swing is outside its cone or the twist outside its range, whichever is more
     Real angular = 0;
 };
