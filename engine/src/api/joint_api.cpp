@@ -130,6 +130,8 @@ void validate(const World& world, const JointDesc& d) {
             }
             require_ordered(h.lower_angle, h.upper_angle, "hinge.lower_angle", "hinge.upper_angle");
         }
+        require_non_negative(h.limit_spring_hertz, "hinge.limit_spring_hertz");
+        require_non_negative(h.limit_damping_ratio, "hinge.limit_damping_ratio");
         require(std::isfinite(h.motor_speed), "hinge.motor_speed", "must be finite", number(h.motor_speed));
         require_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
     }

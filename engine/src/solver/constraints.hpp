@@ -128,9 +128,10 @@ struct JointConstraint {
     // frames then: a light body can turn far within one step.
     Vec3 axis = Vec3::UnitX();  // distance: direction at the step's start (if the anchors meet)
     Softness spring;            // distance, prismatic spring
+    Softness limit_spring;      // hinge: a soft limit's spring (soft_limit)
 
     // Parameters, copied so the hot loop reads one struct.
-    bool enable_limit = false, enable_motor = false, enable_spring = false;
+    bool enable_limit = false, enable_motor = false, enable_spring = false, soft_limit = false;
     Real lower = 0, upper = 0;  // hinge angles, distance lengths or twist range
     Real cone = 0;              // swing-twist: the cone's half angle
     Real max_friction_impulse = 0;

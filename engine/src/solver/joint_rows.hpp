@@ -48,9 +48,11 @@ inline Real angular_mass(const SolverBody& A, const SolverBody& B, const Vec3& a
 inline Softness pass_softness(const JointSolveParams& p) { return p.use_bias ? p.soft : Softness{0, 1, 0}; }
 
 // One side of a limit that allows C >= 0: speculative while apart (may close the gap,
-// no more), soft while violated (`soft`: the pass's joint softness, or the limit's own
-// spring). Returns the impulse to apply (the total stays >= 0).
-Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p);
+// no more), soft while violated: the pass's joint softness, or the limit's own `spring`
+// (physics, not error correction: the same in solve and relax). Returns the impulse to
+// apply (the total stays >= 0).
+Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p,
+                   const Softness* spring = nullptr);
 
 // Point constraint (ball-socket, and the point part of the other joints): the anchors
 // coincide, solved as one 3x3 block.

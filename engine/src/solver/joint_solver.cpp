@@ -22,10 +22,12 @@ Vec3 perpendicular(const Vec3& n) {
     return (t - n * n.dot(t)).normalized();
 }
 
-Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p) {
+Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p, const Softness* spring) {
     Softness s{0, 1, 0};
     if (c > 0) {
         s.bias_rate = p.inv_h;
+    } else if (spring != nullptr) {
+        s = *spring;
     } else if (p.use_bias) {
         s = p.soft;
     }
@@ -141,9 +143,12 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     }
     if (jc.enable_limit) {
         const Real angle = hinge_angle(jc, rows.axis, A.dq, B.dq);
-        const Real lower = limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p);
+        const Softness* spring = jc.soft_limit ? &jc.limit_spring : nullptr;
+        const Real lower = limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p,
+                                         spring);
         apply_angular(A, B, s, lower * rows.axis);
-        const Real upper = limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p);
+        const Real upper = limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p,
+                                         spring);
         apply_angular(A, B, s, -upper * rows.axis);
     }
     {
@@ -240,6 +245,8 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.enable_limit = hp.enable_limit;
             jc.lower = hp.lower_angle;
             jc.upper = hp.upper_angle;
+            jc.soft_limit = hp.limit_spring_hertz > 0;
+            jc.limit_spring = make_softness(hp.limit_spring_hertz, hp.limit_damping_ratio, h);
             jc.enable_motor = hp.enable_motor;
             jc.motor_speed = hp.motor_speed;
             jc.max_motor_impulse = hp.max_motor_torque * h;

@@ -120,6 +120,8 @@ TEST(InvalidJoint, HingeFieldsFollowTheirRules) {
         {"hinge.upper_angle", &HingeParams::upper_angle, Rule::NonNegative},  // -1 is below lower_angle
         {"hinge.motor_speed", &HingeParams::motor_speed, Rule::Finite},
         {"hinge.max_motor_torque", &HingeParams::max_motor_torque, Rule::NonNegative},
+        {"hinge.limit_spring_hertz", &HingeParams::limit_spring_hertz, Rule::NonNegative},
+        {"hinge.limit_damping_ratio", &HingeParams::limit_damping_ratio, Rule::NonNegative},
     };
     for (const auto& [field, member, rule] : fields) {
         for (const Trial& t : kTrials) {

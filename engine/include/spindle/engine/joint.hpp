@@ -62,6 +62,11 @@ struct HingeParams {
     bool enable_motor = false;
     Real motor_speed = 0;       // rad/s of B relative to A about the axis
     Real max_motor_torque = 0;  // N m; the motor gives up beyond it
+    // A soft limit: past it a spring of this frequency (for the mass the limit turns, as
+    // the distance spring) and damping ratio pushes back, so the body overshoots and
+    // settles on the limit, sagging under a load. 0: as stiff as the solver's joints.
+    Real limit_spring_hertz = 0;
+    Real limit_damping_ratio = 0;  // 1 = critical
 };
 
 // Distance: rigid at rest_length, or (enable_spring) a spring toward rest_length that
