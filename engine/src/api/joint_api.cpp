@@ -70,6 +70,22 @@ JointDesc JointDesc::swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& worl
     return d;
 }
 
+JointDesc JointDesc::motor_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::Motor;
+    return d;
+}
+
+JointDesc JointDesc::mouse_at(BodyHandle world, BodyHandle body, const Vec3& world_point, Real hertz,
+                              Real damping_ratio, Real max_force) {
+    JointDesc d = motor_between(world, body, world_point);
+    d.motor.max_force = max_force;
+    d.motor.linear_hertz = hertz;
+    d.motor.linear_damping_ratio = damping_ratio;
+    d.collide_connected = true;  // a dragged body still rests on the ground it is dragged over
+    return d;
+}
+
 JointDesc JointDesc::distance_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor_a,
                                       const Vec3& world_anchor_b) {
     JointDesc d;
@@ -111,7 +127,8 @@ void validate(const World& world, const JointDesc& d) {
         reject("at least one of body_a and body_b must be dynamic");
     }
     if (d.type != JointType::BallSocket && d.type != JointType::Hinge && d.type != JointType::Fixed &&
-        d.type != JointType::Distance && d.type != JointType::SwingTwist && d.type != JointType::Prismatic) {
+        d.type != JointType::Distance && d.type != JointType::SwingTwist && d.type != JointType::Prismatic &&
+        d.type != JointType::Motor) {
         reject("type is not a joint type (" + std::to_string(static_cast<int>(d.type)) + ")");
     }
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
@@ -166,6 +183,17 @@ void validate(const World& world, const JointDesc& d) {
         require(std::isfinite(p.motor_speed), "prismatic.motor_speed", "must be finite", number(p.motor_speed));
         require_non_negative(p.max_motor_force, "prismatic.max_motor_force");
     }
+    if (d.type == JointType::Motor) {
+        const MotorParams& p = d.motor;
+        require_finite(p.linear_offset, "motor.linear_offset");
+        check_orientation(p.angular_offset, "create_joint", "motor.angular_offset");
+        require_non_negative(p.max_force, "motor.max_force");
+        require_non_negative(p.max_torque, "motor.max_torque");
+        require_non_negative(p.linear_hertz, "motor.linear_hertz");
+        require_non_negative(p.linear_damping_ratio, "motor.linear_damping_ratio");
+        require_non_negative(p.angular_hertz, "motor.angular_hertz");
+        require_non_negative(p.angular_damping_ratio, "motor.angular_damping_ratio");
+    }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
         require(std::isfinite(p.rest_length), "distance.rest_length", "must be finite", number(p.rest_length));
@@ -190,6 +218,8 @@ Joint make_joint(const World& world, const JointDesc& d) {
     j.distance = d.distance;
     j.swing_twist = d.swing_twist;
     j.prismatic = d.prismatic;
+    j.motor = d.motor;
+    j.motor.angular_offset.normalize();
     j.collide_connected = d.collide_connected;
     const bool world_frame = d.anchors.frame == JointFrame::World;
     // Anchors are given in the shape's frame (local) or in world; kept relative to the centre of mass.
@@ -263,6 +293,7 @@ void remove_joint(World& world, std::uint32_t slot, std::uint32_t dying = ~0u) {
             add_proxy(world, body);
         }
     }
+    if (j.type == JointType::Motor) world.joint_targets.remove_motor(js.handle(slot));
     js.alive[slot] = 0;
     js.live -= 1;
     js.free_slots.push_back(slot);
@@ -327,6 +358,7 @@ JointHandle Space::create_joint(const JointDesc& desc) {
     js.desc[slot] = desc;
     js.awake_dirty = true;
     block_pair(w, joint, +1);
+    if (joint.type == JointType::Motor) w.joint_targets.add_motor(js.handle(slot));
     return js.handle(slot);
 }
 
@@ -414,7 +446,15 @@ JointError Space::internal_joint_error(JointHandle handle) const {
             e.angular = 2 * std::atan2(error.vec().norm(), std::abs(error.w()));
             break;
         }
-        case JointType::Motor: break;
+        case JointType::Motor: {
+            const MotorParams& p = j.motor;
+            e.linear = (pb - (pa + qa * p.linear_offset)).norm();
+            if (p.max_torque > 0) {
+                const Quat error = qb * (p.angular_offset * j.reference).conjugate() * qa.conjugate();
+                e.angular = 2 * std::atan2(error.vec().norm(), std::abs(error.w()));
+            }
+            break;
+        }
     }
     return e;
 }

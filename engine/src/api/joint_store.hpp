@@ -25,18 +25,19 @@ struct Joint {
     Vec3 axis_b = Vec3::UnitZ();           // hinge (swing-twist: twist) axis on B
     Vec3 ref_a = Vec3::UnitX();            // perpendicular to the axis, equal in world at creation
     Vec3 ref_b = Vec3::UnitX();
-    Quat reference = Quat::Identity();  // fixed, prismatic: B's orientation in A's frame at creation
+    Quat reference = Quat::Identity();  // fixed, prismatic, motor: B's orientation in A's frame at creation
     Real rest_length = 0;               // distance; prismatic: the anchors' offset along the axis at creation
     HingeParams hinge;
     DistanceParams distance;
     SwingTwistParams swing_twist;
     PrismaticParams prismatic;
+    MotorParams motor;  // the offsets as last set (Space::set_motor_target)
     bool collide_connected = false;
     bool sleeping = false;  // both bodies asleep (or one asleep, one static)
 
     // Accumulated impulses of the last step (warm starting).
-    Vec3 linear_impulse = Vec3::Zero();   // point constraint (prismatic: off the axis), world
-    Vec3 angular_impulse = Vec3::Zero();  // hinge alignment / fixed, prismatic rotation / swing-twist friction
+    Vec3 linear_impulse = Vec3::Zero();   // point constraint (prismatic: off the axis; motor: the pull), world
+    Vec3 angular_impulse = Vec3::Zero();  // hinge alignment / fixed, prismatic, motor rotation / swing-twist friction
     Real axial_impulse = 0;               // distance: the rigid or spring row; prismatic: the spring
     Real motor_impulse = 0;
     Real lower_impulse = 0;

@@ -121,6 +121,7 @@ struct JointConstraint {
     Vec3 perp_b[2] = {Vec3::UnitX(), Vec3::UnitY()};
     Vec3 ref_a = Vec3::UnitX(), ref_b = Vec3::UnitX();
     Vec3 perp_a[2] = {Vec3::UnitY(), Vec3::UnitZ()};
+    Vec3 target = Vec3::Zero();  // motor: B's anchor's target from A's anchor, world
     // Fixed: the rotation that takes B's target orientation to its actual one, world.
     Quat rotation_error = Quat::Identity();
     Mat3 rotation_mass = Mat3::Zero();  // fixed, swing-twist friction
@@ -129,14 +130,17 @@ struct JointConstraint {
     Vec3 axis = Vec3::UnitX();  // distance: direction at the step's start (if the anchors meet)
     Softness spring;            // distance, prismatic spring
     Softness limit_spring;      // hinge: a soft limit's spring (soft_limit)
+    Softness angular_spring;    // motor, with enable_angular_spring (linear: spring, enable_spring)
+    bool enable_angular_spring = false;
+    Real max_torque_impulse = 0;  // motor (max_motor_impulse: its force)
 
     // Parameters, copied so the hot loop reads one struct.
     bool enable_limit = false, enable_motor = false, enable_spring = false, soft_limit = false;
     Real lower = 0, upper = 0;  // hinge angles, distance lengths or twist range
     Real cone = 0;              // swing-twist: the cone's half angle
     Real max_friction_impulse = 0;
-    Real rest_length = 0;  // distance; prismatic: the anchors' offset along the axis at creation
-    Real target = 0;       // prismatic spring's translation
+    Real rest_length = 0;         // distance; prismatic: the anchors' offset along the axis at creation
+    Real target_translation = 0;  // prismatic spring's
     Real motor_speed = 0, max_motor_impulse = 0;
     Real spring_hertz = 0;
 

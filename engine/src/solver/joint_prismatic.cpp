@@ -60,7 +60,7 @@ void prepare_prismatic(const Joint& j, const SolverBody& A, const SolverBody& B,
     jc.upper = p.upper_translation;
     jc.enable_spring = p.enable_spring && p.spring_hertz > 0;
     jc.spring = make_softness(p.spring_hertz, p.spring_damping_ratio, h);
-    jc.target = p.target_translation;
+    jc.target_translation = p.target_translation;
     jc.enable_motor = p.enable_motor;
     jc.motor_speed = p.motor_speed;
     jc.max_motor_impulse = p.max_motor_force * h;
@@ -86,7 +86,7 @@ void solve_prismatic(JointConstraint& jc, const SolverBody& A, const SolverBody&
         const Real mass = effective_mass(A, B, f.la, f.rb, f.axis);
         if (jc.enable_spring) {
             // The spring is physics, not error correction: the same in solve and relax.
-            const Real c = f.translation - jc.target;
+            const Real c = f.translation - jc.target_translation;
             const Real impulse = -jc.spring.mass_scale * mass * (row_speed(s, f, f.axis) + jc.spring.bias_rate * c) -
                                  jc.spring.impulse_scale * jc.axial_impulse;
             jc.axial_impulse += impulse;

@@ -59,6 +59,12 @@ Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointS
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p);
 
+// The 3x3 effective mass of a point row with levers ra, rb (pseudo-inverse with locks).
+Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb);
+// Rotation vector of B away from its target orientation relative to A (jc.rotation_error
+// at the step's start, turned by the substeps' deltas).
+Vec3 rotation_error(const JointConstraint& jc, const Quat& dqa, const Quat& dqb);
+
 // Three angular rows that hold B's orientation relative to A's (fixed, prismatic), from
 // jc.rotation_error and jc.rotation_mass, accumulated in jc.angular_impulse.
 void solve_rotation_lock(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
@@ -104,5 +110,12 @@ PrismaticOffset prismatic_offset(const Joint& j, const Vec3& axis, const Vec3& a
 // The world impulse the two perpendicular rows carried, back to the rows (warm starting:
 // the rows turn between steps).
 Vec2 onto_rows(const Vec3 (&rows)[2], const Vec3& impulse);
+
+// Motor (joint_motor.cpp).
+void prepare_motor(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb, Real h,
+                   JointConstraint& jc);
+void warm_start_motor(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s);
+void solve_motor(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                 const JointSolveParams& p);
 
 }  // namespace spindle

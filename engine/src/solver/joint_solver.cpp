@@ -42,6 +42,8 @@ namespace {
 
 constexpr std::uint32_t kJointGrain = 32;
 
+}  // namespace
+
 Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
     const Mat3 sa = skew(ra), sb = skew(rb);
     // Inverse masses per world axis: zero along a locked one.
@@ -51,6 +53,8 @@ Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const 
                    sb * B.inv_inertia * sb.transpose();
     return inverse_or_pseudo(k, has_locks(A, B));
 }
+
+namespace {
 
 // The hinge's two alignment rows: C = (a1.b2, a1.c2) with a1 A's axis and b2, c2
 // perpendicular to B's; Cdot = u.(wB - wA) with u = b2 x a1, c2 x a1.
@@ -75,13 +79,12 @@ Real hinge_angle(const JointConstraint& jc, const Vec3& axis, const Quat& dqa, c
     return std::atan2(axis.dot(ra.cross(rb)), ra.dot(rb));
 }
 
-// Rotation vector of B away from its target orientation relative to A (fixed joint).
+}  // namespace
+
 Vec3 rotation_error(const JointConstraint& jc, const Quat& dqa, const Quat& dqb) {
     const Quat e = dqb * jc.rotation_error * dqa.conjugate();
     return (e.w() < 0 ? -2 : 2) * e.vec();
 }
-
-}  // namespace
 
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
@@ -276,7 +279,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
         }
         case JointType::SwingTwist: prepare_swing_twist(j, A, B, qa, qb, h, jc); break;
         case JointType::Prismatic: prepare_prismatic(j, A, B, qa, qb, h, jc); break;
-        case JointType::Motor: break;
+        case JointType::Motor: prepare_motor(j, A, B, qa, qb, h, jc); break;
     }
 }
 
@@ -348,7 +351,7 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
             apply(A, B, s, ra, rb, jc.linear_impulse);
             break;
         case JointType::Prismatic: warm_start_prismatic(jc, A, B, s); break;
-        case JointType::Motor: break;
+        case JointType::Motor: warm_start_motor(jc, A, B, s); break;
     }
     store(A, B, s);
 }
@@ -365,7 +368,7 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
         case JointType::Distance: solve_distance(jc, A, B, s, params); break;
         case JointType::SwingTwist: solve_swing_twist(jc, A, B, s, params); break;
         case JointType::Prismatic: solve_prismatic(jc, A, B, s, params); break;
-        case JointType::Motor: break;
+        case JointType::Motor: solve_motor(jc, A, B, s, params); break;
     }
     store(A, B, s);
 }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 
 #include "work_stealing_jobs.hpp"
@@ -109,13 +110,14 @@ std::uint64_t run_jointed_scene(JobSystem& jobs) {
 
 // The joints a ragdoll and a machine need: limbs of capsules on swing-twist joints
 // (cones, twist ranges, friction) swinging down onto a floor, and boxes on sliders
-// (limits, springs, motors) from the limbs' ends and the ground.
+// (limits, springs, motors) from the limbs' ends, a motor joint and a mouse joint whose
+// target moves every step.
 std::uint64_t run_limb_scene(JobSystem& jobs) {
     Space space(SpaceSettings{}, &jobs);
     BodyDesc d;
     d.type = MotionType::Static;
     d.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(d);
+    const BodyHandle ground = space.create_body(d);
     for (int c = 0; c < 4; ++c) {
         d.type = MotionType::Static;
         d.shape = Shape::sphere(0.05);
@@ -152,7 +154,24 @@ std::uint64_t run_limb_scene(JobSystem& jobs) {
         joint.prismatic.max_motor_force = 20;
         space.create_joint(joint);
     }
-    for (int i = 0; i < kSteps; ++i) space.update();
+    d.shape = Shape::box(Vec3(0.3, 0.2, 0.1));
+    d.position = Vec3(-2, 1, 0);
+    const BodyHandle driven = space.create_body(d);
+    d.position = Vec3(-2, 2, 0);
+    const BodyHandle dragged = space.create_body(d);
+    JointDesc drive = JointDesc::motor_between(driven, dragged, Vec3(-2, 1.5, 0));
+    drive.motor.linear_offset = Vec3(0.5, 0.2, 0);
+    drive.motor.angular_offset = Quat(Eigen::AngleAxisd(0.7, Vec3::UnitY()));
+    drive.motor.max_force = 100;
+    drive.motor.max_torque = 20;
+    drive.motor.angular_hertz = 4;
+    drive.motor.angular_damping_ratio = 0.7;
+    space.create_joint(drive);
+    const JointHandle mouse = space.create_joint(JointDesc::mouse_at(ground, driven, Vec3(-2, 1.2, 0), 3, 0.8, 200));
+    for (int i = 0; i < kSteps; ++i) {
+        space.set_mouse_target(mouse, Vec3(-2 + std::sin(0.05 * i), 1.5 + 0.5 * std::cos(0.03 * i), 0));
+        space.update();
+    }
     EXPECT_GT(space.counters().joints_solved, 0u);
     EXPECT_GT(space.counters().contact_points_solved, 0u);
     return space.state_hash();

@@ -43,6 +43,12 @@ JointDesc joint_of(JointType type, const Scene& s) {
     d.prismatic.enable_motor = true;
     d.prismatic.motor_speed = 1;
     d.prismatic.max_motor_force = 10;
+    d.motor.linear_offset = Vec3(0.1, 0.2, 0.3);
+    d.motor.angular_offset = Quat(Eigen::AngleAxis<Real>(0.3, Vec3::UnitZ()));
+    d.motor.max_force = 10;
+    d.motor.max_torque = 5;
+    d.motor.linear_hertz = 2;
+    d.motor.angular_hertz = 3;
     return d;
 }
 
@@ -238,6 +244,37 @@ TEST(InvalidJoint, PrismaticFieldsFollowTheirRules) {
             try_joint(
                 JointType::Prismatic, [&](JointDesc& d) { d.prismatic.*member = t.value; }, accepts(rule, t.value),
                 field, t.name);
+        }
+    }
+}
+
+TEST(InvalidJoint, MotorFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Motor, [&](JointDesc& d) { d.motor.linear_offset[axis] = t.value; },
+                accepts(Rule::Finite, t.value), "motor.linear_offset", t.name);
+        }
+    }
+    try_joint(
+        JointType::Motor, [](JointDesc& d) { d.motor.angular_offset = Quat(0, 0, 0, 0); }, false,
+        "motor.angular_offset", "zero");
+    try_joint(
+        JointType::Motor, [](JointDesc& d) { d.motor.angular_offset.x() = kNaN; }, false, "motor.angular_offset",
+        "nan");
+    const std::vector<std::tuple<const char*, Real MotorParams::*, Rule>> fields{
+        {"motor.max_force", &MotorParams::max_force, Rule::NonNegative},
+        {"motor.max_torque", &MotorParams::max_torque, Rule::NonNegative},
+        {"motor.linear_hertz", &MotorParams::linear_hertz, Rule::NonNegative},
+        {"motor.linear_damping_ratio", &MotorParams::linear_damping_ratio, Rule::NonNegative},
+        {"motor.angular_hertz", &MotorParams::angular_hertz, Rule::NonNegative},
+        {"motor.angular_damping_ratio", &MotorParams::angular_damping_ratio, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Motor, [&](JointDesc& d) { d.motor.*member = t.value; }, accepts(rule, t.value), field,
+                t.name);
         }
     }
 }

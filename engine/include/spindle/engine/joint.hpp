@@ -111,6 +111,27 @@ struct PrismaticParams {
     Real max_motor_force = 0;  // N; the motor gives up beyond it
 };
 
+// Motor: drives B toward a target pose relative to A. B's anchor is pulled toward A's
+// anchor plus linear_offset (in A's frame), and B's orientation toward A's turned by
+// angular_offset on top of the relative orientation at creation; the pull is capped at
+// max_force and max_torque. Stiffness: a spring of linear_hertz / angular_hertz (for the
+// mass it moves) with a damping ratio, or, at 0 hertz, as stiff as the solver's joints.
+// The target can be moved while the space runs (Space::set_motor_target, buffered).
+//
+// A mouse (drag) joint is a motor joint whose body_a stands for the world: a static body
+// (the ground, or one made for the purpose), JointDesc::mouse_at. Its target is a world
+// point (Space::set_mouse_target) and its rotation is free (max_torque 0).
+struct MotorParams {
+    Vec3 linear_offset = Vec3::Zero();       // m, in A's frame, from A's anchor to B's anchor's target
+    Quat angular_offset = Quat::Identity();  // in A's frame, on top of the relative orientation at creation
+    Real max_force = 0;                      // N; 0: no pull on the anchor
+    Real max_torque = 0;                     // N m; 0: rotation free
+    Real linear_hertz = 0;                   // 0: as stiff as the solver's joints
+    Real linear_damping_ratio = 1;
+    Real angular_hertz = 0;
+    Real angular_damping_ratio = 1;
+};
+
 struct JointDesc {
     JointType type = JointType::BallSocket;
     BodyHandle body_a;
@@ -120,6 +141,7 @@ struct JointDesc {
     DistanceParams distance;         // used by Distance
     SwingTwistParams swing_twist;    // used by SwingTwist
     PrismaticParams prismatic;       // used by Prismatic
+    MotorParams motor;               // used by Motor
     bool collide_connected = false;  // false: the two bodies never make contacts with each other
     std::uint64_t user_data = 0;
 
@@ -128,6 +150,14 @@ struct JointDesc {
     static JointDesc fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
     static JointDesc prismatic_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis);
     static JointDesc swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_twist_axis);
+    // A motor joint with both anchors at world_anchor and zero offsets (it holds B where
+    // it is); set the offsets, caps and stiffness in `motor`.
+    static JointDesc motor_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
+    // A mouse joint: the point world_point of `body` pulled toward a world target (at
+    // first the point itself) by a spring of `hertz` and damping_ratio, at most max_force;
+    // `world` is a static body. Contacts between the two stay on (collide_connected).
+    static JointDesc mouse_at(BodyHandle world, BodyHandle body, const Vec3& world_point, Real hertz,
+                              Real damping_ratio, Real max_force);
     static JointDesc distance_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor_a,
                                       const Vec3& world_anchor_b);
 };
@@ -137,7 +167,9 @@ struct JointError {
     // m: anchor separation; distance joint: length outside what it allows; prismatic: B's
     // anchor off the axis, plus how far the translation is outside its limits
     Real linear = 0;
-    // rad: hinge axis misalignment, fixed and prismatic joint rotation error; swing-twist: how far the
+    // motor: B's anchor from its target
+    // rad: hinge axis misalignment, fixed and prismatic joint rotation error; motor: B's
+    // turn from its target (0 with max_torque 0); swing-twist: how far the
     // swing is outside its cone or the twist outside its range, whichever is more
     Real angular = 0;
 };
