@@ -303,3 +303,32 @@ TEST(InvalidJoint, HingeMotorSetterChecksSpeedAndTorque) {
         }
     }
 }
+
+TEST(InvalidJoint, MotorTargetSettersCheckEveryComponent) {
+    for (const Trial& t : kTrials) {
+        for (int field = 0; field < 3; ++field) {
+            for (int axis = 0; axis < 3; ++axis) {
+                Scene scene = make_scene();
+                Scene twin = make_scene();
+                const JointHandle motor = scene.space->create_joint(joint_of(JointType::Motor, scene));
+                twin.space->create_joint(joint_of(JointType::Motor, twin));
+                Vec3 v(0.1, 0.2, 0.3);
+                v[axis] = t.value;
+                Quat q = Quat::Identity();
+                q.coeffs()[axis] = t.value;
+                auto change = [&] {
+                    if (field == 0) scene.space->set_motor_target(motor, v, Quat::Identity());
+                    if (field == 1) scene.space->set_motor_target(motor, Vec3::Zero(), q);
+                    if (field == 2) scene.space->set_mouse_target(motor, v);
+                };
+                const char* name = field == 0 ? "linear_offset" : field == 1 ? "angular_offset" : "world_target";
+                // A quaternion is fine with any finite component but not all zero (w stays 1 here).
+                if (std::isfinite(t.value)) {
+                    expect_accepted(change, name, t.name);
+                } else {
+                    expect_rejected(*scene.space, *twin.space, change, name, t.name);
+                }
+            }
+        }
+    }
+}
