@@ -21,6 +21,7 @@
 
 #include "api/access_gate.hpp"
 #include "api/joint_store.hpp"
+#include "api/joint_targets.hpp"
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
 #include "solver/motion_locks.hpp"
@@ -248,6 +249,8 @@ struct World {
 
     // Joints (api/joint_api.cpp); solved with the contacts, coloured first.
     Joints joints;
+    JointTargets joint_targets;                         // motor targets written since the last ApplyWrites
+    std::vector<JointTargetWrite> joint_target_writes;  // drained at ApplyWrites (reused)
 
     // Buffering.
     AccessGate gate;                         // structural calls and updates (api/access_gate.hpp)

@@ -8,6 +8,7 @@
 
 #include "api/describe.hpp"
 #include "api/validation.hpp"
+#include "solver/joint_rows.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -23,6 +24,9 @@ const char* to_string(JointType type) noexcept {
         case JointType::Hinge: return "hinge";
         case JointType::Fixed: return "fixed";
         case JointType::Distance: return "distance";
+        case JointType::Prismatic: return "prismatic";
+        case JointType::SwingTwist: return "swing-twist";
+        case JointType::Motor: return "motor";
     }
     return "?";
 }
@@ -47,6 +51,38 @@ JointDesc JointDesc::hinge_at(BodyHandle a, BodyHandle b, const Vec3& world_anch
 JointDesc JointDesc::fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor) {
     JointDesc d = ball_socket_at(a, b, world_anchor);
     d.type = JointType::Fixed;
+    return d;
+}
+
+JointDesc JointDesc::prismatic_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::Prismatic;
+    d.prismatic.axis_a = world_axis;
+    return d;
+}
+
+JointDesc JointDesc::swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor,
+                                    const Vec3& world_twist_axis) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::SwingTwist;
+    d.swing_twist.twist_axis_a = world_twist_axis;
+    d.swing_twist.twist_axis_b = world_twist_axis;
+    return d;
+}
+
+JointDesc JointDesc::motor_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::Motor;
+    return d;
+}
+
+JointDesc JointDesc::mouse_at(BodyHandle world, BodyHandle body, const Vec3& world_point, Real hertz,
+                              Real damping_ratio, Real max_force) {
+    JointDesc d = motor_between(world, body, world_point);
+    d.motor.max_force = max_force;
+    d.motor.linear_hertz = hertz;
+    d.motor.linear_damping_ratio = damping_ratio;
+    d.collide_connected = true;  // a dragged body still rests on the ground it is dragged over
     return d;
 }
 
@@ -91,7 +127,8 @@ void validate(const World& world, const JointDesc& d) {
         reject("at least one of body_a and body_b must be dynamic");
     }
     if (d.type != JointType::BallSocket && d.type != JointType::Hinge && d.type != JointType::Fixed &&
-        d.type != JointType::Distance) {
+        d.type != JointType::Distance && d.type != JointType::SwingTwist && d.type != JointType::Prismatic &&
+        d.type != JointType::Motor) {
         reject("type is not a joint type (" + std::to_string(static_cast<int>(d.type)) + ")");
     }
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
@@ -110,8 +147,52 @@ void validate(const World& world, const JointDesc& d) {
             }
             require_ordered(h.lower_angle, h.upper_angle, "hinge.lower_angle", "hinge.upper_angle");
         }
+        require_non_negative(h.limit_spring_hertz, "hinge.limit_spring_hertz");
+        require_non_negative(h.limit_damping_ratio, "hinge.limit_damping_ratio");
         require(std::isfinite(h.motor_speed), "hinge.motor_speed", "must be finite", number(h.motor_speed));
         require_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
+    }
+    if (d.type == JointType::SwingTwist) {
+        const SwingTwistParams& p = d.swing_twist;
+        require_axis(p.twist_axis_a, "swing_twist.twist_axis_a");
+        require_axis(p.twist_axis_b, "swing_twist.twist_axis_b");
+        require(std::isfinite(p.cone_half_angle) && p.cone_half_angle >= 0 && p.cone_half_angle <= kPi,
+                "swing_twist.cone_half_angle", "must be in [0, pi]", number(p.cone_half_angle));
+        for (auto [value, field] :
+             {std::pair{p.twist_min, "swing_twist.twist_min"}, {p.twist_max, "swing_twist.twist_max"}}) {
+            require(std::isfinite(value) && std::abs(value) <= kPi, field, "must be in [-pi, pi]", number(value));
+        }
+        require_ordered(p.twist_min, p.twist_max, "swing_twist.twist_min", "swing_twist.twist_max");
+        require_non_negative(p.max_friction_torque, "swing_twist.max_friction_torque");
+    }
+    if (d.type == JointType::Prismatic) {
+        const PrismaticParams& p = d.prismatic;
+        require_axis(p.axis_a, "prismatic.axis_a");
+        require(std::isfinite(p.lower_translation), "prismatic.lower_translation", "must be finite",
+                number(p.lower_translation));
+        require(std::isfinite(p.upper_translation), "prismatic.upper_translation", "must be finite",
+                number(p.upper_translation));
+        if (p.enable_limit) {
+            require_ordered(p.lower_translation, p.upper_translation, "prismatic.lower_translation",
+                            "prismatic.upper_translation");
+        }
+        require_non_negative(p.spring_hertz, "prismatic.spring_hertz");
+        require_non_negative(p.spring_damping_ratio, "prismatic.spring_damping_ratio");
+        require(std::isfinite(p.target_translation), "prismatic.target_translation", "must be finite",
+                number(p.target_translation));
+        require(std::isfinite(p.motor_speed), "prismatic.motor_speed", "must be finite", number(p.motor_speed));
+        require_non_negative(p.max_motor_force, "prismatic.max_motor_force");
+    }
+    if (d.type == JointType::Motor) {
+        const MotorParams& p = d.motor;
+        require_finite(p.linear_offset, "motor.linear_offset");
+        check_orientation(p.angular_offset, "create_joint", "motor.angular_offset");
+        require_non_negative(p.max_force, "motor.max_force");
+        require_non_negative(p.max_torque, "motor.max_torque");
+        require_non_negative(p.linear_hertz, "motor.linear_hertz");
+        require_non_negative(p.linear_damping_ratio, "motor.linear_damping_ratio");
+        require_non_negative(p.angular_hertz, "motor.angular_hertz");
+        require_non_negative(p.angular_damping_ratio, "motor.angular_damping_ratio");
     }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
@@ -122,12 +203,6 @@ void validate(const World& world, const JointDesc& d) {
         require(std::isfinite(p.max_length), "distance.max_length", "must be finite", number(p.max_length));
         require_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
     }
-}
-
-// Some unit vector perpendicular to a unit vector.
-Vec3 perpendicular(const Vec3& n) {
-    const Vec3 t = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
-    return (t - n * n.dot(t)).normalized();
 }
 
 // The joint's frames in each body's centre-of-mass frame, from the bodies' poses now.
@@ -141,14 +216,21 @@ Joint make_joint(const World& world, const JointDesc& d) {
     j.body_b = sb;
     j.hinge = d.hinge;
     j.distance = d.distance;
+    j.swing_twist = d.swing_twist;
+    j.prismatic = d.prismatic;
+    j.motor = d.motor;
+    j.motor.angular_offset.normalize();
     j.collide_connected = d.collide_connected;
     const bool world_frame = d.anchors.frame == JointFrame::World;
     // Anchors are given in the shape's frame (local) or in world; kept relative to the centre of mass.
     j.local_a = world_frame ? Vec3(qa.conjugate() * (d.anchors.a - b.x[sa])) : Vec3(d.anchors.a - b.local_com[sa]);
     j.local_b = world_frame ? Vec3(qb.conjugate() * (d.anchors.b - b.x[sb])) : Vec3(d.anchors.b - b.local_com[sb]);
-    if (d.type == JointType::Hinge) {
-        const Vec3 wa = world_frame ? d.hinge.axis_a.normalized() : Vec3(qa * d.hinge.axis_a.normalized());
-        const Vec3 wb = world_frame ? d.hinge.axis_b.normalized() : Vec3(qb * d.hinge.axis_b.normalized());
+    if (d.type == JointType::Hinge || d.type == JointType::SwingTwist) {
+        const bool hinge = d.type == JointType::Hinge;
+        const Vec3 axis_a = hinge ? d.hinge.axis_a : d.swing_twist.twist_axis_a;
+        const Vec3 axis_b = hinge ? d.hinge.axis_b : d.swing_twist.twist_axis_b;
+        const Vec3 wa = world_frame ? axis_a.normalized() : Vec3(qa * axis_a.normalized());
+        const Vec3 wb = world_frame ? axis_b.normalized() : Vec3(qb * axis_b.normalized());
         j.axis_a = qa.conjugate() * wa;
         j.axis_b = qb.conjugate() * wb;
         // Angle references: one world perpendicular seen from both bodies, so the angle is 0 now.
@@ -159,6 +241,13 @@ Joint make_joint(const World& world, const JointDesc& d) {
         j.ref_b = qb.conjugate() * rb;
     }
     j.reference = (qa.conjugate() * qb).normalized();
+    if (d.type == JointType::Prismatic) {
+        const Vec3 axis = world_frame ? d.prismatic.axis_a.normalized() : Vec3(qa * d.prismatic.axis_a.normalized());
+        j.axis_a = qa.conjugate() * axis;
+        j.ref_a = qa.conjugate() * perpendicular(axis);
+        const Vec3 pa = b.x[sa] + qa * j.local_a, pb = b.x[sb] + qb * j.local_b;
+        j.rest_length = axis.dot(pb - pa);
+    }
     if (d.type == JointType::Distance) {
         const Vec3 pa = b.x[sa] + qa * j.local_a, pb = b.x[sb] + qb * j.local_b;
         j.rest_length = d.distance.rest_length < 0 ? (pb - pa).norm() : d.distance.rest_length;
@@ -204,6 +293,7 @@ void remove_joint(World& world, std::uint32_t slot, std::uint32_t dying = ~0u) {
             add_proxy(world, body);
         }
     }
+    if (j.type == JointType::Motor) world.joint_targets.remove_motor(js.handle(slot));
     js.alive[slot] = 0;
     js.live -= 1;
     js.free_slots.push_back(slot);
@@ -268,6 +358,7 @@ JointHandle Space::create_joint(const JointDesc& desc) {
     js.desc[slot] = desc;
     js.awake_dirty = true;
     block_pair(w, joint, +1);
+    if (joint.type == JointType::Motor) w.joint_targets.add_motor(js.handle(slot));
     return js.handle(slot);
 }
 
@@ -333,6 +424,34 @@ JointError Space::internal_joint_error(JointHandle handle) const {
                 e.linear = std::abs(length - (p.enable_spring ? p.min_length : j.rest_length));
             } else if (p.enable_limit) {
                 e.linear = std::max({Real(0), p.min_length - length, length - p.max_length});
+            }
+            break;
+        }
+        case JointType::SwingTwist: {
+            e.linear = (pb - pa).norm();
+            const SwingTwistAngles angles = swing_twist_angles(qa * j.axis_a, qb * j.axis_b, qa * j.ref_a,
+                                                               qb * j.ref_b);
+            e.angular = swing_twist_violation(angles, j.swing_twist);
+            break;
+        }
+        case JointType::Prismatic: {
+            const PrismaticParams& p = j.prismatic;
+            const PrismaticOffset offset = prismatic_offset(j, qa * j.axis_a, pa, pb);
+            e.linear = offset.off_axis;
+            if (p.enable_limit) {
+                e.linear += std::max(
+                    {Real(0), p.lower_translation - offset.translation, offset.translation - p.upper_translation});
+            }
+            const Quat error = qb * j.reference.conjugate() * qa.conjugate();
+            e.angular = 2 * std::atan2(error.vec().norm(), std::abs(error.w()));
+            break;
+        }
+        case JointType::Motor: {
+            const MotorParams& p = j.motor;
+            e.linear = (pb - (pa + qa * p.linear_offset)).norm();
+            if (p.max_torque > 0) {
+                const Quat error = qb * (p.angular_offset * j.reference).conjugate() * qa.conjugate();
+                e.angular = 2 * std::atan2(error.vec().norm(), std::abs(error.w()));
             }
             break;
         }

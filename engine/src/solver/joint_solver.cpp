@@ -1,18 +1,15 @@
 // The joint solver inside the soft step (solver.cpp): prepare, warm start, solve with
-// soft position correction from the dp/dq deltas, relax, and keep impulses, for the
-// ball-socket, hinge, fixed and distance joints.
+// soft position correction from the dp/dq deltas, relax, and keep impulses. The
+// ball-socket, hinge, fixed and distance joints are here, with the rows all joints share;
+// the others have a file each (joint_<type>.cpp), dispatched from here.
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
-#include "solver/constraints.hpp"
+#include "api/joint_store.hpp"
+#include "solver/joint_rows.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
-namespace {
-
-constexpr std::uint32_t kJointGrain = 32;
 
 Mat3 skew(const Vec3& v) {
     Mat3 m;
@@ -20,31 +17,32 @@ Mat3 skew(const Vec3& v) {
     return m;
 }
 
-// Inverse of an effective-mass matrix, or zero when nothing can move along it. With a
-// dynamic body in the joint K is positive definite (however heavy the body).
-template <typename M>
-M inverse_or_zero(const M& k) {
-    return k.isZero(0) ? M(M::Zero()) : M(k.inverse());
+Vec3 perpendicular(const Vec3& n) {
+    const Vec3 t = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
+    return (t - n * n.dot(t)).normalized();
 }
 
-// The same for a joint of a body with motion locks, where K may be singular (a direction
-// along which neither body can move): the pseudo-inverse, which pushes only where
-// something can move and leaves the locked directions alone.
-template <typename M>
-M inverse_or_pseudo(const M& k, bool locked) {
-    if (!locked) return inverse_or_zero(k);
-    const Eigen::SelfAdjointEigenSolver<M> eigen(k);
-    const auto& values = eigen.eigenvalues();
-    const Real cutoff = 1e-12 * values.cwiseAbs().maxCoeff();
-    M inverse = M::Zero();
-    for (int i = 0; i < M::RowsAtCompileTime; ++i) {
-        if (values[i] > cutoff)
-            inverse += (1 / values[i]) * eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose();
+Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p, const Softness* spring) {
+    Softness s{0, 1, 0};
+    if (c > 0) {
+        s.bias_rate = p.inv_h;
+    } else if (spring != nullptr) {
+        s = *spring;
+    } else if (p.use_bias) {
+        s = p.soft;
     }
-    return inverse;
+    const Real impulse = -s.mass_scale * mass * (cdot + s.bias_rate * c) - s.impulse_scale * accumulated;
+    const Real total = std::max(accumulated + impulse, Real(0));
+    const Real applied = total - accumulated;
+    accumulated = total;
+    return applied;
 }
 
-bool has_locks(const SolverBody& A, const SolverBody& B) { return (A.locks | B.locks) != 0; }
+namespace {
+
+constexpr std::uint32_t kJointGrain = 32;
+
+}  // namespace
 
 Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
     const Mat3 sa = skew(ra), sb = skew(rb);
@@ -55,6 +53,8 @@ Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const 
                    sb * B.inv_inertia * sb.transpose();
     return inverse_or_pseudo(k, has_locks(A, B));
 }
+
+namespace {
 
 // The hinge's two alignment rows: C = (a1.b2, a1.c2) with a1 A's axis and b2, c2
 // perpendicular to B's; Cdot = u.(wB - wA) with u = b2 x a1, c2 x a1.
@@ -79,33 +79,13 @@ Real hinge_angle(const JointConstraint& jc, const Vec3& axis, const Quat& dqa, c
     return std::atan2(axis.dot(ra.cross(rb)), ra.dot(rb));
 }
 
-// Rotation vector of B away from its target orientation relative to A (fixed joint).
+}  // namespace
+
 Vec3 rotation_error(const JointConstraint& jc, const Quat& dqa, const Quat& dqb) {
     const Quat e = dqb * jc.rotation_error * dqa.conjugate();
     return (e.w() < 0 ? -2 : 2) * e.vec();
 }
 
-// The softness of one pass: full strength with use_bias, none (relax) without.
-Softness pass_softness(const JointSolveParams& p) { return p.use_bias ? p.soft : Softness{0, 1, 0}; }
-
-// One side of a limit that allows C >= 0: speculative while apart (may close the gap,
-// no more), soft while violated. Returns the impulse to apply (the total stays >= 0).
-Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p) {
-    Softness s{0, 1, 0};
-    if (c > 0) {
-        s.bias_rate = p.inv_h;
-    } else if (p.use_bias) {
-        s = p.soft;
-    }
-    const Real impulse = -s.mass_scale * mass * (cdot + s.bias_rate * c) - s.impulse_scale * accumulated;
-    const Real total = std::max(accumulated + impulse, Real(0));
-    const Real applied = total - accumulated;
-    accumulated = total;
-    return applied;
-}
-
-// Point constraint (ball-socket, and the point part of hinge and fixed joints): the
-// anchors coincide, solved as one 3x3 block.
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
     const Vec3 ra = A.dq * jc.ra, rb = B.dq * jc.rb;
@@ -122,6 +102,35 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     apply(A, B, s, ra, rb, impulse);
 }
 
+void solve_rotation_lock(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                         const JointSolveParams& p) {
+    const Softness soft = pass_softness(p);
+    const Vec3 c = rotation_error(jc, A.dq, B.dq);
+    const Vec3 cdot = s.wb - s.wa;
+    const Vec3 impulse = -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) -
+                         soft.impulse_scale * jc.angular_impulse;
+    jc.angular_impulse += impulse;
+    apply_angular(A, B, s, impulse);
+}
+
+void prepare_rotation_lock(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb,
+                           JointConstraint& jc) {
+    jc.rotation_error = qb * j.reference.conjugate() * qa.conjugate();
+    jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
+    jc.angular_impulse = j.angular_impulse;
+}
+
+Vec2 onto_rows(const Vec3 (&rows)[2], const Vec3& impulse) {
+    Vec2 r;
+    for (int k = 0; k < 2; ++k) {
+        const Real norm2 = rows[k].squaredNorm();
+        r[k] = norm2 > 1e-12 ? rows[k].dot(impulse) / norm2 : 0;
+    }
+    return r;
+}
+
+namespace {
+
 // Hinge: motor and limit about the axis, two alignment rows, then the point.
 void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
@@ -137,9 +146,12 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     }
     if (jc.enable_limit) {
         const Real angle = hinge_angle(jc, rows.axis, A.dq, B.dq);
-        const Real lower = limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p);
+        const Softness* spring = jc.soft_limit ? &jc.limit_spring : nullptr;
+        const Real lower = limit_impulse(angle - jc.lower, rows.axis.dot(s.wb - s.wa), axial_mass, jc.lower_impulse, p,
+                                         spring);
         apply_angular(A, B, s, lower * rows.axis);
-        const Real upper = limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p);
+        const Real upper = limit_impulse(jc.upper - angle, rows.axis.dot(s.wa - s.wb), axial_mass, jc.upper_impulse, p,
+                                         spring);
         apply_angular(A, B, s, -upper * rows.axis);
     }
     {
@@ -162,13 +174,7 @@ void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
 // Fixed: three angular rows that hold the relative rotation, then the point.
 void solve_fixed(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
-    const Softness soft = pass_softness(p);
-    const Vec3 c = rotation_error(jc, A.dq, B.dq);
-    const Vec3 cdot = s.wb - s.wa;
-    const Vec3 impulse = -soft.mass_scale * (jc.rotation_mass * (cdot + soft.bias_rate * c)) -
-                         soft.impulse_scale * jc.angular_impulse;
-    jc.angular_impulse += impulse;
-    apply_angular(A, B, s, impulse);
+    solve_rotation_lock(jc, A, B, s, p);
     solve_point(jc, A, B, s, p);
 }
 
@@ -237,14 +243,13 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.ref_b = jc.perp_b[0];
             // The kept impulse is a world vector: the rows' directions move between steps.
             const AlignRows rows = align_rows(jc, Quat::Identity(), Quat::Identity());
-            for (int r = 0; r < 2; ++r) {
-                const Real norm2 = rows.u[r].squaredNorm();
-                jc.align_impulse[r] = norm2 > 1e-12 ? rows.u[r].dot(j.angular_impulse) / norm2 : 0;
-            }
+            jc.align_impulse = onto_rows(rows.u, j.angular_impulse);
             const HingeParams& hp = j.hinge;
             jc.enable_limit = hp.enable_limit;
             jc.lower = hp.lower_angle;
             jc.upper = hp.upper_angle;
+            jc.soft_limit = hp.limit_spring_hertz > 0;
+            jc.limit_spring = make_softness(hp.limit_spring_hertz, hp.limit_damping_ratio, h);
             jc.enable_motor = hp.enable_motor;
             jc.motor_speed = hp.motor_speed;
             jc.max_motor_impulse = hp.max_motor_torque * h;
@@ -253,11 +258,7 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.upper_impulse = hp.enable_limit ? j.upper_impulse : 0;
             break;
         }
-        case JointType::Fixed:
-            jc.rotation_error = qb * j.reference.conjugate() * qa.conjugate();
-            jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
-            jc.angular_impulse = j.angular_impulse;
-            break;
+        case JointType::Fixed: prepare_rotation_lock(j, A, B, qa, qb, jc); break;
         case JointType::Distance: {
             const DistanceParams& dp = j.distance;
             const Vec3 d = jc.delta_center + jc.rb - jc.ra;
@@ -276,6 +277,9 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.upper_impulse = dp.enable_limit ? j.upper_impulse : 0;
             break;
         }
+        case JointType::SwingTwist: prepare_swing_twist(j, A, B, qa, qb, h, jc); break;
+        case JointType::Prismatic: prepare_prismatic(j, A, B, qa, qb, h, jc); break;
+        case JointType::Motor: prepare_motor(j, A, B, qa, qb, h, jc); break;
     }
 }
 
@@ -342,6 +346,12 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
             apply(A, B, s, ra, rb, (jc.axial_impulse + jc.lower_impulse - jc.upper_impulse) * axis);
             break;
         }
+        case JointType::SwingTwist:
+            warm_start_swing_twist(jc, A, B, s);
+            apply(A, B, s, ra, rb, jc.linear_impulse);
+            break;
+        case JointType::Prismatic: warm_start_prismatic(jc, A, B, s); break;
+        case JointType::Motor: warm_start_motor(jc, A, B, s); break;
     }
     store(A, B, s);
 }
@@ -356,6 +366,9 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
         case JointType::Hinge: solve_hinge(jc, A, B, s, params); break;
         case JointType::Fixed: solve_fixed(jc, A, B, s, params); break;
         case JointType::Distance: solve_distance(jc, A, B, s, params); break;
+        case JointType::SwingTwist: solve_swing_twist(jc, A, B, s, params); break;
+        case JointType::Prismatic: solve_prismatic(jc, A, B, s, params); break;
+        case JointType::Motor: solve_motor(jc, A, B, s, params); break;
     }
     store(A, B, s);
 }
@@ -371,9 +384,15 @@ void store_joint_impulses(World& world, SolverScratch& scratch) {
         j.motor_impulse = jc.motor_impulse;
         j.lower_impulse = jc.lower_impulse;
         j.upper_impulse = jc.upper_impulse;
+        j.swing_impulse = jc.swing_impulse;
         if (jc.type == JointType::Hinge) {
             const AlignRows rows = align_rows(jc, bodies[jc.a].dq, bodies[jc.b].dq);
             j.angular_impulse = jc.align_impulse.x() * rows.u[0] + jc.align_impulse.y() * rows.u[1];
+        }
+        if (jc.type == JointType::Prismatic) {
+            const Quat& dqa = bodies[jc.a].dq;
+            j.linear_impulse = jc.align_impulse.x() * (dqa * jc.perp_a[0]) +
+                               jc.align_impulse.y() * (dqa * jc.perp_a[1]);
         }
     }
 }

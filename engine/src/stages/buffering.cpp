@@ -53,6 +53,7 @@ void reset_history(Bodies& b, std::uint32_t i) {
 // Each written body once, whatever the number of writes made to it (WriteBuffer
 // coalesces them): pose, then velocities, then impulses, then forces for the next step.
 void apply_writes(World& world) {
+    apply_joint_targets(world);  // free while no motor target was written
     std::uint32_t superseded = 0;
     world.writes.drain(world.drained, superseded);
     world.stats.writes_rejected += static_cast<int>(superseded);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 
 #include "work_stealing_jobs.hpp"
@@ -107,7 +108,87 @@ std::uint64_t run_jointed_scene(JobSystem& jobs) {
     return space.state_hash();
 }
 
+// The joints a ragdoll and a machine need: limbs of capsules on swing-twist joints
+// (cones, twist ranges, friction) swinging down onto a floor, and boxes on sliders
+// (limits, springs, motors) from the limbs' ends, a motor joint and a mouse joint whose
+// target moves every step.
+std::uint64_t run_limb_scene(JobSystem& jobs) {
+    Space space(SpaceSettings{}, &jobs);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    const BodyHandle ground = space.create_body(d);
+    for (int c = 0; c < 4; ++c) {
+        d.type = MotionType::Static;
+        d.shape = Shape::sphere(0.05);
+        d.position = Vec3(1.5 * c, 2, 0);
+        BodyHandle previous = space.create_body(d);
+        d.type = MotionType::Dynamic;
+        d.shape = Shape::capsule(0.15, 0.08);
+        d.orientation = Quat(Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()));  // capsules lie along x
+        for (int i = 0; i < 6; ++i) {
+            const Vec3 pivot(1.5 * c + 0.4 * i, 2, 0.1 * c);
+            d.position = pivot + Vec3(0.2, 0, 0);
+            const BodyHandle link = space.create_body(d);
+            JointDesc joint = JointDesc::swing_twist_at(previous, link, pivot, Vec3::UnitX());
+            joint.swing_twist.cone_half_angle = 0.3 + 0.1 * i;
+            joint.swing_twist.twist_min = -0.2;
+            joint.swing_twist.twist_max = 0.1 * c;
+            joint.swing_twist.max_friction_torque = 0.05 * (c % 2);
+            space.create_joint(joint);
+            previous = link;
+        }
+        d.shape = Shape::box(Vec3(0.1, 0.1, 0.1));
+        d.orientation = Quat::Identity();
+        d.position = Vec3(1.5 * c + 2.6, 2, 0.1 * c);
+        const BodyHandle slider = space.create_body(d);
+        JointDesc joint = JointDesc::prismatic_at(previous, slider, d.position, Vec3(1, 1, c).normalized());
+        joint.prismatic.enable_limit = true;
+        joint.prismatic.lower_translation = -0.3;
+        joint.prismatic.upper_translation = 0.2;
+        joint.prismatic.enable_spring = c % 2 == 0;
+        joint.prismatic.spring_hertz = 3;
+        joint.prismatic.spring_damping_ratio = 0.3;
+        joint.prismatic.enable_motor = c % 2 == 1;
+        joint.prismatic.motor_speed = 1;
+        joint.prismatic.max_motor_force = 20;
+        space.create_joint(joint);
+    }
+    d.shape = Shape::box(Vec3(0.3, 0.2, 0.1));
+    d.position = Vec3(-2, 1, 0);
+    const BodyHandle driven = space.create_body(d);
+    d.position = Vec3(-2, 2, 0);
+    const BodyHandle dragged = space.create_body(d);
+    JointDesc drive = JointDesc::motor_between(driven, dragged, Vec3(-2, 1.5, 0));
+    drive.motor.linear_offset = Vec3(0.5, 0.2, 0);
+    drive.motor.angular_offset = Quat(Eigen::AngleAxisd(0.7, Vec3::UnitY()));
+    drive.motor.max_force = 100;
+    drive.motor.max_torque = 20;
+    drive.motor.angular_hertz = 4;
+    drive.motor.angular_damping_ratio = 0.7;
+    space.create_joint(drive);
+    const JointHandle mouse = space.create_joint(JointDesc::mouse_at(ground, driven, Vec3(-2, 1.2, 0), 3, 0.8, 200));
+    for (int i = 0; i < kSteps; ++i) {
+        space.set_mouse_target(mouse, Vec3(-2 + std::sin(0.05 * i), 1.5 + 0.5 * std::cos(0.03 * i), 0));
+        space.update();
+    }
+    EXPECT_GT(space.counters().joints_solved, 0u);
+    EXPECT_GT(space.counters().contact_points_solved, 0u);
+    return space.state_hash();
+}
+
 }  // namespace
+
+TEST(Determinism, LimbSceneHashIsTheSameForOneToFourWorkers) {
+    const std::uint64_t reference = [] {
+        SingleThreadedJobSystem single;
+        return run_limb_scene(single);
+    }();
+    for (unsigned workers : {1u, 2u, 3u, 4u}) {
+        auto jobs = jobs_for(workers);
+        EXPECT_EQ(run_limb_scene(*jobs), reference) << workers << " workers";
+    }
+}
 
 TEST(Determinism, MixedSceneHashIsTheSameForOneToFourWorkers) {
     const std::uint64_t reference = [] {

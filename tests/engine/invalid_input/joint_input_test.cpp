@@ -27,6 +27,28 @@ JointDesc joint_of(JointType type, const Scene& s) {
     d.distance.enable_limit = true;
     d.distance.min_length = 0;
     d.distance.max_length = 5;
+    d.swing_twist.twist_axis_a = d.swing_twist.twist_axis_b = Vec3(0, 1, 0);
+    d.swing_twist.cone_half_angle = 0.5;
+    d.swing_twist.twist_min = -0.25;
+    d.swing_twist.twist_max = 0.25;
+    d.swing_twist.max_friction_torque = 2;
+    d.prismatic.axis_a = Vec3(0, 1, 0);
+    d.prismatic.enable_limit = true;
+    d.prismatic.lower_translation = -0.5;
+    d.prismatic.upper_translation = 0.5;
+    d.prismatic.enable_spring = true;
+    d.prismatic.spring_hertz = 2;
+    d.prismatic.spring_damping_ratio = 0.5;
+    d.prismatic.target_translation = 0.1;
+    d.prismatic.enable_motor = true;
+    d.prismatic.motor_speed = 1;
+    d.prismatic.max_motor_force = 10;
+    d.motor.linear_offset = Vec3(0.1, 0.2, 0.3);
+    d.motor.angular_offset = Quat(Eigen::AngleAxis<Real>(0.3, Vec3::UnitZ()));
+    d.motor.max_force = 10;
+    d.motor.max_torque = 5;
+    d.motor.linear_hertz = 2;
+    d.motor.angular_hertz = 3;
     return d;
 }
 
@@ -50,7 +72,8 @@ using Spoil = std::function<void(JointDesc&, Real)>;
 }  // namespace
 
 TEST(InvalidJoint, AnchorsMustBeFiniteForEveryType) {
-    for (JointType type : {JointType::BallSocket, JointType::Hinge, JointType::Fixed, JointType::Distance}) {
+    for (JointType type :
+         {JointType::BallSocket, JointType::Hinge, JointType::Fixed, JointType::Distance, JointType::SwingTwist}) {
         for (const char* field : {"anchors.a", "anchors.b"}) {
             for (int axis = 0; axis < 3; ++axis) {
                 for (const Trial& t : kTrials) {
@@ -103,6 +126,8 @@ TEST(InvalidJoint, HingeFieldsFollowTheirRules) {
         {"hinge.upper_angle", &HingeParams::upper_angle, Rule::NonNegative},  // -1 is below lower_angle
         {"hinge.motor_speed", &HingeParams::motor_speed, Rule::Finite},
         {"hinge.max_motor_torque", &HingeParams::max_motor_torque, Rule::NonNegative},
+        {"hinge.limit_spring_hertz", &HingeParams::limit_spring_hertz, Rule::NonNegative},
+        {"hinge.limit_damping_ratio", &HingeParams::limit_damping_ratio, Rule::NonNegative},
     };
     for (const auto& [field, member, rule] : fields) {
         for (const Trial& t : kTrials) {
@@ -130,6 +155,130 @@ TEST(InvalidJoint, DistanceFieldsFollowTheirRules) {
     }
 }
 
+TEST(InvalidJoint, SwingTwistFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::SwingTwist,
+                [&](JointDesc& d) {
+                    d.swing_twist.twist_axis_a = Vec3(1, 1, 1);
+                    d.swing_twist.twist_axis_a[axis] = t.value;
+                    d.swing_twist.twist_axis_b = d.swing_twist.twist_axis_a;
+                },
+                accepts(Rule::Finite, t.value), "swing_twist.twist_axis_a", t.name);
+            try_joint(
+                JointType::SwingTwist,
+                [&](JointDesc& d) {
+                    d.anchors = JointAnchors::local(Vec3::Zero(), Vec3::Zero());
+                    d.swing_twist.twist_axis_b = Vec3(1, 1, 1);
+                    d.swing_twist.twist_axis_b[axis] = t.value;
+                },
+                accepts(Rule::Finite, t.value), "swing_twist.twist_axis_b", t.name);
+        }
+    }
+    try_joint(
+        JointType::SwingTwist,
+        [](JointDesc& d) { d.swing_twist.twist_axis_a = d.swing_twist.twist_axis_b = Vec3::Zero(); }, false,
+        "swing_twist.twist_axis_a", "zero");
+    const std::vector<std::tuple<const char*, Real SwingTwistParams::*, Rule>> fields{
+        {"swing_twist.cone_half_angle", &SwingTwistParams::cone_half_angle, Rule::NonNegative},
+        {"swing_twist.twist_min", &SwingTwistParams::twist_min, Rule::Finite},       // -1 and 0 are within [-pi, max]
+        {"swing_twist.twist_max", &SwingTwistParams::twist_max, Rule::NonNegative},  // -1 is below twist_min
+        {"swing_twist.max_friction_torque", &SwingTwistParams::max_friction_torque, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::SwingTwist, [&](JointDesc& d) { d.swing_twist.*member = t.value; }, accepts(rule, t.value),
+                field, t.name);
+        }
+    }
+    // Angles beyond their range, and a twist range upside down.
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.cone_half_angle = 3.2; }, false,
+        "swing_twist.cone_half_angle", "3.2");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.cone_half_angle = kPi; }, true,
+        "swing_twist.cone_half_angle", "pi");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.twist_min = -3.2; }, false, "swing_twist.twist_min",
+        "-3.2");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.twist_max = 3.2; }, false, "swing_twist.twist_max",
+        "3.2");
+    try_joint(
+        JointType::SwingTwist,
+        [](JointDesc& d) {
+            d.swing_twist.twist_min = 0.2;
+            d.swing_twist.twist_max = 0.1;
+        },
+        false, "swing_twist.twist_min", "above twist_max");
+}
+
+TEST(InvalidJoint, PrismaticFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Prismatic,
+                [&](JointDesc& d) {
+                    d.prismatic.axis_a = Vec3(1, 1, 1);
+                    d.prismatic.axis_a[axis] = t.value;
+                },
+                accepts(Rule::Finite, t.value), "prismatic.axis_a", t.name);
+        }
+    }
+    try_joint(
+        JointType::Prismatic, [](JointDesc& d) { d.prismatic.axis_a = Vec3::Zero(); }, false, "prismatic.axis_a",
+        "zero");
+    const std::vector<std::tuple<const char*, Real PrismaticParams::*, Rule>> fields{
+        {"prismatic.lower_translation", &PrismaticParams::lower_translation, Rule::Finite},       // <= upper (0.5)
+        {"prismatic.upper_translation", &PrismaticParams::upper_translation, Rule::NonNegative},  // -1 < lower
+        {"prismatic.spring_hertz", &PrismaticParams::spring_hertz, Rule::NonNegative},
+        {"prismatic.spring_damping_ratio", &PrismaticParams::spring_damping_ratio, Rule::NonNegative},
+        {"prismatic.target_translation", &PrismaticParams::target_translation, Rule::Finite},
+        {"prismatic.motor_speed", &PrismaticParams::motor_speed, Rule::Finite},
+        {"prismatic.max_motor_force", &PrismaticParams::max_motor_force, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Prismatic, [&](JointDesc& d) { d.prismatic.*member = t.value; }, accepts(rule, t.value),
+                field, t.name);
+        }
+    }
+}
+
+TEST(InvalidJoint, MotorFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Motor, [&](JointDesc& d) { d.motor.linear_offset[axis] = t.value; },
+                accepts(Rule::Finite, t.value), "motor.linear_offset", t.name);
+        }
+    }
+    try_joint(
+        JointType::Motor, [](JointDesc& d) { d.motor.angular_offset = Quat(0, 0, 0, 0); }, false,
+        "motor.angular_offset", "zero");
+    try_joint(
+        JointType::Motor, [](JointDesc& d) { d.motor.angular_offset.x() = kNaN; }, false, "motor.angular_offset",
+        "nan");
+    const std::vector<std::tuple<const char*, Real MotorParams::*, Rule>> fields{
+        {"motor.max_force", &MotorParams::max_force, Rule::NonNegative},
+        {"motor.max_torque", &MotorParams::max_torque, Rule::NonNegative},
+        {"motor.linear_hertz", &MotorParams::linear_hertz, Rule::NonNegative},
+        {"motor.linear_damping_ratio", &MotorParams::linear_damping_ratio, Rule::NonNegative},
+        {"motor.angular_hertz", &MotorParams::angular_hertz, Rule::NonNegative},
+        {"motor.angular_damping_ratio", &MotorParams::angular_damping_ratio, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::Motor, [&](JointDesc& d) { d.motor.*member = t.value; }, accepts(rule, t.value), field,
+                t.name);
+        }
+    }
+}
+
 TEST(InvalidJoint, HingeMotorSetterChecksSpeedAndTorque) {
     for (const Trial& t : kTrials) {
         for (const bool speed : {true, false}) {
@@ -150,6 +299,35 @@ TEST(InvalidJoint, HingeMotorSetterChecksSpeedAndTorque) {
                 expect_accepted(change, field, t.name);
             } else {
                 expect_rejected(*scene.space, *twin.space, change, field, t.name);
+            }
+        }
+    }
+}
+
+TEST(InvalidJoint, MotorTargetSettersCheckEveryComponent) {
+    for (const Trial& t : kTrials) {
+        for (int field = 0; field < 3; ++field) {
+            for (int axis = 0; axis < 3; ++axis) {
+                Scene scene = make_scene();
+                Scene twin = make_scene();
+                const JointHandle motor = scene.space->create_joint(joint_of(JointType::Motor, scene));
+                twin.space->create_joint(joint_of(JointType::Motor, twin));
+                Vec3 v(0.1, 0.2, 0.3);
+                v[axis] = t.value;
+                Quat q = Quat::Identity();
+                q.coeffs()[axis] = t.value;
+                auto change = [&] {
+                    if (field == 0) scene.space->set_motor_target(motor, v, Quat::Identity());
+                    if (field == 1) scene.space->set_motor_target(motor, Vec3::Zero(), q);
+                    if (field == 2) scene.space->set_mouse_target(motor, v);
+                };
+                const char* name = field == 0 ? "linear_offset" : field == 1 ? "angular_offset" : "world_target";
+                // A quaternion is fine with any finite component but not all zero (w stays 1 here).
+                if (std::isfinite(t.value)) {
+                    expect_accepted(change, name, t.name);
+                } else {
+                    expect_rejected(*scene.space, *twin.space, change, name, t.name);
+                }
             }
         }
     }

@@ -61,6 +61,40 @@ TEST(Hinge, LimitHoldsTheAngleWithinItsRange) {
     EXPECT_LT(space.internal_joint_error(h.joint).angular, 1e-3);
 }
 
+// The bar falls from level onto a lower limit of -0.5 rad. A soft limit (4 Hz, damping
+// ratio 0.5) lets it overshoot far more than the rigid one, then settles on the limit,
+// sagging under the bar's weight as a spring of k = I w^2 for the inertia the limit row
+// turns (the bar's about its centre, 0.0842 kg m^2): m g (L/2) cos(angle) / k = 0.077 rad.
+TEST(Hinge, SoftLimitOvershootsMoreThanARigidOneAndSettlesOnTheLimit) {
+    double overshoot[2] = {}, rest[2] = {};
+    for (const int soft : {0, 1}) {
+        Space space;
+        space.set_sleep(SleepSettings{.enabled = false});
+        HingeParams params;
+        params.enable_limit = true;
+        params.lower_angle = -0.5;
+        params.upper_angle = 0.5;
+        params.limit_spring_hertz = soft ? 4 : 0;
+        params.limit_damping_ratio = soft ? 0.5 : 0;
+        const HingedBar h = make_hinged_bar(space, params);
+        double lowest = 0;
+        for (int i = 0; i < 300; ++i) {
+            space.update();
+            lowest = std::min(lowest, space.internal_hinge_angle(h.joint));
+        }
+        overshoot[soft] = -0.5 - lowest;
+        rest[soft] = space.internal_hinge_angle(h.joint);
+        std::printf("hinge limit -0.5 rad, %s: overshoot %.5f rad, rests at %.5f rad\n", soft ? "soft 4 Hz" : "rigid",
+                    overshoot[soft], rest[soft]);
+    }
+    const double inertia = 1.0 * (1.0 + 0.01) / 12, k = inertia * std::pow(2 * kPi * 4, 2);
+    const double sag = 1 * 9.81 * 0.5 * std::cos(rest[1]) / k;
+    EXPECT_LT(overshoot[0], 0.01);
+    EXPECT_GT(overshoot[1], 5 * overshoot[0] + 0.05);
+    EXPECT_NEAR(rest[0], -0.5, 0.005);
+    EXPECT_NEAR(rest[1], -0.5 - sag, 0.02 * sag);
+}
+
 TEST(Hinge, MotorReachesTargetSpeedAndRespectsItsTorque) {
     Space space;
     space.set_gravity(Vec3::Zero());

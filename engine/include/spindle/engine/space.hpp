@@ -66,6 +66,15 @@ public:
     JointDesc joint_desc(JointHandle joint) const;  // as created (a copy)
     // Changes a hinge's motor (between updates); max_torque >= 0.
     void set_hinge_motor(JointHandle joint, bool enable, Real speed, Real max_torque);
+    // A motor joint's target (MotorParams::linear_offset, angular_offset), or a mouse
+    // joint's world target point (the angular offset stays). Buffered: any thread, any
+    // time, concurrently with update(); the last write wins, applied at the next
+    // update's ApplyWrites, waking the joint's bodies. Values are checked first, then the
+    // handle (a live motor joint) under the joint targets' own small lock, which update()
+    // takes only to drain them: a rejected call throws spindle::Error and changes nothing.
+    // A joint destroyed before ApplyWrites drops its write (last_update().writes_rejected).
+    void set_motor_target(JointHandle joint, const Vec3& linear_offset, const Quat& angular_offset);
+    void set_mouse_target(JointHandle joint, const Vec3& world_target);
 
     // Collision filtering: the layer table. Whether bodies on layers a and b collide
     // (symmetric; every pair collides by default). a, b < kLayerCount, else spindle::Error
