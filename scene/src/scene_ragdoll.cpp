@@ -40,14 +40,14 @@ enum class Kind : std::uint8_t { SwingTwist, Hinge };
 // bends within [lower, upper], 0 straight, positive bending the elbow forward and the
 // knee back.
 //
-//   joint       parent     child      kind         twist axis at rest   cone  twist   hinge
-//   lower back  pelvis     abdomen    swing-twist  up the spine          30   ±25
-//   upper back  abdomen    chest      swing-twist  up the spine          36   ±24
-//   neck        chest      head       swing-twist  up the spine          45   ±29
-//   shoulder    chest      upper arm  swing-twist  down the arm          64   ±79
-//   elbow       upper arm  forearm    hinge                                          -5..150
-//   hip         pelvis     thigh      swing-twist  down the leg          45   ±33
-//   knee        thigh      shank      hinge                                          -5..135
+//   joint       parent     child      kind         twist axis at rest   cone  twist   hinge    friction
+//   lower back  pelvis     abdomen    swing-twist  up the spine          30   ±25              5 N m
+//   upper back  abdomen    chest      swing-twist  up the spine          36   ±24              5
+//   neck        chest      head       swing-twist  up the spine          45   ±29              5
+//   shoulder    chest      upper arm  swing-twist  down the arm          64   ±79              2.5
+//   elbow       upper arm  forearm    hinge                                          -5..150   2.5
+//   hip         pelvis     thigh      swing-twist  down the leg          45   ±33              5
+//   knee        thigh      shank      hinge                                          -5..135   5
 //
 // The swing-twist rows are Jolt's ragdoll (JoltPhysics Assets/Human.tof, the humanoid of
 // its PerformanceTest "Ragdoll" scene). Jolt's cones are elliptical; these are round, with
@@ -57,20 +57,22 @@ enum class Kind : std::uint8_t { SwingTwist, Hinge };
 // C_Spine_4 (twist); neck C_Head_0 (cone) and C_Neck_1 (twist); shoulder L_Arm_0; hip
 // L_Leg_0. The hinge rows are common clinical ranges of motion (elbow flexion to 150
 // degrees, knee to 135) with 5 degrees of hyperextension; Jolt makes elbows and knees
-// narrow swing-twist joints instead. Each joint's rest pose (the one built) is the middle
-// of its cone, so arms hang 45 degrees out from the body.
+// narrow swing-twist joints instead. Friction is Human.tof's joint friction; a hinge's is
+// its motor held at speed 0. Each joint's rest pose (the one built) is the middle of its
+// cone, so arms hang 45 degrees out from the body.
 struct Limits {
     Kind kind;
     Real cone, twist;   // swing-twist
     Real lower, upper;  // hinge
+    Real friction;      // N m
 };
-constexpr Limits kLowerBack{Kind::SwingTwist, 30, 25, 0, 0};
-constexpr Limits kUpperBack{Kind::SwingTwist, 36, 24, 0, 0};
-constexpr Limits kNeck{Kind::SwingTwist, 45, 29, 0, 0};
-constexpr Limits kShoulder{Kind::SwingTwist, 64, 79, 0, 0};
-constexpr Limits kElbow{Kind::Hinge, 0, 0, -5, 150};
-constexpr Limits kHip{Kind::SwingTwist, 45, 33, 0, 0};
-constexpr Limits kKnee{Kind::Hinge, 0, 0, -5, 135};
+constexpr Limits kLowerBack{Kind::SwingTwist, 30, 25, 0, 0, 5};
+constexpr Limits kUpperBack{Kind::SwingTwist, 36, 24, 0, 0, 5};
+constexpr Limits kNeck{Kind::SwingTwist, 45, 29, 0, 0, 5};
+constexpr Limits kShoulder{Kind::SwingTwist, 64, 79, 0, 0, 2.5};
+constexpr Limits kElbow{Kind::Hinge, 0, 0, -5, 150, 2.5};
+constexpr Limits kHip{Kind::SwingTwist, 45, 33, 0, 0, 5};
+constexpr Limits kKnee{Kind::Hinge, 0, 0, -5, 135, 5};
 
 // A part's shape in the standing pose: a box about `centre`, or a capsule whose segment
 // runs from `from` to `to` (its end spheres centred on the joints, so neighbours overlap
@@ -178,6 +180,9 @@ JointDesc part_joint(const JointLayout& joint, const Vec3& anchor, const Vec3& a
         d.hinge.enable_limit = true;
         d.hinge.lower_angle = joint.limits.lower * kDegree;
         d.hinge.upper_angle = joint.limits.upper * kDegree;
+        d.hinge.enable_motor = true;
+        d.hinge.motor_speed = 0;
+        d.hinge.max_motor_torque = joint.limits.friction;
         return d;
     }
     return JointDesc::ball_socket_at({}, {}, anchor);  // swing-twist: waiting for the joint (issue 18)
