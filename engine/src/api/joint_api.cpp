@@ -8,6 +8,7 @@
 
 #include "api/describe.hpp"
 #include "api/validation.hpp"
+#include "solver/joint_rows.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -23,6 +24,9 @@ const char* to_string(JointType type) noexcept {
         case JointType::Hinge: return "hinge";
         case JointType::Fixed: return "fixed";
         case JointType::Distance: return "distance";
+        case JointType::Prismatic: return "prismatic";
+        case JointType::SwingTwist: return "swing-twist";
+        case JointType::Motor: return "motor";
     }
     return "?";
 }
@@ -47,6 +51,15 @@ JointDesc JointDesc::hinge_at(BodyHandle a, BodyHandle b, const Vec3& world_anch
 JointDesc JointDesc::fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor) {
     JointDesc d = ball_socket_at(a, b, world_anchor);
     d.type = JointType::Fixed;
+    return d;
+}
+
+JointDesc JointDesc::swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor,
+                                    const Vec3& world_twist_axis) {
+    JointDesc d = ball_socket_at(a, b, world_anchor);
+    d.type = JointType::SwingTwist;
+    d.swing_twist.twist_axis_a = world_twist_axis;
+    d.swing_twist.twist_axis_b = world_twist_axis;
     return d;
 }
 
@@ -91,7 +104,7 @@ void validate(const World& world, const JointDesc& d) {
         reject("at least one of body_a and body_b must be dynamic");
     }
     if (d.type != JointType::BallSocket && d.type != JointType::Hinge && d.type != JointType::Fixed &&
-        d.type != JointType::Distance) {
+        d.type != JointType::Distance && d.type != JointType::SwingTwist) {
         reject("type is not a joint type (" + std::to_string(static_cast<int>(d.type)) + ")");
     }
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
@@ -113,6 +126,19 @@ void validate(const World& world, const JointDesc& d) {
         require(std::isfinite(h.motor_speed), "hinge.motor_speed", "must be finite", number(h.motor_speed));
         require_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
     }
+    if (d.type == JointType::SwingTwist) {
+        const SwingTwistParams& p = d.swing_twist;
+        require_axis(p.twist_axis_a, "swing_twist.twist_axis_a");
+        require_axis(p.twist_axis_b, "swing_twist.twist_axis_b");
+        require(std::isfinite(p.cone_half_angle) && p.cone_half_angle >= 0 && p.cone_half_angle <= kPi,
+                "swing_twist.cone_half_angle", "must be in [0, pi]", number(p.cone_half_angle));
+        for (auto [value, field] :
+             {std::pair{p.twist_min, "swing_twist.twist_min"}, {p.twist_max, "swing_twist.twist_max"}}) {
+            require(std::isfinite(value) && std::abs(value) <= kPi, field, "must be in [-pi, pi]", number(value));
+        }
+        require_ordered(p.twist_min, p.twist_max, "swing_twist.twist_min", "swing_twist.twist_max");
+        require_non_negative(p.max_friction_torque, "swing_twist.max_friction_torque");
+    }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
         require(std::isfinite(p.rest_length), "distance.rest_length", "must be finite", number(p.rest_length));
@@ -122,12 +148,6 @@ void validate(const World& world, const JointDesc& d) {
         require(std::isfinite(p.max_length), "distance.max_length", "must be finite", number(p.max_length));
         require_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
     }
-}
-
-// Some unit vector perpendicular to a unit vector.
-Vec3 perpendicular(const Vec3& n) {
-    const Vec3 t = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
-    return (t - n * n.dot(t)).normalized();
 }
 
 // The joint's frames in each body's centre-of-mass frame, from the bodies' poses now.
@@ -141,14 +161,18 @@ Joint make_joint(const World& world, const JointDesc& d) {
     j.body_b = sb;
     j.hinge = d.hinge;
     j.distance = d.distance;
+    j.swing_twist = d.swing_twist;
     j.collide_connected = d.collide_connected;
     const bool world_frame = d.anchors.frame == JointFrame::World;
     // Anchors are given in the shape's frame (local) or in world; kept relative to the centre of mass.
     j.local_a = world_frame ? Vec3(qa.conjugate() * (d.anchors.a - b.x[sa])) : Vec3(d.anchors.a - b.local_com[sa]);
     j.local_b = world_frame ? Vec3(qb.conjugate() * (d.anchors.b - b.x[sb])) : Vec3(d.anchors.b - b.local_com[sb]);
-    if (d.type == JointType::Hinge) {
-        const Vec3 wa = world_frame ? d.hinge.axis_a.normalized() : Vec3(qa * d.hinge.axis_a.normalized());
-        const Vec3 wb = world_frame ? d.hinge.axis_b.normalized() : Vec3(qb * d.hinge.axis_b.normalized());
+    if (d.type == JointType::Hinge || d.type == JointType::SwingTwist) {
+        const bool hinge = d.type == JointType::Hinge;
+        const Vec3 axis_a = hinge ? d.hinge.axis_a : d.swing_twist.twist_axis_a;
+        const Vec3 axis_b = hinge ? d.hinge.axis_b : d.swing_twist.twist_axis_b;
+        const Vec3 wa = world_frame ? axis_a.normalized() : Vec3(qa * axis_a.normalized());
+        const Vec3 wb = world_frame ? axis_b.normalized() : Vec3(qb * axis_b.normalized());
         j.axis_a = qa.conjugate() * wa;
         j.axis_b = qb.conjugate() * wb;
         // Angle references: one world perpendicular seen from both bodies, so the angle is 0 now.
@@ -336,6 +360,15 @@ JointError Space::internal_joint_error(JointHandle handle) const {
             }
             break;
         }
+        case JointType::SwingTwist: {
+            e.linear = (pb - pa).norm();
+            const SwingTwistAngles angles = swing_twist_angles(qa * j.axis_a, qb * j.axis_b, qa * j.ref_a,
+                                                               qb * j.ref_b);
+            e.angular = swing_twist_violation(angles, j.swing_twist);
+            break;
+        }
+        case JointType::Prismatic:
+        case JointType::Motor: break;
     }
     return e;
 }

@@ -21,24 +21,26 @@ struct Joint {
     std::uint32_t body_a = 0, body_b = 0;  // slots
     Vec3 local_a = Vec3::Zero();           // anchor on A
     Vec3 local_b = Vec3::Zero();           // anchor on B
-    Vec3 axis_a = Vec3::UnitZ();           // hinge axis on A
-    Vec3 axis_b = Vec3::UnitZ();           // hinge axis on B
-    Vec3 ref_a = Vec3::UnitX();            // hinge: perpendicular to the axis, equal in world at creation
+    Vec3 axis_a = Vec3::UnitZ();           // hinge (swing-twist: twist) axis on A
+    Vec3 axis_b = Vec3::UnitZ();           // hinge (swing-twist: twist) axis on B
+    Vec3 ref_a = Vec3::UnitX();            // perpendicular to the axis, equal in world at creation
     Vec3 ref_b = Vec3::UnitX();
     Quat reference = Quat::Identity();  // fixed: B's orientation in A's frame at creation
     Real rest_length = 0;               // distance
     HingeParams hinge;
     DistanceParams distance;
+    SwingTwistParams swing_twist;
     bool collide_connected = false;
     bool sleeping = false;  // both bodies asleep (or one asleep, one static)
 
     // Accumulated impulses of the last step (warm starting).
     Vec3 linear_impulse = Vec3::Zero();   // point constraint, world
-    Vec3 angular_impulse = Vec3::Zero();  // hinge alignment / fixed rotation, world
+    Vec3 angular_impulse = Vec3::Zero();  // hinge alignment / fixed rotation / swing-twist friction, world
     Real axial_impulse = 0;               // distance: the rigid or spring row
     Real motor_impulse = 0;
     Real lower_impulse = 0;
     Real upper_impulse = 0;
+    Real swing_impulse = 0;  // swing-twist cone, along the swing axis
 };
 
 // Joints by slot (holes where joints were destroyed), like Bodies. Hot data (Joint)

@@ -114,12 +114,14 @@ struct JointConstraint {
     Vec3 delta_center = Vec3::Zero();  // B's centre of mass minus A's
 
     // Hinge: A's axis, two perpendiculars of B's axis (the alignment rows), angle references.
+    // Swing-twist: each body's twist axis (axis_a, axis_b) and twist references.
     Vec3 axis_a = Vec3::UnitZ();
+    Vec3 axis_b = Vec3::UnitZ();
     Vec3 perp_b[2] = {Vec3::UnitX(), Vec3::UnitY()};
     Vec3 ref_a = Vec3::UnitX(), ref_b = Vec3::UnitX();
     // Fixed: the rotation that takes B's target orientation to its actual one, world.
     Quat rotation_error = Quat::Identity();
-    Mat3 rotation_mass = Mat3::Zero();
+    Mat3 rotation_mass = Mat3::Zero();  // fixed, swing-twist friction
     // Effective masses of the other rows are computed as they are solved, from the
     // frames then: a light body can turn far within one step.
     Vec3 axis = Vec3::UnitX();  // distance: direction at the step's start (if the anchors meet)
@@ -127,16 +129,19 @@ struct JointConstraint {
 
     // Parameters, copied so the hot loop reads one struct.
     bool enable_limit = false, enable_motor = false, enable_spring = false;
-    Real lower = 0, upper = 0;  // hinge angles or distance lengths
+    Real lower = 0, upper = 0;  // hinge angles, distance lengths or twist range
+    Real cone = 0;              // swing-twist: the cone's half angle
+    Real max_friction_impulse = 0;
     Real rest_length = 0;
     Real motor_speed = 0, max_motor_impulse = 0;
     Real spring_hertz = 0;
 
     // Accumulated impulses.
     Vec3 linear_impulse = Vec3::Zero();
-    Vec3 angular_impulse = Vec3::Zero();  // fixed
+    Vec3 angular_impulse = Vec3::Zero();  // fixed; swing-twist friction
     Vec2 align_impulse = Vec2::Zero();    // hinge, along the two alignment rows
     Real axial_impulse = 0, motor_impulse = 0, lower_impulse = 0, upper_impulse = 0;
+    Real swing_impulse = 0;
 };
 
 // How joints are solved in one pass: soft position correction with use_bias, none

@@ -1,18 +1,15 @@
 // The joint solver inside the soft step (solver.cpp): prepare, warm start, solve with
-// soft position correction from the dp/dq deltas, relax, and keep impulses, for the
-// ball-socket, hinge, fixed and distance joints.
+// soft position correction from the dp/dq deltas, relax, and keep impulses. The
+// ball-socket, hinge, fixed and distance joints are here, with the rows all joints share;
+// the others have a file each (joint_<type>.cpp), dispatched from here.
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
-#include "solver/constraints.hpp"
+#include "api/joint_store.hpp"
+#include "solver/joint_rows.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
-namespace {
-
-constexpr std::uint32_t kJointGrain = 32;
 
 Mat3 skew(const Vec3& v) {
     Mat3 m;
@@ -20,31 +17,28 @@ Mat3 skew(const Vec3& v) {
     return m;
 }
 
-// Inverse of an effective-mass matrix, or zero when nothing can move along it. With a
-// dynamic body in the joint K is positive definite (however heavy the body).
-template <typename M>
-M inverse_or_zero(const M& k) {
-    return k.isZero(0) ? M(M::Zero()) : M(k.inverse());
+Vec3 perpendicular(const Vec3& n) {
+    const Vec3 t = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
+    return (t - n * n.dot(t)).normalized();
 }
 
-// The same for a joint of a body with motion locks, where K may be singular (a direction
-// along which neither body can move): the pseudo-inverse, which pushes only where
-// something can move and leaves the locked directions alone.
-template <typename M>
-M inverse_or_pseudo(const M& k, bool locked) {
-    if (!locked) return inverse_or_zero(k);
-    const Eigen::SelfAdjointEigenSolver<M> eigen(k);
-    const auto& values = eigen.eigenvalues();
-    const Real cutoff = 1e-12 * values.cwiseAbs().maxCoeff();
-    M inverse = M::Zero();
-    for (int i = 0; i < M::RowsAtCompileTime; ++i) {
-        if (values[i] > cutoff)
-            inverse += (1 / values[i]) * eigen.eigenvectors().col(i) * eigen.eigenvectors().col(i).transpose();
+Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p) {
+    Softness s{0, 1, 0};
+    if (c > 0) {
+        s.bias_rate = p.inv_h;
+    } else if (p.use_bias) {
+        s = p.soft;
     }
-    return inverse;
+    const Real impulse = -s.mass_scale * mass * (cdot + s.bias_rate * c) - s.impulse_scale * accumulated;
+    const Real total = std::max(accumulated + impulse, Real(0));
+    const Real applied = total - accumulated;
+    accumulated = total;
+    return applied;
 }
 
-bool has_locks(const SolverBody& A, const SolverBody& B) { return (A.locks | B.locks) != 0; }
+namespace {
+
+constexpr std::uint32_t kJointGrain = 32;
 
 Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
     const Mat3 sa = skew(ra), sb = skew(rb);
@@ -85,27 +79,8 @@ Vec3 rotation_error(const JointConstraint& jc, const Quat& dqa, const Quat& dqb)
     return (e.w() < 0 ? -2 : 2) * e.vec();
 }
 
-// The softness of one pass: full strength with use_bias, none (relax) without.
-Softness pass_softness(const JointSolveParams& p) { return p.use_bias ? p.soft : Softness{0, 1, 0}; }
+}  // namespace
 
-// One side of a limit that allows C >= 0: speculative while apart (may close the gap,
-// no more), soft while violated. Returns the impulse to apply (the total stays >= 0).
-Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointSolveParams& p) {
-    Softness s{0, 1, 0};
-    if (c > 0) {
-        s.bias_rate = p.inv_h;
-    } else if (p.use_bias) {
-        s = p.soft;
-    }
-    const Real impulse = -s.mass_scale * mass * (cdot + s.bias_rate * c) - s.impulse_scale * accumulated;
-    const Real total = std::max(accumulated + impulse, Real(0));
-    const Real applied = total - accumulated;
-    accumulated = total;
-    return applied;
-}
-
-// Point constraint (ball-socket, and the point part of hinge and fixed joints): the
-// anchors coincide, solved as one 3x3 block.
 void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
                  const JointSolveParams& p) {
     const Vec3 ra = A.dq * jc.ra, rb = B.dq * jc.rb;
@@ -121,6 +96,8 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
     jc.linear_impulse += impulse;
     apply(A, B, s, ra, rb, impulse);
 }
+
+namespace {
 
 // Hinge: motor and limit about the axis, two alignment rows, then the point.
 void solve_hinge(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
@@ -276,6 +253,9 @@ void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint
             jc.upper_impulse = dp.enable_limit ? j.upper_impulse : 0;
             break;
         }
+        case JointType::SwingTwist: prepare_swing_twist(j, A, B, qa, qb, h, jc); break;
+        case JointType::Prismatic:
+        case JointType::Motor: break;
     }
 }
 
@@ -342,6 +322,12 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
             apply(A, B, s, ra, rb, (jc.axial_impulse + jc.lower_impulse - jc.upper_impulse) * axis);
             break;
         }
+        case JointType::SwingTwist:
+            warm_start_swing_twist(jc, A, B, s);
+            apply(A, B, s, ra, rb, jc.linear_impulse);
+            break;
+        case JointType::Prismatic:
+        case JointType::Motor: break;
     }
     store(A, B, s);
 }
@@ -356,6 +342,9 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
         case JointType::Hinge: solve_hinge(jc, A, B, s, params); break;
         case JointType::Fixed: solve_fixed(jc, A, B, s, params); break;
         case JointType::Distance: solve_distance(jc, A, B, s, params); break;
+        case JointType::SwingTwist: solve_swing_twist(jc, A, B, s, params); break;
+        case JointType::Prismatic:
+        case JointType::Motor: break;
     }
     store(A, B, s);
 }
@@ -371,6 +360,7 @@ void store_joint_impulses(World& world, SolverScratch& scratch) {
         j.motor_impulse = jc.motor_impulse;
         j.lower_impulse = jc.lower_impulse;
         j.upper_impulse = jc.upper_impulse;
+        j.swing_impulse = jc.swing_impulse;
         if (jc.type == JointType::Hinge) {
             const AlignRows rows = align_rows(jc, bodies[jc.a].dq, bodies[jc.b].dq);
             j.angular_impulse = jc.align_impulse.x() * rows.u[0] + jc.align_impulse.y() * rows.u[1];

@@ -108,6 +108,41 @@ std::uint64_t run_jointed_scene(JobSystem& jobs) {
     return space.state_hash();
 }
 
+// The joints a ragdoll and a machine need: limbs of capsules on swing-twist joints
+// (cones, twist ranges, friction) swinging down onto a floor.
+std::uint64_t run_limb_scene(JobSystem& jobs) {
+    Space space(SpaceSettings{}, &jobs);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(d);
+    for (int c = 0; c < 4; ++c) {
+        d.type = MotionType::Static;
+        d.shape = Shape::sphere(0.05);
+        d.position = Vec3(1.5 * c, 2, 0);
+        BodyHandle previous = space.create_body(d);
+        d.type = MotionType::Dynamic;
+        d.shape = Shape::capsule(0.15, 0.08);
+        d.orientation = Quat(Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()));  // capsules lie along x
+        for (int i = 0; i < 6; ++i) {
+            const Vec3 pivot(1.5 * c + 0.4 * i, 2, 0.1 * c);
+            d.position = pivot + Vec3(0.2, 0, 0);
+            const BodyHandle link = space.create_body(d);
+            JointDesc joint = JointDesc::swing_twist_at(previous, link, pivot, Vec3::UnitX());
+            joint.swing_twist.cone_half_angle = 0.3 + 0.1 * i;
+            joint.swing_twist.twist_min = -0.2;
+            joint.swing_twist.twist_max = 0.1 * c;
+            joint.swing_twist.max_friction_torque = 0.05 * (c % 2);
+            space.create_joint(joint);
+            previous = link;
+        }
+    }
+    for (int i = 0; i < kSteps; ++i) space.update();
+    EXPECT_GT(space.counters().joints_solved, 0u);
+    EXPECT_GT(space.counters().contact_points_solved, 0u);
+    return space.state_hash();
+}
+
 // Three levels of four ragdolls ([[ragdoll]]: swing-twist joints and limited hinges, a
 // collision group each) dropped on a heightfield into piles: joints, limits and contacts
 // between ragdolls in one island.
@@ -136,6 +171,17 @@ copies = { count = [2, 3, 2], step = [3, 0.6, 3] }
 }
 
 }  // namespace
+
+TEST(Determinism, LimbSceneHashIsTheSameForOneToFourWorkers) {
+    const std::uint64_t reference = [] {
+        SingleThreadedJobSystem single;
+        return run_limb_scene(single);
+    }();
+    for (unsigned workers : {1u, 2u, 3u, 4u}) {
+        auto jobs = jobs_for(workers);
+        EXPECT_EQ(run_limb_scene(*jobs), reference) << workers << " workers";
+    }
+}
 
 TEST(Determinism, MixedSceneHashIsTheSameForOneToFourWorkers) {
     const std::uint64_t reference = [] {

@@ -27,6 +27,11 @@ JointDesc joint_of(JointType type, const Scene& s) {
     d.distance.enable_limit = true;
     d.distance.min_length = 0;
     d.distance.max_length = 5;
+    d.swing_twist.twist_axis_a = d.swing_twist.twist_axis_b = Vec3(0, 1, 0);
+    d.swing_twist.cone_half_angle = 0.5;
+    d.swing_twist.twist_min = -0.25;
+    d.swing_twist.twist_max = 0.25;
+    d.swing_twist.max_friction_torque = 2;
     return d;
 }
 
@@ -50,7 +55,8 @@ using Spoil = std::function<void(JointDesc&, Real)>;
 }  // namespace
 
 TEST(InvalidJoint, AnchorsMustBeFiniteForEveryType) {
-    for (JointType type : {JointType::BallSocket, JointType::Hinge, JointType::Fixed, JointType::Distance}) {
+    for (JointType type :
+         {JointType::BallSocket, JointType::Hinge, JointType::Fixed, JointType::Distance, JointType::SwingTwist}) {
         for (const char* field : {"anchors.a", "anchors.b"}) {
             for (int axis = 0; axis < 3; ++axis) {
                 for (const Trial& t : kTrials) {
@@ -128,6 +134,66 @@ TEST(InvalidJoint, DistanceFieldsFollowTheirRules) {
                 t.name);
         }
     }
+}
+
+TEST(InvalidJoint, SwingTwistFieldsFollowTheirRules) {
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::SwingTwist,
+                [&](JointDesc& d) {
+                    d.swing_twist.twist_axis_a = Vec3(1, 1, 1);
+                    d.swing_twist.twist_axis_a[axis] = t.value;
+                    d.swing_twist.twist_axis_b = d.swing_twist.twist_axis_a;
+                },
+                accepts(Rule::Finite, t.value), "swing_twist.twist_axis_a", t.name);
+            try_joint(
+                JointType::SwingTwist,
+                [&](JointDesc& d) {
+                    d.anchors = JointAnchors::local(Vec3::Zero(), Vec3::Zero());
+                    d.swing_twist.twist_axis_b = Vec3(1, 1, 1);
+                    d.swing_twist.twist_axis_b[axis] = t.value;
+                },
+                accepts(Rule::Finite, t.value), "swing_twist.twist_axis_b", t.name);
+        }
+    }
+    try_joint(
+        JointType::SwingTwist,
+        [](JointDesc& d) { d.swing_twist.twist_axis_a = d.swing_twist.twist_axis_b = Vec3::Zero(); }, false,
+        "swing_twist.twist_axis_a", "zero");
+    const std::vector<std::tuple<const char*, Real SwingTwistParams::*, Rule>> fields{
+        {"swing_twist.cone_half_angle", &SwingTwistParams::cone_half_angle, Rule::NonNegative},
+        {"swing_twist.twist_min", &SwingTwistParams::twist_min, Rule::Finite},       // -1 and 0 are within [-pi, max]
+        {"swing_twist.twist_max", &SwingTwistParams::twist_max, Rule::NonNegative},  // -1 is below twist_min
+        {"swing_twist.max_friction_torque", &SwingTwistParams::max_friction_torque, Rule::NonNegative},
+    };
+    for (const auto& [field, member, rule] : fields) {
+        for (const Trial& t : kTrials) {
+            try_joint(
+                JointType::SwingTwist, [&](JointDesc& d) { d.swing_twist.*member = t.value; }, accepts(rule, t.value),
+                field, t.name);
+        }
+    }
+    // Angles beyond their range, and a twist range upside down.
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.cone_half_angle = 3.2; }, false,
+        "swing_twist.cone_half_angle", "3.2");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.cone_half_angle = kPi; }, true,
+        "swing_twist.cone_half_angle", "pi");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.twist_min = -3.2; }, false, "swing_twist.twist_min",
+        "-3.2");
+    try_joint(
+        JointType::SwingTwist, [](JointDesc& d) { d.swing_twist.twist_max = 3.2; }, false, "swing_twist.twist_max",
+        "3.2");
+    try_joint(
+        JointType::SwingTwist,
+        [](JointDesc& d) {
+            d.swing_twist.twist_min = 0.2;
+            d.swing_twist.twist_max = 0.1;
+        },
+        false, "swing_twist.twist_min", "above twist_max");
 }
 
 TEST(InvalidJoint, HingeMotorSetterChecksSpeedAndTorque) {

@@ -1,5 +1,6 @@
 // Joints as the user sees them: a generational handle, a description to create one
-// from (ball-socket, hinge, fixed, distance), and the error a joint currently has.
+// from (ball-socket, hinge, fixed, distance, prismatic, swing-twist, motor), and the
+// error a joint currently has.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,9 @@ enum class JointType : std::uint8_t {
     Hinge,       // the anchors coincide and the axes stay aligned; optional limit and motor
     Fixed,       // the anchors coincide and the relative rotation stays as at creation (weld)
     Distance,    // the anchors keep a distance: rigid, or a spring with optional min/max
+    Prismatic,   // a slider: B translates along one axis of A, no relative rotation
+    SwingTwist,  // the anchors coincide; a cone limit on the swing, a range on the twist
+    Motor,       // drives B toward a target pose relative to A (and the mouse joint)
 };
 const char* to_string(JointType type) noexcept;
 
@@ -72,6 +76,19 @@ struct DistanceParams {
     Real max_length = kHuge;  // m; >= min_length
 };
 
+// Swing-twist (ragdoll shoulders, hips, neck): the anchors coincide; B's twist axis may swing
+// away from A's twist axis within a cone, and B may twist about its twist axis within
+// [twist_min, twist_max], measured from the relative pose at creation (0 there); friction
+// torque resists both.
+struct SwingTwistParams {
+    Vec3 twist_axis_a = Vec3::UnitY();  // in anchors.frame; normalised at creation
+    Vec3 twist_axis_b = Vec3::UnitY();  // World frame: must be the same axis as twist_axis_a
+    Real cone_half_angle = kPi / 4;     // rad, in [0, pi]: the swing limit
+    Real twist_min = -kPi / 4;          // rad, in [-pi, pi], <= twist_max
+    Real twist_max = kPi / 4;
+    Real max_friction_torque = 0;  // N m
+};
+
 struct JointDesc {
     JointType type = JointType::BallSocket;
     BodyHandle body_a;
@@ -79,20 +96,24 @@ struct JointDesc {
     JointAnchors anchors;
     HingeParams hinge;               // used by Hinge
     DistanceParams distance;         // used by Distance
+    SwingTwistParams swing_twist;    // used by SwingTwist
     bool collide_connected = false;  // false: the two bodies never make contacts with each other
     std::uint64_t user_data = 0;
 
     static JointDesc ball_socket_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
     static JointDesc hinge_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_axis);
     static JointDesc fixed_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor);
+    static JointDesc swing_twist_at(BodyHandle a, BodyHandle b, const Vec3& world_anchor, const Vec3& world_twist_axis);
     static JointDesc distance_between(BodyHandle a, BodyHandle b, const Vec3& world_anchor_a,
                                       const Vec3& world_anchor_b);
 };
 
 // How far a joint is from satisfied, from the bodies' current poses.
 struct JointError {
-    Real linear = 0;   // m: anchor separation; distance joint: length outside what it allows
-    Real angular = 0;  // rad: hinge axis misalignment, fixed joint rotation error
+    Real linear = 0;  // m: anchor separation; distance joint: length outside what it allows
+    // rad: hinge axis misalignment, fixed joint rotation error; swing-twist: how far the
+    // swing is outside its cone or the twist outside its range, whichever is more
+    Real angular = 0;
 };
 
 }  // namespace spindle

@@ -1,0 +1,102 @@
+// The swing-twist joint (ragdoll shoulders, hips, necks): the point constraint, a cone
+// limit on the swing of B's twist axis away from A's, a range on the twist about it, and
+// friction against both. One row along the swing axis for the cone, one per twist side.
+#include <algorithm>
+#include <cmath>
+
+#include "api/joint_store.hpp"
+#include "solver/joint_rows.hpp"
+
+namespace spindle {
+namespace {
+
+// Below this the swing axis (a x b normalised) is noise, and a cone of any size is far off.
+constexpr Real kMinSwingSine = 1e-9;
+
+// Twist ranges that cover the whole turn have no limit (the angle wraps at pi).
+bool limits_twist(const JointConstraint& jc) { return jc.lower > -kPi || jc.upper < kPi; }
+
+SwingTwistAngles angles_now(const JointConstraint& jc, const SolverBody& A, const SolverBody& B) {
+    return swing_twist_angles(A.dq * jc.axis_a, B.dq * jc.axis_b, A.dq * jc.ref_a, B.dq * jc.ref_b);
+}
+
+}  // namespace
+
+SwingTwistAngles swing_twist_angles(const Vec3& axis_a, const Vec3& axis_b, const Vec3& ref_a, const Vec3& ref_b) {
+    SwingTwistAngles r;
+    const Vec3 cross = axis_a.cross(axis_b);
+    const Real sine = cross.norm();
+    r.swing = std::atan2(sine, axis_a.dot(axis_b));
+    if (sine > kMinSwingSine) r.swing_axis = cross / sine;
+    // Undo the swing on B's reference: what is left is a turn about A's axis, the twist.
+    const Vec3 unswung = Quat::FromTwoVectors(axis_b, axis_a) * ref_b;
+    r.twist = std::atan2(axis_a.dot(ref_a.cross(unswung)), ref_a.dot(unswung));
+    const Vec3 halfway = axis_a + axis_b;
+    r.twist_axis = halfway.norm() > 1e-6 ? Vec3(halfway.normalized()) : axis_a;
+    return r;
+}
+
+Real swing_twist_violation(const SwingTwistAngles& angles, const SwingTwistParams& params) {
+    return std::max({Real(0), angles.swing - params.cone_half_angle, params.twist_min - angles.twist,
+                     angles.twist - params.twist_max});
+}
+
+void prepare_swing_twist(const Joint& j, const SolverBody& A, const SolverBody& B, const Quat& qa, const Quat& qb,
+                         Real h, JointConstraint& jc) {
+    const SwingTwistParams& p = j.swing_twist;
+    jc.axis_a = qa * j.axis_a;
+    jc.axis_b = qb * j.axis_b;
+    jc.ref_a = qa * j.ref_a;
+    jc.ref_b = qb * j.ref_b;
+    jc.cone = p.cone_half_angle;
+    jc.lower = p.twist_min;
+    jc.upper = p.twist_max;
+    jc.swing_impulse = jc.cone < kPi ? j.swing_impulse : 0;
+    jc.lower_impulse = limits_twist(jc) ? j.lower_impulse : 0;
+    jc.upper_impulse = limits_twist(jc) ? j.upper_impulse : 0;
+    jc.max_friction_impulse = p.max_friction_torque * h;
+    jc.angular_impulse = p.max_friction_torque > 0 ? j.angular_impulse : Vec3::Zero();
+    if (p.max_friction_torque > 0) {
+        jc.rotation_mass = inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B));
+    }
+}
+
+void warm_start_swing_twist(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s) {
+    const SwingTwistAngles angles = angles_now(jc, A, B);
+    apply_angular(A, B, s,
+                  jc.angular_impulse - jc.swing_impulse * angles.swing_axis +
+                      (jc.lower_impulse - jc.upper_impulse) * angles.twist_axis);
+}
+
+// Friction first (it is not error correction: the same in solve and relax), then the
+// limits, then the point, which matters most.
+void solve_swing_twist(JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s,
+                       const JointSolveParams& p) {
+    if (jc.max_friction_impulse > 0) {
+        const Vec3 old = jc.angular_impulse;
+        Vec3 total = old - jc.rotation_mass * (s.wb - s.wa);
+        const Real norm = total.norm();
+        if (norm > jc.max_friction_impulse) total *= jc.max_friction_impulse / norm;
+        jc.angular_impulse = total;
+        apply_angular(A, B, s, total - old);
+    }
+    const SwingTwistAngles angles = angles_now(jc, A, B);
+    if (limits_twist(jc)) {
+        const Vec3& axis = angles.twist_axis;
+        const Real mass = angular_mass(A, B, axis);
+        const Real lower = limit_impulse(angles.twist - jc.lower, axis.dot(s.wb - s.wa), mass, jc.lower_impulse, p);
+        apply_angular(A, B, s, lower * axis);
+        const Real upper = limit_impulse(jc.upper - angles.twist, axis.dot(s.wa - s.wb), mass, jc.upper_impulse, p);
+        apply_angular(A, B, s, -upper * axis);
+    }
+    if (jc.cone < kPi && angles.swing_axis != Vec3::Zero()) {
+        // The swing grows along a x b: the row allows swing <= cone.
+        const Vec3& axis = angles.swing_axis;
+        const Real impulse = limit_impulse(jc.cone - angles.swing, axis.dot(s.wa - s.wb), angular_mass(A, B, axis),
+                                           jc.swing_impulse, p);
+        apply_angular(A, B, s, -impulse * axis);
+    }
+    solve_point(jc, A, B, s, p);
+}
+
+}  // namespace spindle
