@@ -185,7 +185,12 @@ JointDesc part_joint(const JointLayout& joint, const Vec3& anchor, const Vec3& a
         d.hinge.max_motor_torque = joint.limits.friction;
         return d;
     }
-    return JointDesc::ball_socket_at({}, {}, anchor);  // swing-twist: waiting for the joint (issue 18)
+    JointDesc d = JointDesc::swing_twist_at({}, {}, anchor, axis);
+    d.swing_twist.cone_half_angle = joint.limits.cone * kDegree;
+    d.swing_twist.twist_min = -joint.limits.twist * kDegree;
+    d.swing_twist.twist_max = joint.limits.twist * kDegree;
+    d.swing_twist.max_friction_torque = joint.limits.friction;
+    return d;
 }
 
 }  // namespace

@@ -35,7 +35,6 @@ enum Part : std::uint32_t {
 };
 constexpr std::size_t kJoints = 11;
 constexpr Real kDegree = kPi / 180;
-constexpr JointType kSwingTwist = JointType::BallSocket;  // TEMPORARY until the swing-twist joint lands
 
 std::string parse_error(const std::string& text) {
     try {
@@ -79,10 +78,52 @@ TEST(SceneRagdoll, OneRagdoll_HasTwelvePartsElevenJointsAndAHumansMass) {
             ++hinges;
             EXPECT_TRUE(joint.desc.hinge.enable_limit);
         }
-        if (joint.desc.type == kSwingTwist) ++swing_twists;
+        if (joint.desc.type == JointType::SwingTwist) ++swing_twists;
     }
     EXPECT_EQ(hinges, 4);  // elbows and knees
     EXPECT_EQ(swing_twists, 7);
+    // The limits table of docs/scenes.md, in degrees: cone and twist, or the hinge's range.
+    struct Row {
+        Part parent, child;
+        JointType type;
+        Real cone_or_lower, twist_or_upper, friction;
+    };
+    const Row table[] = {
+        {Pelvis, Abdomen, JointType::SwingTwist, 30, 25, 5},
+        {Abdomen, Chest, JointType::SwingTwist, 36, 24, 5},
+        {Chest, Head, JointType::SwingTwist, 45, 29, 5},
+        {Chest, LeftUpperArm, JointType::SwingTwist, 64, 79, 2.5},
+        {Chest, RightUpperArm, JointType::SwingTwist, 64, 79, 2.5},
+        {LeftUpperArm, LeftForearm, JointType::Hinge, -5, 150, 2.5},
+        {RightUpperArm, RightForearm, JointType::Hinge, -5, 150, 2.5},
+        {Pelvis, LeftThigh, JointType::SwingTwist, 45, 33, 5},
+        {Pelvis, RightThigh, JointType::SwingTwist, 45, 33, 5},
+        {LeftThigh, LeftShank, JointType::Hinge, -5, 135, 5},
+        {RightThigh, RightShank, JointType::Hinge, -5, 135, 5},
+    };
+    for (const Row& row : table) {
+        const JointDesc& d = scene.joints[joint_between(scene, row.parent, row.child)].desc;
+        SCOPED_TRACE(std::to_string(row.parent) + " -> " + std::to_string(row.child));
+        ASSERT_EQ(d.type, row.type);
+        if (row.type == JointType::Hinge) {
+            EXPECT_NEAR(d.hinge.lower_angle, row.cone_or_lower * kDegree, 1e-12);
+            EXPECT_NEAR(d.hinge.upper_angle, row.twist_or_upper * kDegree, 1e-12);
+            EXPECT_TRUE(d.hinge.enable_motor);  // friction: a motor held at speed 0
+            EXPECT_EQ(d.hinge.motor_speed, 0);
+            EXPECT_EQ(d.hinge.max_motor_torque, row.friction);
+        } else {
+            EXPECT_NEAR(d.swing_twist.cone_half_angle, row.cone_or_lower * kDegree, 1e-12);
+            EXPECT_NEAR(d.swing_twist.twist_min, -row.twist_or_upper * kDegree, 1e-12);
+            EXPECT_NEAR(d.swing_twist.twist_max, row.twist_or_upper * kDegree, 1e-12);
+            EXPECT_EQ(d.swing_twist.max_friction_torque, row.friction);
+        }
+    }
+    // Swing-twist axes point from the parent into the child: up the spine, down the limbs.
+    EXPECT_NEAR(scene.joints[joint_between(scene, Chest, Head)].desc.swing_twist.twist_axis_a.y(), 1, 1e-12);
+    EXPECT_NEAR(scene.joints[joint_between(scene, Pelvis, LeftThigh)].desc.swing_twist.twist_axis_a.y(), -1, 1e-12);
+    const Vec3 arm = scene.joints[joint_between(scene, Chest, LeftUpperArm)].desc.swing_twist.twist_axis_a;
+    EXPECT_NEAR(arm.x(), std::sqrt(0.5), 1e-12);
+    EXPECT_NEAR(arm.y(), -std::sqrt(0.5), 1e-12);
     // Every part but the pelvis hangs from exactly one joint: a tree.
     std::set<std::uint32_t> children;
     for (const SceneJoint& joint : scene.joints) children.insert(joint.body_b);
@@ -262,8 +303,11 @@ namespace spindle {
 namespace {
 
 // Two piles of two ragdolls on crests and two in troughs of a sine heightfield, as in the
-// built-in `ragdolls` scene (the same body properties), small enough for a test.
+// built-in `ragdolls` scene (the same body properties), small enough for a test. Sleeping
+// is off, so that coming to rest is the ragdolls' own doing.
 constexpr const char* kPiles = R"(
+[settings]
+sleep = false
 [defaults]
 friction = 1
 restitution = 0.15
@@ -321,19 +365,26 @@ TEST(SceneRagdoll, PilesOnAHeightfield_SettleInsideTheirLimits) {
             const Real angle = space.internal_hinge_angle(joints[j]);
             worst_hinge = std::max({worst_hinge, desc.hinge.lower_angle - angle, angle - desc.hinge.upper_angle});
             worst_angular = std::max(worst_angular, error.angular);  // the axes' misalignment
-        } else if (desc.type == kSwingTwist) {
+        } else if (desc.type == JointType::SwingTwist) {
             worst_angular = std::max(worst_angular, error.angular);  // outside the cone or twist range
         }
     }
-    std::printf("ragdoll piles after %d steps: fastest %.4f m/s, %.4f rad/s; lowest centre %.4f m above the "
+    std::printf("ragdoll piles after %d steps: fastest %.2e m/s, %.2e rad/s; lowest centre %.4f m above the "
                 "terrain; worst joint error %.5f m, %.5f rad; worst hinge limit violation %.5f rad\n",
                 kSteps, fastest, spinning, lowest, worst_linear, worst_angular, worst_hinge);
+    // At rest as the engine's sleep test has it (its default thresholds).
     EXPECT_LT(fastest, 0.05);
-    EXPECT_LT(spinning, 0.2);
+    EXPECT_LT(spinning, 0.05);
+    // No part through the terrain: a centre above the surface (the thinnest part's radius
+    // is 4 cm; a part that fell through ends below it).
     EXPECT_GT(lowest, 0);
-    EXPECT_LT(worst_linear, 0.01);
-    EXPECT_LT(worst_angular, 2 * kDegree);
-    EXPECT_LT(worst_hinge, 2 * kDegree);
+    // Soft joints stretch a little under load (joint_hertz 60, damping ratio 2): a few
+    // times the worst measured (printed above; the commit that set these says what it was)
+    // allows for other builds' rounding, and still fails a joint that lets go or a limit
+    // that is not held.
+    EXPECT_LT(worst_linear, 0.005);
+    EXPECT_LT(worst_angular, 1 * kDegree);
+    EXPECT_LT(worst_hinge, 1 * kDegree);
 }
 
 }  // namespace
