@@ -224,12 +224,13 @@ void parse_ragdoll(const TomlReader& r, const toml::table& entry, const BodyTemp
                                    std::to_string(kMaxSceneBodies));
     }
 
-    // The shapes, shared by every copy; the two sides share theirs.
+    // The shapes, shared by every copy.
     const Humanoid& h = humanoid();
     std::array<std::uint32_t, kPartCount> shape{};
     std::array<Real, kPartCount> volume{};
     Real total_volume = 0;
     for (std::size_t p = 0; p < kPartCount; ++p) {
+        // A right part comes two after its left twin (Part) and shares its shape.
         const bool mirrored = p == RightUpperArm || p == RightForearm || p == RightThigh || p == RightShank;
         const ShapeSpec s = part_shape(h.parts[p]);
         volume[p] = part_volume(s);
