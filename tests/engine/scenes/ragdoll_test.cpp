@@ -12,6 +12,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace spindle {
@@ -250,7 +251,7 @@ TEST(SceneRagdoll, KneesAndElbows_BendTheRightWayWithinTheirLimits) {
     const Vec3 knee_at(0.09, -0.5, 0);
     EXPECT_NEAR(hinge_angle_after_bending(space, bodies, joints, knee, LeftShank, knee_at, down, -forward, 30),
                 30 * kDegree, 1e-9);
-    EXPECT_NEAR(joints.size() ? space.joint_desc(joints[knee]).hinge.upper_angle : 0, 135 * kDegree, 1e-12);
+    EXPECT_NEAR(space.joint_desc(joints[knee]).hinge.upper_angle, 135 * kDegree, 1e-12);
     EXPECT_NEAR(space.joint_desc(joints[knee]).hinge.lower_angle, -5 * kDegree, 1e-12);
     // The elbow bends the forearm forward (+z), on both sides.
     for (const auto& [upper, fore, side] :
@@ -284,14 +285,14 @@ TEST(SceneRagdoll, OwnPartsNeverCollide_OtherRagdollsDo) {
         space.update();
         space.read_contact_events(events);
     }
-    auto ragdoll_of = [&](BodyHandle h) {
+    auto in_second = [&](BodyHandle h) {
         return std::find(bodies.begin(), bodies.end(), h) - bodies.begin() >= static_cast<std::ptrdiff_t>(kParts);
     };
     int between = 0;
     for (const ContactEvent& e : events) {
-        EXPECT_NE(ragdoll_of(e.body_a), ragdoll_of(e.body_b))
+        EXPECT_NE(in_second(e.body_a), in_second(e.body_b))
             << "a contact within one ragdoll: bodies " << e.body_a.index << " and " << e.body_b.index;
-        if (ragdoll_of(e.body_a) != ragdoll_of(e.body_b)) ++between;
+        if (in_second(e.body_a) != in_second(e.body_b)) ++between;
     }
     EXPECT_GT(between, 0) << "the second ragdoll's forearm inside the first one's thigh made no contact";
 }
