@@ -1,11 +1,14 @@
 // bench_engine: Spindle's throughput on named scenes (the table below), each at 1 and 2
 // threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
 // Scenes: Jolt's pyramid, 196 small pyramids, a mixed pile on a terrain mesh, a pile of 100
-// jointed capsule chains, and a 10k box grid awake and asleep.
+// jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), and a 10k
+// box grid awake and asleep.
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
 #include "common/jobs.hpp"
+
+#include <spindle/scene/scene.hpp>
 
 #include <benchmark/benchmark.h>
 
@@ -29,6 +32,7 @@ enum class SceneKind {
     ManyPyramids,     // 196 small pyramids, from rest
     MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
     ChainPile,        // 100 ball-socket chains of 10 capsules landing in a tangle (ragdoll-pile load)
+    Ragdolls,         // configs/scenes/ragdolls.toml: 160 ragdolls in 16 piles on a heightfield, from the drop
     GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
     GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
 };
@@ -47,6 +51,7 @@ constexpr EngineScene kScenes[] = {
     {"many_pyramids", SceneKind::ManyPyramids, 40},
     {"mixed_pile_on_mesh", SceneKind::MixedPileOnMesh, 200},
     {"chain_pile", SceneKind::ChainPile, 100},
+    {"ragdolls", SceneKind::Ragdolls, 300},  // five seconds: dropped, piled and come to rest
     {"grid_10k_awake", SceneKind::GridAwake, 60},
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
 };
@@ -65,9 +70,10 @@ bool g_quick = false;
 struct Built {
     std::unique_ptr<JobSystem> jobs;
     std::unique_ptr<Space> space;
-    std::vector<BodyHandle> bodies;  // the dynamic ones
-    bool asleep = true;              // GridSleeping: did every body fall asleep before timing
-    std::int64_t heap_before = 0;    // live heap before the space was made
+    std::vector<BodyHandle> bodies;   // the dynamic ones
+    std::vector<JointHandle> joints;  // scenes from files: their joints
+    bool asleep = true;               // GridSleeping: did every body fall asleep before timing
+    std::int64_t heap_before = 0;     // live heap before the space was made
 
     // The heap the space holds now (bodies, shapes, broadphase, contacts, solver scratch)
     // per dynamic body; taken after the timed steps, so every scene counts the same things.
@@ -90,7 +96,8 @@ Built build(SceneKind kind, unsigned threads) {
         case SceneKind::GridAwake:
         case SceneKind::GridSleeping: boxes = box_grid_scene(kGridPerSide); break;
         case SceneKind::MixedPileOnMesh:
-        case SceneKind::ChainPile: break;
+        case SceneKind::ChainPile:
+        case SceneKind::Ragdolls: break;
     }
     built.heap_before = live_heap_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
@@ -99,6 +106,13 @@ Built build(SceneKind kind, unsigned threads) {
         built.bodies = add_mixed_pile_on_mesh(space, kMixedPileBodies);
     } else if (kind == SceneKind::ChainPile) {
         built.bodies = add_chain_pile(space, kChains, kLinksPerChain);
+    } else if (kind == SceneKind::Ragdolls) {
+        // The scene's own settings (sleeping on, as in Jolt's), like `spindle bench ragdolls`.
+        const SceneDesc scene = load_scene(SPINDLE_SOURCE_DIR "/configs/scenes/ragdolls.toml");
+        const std::vector<BodyHandle> handles = spindle::build(scene, space, &built.joints);
+        for (std::size_t i = 0; i < handles.size(); ++i) {
+            if (scene.bodies[i].desc.type == MotionType::Dynamic) built.bodies.push_back(handles[i]);
+        }
     } else {
         built.bodies = add_to_space(space, boxes, {.floor = FloorShape::Box, .allow_sleep = settings.sleep.enabled});
     }
@@ -114,6 +128,26 @@ Built build(SceneKind kind, unsigned threads) {
         built.asleep = space.last_update().awake_bodies == 0;
     }
     return built;
+}
+
+struct WorstJointError {
+    Real linear = 0;   // m: anchors apart
+    Real angular = 0;  // rad: axes apart, outside a cone or twist range, or a hinge outside its limits
+};
+
+WorstJointError worst_joint_error(const Space& space, const std::vector<JointHandle>& joints) {
+    WorstJointError worst;
+    for (JointHandle joint : joints) {
+        const JointError error = space.internal_joint_error(joint);
+        worst.linear = std::max(worst.linear, error.linear);
+        worst.angular = std::max(worst.angular, error.angular);
+        const JointDesc desc = space.joint_desc(joint);
+        if (desc.type == JointType::Hinge && desc.hinge.enable_limit) {
+            const Real angle = space.internal_hinge_angle(joint);
+            worst.angular = std::max({worst.angular, desc.hinge.lower_angle - angle, angle - desc.hinge.upper_angle});
+        }
+    }
+    return worst;
 }
 
 void bm_scene(benchmark::State& state, EngineScene scene) {
@@ -137,6 +171,11 @@ void bm_scene(benchmark::State& state, EngineScene scene) {
     state.counters["awake"] = space.last_update().awake_bodies;
     state.counters["contacts"] = space.last_update().contacts;
     if (scene.kind == SceneKind::Pyramid) state.counters["top_y"] = height_of(space, built.bodies.back());
+    if (!built.joints.empty()) {
+        const WorstJointError worst = worst_joint_error(space, built.joints);
+        state.counters["joint_error_m"] = worst.linear;
+        state.counters["joint_error_rad"] = worst.angular;
+    }
 }
 
 void print_notes() {

@@ -18,7 +18,7 @@ namespace {
 
 }  // namespace
 
-std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
+std::vector<BodyHandle> build(const SceneDesc& scene, Space& space, std::vector<JointHandle>* joints) {
     // Shapes first: a factory that rejects one (or does not exist yet) fails before
     // anything in the space has changed. Each is made once and shared by its bodies.
     std::vector<Shape> shapes;
@@ -70,12 +70,14 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
             fail_at(scene, body, "body", e);
         }
     }
+    std::vector<JointHandle> joint_handles;
+    joint_handles.reserve(scene.joints.size());
     for (const SceneJoint& joint : scene.joints) {
-        const BodyHandle a = handles[joint.body_a], b = handles[joint.body_b];
-        const JointDesc desc = joint.type == JointType::Hinge ? JointDesc::hinge_at(a, b, joint.anchor, joint.axis)
-                                                              : JointDesc::ball_socket_at(a, b, joint.anchor);
+        JointDesc desc = joint.desc;
+        desc.body_a = handles[joint.body_a];
+        desc.body_b = handles[joint.body_b];
         try {
-            space.create_joint(desc);
+            joint_handles.push_back(space.create_joint(desc));
         } catch (const Error& e) {
             // Destroying the bodies destroys the joints made so far with them.
             for (auto it = handles.rbegin(); it != handles.rend(); ++it) space.destroy_body(*it);
@@ -84,6 +86,7 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space) {
                         ": joint: " + e.what());
         }
     }
+    if (joints) *joints = std::move(joint_handles);
     return handles;
 }
 

@@ -1,6 +1,7 @@
 // Scene entries that make bodies: [[body]] (one), [[stack]] (a column), [[pyramid]]
-// (Jolt's 3D pyramid), [[pyramid_2d]] (a wall-like triangle), each optionally
-// repeated on a grid by `copies`, so that big scenes stay short.
+// (Jolt's 3D pyramid), [[pyramid_2d]] (a wall-like triangle), [[chain]] (jointed links),
+// each optionally repeated on a grid by `copies`, so that big scenes stay short.
+// [[ragdoll]] is scene_ragdoll.cpp's.
 #include <spindle/scene/scene.hpp>
 
 #include <array>
@@ -9,17 +10,6 @@
 #include "scene_parts.hpp"
 
 namespace spindle::scene_detail {
-namespace {
-
-constexpr std::int64_t kMaxCount = 1'000'000;
-
-// copies = { count = [nx, ny, nz], step = [dx, dy, dz] }: the entry's bodies repeated
-// nx * ny * nz times, copy (i, j, k) moved by (i dx, j dy, k dz).
-struct Copies {
-    std::array<std::int64_t, 3> count{1, 1, 1};
-    Vec3 step = Vec3::Zero();
-    double total() const { return static_cast<double>(count[0]) * static_cast<double>(count[1]) * count[2]; }
-};
 
 Copies parse_copies(const TomlReader& r, const toml::node& node, const std::string& what) {
     const toml::table& t = r.table(node, what, "{ count = [nx, ny, nz], step = [dx, dy, dz] }");
@@ -28,10 +18,14 @@ Copies parse_copies(const TomlReader& r, const toml::node& node, const std::stri
     const toml::node& count = r.require(t, what, "count");
     const toml::array* list = count.as_array();
     if (!list || list->size() != 3) r.fail(count, what + ".count: expected [nx, ny, nz], three integers >= 1");
-    for (std::size_t i = 0; i < 3; ++i) c.count[i] = r.integer(*list->get(i), what + ".count", 1, kMaxCount);
+    for (std::size_t i = 0; i < 3; ++i) c.count[i] = r.integer(*list->get(i), what + ".count", 1, kMaxCopies);
     c.step = r.vec3(r.require(t, what, "step"), what + ".step", "dx, dy, dz in m");
     return c;
 }
+
+namespace {
+
+constexpr std::int64_t kMaxCount = 1'000'000;
 
 // Layer i of an n-layer pyramid has boxes j, k in [i/2, n - (i+1)/2) (integer
 // division), shifted by half a spacing on odd layers: exactly Jolt's PerformanceTest
@@ -137,11 +131,11 @@ void add_chain_joints(SceneDesc& scene, const Chain& chain, const Vec3& origin, 
     scene.bodies.push_back(anchor);
     for (std::int64_t i = 0; i < chain.links; ++i) {
         SceneJoint joint;
-        joint.type = chain.joint;
+        const Vec3 at_link = origin + chain.direction * (chain.spacing * static_cast<Real>(i));
+        joint.desc = chain.joint == JointType::Hinge ? JointDesc::hinge_at({}, {}, at_link, chain.axis)
+                                                     : JointDesc::ball_socket_at({}, {}, at_link);
         joint.body_a = i == 0 ? anchor_index : first + static_cast<std::uint32_t>(i - 1);
         joint.body_b = first + static_cast<std::uint32_t>(i);
-        joint.anchor = origin + chain.direction * (chain.spacing * static_cast<Real>(i));
-        joint.axis = chain.axis;
         joint.line = at.line;
         joint.column = at.column;
         scene.joints.push_back(joint);
@@ -160,7 +154,7 @@ std::vector<std::string_view> own_keys(std::string_view kind) {
 }  // namespace
 
 const std::vector<std::string_view>& entry_kinds() {
-    static const std::vector<std::string_view> kinds = {"body", "stack", "pyramid", "pyramid_2d", "chain"};
+    static const std::vector<std::string_view> kinds = {"body", "stack", "pyramid", "pyramid_2d", "chain", "ragdoll"};
     return kinds;
 }
 

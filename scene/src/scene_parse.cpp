@@ -307,7 +307,15 @@ SceneDesc parse_scene(std::string_view toml_text, std::string_view source_name) 
     std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
         return a.line != b.line ? a.line < b.line : a.column < b.column;
     });
-    for (const Entry& e : entries) parse_entry(r, e.kind, *e.table, defaults, scene);
+    std::vector<RagdollBodies> ragdolls;
+    for (const Entry& e : entries) {
+        if (e.kind == "ragdoll") {
+            parse_ragdoll(r, *e.table, defaults, scene, ragdolls);
+        } else {
+            parse_entry(r, e.kind, *e.table, defaults, scene);
+        }
+    }
+    assign_ragdoll_groups(r, scene, ragdolls);
     return scene;
 }
 

@@ -1,9 +1,12 @@
 // What the scene loader's files share: shapes (scene_shapes.cpp), body properties
 // and [defaults] (scene_parse.cpp), and the entries that expand into bodies
-// (scene_entries.cpp: [[body]], [[stack]], [[pyramid]], [[pyramid_2d]], copies).
+// (scene_entries.cpp: [[body]], [[stack]], [[pyramid]], [[pyramid_2d]], [[chain]], copies;
+// scene_ragdoll.cpp: [[ragdoll]]).
 #pragma once
 
+#include <array>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -46,8 +49,34 @@ void check_body_template(const TomlReader& reader, const BodyTemplate& body, con
 // The entry kinds that make bodies, as top-level keys of arrays of tables.
 const std::vector<std::string_view>& entry_kinds();
 
-// Expands one [[kind]] entry into scene.bodies (generators and copies included).
+// Expands one [[kind]] entry into scene.bodies (generators and copies included); not
+// [[ragdoll]], which parse_ragdoll expands.
 void parse_entry(const TomlReader& reader, std::string_view kind, const toml::table& entry,
                  const BodyTemplate& defaults, SceneDesc& scene);
+
+// copies = { count = [nx, ny, nz], step = [dx, dy, dz] }: the entry's bodies repeated
+// nx * ny * nz times, copy (i, j, k) moved by (i dx, j dy, k dz), x varying fastest.
+struct Copies {
+    std::array<std::int64_t, 3> count{1, 1, 1};
+    Vec3 step = Vec3::Zero();
+    double total() const { return static_cast<double>(count[0]) * static_cast<double>(count[1]) * count[2]; }
+};
+inline constexpr std::int64_t kMaxCopies = 1'000'000;
+Copies parse_copies(const TomlReader& reader, const toml::node& node, const std::string& what);
+
+// The bodies of one ragdoll: scene.bodies[first, first + count).
+struct RagdollBodies {
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+};
+
+// Expands one [[ragdoll]] entry (and its copies) into scene.bodies and scene.joints, and
+// appends each ragdoll's bodies to `ragdolls`; their groups are given once the whole file
+// is read (assign_ragdoll_groups).
+void parse_ragdoll(const TomlReader& reader, const toml::table& entry, const BodyTemplate& defaults, SceneDesc& scene,
+                   std::vector<RagdollBodies>& ragdolls);
+
+// Gives each ragdoll a collision group of its own that no other body of the scene uses.
+void assign_ragdoll_groups(const TomlReader& reader, SceneDesc& scene, const std::vector<RagdollBodies>& ragdolls);
 
 }  // namespace spindle::scene_detail

@@ -1,6 +1,7 @@
 // Same scene + same settings => bitwise identical states for 1, 2, 3 and 4 workers,
 // and from run to run (design.md section 5).
 #include <spindle/engine/space.hpp>
+#include <spindle/scene/scene.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
 
 #include <gtest/gtest.h>
@@ -177,6 +178,33 @@ std::uint64_t run_limb_scene(JobSystem& jobs) {
     return space.state_hash();
 }
 
+// Three levels of four ragdolls ([[ragdoll]]: swing-twist joints and limited hinges, a
+// collision group each) dropped on a heightfield into piles: joints, limits and contacts
+// between ragdolls in one island.
+std::uint64_t run_ragdoll_scene(JobSystem& jobs) {
+    const SceneDesc scene = parse_scene(R"(
+[defaults]
+friction = 1
+restitution = 0.15
+linear_damping = 0.05
+angular_damping = 0.05
+[[body]]
+type = "static"
+shape = { heightfield = { size = [12, 12], cells = [12, 12], amplitude = 0.5, wavelength = 8 } }
+[[ragdoll]]
+position = [-1.5, 1.1, -1.5]
+orientation = [0.707107, -0.707107, 0, 0]
+copies = { count = [2, 3, 2], step = [3, 0.6, 3] }
+)",
+                                        "ragdolls.toml");
+    Space space(SpaceSettings{}, &jobs);
+    build(scene, space);
+    for (int i = 0; i < kSteps; ++i) space.update();
+    EXPECT_GT(space.counters().joints_solved, 0u);
+    EXPECT_GT(space.counters().contact_points_solved, 0u);
+    return space.state_hash();
+}
+
 }  // namespace
 
 TEST(Determinism, LimbSceneHashIsTheSameForOneToFourWorkers) {
@@ -215,5 +243,16 @@ TEST(Determinism, JointedSceneHashIsTheSameForOneToFourWorkers) {
     for (unsigned workers : {2u, 3u, 4u}) {
         auto jobs = jobs_for(workers);
         EXPECT_EQ(run_jointed_scene(*jobs), reference) << workers << " workers";
+    }
+}
+
+TEST(Determinism, RagdollSceneHashIsTheSameForOneToFourWorkers) {
+    const std::uint64_t reference = [] {
+        SingleThreadedJobSystem single;
+        return run_ragdoll_scene(single);
+    }();
+    for (unsigned workers : {1u, 2u, 3u, 4u}) {
+        auto jobs = jobs_for(workers);
+        EXPECT_EQ(run_ragdoll_scene(*jobs), reference) << workers << " workers";
     }
 }

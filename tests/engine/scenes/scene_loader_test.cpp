@@ -547,7 +547,7 @@ TEST(SceneParse, Chain_MakesLinksAnAnchorAndJoints) {
     EXPECT_EQ(scene.joints[0].body_a, 3u);                     // anchor to first link
     EXPECT_EQ(scene.joints[0].body_b, 0u);
     EXPECT_EQ(scene.joints[2].body_a, 1u);
-    EXPECT_NEAR(scene.joints[2].anchor.x(), 2.0, 1e-12);
+    EXPECT_NEAR(scene.joints[2].desc.anchors.a.x(), 2.0, 1e-12);
     EXPECT_NEAR(scene.bodies[4].desc.position.z(), 2.0, 1e-12);  // second copy
     EXPECT_EQ(scene.joints[3].body_a, 7u);
 }

@@ -45,13 +45,12 @@ struct SceneBody {
     std::uint32_t column = 0;
 };
 
-// A joint between two scene bodies (indices into SceneDesc::bodies), at a world point.
+// A joint between two scene bodies (indices into SceneDesc::bodies). desc holds its kind,
+// anchor, axes and limits in the World frame; build() fills in desc.body_a and body_b.
 struct SceneJoint {
-    JointType type = JointType::BallSocket;  // BallSocket or Hinge
+    JointDesc desc;
     std::uint32_t body_a = 0, body_b = 0;
-    Vec3 anchor = Vec3::Zero();  // world (m)
-    Vec3 axis = Vec3::UnitZ();   // hinge axis, world
-    std::uint32_t line = 0, column = 0;
+    std::uint32_t line = 0, column = 0;  // where the entry that made this joint starts
 };
 
 struct SceneDesc {
@@ -63,7 +62,7 @@ struct SceneDesc {
     std::vector<std::array<std::uint32_t, 2>> ignore_layers;
     std::vector<ShapeSpec> shapes;
     std::vector<SceneBody> bodies;   // generators expanded, in file order
-    std::vector<SceneJoint> joints;  // made by [[chain]]; created after the bodies
+    std::vector<SceneJoint> joints;  // made by [[chain]] and [[ragdoll]]; created after the bodies
 
     std::size_t dynamic_body_count() const noexcept;
 };
@@ -76,11 +75,12 @@ SceneDesc load_scene(const std::string& path);
 
 // Applies the scene's settings (gravity, time step duration and caps, solver, sleep, the
 // ignored layer pairs; the space's use_internal_time_stepping is kept) and creates its bodies, in scene
-// order, then its joints. Returns the bodies' handles, one per SceneDesc::bodies entry. Every shape is made
+// order, then its joints. Returns the bodies' handles, one per SceneDesc::bodies entry, and,
+// when `joints` is given, the joints' handles in it, one per SceneDesc::joints entry. Every shape is made
 // before any body is created; if anything is rejected the bodies created so far are
 // destroyed again, the settings restored, and the spindle::Error names the entry's
 // file:line:column.
 // Who may call: the thread that updates the space, while no update runs.
-std::vector<BodyHandle> build(const SceneDesc& scene, Space& space);
+std::vector<BodyHandle> build(const SceneDesc& scene, Space& space, std::vector<JointHandle>* joints = nullptr);
 
 }  // namespace spindle
