@@ -113,6 +113,10 @@ struct ContactPoint {
 struct ContactManifold {
     Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
     int point_count = 0;
+    std::uint32_t part_a = 0, part_b = 0;  // the compound parts that touch (Manifold::part_a, part_b)
+    // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
+    // when collided, so that recycling and the solver stay off the cold descriptions.
+    Real radius_a = 0, radius_b = 0;
     ContactPoint points[kMaxManifoldPoints];
     // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
     // central friction): the tangential impulse there (world, in the contact plane) and
@@ -130,12 +134,9 @@ inline constexpr std::uint8_t kContactSensor = 1u << 1;
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
-    // Each body's round part (sphere, capsule radius; else 0), copied from the shapes at
-    // creation so that recycling and the solver stay off the cold descriptions.
-    Real radius_a = 0, radius_b = 0;
     int manifold_count = 0;
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
-    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
+    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
     bool sleeping = false;
     std::uint8_t events = 0;      // kContactReports, kContactSensor (set at creation)
     bool touch_reported = false;  // touching as last reported by a Begin (an End clears it)
