@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "compound_test_util.hpp"
@@ -196,6 +197,34 @@ TEST(CompoundResting, LopsidedBenchDoesNotRock) {
     add_plane(space);
     const BodyHandle bench = space.create_body(body(Shape::compound(parts), Vec3::Zero()));
     expect_no_drift(space, bench, "bench");
+}
+
+TEST(CompoundContinuous, FastSpinningCompoundBarStopsAtAThinWall) {
+    // Continuous's bar (a 4 m bar spinning at 60 rad/s 1 m from a 4 cm wall: its tip turns
+    // through the wall within one step) made of two 2 m boxes end to end.
+    auto furthest_tip = [](bool fast) {
+        SpaceSettings settings = sleepless();
+        settings.gravity = Vec3::Zero();
+        Space space(settings);
+        space.create_body(body(Shape::box(Vec3(0.02, 5, 5)), Vec3(0.5, 0, 0), MotionType::Static));
+        const Vec3 half(1, 0.05, 0.05);
+        const CompoundPart halves[] = {{Shape::box(half), Vec3(-1, 0, 0), Quat::Identity()},
+                                       {Shape::box(half), Vec3(1, 0, 0), Quat::Identity()}};
+        BodyDesc d = body(Shape::compound(halves), Vec3(-1, 0, 0));
+        d.orientation = Quat(Eigen::AngleAxisd(2.0, Vec3::UnitZ()));
+        d.angular_velocity = Vec3(0, 0, -60);
+        d.fast = fast;
+        const BodyHandle bar = space.create_body(d);
+        Real tip = -kHuge;
+        for (int i = 0; i < 30; ++i) {
+            space.update();
+            for (const Real end : {2.0, -2.0})
+                tip = std::max(tip, space.position(bar).x() + (space.orientation(bar) * Vec3(end, 0, 0)).x());
+        }
+        return tip;
+    };
+    EXPECT_LT(furthest_tip(true), 0.48 + 0.01);  // the wall's near face, plus a little soft penetration
+    EXPECT_GT(furthest_tip(false), 0.52);        // what the sweep is for
 }
 
 TEST(CompoundResting, CompoundOfOneBallRollsAsTheBall) {
