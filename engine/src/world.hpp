@@ -154,15 +154,21 @@ struct Contact {
     }
 };
 
+// The most manifolds one contact keeps: a compound's touching part pairs (a triangle
+// mesh keeps fewer, collide_mesh.cpp).
+inline constexpr int kMaxContactManifolds = 8;
+
 // A contact's manifolds packed for the solver's listing: the point count of manifold m
-// in bits [4m, 4m + 4), and whether the contact has restitution.
-inline constexpr std::uint32_t kSummaryRestitution = 1u << 17;
+// in bits [3m, 3m + 3), and whether the contact has restitution (the top bit).
+inline constexpr int kSummaryBitsPerManifold = 3;
+inline constexpr std::uint32_t kSummaryRestitution = 1u << 31;
 inline std::uint32_t contact_summary(const Contact& contact) {
-    static_assert(kMaxManifoldPoints < 16, "a point count in 4 bits");
+    static_assert(kMaxManifoldPoints < (1 << kSummaryBitsPerManifold), "a point count in 3 bits");
+    static_assert(kMaxContactManifolds * kSummaryBitsPerManifold < 31, "the point counts below the restitution bit");
     if ((contact.events & kContactSensor) != 0) return 0;  // a sensor's manifolds push nothing
     std::uint32_t summary = contact.restitution > 0 ? kSummaryRestitution : 0u;
     for (int m = 0; m < contact.manifold_count; ++m) {
-        summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (4 * m);
+        summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (kSummaryBitsPerManifold * m);
     }
     return summary;
 }

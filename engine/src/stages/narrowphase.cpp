@@ -16,8 +16,7 @@
 namespace spindle {
 namespace {
 
-constexpr int kMaxManifolds = 4;
-static_assert(kMaxManifolds <= 4, "contact_summary (world.hpp) packs the point counts of at most 4 manifolds");
+constexpr int kMaxManifolds = kMaxContactManifolds;
 
 // Within this distance an old point stands for a new one whose feature id changed.
 constexpr Real kCarryDistance = 0.02;
