@@ -30,11 +30,14 @@ void keep(Gathered& g, const Manifold& m) {
         g.list[static_cast<std::size_t>(g.count++)] = m;
         return;
     }
-    Manifold* shallowest = &g.list[0];
-    for (Manifold& other : g.list) {
-        if (deepest(other) > deepest(*shallowest)) shallowest = &other;
+    auto shallowest = g.list.begin();
+    for (auto it = g.list.begin(); it != g.list.end(); ++it) {
+        if (deepest(*it) > deepest(*shallowest)) shallowest = it;
     }
-    if (deepest(m) < deepest(*shallowest)) *shallowest = m;
+    if (deepest(m) >= deepest(*shallowest)) return;
+    // Out of its place, and m at the end: the list stays in the order of the walk.
+    std::move(shallowest + 1, g.list.end(), shallowest);
+    g.list.back() = m;
 }
 
 // Shape a (part `part_a` of its body, 0 if it is whole) against every part of compound b

@@ -65,6 +65,23 @@ TEST(CompoundCollide, MorePartPairsThanFitKeepTheDeepestInPartOrder) {
     for (std::uint32_t i = 0; i < 4; ++i) EXPECT_EQ(m[i].part_b, i + 3);
 }
 
+TEST(CompoundCollide, ManyTouchingPartsKeepTheDeepestInPartOrder) {
+    // 70 balls in a row on a plane, every ninth (from part 4) a millimetre deeper: more
+    // part pairs than the walk holds, and the deepest eight come out in part order.
+    std::vector<CompoundPart> parts;
+    for (int i = 0; i < 70; ++i) {
+        const Real depth = i % 9 == 4 ? 0.002 : 0.001;
+        parts.push_back({Shape::sphere(0.1), Vec3(0.25 * i, 0.1 - depth, 0), Quat::Identity()});
+    }
+    const std::vector<Manifold> m = collide_all(Shape::plane(Vec3::UnitY(), 0), Transform{}, Shape::compound(parts),
+                                                Transform{});
+    ASSERT_EQ(m.size(), 8u);
+    for (std::uint32_t k = 0; k < 8; ++k) {
+        EXPECT_EQ(m[k].part_b, 4 + 9 * k);
+        EXPECT_NEAR(m[k].points[0].separation, -0.002, 1e-12);
+    }
+}
+
 TEST(CompoundCollide, CompoundOnCompoundLabelsBothParts) {
     // The dumbbell lies across the table's top (part 0) on its two bells (parts 0 and 1).
     const Transform on_top{Vec3(0, kTableHeight + kBell - 0.001, 0), Quat::Identity()};

@@ -227,6 +227,21 @@ TEST(CompoundContinuous, FastSpinningCompoundBarStopsAtAThinWall) {
     EXPECT_GT(furthest_tip(false), 0.52);        // what the sweep is for
 }
 
+TEST(CompoundResting, BallChangedIntoATableStandsOnItsLegs) {
+    // set_shape rebuilds the mass from the parts and remakes the contacts part by part.
+    Space space;
+    add_plane(space);
+    const Vec3 start(0.5, 0.3, 0);
+    const BodyHandle b = space.create_body(body(Shape::sphere(0.3), start));
+    for (int i = 0; i < 30; ++i) space.update();
+    space.set_shape(b, table());
+    space.set_position(b, Vec3(start.x(), 0.02, start.z()));
+    space.update();
+    expect_rests(space, b, start, 0, Quat::Identity(), "ball turned table");
+    const MassProperties mp = table().mass_properties(BodyDesc{}.density);
+    EXPECT_NEAR(space.center_of_mass(b).y(), mp.center_of_mass.y(), kRestDepth);
+}
+
 TEST(CompoundResting, CompoundOfOneBallRollsAsTheBall) {
     auto roll = [](const Shape& shape) {
         Space space(sleepless());
