@@ -10,6 +10,7 @@
 #include "api/space_internals.hpp"
 #include "collision/collide.hpp"
 #include "compound_test_util.hpp"
+#include "stages/stages.hpp"
 
 namespace spindle {
 namespace {
@@ -121,6 +122,50 @@ TEST(CompoundCollide, ContactKeepsAManifoldPerTouchingLegAndStandsStill) {
     for (int i = 0; i < 6; ++i) EXPECT_EQ(contact.manifold_at(i).part_b, static_cast<std::uint32_t>(i + 1));
     EXPECT_LT(space.position(bench).norm(), 1e-3);
     EXPECT_LT(space.angular_velocity(bench).norm(), 1e-3);
+}
+
+TEST(CompoundCollide, RecollidedLegsKeepTheirOwnWarmStart) {
+    // A block near one end loads the near legs more than the far ones. All legs stand on
+    // the plane with the same feature ids; collided afresh, each leg's points must take the
+    // impulses of the same leg, not of the first leg whose ids match.
+    std::vector<CompoundPart> parts;
+    parts.push_back({Shape::box(Vec3(1.1, 0.05, 0.5)), Vec3(0, 0.65, 0), Quat::Identity()});
+    parts.push_back({Shape::box(Vec3(0.3, 0.3, 0.3)), Vec3(0.75, 1.0, 0), Quat::Identity()});
+    for (const Real x : {-1.0, 1.0}) {
+        for (const Real z : {-0.4, 0.4}) {
+            parts.push_back({Shape::box(Vec3(0.05, 0.3, 0.05)), Vec3(x, 0.3, z), Quat::Identity()});
+        }
+    }
+    SpaceSettings settings;
+    settings.sleep.enabled = false;
+    Space space(settings);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(d);
+    d.type = MotionType::Dynamic;
+    d.shape = Shape::compound(parts);
+    d.position = Vec3::Zero();
+    space.create_body(d);
+    for (int i = 0; i < 120; ++i) space.update();
+
+    World& world = SpaceInternals::world(space);
+    ASSERT_EQ(world.contacts.size(), 1u);
+    Contact& contact = world.contacts[0];
+    ASSERT_EQ(contact.manifold_count, 4);
+    auto leg_load = [&](int m) {
+        Real sum = 0;
+        const ContactManifold& leg = contact.manifold_at(m);
+        for (int j = 0; j < leg.point_count; ++j) sum += leg.points[j].normal_impulse;
+        return sum;
+    };
+    Real before[4];
+    for (int m = 0; m < 4; ++m) before[m] = leg_load(m);
+    EXPECT_GT(before[3], 2 * before[0]);  // the near legs (x = +1) carry more than the far ones
+    contact.cached = false;               // collide afresh instead of recycling
+    update_narrowphase(world);
+    ASSERT_EQ(contact.manifold_count, 4);
+    for (int m = 0; m < 4; ++m) EXPECT_NEAR(leg_load(m), before[m], 1e-9 + 1e-6 * before[m]) << "leg " << m;
 }
 
 }  // namespace
