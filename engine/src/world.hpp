@@ -114,6 +114,10 @@ struct ContactPoint {
 struct ContactManifold {
     Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
     int point_count = 0;
+    std::uint32_t part_a = 0, part_b = 0;  // the compound parts that touch (Manifold::part_a, part_b)
+    // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
+    // when collided, so that recycling and the solver stay off the cold descriptions.
+    Real radius_a = 0, radius_b = 0;
     ContactPoint points[kMaxManifoldPoints];
     // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
     // central friction): the tangential impulse there (world, in the contact plane) and
@@ -131,12 +135,9 @@ inline constexpr std::uint8_t kContactSensor = 1u << 1;
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
-    // Each body's round part (sphere, capsule radius; else 0), copied from the shapes at
-    // creation so that recycling and the solver stay off the cold descriptions.
-    Real radius_a = 0, radius_b = 0;
     int manifold_count = 0;
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
-    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes)
+    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
     bool sleeping = false;
     std::uint8_t events = 0;      // kContactReports, kContactSensor (set at creation)
     bool touch_reported = false;  // touching as last reported by a Begin (an End clears it)
@@ -154,15 +155,21 @@ struct Contact {
     }
 };
 
+// The most manifolds one contact keeps: a compound's touching part pairs (a triangle
+// mesh keeps fewer, collide_mesh.cpp).
+inline constexpr int kMaxContactManifolds = 8;
+
 // A contact's manifolds packed for the solver's listing: the point count of manifold m
-// in bits [4m, 4m + 4), and whether the contact has restitution.
-inline constexpr std::uint32_t kSummaryRestitution = 1u << 17;
+// in bits [3m, 3m + 3), and whether the contact has restitution (the top bit).
+inline constexpr int kSummaryBitsPerManifold = 3;
+inline constexpr std::uint32_t kSummaryRestitution = 1u << 31;
 inline std::uint32_t contact_summary(const Contact& contact) {
-    static_assert(kMaxManifoldPoints < 16, "a point count in 4 bits");
+    static_assert(kMaxManifoldPoints < (1 << kSummaryBitsPerManifold), "a point count in 3 bits");
+    static_assert(kMaxContactManifolds * kSummaryBitsPerManifold < 31, "the point counts below the restitution bit");
     if ((contact.events & kContactSensor) != 0) return 0;  // a sensor's manifolds push nothing
     std::uint32_t summary = contact.restitution > 0 ? kSummaryRestitution : 0u;
     for (int m = 0; m < contact.manifold_count; ++m) {
-        summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (4 * m);
+        summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (kSummaryBitsPerManifold * m);
     }
     return summary;
 }

@@ -125,7 +125,21 @@ std::array<bool, 3> parse_axes(const TomlReader& r, const toml::node& node, cons
     return locked;
 }
 
-// [w, x, y, z], or { axis = [x, y, z], degrees = a } / { axis, radians = a }.
+std::string stem(std::string_view source) {
+    std::string_view name = source;
+    if (const auto slash = name.find_last_of("/\\"); slash != std::string_view::npos) name.remove_prefix(slash + 1);
+    if (name.size() > 5 && name.substr(name.size() - 5) == ".toml") name.remove_suffix(5);
+    return std::string(name);
+}
+
+struct Entry {
+    std::uint32_t line, column;
+    std::string_view kind;
+    const toml::table* table;
+};
+
+}  // namespace
+
 Quat parse_orientation(const TomlReader& r, const toml::node& node, const std::string& what) {
     if (node.is_array()) {
         const std::vector<Real> q = r.numbers(node, what, 4, "w, x, y, z (a quaternion)");
@@ -148,21 +162,6 @@ Quat parse_orientation(const TomlReader& r, const toml::node& node, const std::s
                                : r.number(*radians, what + ".radians");
     return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized()));
 }
-
-std::string stem(std::string_view source) {
-    std::string_view name = source;
-    if (const auto slash = name.find_last_of("/\\"); slash != std::string_view::npos) name.remove_prefix(slash + 1);
-    if (name.size() > 5 && name.substr(name.size() - 5) == ".toml") name.remove_suffix(5);
-    return std::string(name);
-}
-
-struct Entry {
-    std::uint32_t line, column;
-    std::string_view kind;
-    const toml::table* table;
-};
-
-}  // namespace
 
 const std::vector<std::string_view>& body_property_keys() {
     static const std::vector<std::string_view> keys = {"type",

@@ -23,6 +23,9 @@ inline constexpr std::size_t kMaxSceneBodies = 1'000'000;
 // A shape table such as { box = [1, 1, 1] }; `what` is its dotted key ("body.shape").
 ShapeSpec parse_shape(const TomlReader& reader, const toml::node& node, std::string_view what);
 
+// [w, x, y, z], or { axis = [x, y, z], degrees = a } / { axis, radians = a }; normalised.
+Quat parse_orientation(const TomlReader& reader, const toml::node& node, const std::string& what);
+
 // An array of [x, y, z] points, at least `min_count`.
 std::vector<Vec3> parse_points(const TomlReader& reader, const toml::node& node, std::string_view what,
                                std::size_t min_count);

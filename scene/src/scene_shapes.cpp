@@ -1,5 +1,5 @@
 // Scene shapes: the `shape = { ... }` tables (sphere, box, capsule, hull, plane, mesh,
-// heightfield), their check at parse time, and the Shape factories at build time.
+// heightfield, compound), their check at parse time, and the Shape factories at build time.
 #include <spindle/platform/error.hpp>
 #include <spindle/scene/scene.hpp>
 
@@ -131,6 +131,36 @@ ShapeSpec parse_heightfield(const TomlReader& r, const toml::node& node, const s
     return s;
 }
 
+// Parts of a body: [{ shape = ..., position = [x, y, z], orientation = ... }, ...], each
+// a convex shape (its own checks make a part of zero size fail at its line).
+ShapeSpec parse_compound(const TomlReader& r, const toml::node& node, const std::string& what) {
+    const toml::array& list = r.array(node, what,
+                                      "of parts { shape = { ... }, position = [x, y, z], orientation = [w, x, y, z] }");
+    if (list.empty()) r.fail(node, what + ": expected at least one part");
+    ShapeSpec s;
+    s.type = ShapeType::Compound;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        const std::string item = what + "[" + std::to_string(i) + "]";
+        const toml::table& t = r.table(list[i], item, "{ shape = { ... }, position = [x, y, z], orientation = ... }");
+        r.check_keys(t, item, {"shape", "position", "orientation"});
+        const toml::node& shape_node = r.require(t, item, "shape");
+        CompoundPartSpec part;
+        part.shape = parse_shape(r, shape_node, item + ".shape");
+        const ShapeType type = part.shape.type;
+        if (type != ShapeType::Sphere && type != ShapeType::Box && type != ShapeType::Capsule &&
+            type != ShapeType::ConvexHull) {
+            r.fail(shape_node, item + ".shape: a compound part must be a sphere, box, capsule or hull, got " +
+                                   std::string(to_string(type)));
+        }
+        if (const toml::node* position = t.get("position")) part.position = r.vec3(*position, item + ".position");
+        if (const toml::node* orientation = t.get("orientation")) {
+            part.orientation = parse_orientation(r, *orientation, item + ".orientation");
+        }
+        s.parts.push_back(std::move(part));
+    }
+    return s;
+}
+
 }  // namespace
 
 std::vector<Vec3> parse_points(const TomlReader& r, const toml::node& node, std::string_view what,
@@ -152,10 +182,11 @@ ShapeSpec parse_shape(const TomlReader& r, const toml::node& node, std::string_v
     constexpr const char* kExpected =
         "{ sphere = r }, { box = [hx, hy, hz] }, { capsule = { half_height, radius } }, "
         "{ hull = [[x, y, z], ...] }, { plane = { normal, offset } }, { mesh = { vertices, triangles } } or "
-        "{ heightfield = { size, cells, amplitude, wavelength } }";
+        "{ heightfield = { size, cells, amplitude, wavelength } } or "
+        "{ compound = [{ shape, position, orientation }, ...] }";
     const toml::table* t = node.as_table();
     if (!t || t->size() != 1) r.fail(node, what + ": expected one of " + std::string(kExpected));
-    r.check_keys(*t, what, {"sphere", "box", "capsule", "hull", "plane", "mesh", "heightfield"});
+    r.check_keys(*t, what, {"sphere", "box", "capsule", "hull", "plane", "mesh", "heightfield", "compound"});
     const auto entry = t->begin();
     const toml::key& key = entry->first;
     const toml::node& value = entry->second;
@@ -176,6 +207,8 @@ ShapeSpec parse_shape(const TomlReader& r, const toml::node& node, std::string_v
         s = parse_plane(r, value, name);
     } else if (key.str() == "mesh") {
         s = parse_mesh(r, value, name);
+    } else if (key.str() == "compound") {
+        s = parse_compound(r, value, name);
     } else {
         s = parse_heightfield(r, value, name);
     }
@@ -192,6 +225,17 @@ Shape ShapeSpec::make() const {
         case ShapeType::ConvexHull: return Shape::convex_hull(points);
         case ShapeType::Plane: return Shape::plane(normal, offset);
         case ShapeType::TriangleMesh: return Shape::triangle_mesh(points, indices);
+        case ShapeType::Compound: {
+            std::vector<CompoundPart> made;
+            for (std::size_t i = 0; i < parts.size(); ++i) {
+                try {
+                    made.push_back({parts[i].shape.make(), parts[i].position, parts[i].orientation});
+                } catch (const Error& e) {
+                    throw Error("compound: part " + std::to_string(i) + ": " + e.what());
+                }
+            }
+            return Shape::compound(made);
+        }
         case ShapeType::Count: break;
     }
     throw Error("scene: unknown shape type");
@@ -206,6 +250,15 @@ Vec3 ShapeSpec::half_size(const Quat& q) const {
         case ShapeType::ConvexHull: {
             Aabb box;
             for (const Vec3& p : points) box.include(q.normalized() * p);
+            return box.extents();
+        }
+        case ShapeType::Compound: {
+            Aabb box;
+            for (const CompoundPartSpec& part : parts) {
+                const Vec3 center = q.normalized() * part.position;
+                const Vec3 half = part.shape.half_size(q.normalized() * part.orientation);
+                box = box.merged(Aabb::from_center_extents(center, half));
+            }
             return box.extents();
         }
         default: return Vec3::Zero();

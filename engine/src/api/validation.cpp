@@ -145,6 +145,9 @@ void validate(const Shape& s, const char* who) {
             if (!s.mesh)
                 reject_field(who, "shape.mesh", "must be set for a triangle mesh (Shape::triangle_mesh)", "none");
             return;
+        case ShapeType::Compound:
+            if (!s.parts) reject_field(who, "shape.parts", "must be set for a compound (Shape::compound)", "none");
+            return;
         case ShapeType::Count: break;
     }
     reject_field(who, "shape.type", "must be a shape type", std::to_string(static_cast<int>(s.type)));

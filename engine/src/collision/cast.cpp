@@ -12,6 +12,7 @@
 #include <spindle/platform/assert.hpp>
 
 #include "collision/collide.hpp"
+#include "collision/compound.hpp"
 #include "collision/convex_hull.hpp"
 #include "collision/gjk.hpp"
 #include "collision/polyhedron.hpp"
@@ -208,6 +209,23 @@ bool ray_mesh(const Segment& s, const TriangleMesh& mesh, LocalHit& hit) {
     return true;
 }
 
+bool ray_local(const Shape& shape, const Segment& s, LocalHit& hit);
+
+// The nearest entry into any part, each met in its own frame; a part the segment starts
+// inside is not entered, though another may be.
+bool ray_compound(const Segment& s, const Compound& compound, LocalHit& hit) {
+    bool found = false;
+    for (std::uint32_t i = 0; i < compound.size(); ++i) {
+        const Transform& pose = compound.pose(i);
+        LocalHit local;
+        if (!ray_local(compound.shape(i), {pose.apply_inverse(s.a), pose.rotate_inverse(s.d)}, local)) continue;
+        if (found && local.t >= hit.t) continue;
+        hit = {local.t, pose.rotate(local.normal), i};
+        found = true;
+    }
+    return found;
+}
+
 bool ray_local(const Shape& shape, const Segment& s, LocalHit& hit) {
     switch (shape.type) {
         case ShapeType::Sphere: return enter_ball(s, Vec3::Zero(), shape.radius, hit);
@@ -216,6 +234,7 @@ bool ray_local(const Shape& shape, const Segment& s, LocalHit& hit) {
         case ShapeType::ConvexHull: return ray_polyhedron(s, detail::view_of(*shape.hull), hit);
         case ShapeType::Plane: return ray_plane(s, shape, hit);
         case ShapeType::TriangleMesh: return ray_mesh(s, *shape.mesh, hit);
+        case ShapeType::Compound: return ray_compound(s, *shape.parts, hit);
         case ShapeType::Count: break;
     }
     return false;
@@ -229,7 +248,10 @@ struct Core {
     Real radius = 0;
 };
 
-bool is_convex(const Shape& shape) { return !shape.static_only() && shape.type < ShapeType::Count; }
+bool is_convex(const Shape& shape) {
+    return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule || shape.type == ShapeType::Box ||
+           shape.type == ShapeType::ConvexHull;
+}
 
 bool pose_is_finite(const Transform& x) { return is_finite(x.p) && is_finite(x.q); }
 
@@ -426,8 +448,45 @@ bool ray_cast(const Shape& shape, const Transform& pose, const Vec3& from, const
     return true;
 }
 
+namespace {
+
+// The first hit of any part (the earliest part on a tie); for the target's parts, `part`
+// names the one hit.
+template <typename Cast>
+bool first_part_hit(const Compound& compound, CastHit& hit, bool name_part, Cast cast) {
+    bool found = false;
+    for (std::uint32_t i = 0; i < compound.size(); ++i) {
+        CastHit candidate;
+        if (!cast(compound.shape(i), compound.pose(i), candidate)) continue;
+        if (found && candidate.fraction >= hit.fraction) continue;
+        hit = candidate;
+        if (name_part) hit.part = i;
+        found = true;
+    }
+    return found;
+}
+
+bool part_overlaps(const Compound& compound, const Transform& pose, const Shape& other, const Transform& other_pose) {
+    for (std::uint32_t i = 0; i < compound.size(); ++i) {
+        if (overlaps(compound.shape(i), pose * compound.pose(i), other, other_pose)) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
 bool shape_cast(const Shape& moving, const Transform& start, const Vec3& translation, const Shape& target,
                 const Transform& target_pose, CastHit& hit) {
+    if (moving.type == ShapeType::Compound && moving.parts) {
+        return first_part_hit(*moving.parts, hit, false, [&](const Shape& part, const Transform& pose, CastHit& h) {
+            return shape_cast(part, start * pose, translation, target, target_pose, h);
+        });
+    }
+    if (target.type == ShapeType::Compound && target.parts) {
+        return first_part_hit(*target.parts, hit, true, [&](const Shape& part, const Transform& pose, CastHit& h) {
+            return shape_cast(moving, start, translation, part, target_pose * pose, h);
+        });
+    }
     if (!is_convex(moving) || target.type >= ShapeType::Count) return false;
     if (!is_finite(translation) || !pose_is_finite(start) || !pose_is_finite(target_pose)) return false;
     const Transform to_target = target_pose.inverse();
@@ -440,6 +499,8 @@ bool shape_cast(const Shape& moving, const Transform& start, const Vec3& transla
 bool overlaps(const Shape& a, const Transform& pa, const Shape& b, const Transform& pb) {
     if (a.static_only() && b.static_only()) return false;
     if (a.static_only()) return overlaps(b, pb, a, pa);
+    if (a.type == ShapeType::Compound && a.parts) return part_overlaps(*a.parts, pa, b, pb);
+    if (b.type == ShapeType::Compound && b.parts) return part_overlaps(*b.parts, pb, a, pa);
     if (!pose_is_finite(pa) || !pose_is_finite(pb)) return false;
     const Transform a_in_b = pb.inverse() * pa;
     Core core;

@@ -14,7 +14,7 @@ struct CastHit {
     Real fraction = 0;            // of the segment or translation, in [0, 1]
     Vec3 point = Vec3::Zero();    // world, on the surface of the shape that was hit
     Vec3 normal = Vec3::UnitY();  // world, unit, from the hit shape toward the caster
-    std::uint32_t part = 0;       // triangle index into TriangleMesh::triangles(); else 0
+    std::uint32_t part = 0;       // triangle index into TriangleMesh::triangles(), part index of a compound; else 0
 };
 
 // First point where the segment from -> to enters the shape (posed by `pose`); `hit` is
@@ -24,12 +24,16 @@ struct CastHit {
 //   that starts on the surface and goes in hits at fraction 0. Grazing contact is a hit.
 // - Triangle meshes are two-sided: the nearest triangle crossed, with the normal turned to
 //   face the segment's start. A segment lying in a triangle's plane does not hit it.
+// - Compounds: the nearest entry into any part, `part` naming it; a part the segment
+//   starts inside is not entered (another may be).
 // - A zero-length segment never hits; non-finite from, to or pose gives false.
 bool ray_cast(const Shape& shape, const Transform& pose, const Vec3& from, const Vec3& to, CastHit& hit);
 
-// First contact of `moving` (sphere, capsule, box or hull, posed by `start`) translated by
-// `translation` against `target` (any shape, posed by `target_pose`); `hit` is written
-// only when this returns true. The point is on the target's surface.
+// First contact of `moving` (sphere, capsule, box, hull or compound, posed by `start`)
+// translated by `translation` against `target` (any shape, posed by `target_pose`); `hit`
+// is written only when this returns true. The point is on the target's surface. A
+// compound is swept part by part: the first part to hit (the lowest index on a tie)
+// gives the hit, and for a compound target `part` names the target's part.
 // - Conservative advancement on the GJK distance: the fraction is never past the contact
 //   and the gap left there is below the tolerance (1e-4 of the translation's length,
 //   clamped to [1e-9, 1e-5] m), so the fraction is short by at most that gap over the

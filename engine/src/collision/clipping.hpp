@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "collision/collide.hpp"
@@ -112,6 +113,9 @@ inline void manifold_to_world(Manifold& m, const Transform& x) {
     for (int i = 0; i < m.point_count; ++i) m.points[i].point = x.apply(m.points[i].point);
 }
 
-inline void flip_manifold(Manifold& m) { m.normal = -m.normal; }
+inline void flip_manifold(Manifold& m) {
+    m.normal = -m.normal;
+    std::swap(m.part_a, m.part_b);
+}
 
 }  // namespace spindle::detail

@@ -21,12 +21,16 @@ struct Manifold {
     Vec3 normal = Vec3::UnitY();  // world, unit length, pointing from shape A to shape B
     ManifoldPoint points[kMaxManifoldPoints];
     int point_count = 0;
+    // The parts that touch when a shape is a compound (their indices in it); else 0.
+    std::uint32_t part_a = 0, part_b = 0;
 };
 
 // Writes the manifolds of a (posed by xa) against b (posed by xb) into out[0..capacity)
 // and returns how many. Points are produced while the shapes are closer than
 // `speculative_distance` (speculative contacts have separation > 0). Convex pairs give
-// at most one manifold; a triangle mesh may give several (one per distinct normal).
+// at most one manifold; a triangle mesh may give several (one per distinct normal, the
+// deepest four), a compound one (or a mesh's several) per touching part pair, in part
+// order, the deepest `capacity` of them when more touch.
 // Any order of shape types is accepted; normals always point from a to b.
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
             Manifold* out, int capacity);

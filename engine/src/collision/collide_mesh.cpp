@@ -14,6 +14,7 @@ namespace spindle::detail {
 namespace {
 
 constexpr int kMaxMeshManifolds = 32;   // distinct normals kept while walking triangles
+constexpr int kMaxMeshOutput = 4;       // the deepest of them a shape keeps against the mesh
 constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
 constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
@@ -145,7 +146,7 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
 
     std::sort(found.begin(), found.begin() + found_count,
               [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
-    const int count = std::min(found_count, capacity);
+    const int count = std::min({found_count, capacity, kMaxMeshOutput});
     for (int i = 0; i < count; ++i) {
         out[i] = found[i];
         manifold_to_world(out[i], xb);

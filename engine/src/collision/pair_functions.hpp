@@ -34,6 +34,10 @@ int collide_convex_plane(const Shape&, const Transform&, const Shape&, const Tra
 // collide_mesh.cpp: every convex shape against a triangle mesh (B).
 int collide_convex_mesh(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 
+// collide_compound.cpp: any shape against a compound (B), and two compounds, part by part.
+int collide_shape_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+int collide_compound_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+
 // ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and
 // Gauss-map-pruned edge pairs, then face clipping or a single edge-edge point.

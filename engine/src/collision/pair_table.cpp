@@ -47,6 +47,10 @@ Table make_table() {
         add<collide_convex_plane>(table, convex, T::Plane);
         add<collide_convex_mesh>(table, convex, T::TriangleMesh);
     }
+    for (int other = 0; other < static_cast<int>(T::Compound); ++other) {
+        add<collide_shape_compound>(table, static_cast<T>(other), T::Compound);
+    }
+    add<collide_compound_compound>(table, T::Compound, T::Compound);
     return table;
 }
 

@@ -5,6 +5,7 @@
 #include <spindle/engine/shape.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "collision/compound.hpp"
 #include "collision/error_text.hpp"
 #include "collision/triangle_mesh.hpp"
 
@@ -107,6 +108,13 @@ Shape Shape::triangle_mesh(std::span<const Vec3> vertices, std::span<const std::
     return s;
 }
 
+Shape Shape::compound(std::span<const CompoundPart> parts) {
+    Shape s;
+    s.type = ShapeType::Compound;
+    s.parts = std::make_shared<const Compound>(parts);
+    return s;
+}
+
 Aabb Shape::bounds(const Transform& x) const {
     switch (type) {
         case ShapeType::Sphere: return Aabb::from_center_extents(x.p, Vec3::Constant(radius));
@@ -128,6 +136,7 @@ Aabb Shape::bounds(const Transform& x) const {
             const Aabb& local = mesh->local_bounds();
             return rotated_box_bounds(x, local.center(), local.extents());
         }
+        case ShapeType::Compound: return parts->bounds(x);
         case ShapeType::Count: break;
     }
     return {};
@@ -174,6 +183,7 @@ MassProperties Shape::mass_properties(Real density) const {
             mp.inertia = density * (c.trace() * Mat3::Identity() - c);
             break;
         }
+        case ShapeType::Compound: return parts->mass_properties(density);
         default: break;
     }
     return mp;

@@ -11,6 +11,7 @@ const char* to_string(ShapeType type) noexcept {
         case ShapeType::ConvexHull: return "convex hull";
         case ShapeType::Plane: return "plane";
         case ShapeType::TriangleMesh: return "triangle mesh";
+        case ShapeType::Compound: return "compound";
         case ShapeType::Count: break;
     }
     return "unknown shape";

@@ -26,7 +26,7 @@ AabbTreeSettings query_tree_settings() {
 bool same_shape(const Shape& a, const Shape& b) {
     return a.type == b.type && a.radius == b.radius && a.half_height == b.half_height &&
            a.half_extents == b.half_extents && a.normal == b.normal && a.offset == b.offset && a.hull == b.hull &&
-           a.mesh == b.mesh;
+           a.mesh == b.mesh && a.parts == b.parts;
 }
 
 }  // namespace

@@ -267,8 +267,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.against_static[l] =
             b.type[contact.body_a] == MotionType::Static || b.type[contact.body_b] == MotionType::Static ? 1 : 0;
         wc.restitution[l] = contact.restitution;
-        wc.radius_a[l] = contact.radius_a;
-        wc.radius_b[l] = contact.radius_b;
+        wc.radius_a[l] = m.radius_a;
+        wc.radius_b[l] = m.radius_b;
         wc.gravity_normal[l] =
             m.normal.dot(project_linear((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g, B.locks) -
                          project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));

@@ -36,8 +36,6 @@ void create_contact(World& world, std::uint64_t key) {
     // Mixing rules as most engines: geometric mean friction, largest restitution.
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
-    contact.radius_a = round_radius(bodies.desc[a].shape);
-    contact.radius_b = round_radius(bodies.desc[b].shape);
     note_contact_created(world, contact);  // before the summary: a sensor's has no points
     world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contact_summaries.push_back(contact_summary(contact));

@@ -9,14 +9,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collision/compound.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
 namespace {
 
-constexpr int kMaxManifolds = 4;
-static_assert(kMaxManifolds <= 4, "contact_summary (world.hpp) packs the point counts of at most 4 manifolds");
+constexpr int kMaxManifolds = kMaxContactManifolds;
 
 // Within this distance an old point stands for a new one whose feature id changed.
 constexpr Real kCarryDistance = 0.02;
@@ -73,13 +73,12 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
     const Quat& dqa = turns.dqa;
     const Quat& dqb = turns.dqb;
     const Vec3 moved = b.x[contact.body_b] - b.x[contact.body_a];
-    const Real radius_a = contact.radius_a, radius_b = contact.radius_b;
     for (int m = 0; m < contact.manifold_count; ++m) {
         ContactManifold& manifold = contact.manifold_at(m);
         const Vec3& n = manifold.normal;
         // n.(dq r) = (dq^-1 n).r: each rotation applied once per manifold.
         const Vec3 na = dqa.conjugate() * n, nb = dqb.conjugate() * n;
-        const Real base = n.dot(moved) + radius_a * (na.dot(n) - 1) + radius_b * (nb.dot(n) - 1);
+        const Real base = n.dot(moved) + manifold.radius_a * (na.dot(n) - 1) + manifold.radius_b * (nb.dot(n) - 1);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
             p.geometry.separation = p.base_separation + base + nb.dot(p.anchor_b) - na.dot(p.anchor_a);
@@ -110,12 +109,18 @@ void remember(Contact& contact, const Bodies& b, const Vec3& position) {
 // when the id changed (two faces aligned exactly flip between reference features from
 // step to step), of the nearest old point within kCarryDistance: losing the warm start
 // there makes a tall stack jitter and walk. The manifold takes the friction and twist
-// impulses of the old manifold facing the same way.
+// impulses of the old manifold facing the same way. Only manifolds of the same part pair
+// match: two legs of a compound table stand on the same face with the same feature ids.
+bool same_parts(const ContactManifold& x, const ContactManifold& y) {
+    return x.part_a == y.part_a && x.part_b == y.part_b;
+}
+
 void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     const ContactManifold* facing = nullptr;
     Real best_alignment = kSameFace;
     for (int m = 0; m < old_contact.manifold_count; ++m) {
         const ContactManifold& old = old_contact.manifold_at(m);
+        if (!same_parts(old, fresh)) continue;
         const Real alignment = old.normal.dot(fresh.normal);
         if (alignment > best_alignment) best_alignment = alignment, facing = &old;
     }
@@ -129,7 +134,7 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
         Real nearest = kCarryDistance * kCarryDistance;
         for (int m = 0; m < old_contact.manifold_count && !(match && match->geometry.id == p.geometry.id); ++m) {
             const ContactManifold& old = old_contact.manifold_at(m);
-            if (old.normal.dot(fresh.normal) < kSameFace) continue;
+            if (!same_parts(old, fresh) || old.normal.dot(fresh.normal) < kSameFace) continue;
             for (int k = 0; k < old.point_count; ++k) {
                 const ContactPoint& o = old.points[k];
                 if (o.geometry.id == p.geometry.id) {
@@ -193,11 +198,17 @@ void update_narrowphase(World& world) {
             // Speculative contacts reach as far as the bodies can close in one step.
             const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
             const Real speculative = settings.speculative_distance + closing;
-            const int n = collide(b.desc[a].shape, ta, b.desc[bb].shape, tb, speculative, found, kMaxManifolds);
+            const Shape& shape_a = b.desc[a].shape;
+            const Shape& shape_b = b.desc[bb].shape;
+            const int n = collide(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds);
             ContactManifold fresh[kMaxManifolds];
             for (int m = 0; m < n; ++m) {
                 fresh[m].normal = found[m].normal;
                 fresh[m].point_count = found[m].point_count;
+                fresh[m].part_a = found[m].part_a;
+                fresh[m].part_b = found[m].part_b;
+                fresh[m].radius_a = round_radius(part_shape(shape_a, found[m].part_a));
+                fresh[m].radius_b = round_radius(part_shape(shape_b, found[m].part_b));
                 for (int j = 0; j < found[m].point_count; ++j) fresh[m].points[j].geometry = found[m].points[j];
                 carry_impulses(contact, fresh[m]);
             }

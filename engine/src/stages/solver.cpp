@@ -80,9 +80,10 @@ bool list_manifolds(World& world, SolverScratch& scratch) {
         const std::uint64_t key = world.contact_keys[c];
         const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
         const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
-        std::uint32_t point_counts = summary & 0xffffu;  // 4 bits per manifold
-        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= 4) {
-            if ((point_counts & 0xfu) == 0) continue;
+        constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
+        std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
+        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
+            if ((point_counts & kCountMask) == 0) continue;
             scratch.manifolds.push_back({c, m, a, bb});
             restitution = restitution || (summary & kSummaryRestitution) != 0;
         }

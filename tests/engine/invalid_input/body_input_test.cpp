@@ -223,7 +223,24 @@ TEST(InvalidBody, ShapeFactoriesRejectBadValues) {
             const std::vector<std::uint32_t> indices{0, 1, 2, 0, 1, 3};
             check(
                 accepts(Rule::Finite, t.value), [&] { Shape::triangle_mesh(vertices, indices); }, "vertex 2");
+            // A compound's part position, and its orientation's coefficients (any finite
+            // non-zero quaternion is normalised; zero in one coefficient leaves it non-zero).
+            std::vector<CompoundPart> parts(2, CompoundPart{Shape::sphere(1), Vec3::Zero(), Quat::Identity()});
+            parts[1].position[axis] = t.value;
+            check(
+                accepts(Rule::Finite, t.value), [&] { Shape::compound(parts); }, "part 1: position");
+            parts[1].position = Vec3::Zero();
+            parts[1].orientation.coeffs()[axis] = t.value;
+            check(
+                accepts(Rule::Finite, t.value), [&] { Shape::compound(parts); }, "part 1: orientation");
         }
+        // A part's size, set by hand (the factory would reject it first).
+        Shape ball;
+        ball.type = ShapeType::Sphere;
+        ball.radius = t.value;
+        const std::vector<CompoundPart> one{{ball, Vec3::Zero(), Quat::Identity()}};
+        check(
+            positive, [&] { Shape::compound(one); }, "part 0: sphere radius");
         check(
             accepts(Rule::Finite, t.value), [&] { Shape::plane(Vec3::UnitY(), t.value); }, "offset");
         check(

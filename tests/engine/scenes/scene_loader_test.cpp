@@ -225,6 +225,67 @@ shape = { heightfield = { size = [2, 2], heights = [[0, 1], [2, 3]] } }
     EXPECT_EQ(listed.points[3], Vec3(1, 3, 1));  // row 1 (z = +1), column 1 (x = +1)
 }
 
+TEST(SceneParse, Compound_IsReadAndBuilt) {
+    const SceneDesc scene = parse_scene(R"(
+[[body]]
+position = [0, 2, 0]
+shape = { compound = [
+  { shape = { box = [1, 0.1, 0.5] }, position = [0, 0.5, 0] },
+  { shape = { sphere = 0.25 }, position = [0.5, 0, 0], orientation = [2, 0, 0, 0] },
+  { shape = { capsule = { half_height = 0.3, radius = 0.1 } }, orientation = { axis = [0, 0, 1], degrees = 90 } },
+] }
+)",
+                                        "compound.toml");
+    ASSERT_EQ(scene.shapes.size(), 1u);
+    const ShapeSpec& spec = scene.shapes[0];
+    EXPECT_EQ(spec.type, ShapeType::Compound);
+    ASSERT_EQ(spec.parts.size(), 3u);
+    EXPECT_EQ(spec.parts[0].shape.type, ShapeType::Box);
+    EXPECT_EQ(spec.parts[0].position, Vec3(0, 0.5, 0));
+    EXPECT_EQ(spec.parts[1].orientation.coeffs(), Quat::Identity().coeffs());  // normalised
+    EXPECT_EQ(spec.parts[2].position, Vec3::Zero());
+    EXPECT_LT((spec.parts[2].orientation * Vec3::UnitY() - Vec3(-1, 0, 0)).norm(), 1e-12);
+    // The box's half width plus its position, under a quarter turn about y.
+    const Vec3 half = spec.half_size(Quat(Eigen::AngleAxisd(kPi / 2, Vec3::UnitY())));
+    EXPECT_NEAR(half.z(), 1, 1e-12);
+    EXPECT_NEAR(half.y(), 0.425, 1e-12);  // from the sphere's bottom at -0.25 to the box's top at 0.6
+
+    Space space;
+    const std::vector<BodyHandle> bodies = build(scene, space);
+    ASSERT_EQ(bodies.size(), 1u);
+    EXPECT_EQ(space.internal_desc(bodies[0]).shape.type, ShapeType::Compound);
+}
+
+TEST(SceneParse, BrokenCompounds_AreRejectedAtTheLineAndColumn) {
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [] }\n", "2:22", "body.shape.compound: expected at least one part");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { sphere = 0 } }] }\n", "2:44",
+                    "body.shape.compound[0].shape.sphere: expected a number > 0");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { sphere = 1 } }, { shape = { box = [1, 0, 1] } }] }\n",
+                    "2:73", "body.shape.compound[1].shape.box: expected numbers > 0");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { plane = { normal = [0, 1, 0] } } }] }\n", "2:33",
+                    "body.shape.compound[0].shape: a compound part must be a sphere, box, capsule or hull, got plane");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { compound = [{ shape = { sphere = 1 } }] } }] }\n",
+                    "2:33", "a compound part must be a sphere, box, capsule or hull, got compound");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { sphere = 1 }, rotation = [1, 0, 0, 0] }] }\n", "2:49",
+                    "unknown key 'rotation' in body.shape.compound[0]");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ position = [0, 0, 0] }] }\n", "2:23",
+                    "body.shape.compound[0]: missing key 'shape'");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = [{ shape = { sphere = 1 }, orientation = [0, 0, 0, 0] }] }\n",
+                    "2:63", "body.shape.compound[0].orientation: expected a non-zero quaternion");
+    EXPECT_REJECTED("[[body]]\nshape = { compound = { shape = { sphere = 1 } } }\n", "2:22",
+                    "body.shape.compound: expected an array");
+}
+
+TEST(SceneBuild, CompoundWithAFlatHullPart_NamesThePartAndTheLine) {
+    const SceneDesc scene = parse_scene("\n\n\n[[body]]\nshape = { compound = [{ shape = { sphere = 1 } }, "
+                                        "{ shape = { hull = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]] } }] }\n",
+                                        "flat.toml");
+    Space space;
+    const std::string message = build_error(scene, space);
+    EXPECT_NE(message.find("flat.toml:4:1: shape: compound: part 1: "), std::string::npos) << message;
+    EXPECT_EQ(space.body_count(), 0u);
+}
+
 TEST(SceneParse, BodyProperties_DefaultsThenEntryKeys) {
     const SceneDesc scene = parse_scene(R"(
 [defaults]

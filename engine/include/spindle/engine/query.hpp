@@ -31,7 +31,7 @@ struct QueryHit {
     Real fraction = 0;            // of the segment or translation, in [0, 1]
     Vec3 point = Vec3::Zero();    // world, on the hit body's surface
     Vec3 normal = Vec3::UnitY();  // world, unit, from the hit body toward the caster
-    std::uint32_t part = 0;       // triangle index for a mesh, else 0
+    std::uint32_t part = 0;       // triangle index for a mesh, part index for a compound, else 0
 };
 
 }  // namespace spindle

@@ -11,10 +11,12 @@
 
 namespace spindle {
 
+class Compound;      // compound.hpp
 class ConvexHull;    // convex_hull.hpp
 class TriangleMesh;  // triangle_mesh.hpp
+struct CompoundPart;
 
-enum class ShapeType : std::uint8_t { Sphere, Capsule, Box, ConvexHull, Plane, TriangleMesh, Count };
+enum class ShapeType : std::uint8_t { Sphere, Capsule, Box, ConvexHull, Plane, TriangleMesh, Compound, Count };
 
 const char* to_string(ShapeType type) noexcept;
 
@@ -33,6 +35,7 @@ struct Shape {
     Real offset = 0;                   // plane
     std::shared_ptr<const ConvexHull> hull;
     std::shared_ptr<const TriangleMesh> mesh;
+    std::shared_ptr<const Compound> parts;  // compound
 
     static Shape sphere(Real radius);
     static Shape capsule(Real half_height, Real radius);
@@ -44,6 +47,11 @@ struct Shape {
     // Static only. Rejects out-of-range indices and non-finite vertices; drops
     // zero-area triangles.
     static Shape triangle_mesh(std::span<const Vec3> vertices, std::span<const std::uint32_t> indices);
+    // A body made of convex parts (sphere, capsule, box, hull) at poses in this shape's
+    // frame; its mass adds up the parts' (overlapping parts count twice). Rejects an empty
+    // list, a plane, mesh or compound part, a part of zero volume and a non-finite pose or
+    // zero orientation, naming the part; a non-unit orientation is normalised.
+    static Shape compound(std::span<const CompoundPart> parts);
 
     // Plane and triangle mesh can only belong to static bodies.
     bool static_only() const noexcept { return type == ShapeType::Plane || type == ShapeType::TriangleMesh; }
@@ -51,6 +59,13 @@ struct Shape {
     Aabb bounds(const Transform& x) const;
     // Mass, centre of mass and inertia for a uniform density (> 0). Throws for static-only shapes.
     MassProperties mass_properties(Real density) const;
+};
+
+// One part of a compound: a convex shape posed in the compound's frame.
+struct CompoundPart {
+    Shape shape;
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
 };
 
 }  // namespace spindle

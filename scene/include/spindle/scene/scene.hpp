@@ -19,21 +19,30 @@ class Space;
 // A shape as the file describes it. Kept apart from Shape so that a scene can be parsed
 // (and checked) without building the geometry: build() calls the factories once per
 // ShapeSpec and every body made from it shares the result.
+struct CompoundPartSpec;
+
 struct ShapeSpec {
     ShapeType type = ShapeType::Sphere;
-    Real radius = 0;                     // sphere, capsule (m)
-    Real half_height = 0;                // capsule (m)
-    Vec3 half_extents = Vec3::Zero();    // box (m)
-    Vec3 normal = Vec3::UnitY();         // plane
-    Real offset = 0;                     // plane (m)
-    std::vector<Vec3> points;            // hull points, or mesh vertices (m, body frame)
-    std::vector<std::uint32_t> indices;  // mesh: 3 per triangle, counter-clockwise from the front
+    Real radius = 0;                      // sphere, capsule (m)
+    Real half_height = 0;                 // capsule (m)
+    Vec3 half_extents = Vec3::Zero();     // box (m)
+    Vec3 normal = Vec3::UnitY();          // plane
+    Real offset = 0;                      // plane (m)
+    std::vector<Vec3> points;             // hull points, or mesh vertices (m, body frame)
+    std::vector<std::uint32_t> indices;   // mesh: 3 per triangle, counter-clockwise from the front
+    std::vector<CompoundPartSpec> parts;  // compound: convex parts posed in the body's frame
 
     // Calls the Shape factory. Throws spindle::Error when the factory rejects it.
     Shape make() const;
     // Half the size of the shape's bounds under orientation q (generators space bodies
     // by it); zero for static-only shapes (plane, mesh).
     Vec3 half_size(const Quat& q) const;
+};
+
+struct CompoundPartSpec {
+    ShapeSpec shape;
+    Vec3 position = Vec3::Zero();
+    Quat orientation = Quat::Identity();
 };
 
 // One body of the scene. desc holds everything but the shape: build() fills

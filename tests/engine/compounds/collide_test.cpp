@@ -1,0 +1,172 @@
+// collide() with compounds: one manifold per touching part pair, labelled with the parts,
+// in part order, the deepest kept when more touch than fit; and in a Space a contact
+// keeps one manifold per touching part pair.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "api/space_internals.hpp"
+#include "collision/collide.hpp"
+#include "compound_test_util.hpp"
+#include "stages/stages.hpp"
+
+namespace spindle {
+namespace {
+
+using namespace test;
+
+// A top (part 0) on six legs (parts 1..6) along x; leg i reaches `extra * i` below y = 0.
+Shape six_legged_bench(Real extra = 0) {
+    std::vector<CompoundPart> parts;
+    parts.push_back({Shape::box(Vec3(1.2, 0.05, 0.5)), Vec3(0, 0.65, 0), Quat::Identity()});
+    std::uint32_t i = 1;
+    for (const Real x : {-1.0, 0.0, 1.0}) {
+        for (const Real z : {-0.4, 0.4}) {
+            const Real drop = extra * i++;
+            parts.push_back(
+                {Shape::box(Vec3(0.05, 0.3 + drop / 2, 0.05)), Vec3(x, 0.3 - drop / 2, z), Quat::Identity()});
+        }
+    }
+    return Shape::compound(parts);
+}
+
+std::vector<Manifold> collide_all(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                  int capacity = kMaxContactManifolds) {
+    std::vector<Manifold> out(static_cast<std::size_t>(capacity));
+    out.resize(static_cast<std::size_t>(collide(a, xa, b, xb, 0.01, out.data(), capacity)));
+    return out;
+}
+
+TEST(CompoundCollide, EachTouchingPartPairHasItsOwnManifoldInPartOrder) {
+    const Shape plane = Shape::plane(Vec3::UnitY(), 0);
+    const std::vector<Manifold> m = collide_all(plane, Transform{}, six_legged_bench(), Transform{});
+    ASSERT_EQ(m.size(), 6u);  // the top is far above the plane
+    for (std::uint32_t i = 0; i < 6; ++i) {
+        EXPECT_EQ(m[i].part_a, 0u);
+        EXPECT_EQ(m[i].part_b, i + 1);
+        EXPECT_LT((m[i].normal - Vec3::UnitY()).norm(), 1e-12);  // from the plane to the bench
+        EXPECT_EQ(m[i].point_count, 4);
+        for (int k = 0; k < m[i].point_count; ++k) EXPECT_NEAR(m[i].points[k].separation, 0, 1e-12);
+    }
+    // The other way round the parts and the normal swap sides.
+    const std::vector<Manifold> flipped = collide_all(six_legged_bench(), Transform{}, plane, Transform{});
+    ASSERT_EQ(flipped.size(), 6u);
+    EXPECT_EQ(flipped[2].part_a, 3u);
+    EXPECT_EQ(flipped[2].part_b, 0u);
+    EXPECT_LT((flipped[2].normal + Vec3::UnitY()).norm(), 1e-12);
+}
+
+TEST(CompoundCollide, MorePartPairsThanFitKeepTheDeepestInPartOrder) {
+    // Leg i reaches i mm below the plane: legs 3..6 are the deepest four.
+    const Shape plane = Shape::plane(Vec3::UnitY(), 0);
+    const std::vector<Manifold> m = collide_all(plane, Transform{}, six_legged_bench(0.001), Transform{}, 4);
+    ASSERT_EQ(m.size(), 4u);
+    for (std::uint32_t i = 0; i < 4; ++i) EXPECT_EQ(m[i].part_b, i + 3);
+}
+
+TEST(CompoundCollide, ManyTouchingPartsKeepTheDeepestInPartOrder) {
+    // 70 balls in a row on a plane, every ninth (from part 4) a millimetre deeper: more
+    // part pairs than the walk holds, and the deepest eight come out in part order.
+    std::vector<CompoundPart> parts;
+    for (int i = 0; i < 70; ++i) {
+        const Real depth = i % 9 == 4 ? 0.002 : 0.001;
+        parts.push_back({Shape::sphere(0.1), Vec3(0.25 * i, 0.1 - depth, 0), Quat::Identity()});
+    }
+    const std::vector<Manifold> m = collide_all(Shape::plane(Vec3::UnitY(), 0), Transform{}, Shape::compound(parts),
+                                                Transform{});
+    ASSERT_EQ(m.size(), 8u);
+    for (std::uint32_t k = 0; k < 8; ++k) {
+        EXPECT_EQ(m[k].part_b, 4 + 9 * k);
+        EXPECT_NEAR(m[k].points[0].separation, -0.002, 1e-12);
+    }
+}
+
+TEST(CompoundCollide, CompoundOnCompoundLabelsBothParts) {
+    // The dumbbell lies across the table's top (part 0) on its two bells (parts 0 and 1).
+    const Transform on_top{Vec3(0, kTableHeight + kBell - 0.001, 0), Quat::Identity()};
+    const std::vector<Manifold> m = collide_all(table(), Transform{}, dumbbell(), on_top);
+    ASSERT_EQ(m.size(), 2u);
+    EXPECT_EQ(m[0].part_a, 0u);
+    EXPECT_EQ(m[0].part_b, 0u);
+    EXPECT_EQ(m[1].part_a, 0u);
+    EXPECT_EQ(m[1].part_b, 1u);
+    for (const Manifold& each : m) {
+        EXPECT_LT((each.normal - Vec3::UnitY()).norm(), 1e-9);
+        ASSERT_EQ(each.point_count, 1);
+        EXPECT_NEAR(each.points[0].separation, -0.001, 1e-9);
+    }
+    // Lifted clear of the top (beyond the speculative distance), nothing.
+    const Transform above{on_top.p + Vec3(0, 0.05, 0), on_top.q};
+    EXPECT_TRUE(collide_all(table(), Transform{}, dumbbell(), above).empty());
+}
+
+TEST(CompoundCollide, ContactKeepsAManifoldPerTouchingLegAndStandsStill) {
+    SpaceSettings settings;
+    settings.sleep.enabled = false;
+    Space space(settings);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(d);
+    d.type = MotionType::Dynamic;
+    d.shape = six_legged_bench();
+    d.position = Vec3::Zero();
+    const BodyHandle bench = space.create_body(d);
+    for (int i = 0; i < 120; ++i) space.update();
+    const World& world = SpaceInternals::world(space);
+    ASSERT_EQ(world.contacts.size(), 1u);
+    const Contact& contact = world.contacts[0];
+    ASSERT_EQ(contact.manifold_count, 6);
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(contact.manifold_at(i).part_b, static_cast<std::uint32_t>(i + 1));
+    EXPECT_LT(space.position(bench).norm(), 1e-3);
+    EXPECT_LT(space.angular_velocity(bench).norm(), 1e-3);
+}
+
+TEST(CompoundCollide, RecollidedLegsKeepTheirOwnWarmStart) {
+    // A block near one end loads the near legs more than the far ones. All legs stand on
+    // the plane with the same feature ids; collided afresh, each leg's points must take the
+    // impulses of the same leg, not of the first leg whose ids match.
+    std::vector<CompoundPart> parts;
+    parts.push_back({Shape::box(Vec3(1.1, 0.05, 0.5)), Vec3(0, 0.65, 0), Quat::Identity()});
+    parts.push_back({Shape::box(Vec3(0.3, 0.3, 0.3)), Vec3(0.75, 1.0, 0), Quat::Identity()});
+    for (const Real x : {-1.0, 1.0}) {
+        for (const Real z : {-0.4, 0.4}) {
+            parts.push_back({Shape::box(Vec3(0.05, 0.3, 0.05)), Vec3(x, 0.3, z), Quat::Identity()});
+        }
+    }
+    SpaceSettings settings;
+    settings.sleep.enabled = false;
+    Space space(settings);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::plane(Vec3::UnitY(), 0);
+    space.create_body(d);
+    d.type = MotionType::Dynamic;
+    d.shape = Shape::compound(parts);
+    d.position = Vec3::Zero();
+    space.create_body(d);
+    for (int i = 0; i < 120; ++i) space.update();
+
+    World& world = SpaceInternals::world(space);
+    ASSERT_EQ(world.contacts.size(), 1u);
+    Contact& contact = world.contacts[0];
+    ASSERT_EQ(contact.manifold_count, 4);
+    auto leg_load = [&](int m) {
+        Real sum = 0;
+        const ContactManifold& leg = contact.manifold_at(m);
+        for (int j = 0; j < leg.point_count; ++j) sum += leg.points[j].normal_impulse;
+        return sum;
+    };
+    Real before[4];
+    for (int m = 0; m < 4; ++m) before[m] = leg_load(m);
+    EXPECT_GT(before[3], 2 * before[0]);  // the near legs (x = +1) carry more than the far ones
+    contact.cached = false;               // collide afresh instead of recycling
+    update_narrowphase(world);
+    ASSERT_EQ(contact.manifold_count, 4);
+    for (int m = 0; m < 4; ++m) EXPECT_NEAR(leg_load(m), before[m], 1e-9 + 1e-6 * before[m]) << "leg " << m;
+}
+
+}  // namespace
+}  // namespace spindle
