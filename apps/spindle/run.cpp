@@ -9,8 +9,6 @@
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/layout.hpp>
-#include <spindle/platform/thread.hpp>
-#include <spindle/platform/topology.hpp>
 #include <spindle/scene/scene.hpp>
 
 #include <unistd.h>
@@ -32,6 +30,7 @@
 #include "progress.hpp"
 #include "recorder.hpp"
 #include "scenes.hpp"
+#include "session.hpp"
 #include "smoothness.hpp"
 #include "trace.hpp"
 
@@ -140,12 +139,7 @@ void print_summary(const SceneDesc& scene, const Layout& layout, const RunOption
 }
 
 int run(const RunOptions& o) {
-    const SceneDesc scene = resolve_scene(o.scene);
-
-    const Topology real = Topology::from_system();
-    const Layout layout = o.layout_file ? Layout::load(*o.layout_file, &real) : Layout::native(real);
-    const Topology model = layout.model_topology(real);
-    const LayoutMapping mapping = map_layout(layout, model, real);
+    Session session = Session::load(o.scene, o.layout_file);
 
     // Outputs are opened before anything runs, so a bad path fails at once.
     std::ofstream trace_out;
@@ -156,11 +150,14 @@ int run(const RunOptions& o) {
     std::optional<MotionRecorder> recorder;
     if (o.record_file) recorder.emplace(*o.record_file);
 
-    set_current_thread_name("spindle-game");
-    pin_current_thread(mapping.game.real_pu);
-
-    std::unique_ptr<JobSystem> jobs = make_jobs(mapping);
-    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
+    session.build();
+    const SceneDesc& scene = session.scene;
+    const Layout& layout = session.layout;
+    const LayoutMapping& mapping = session.mapping;
+    Space& space = *session.space;
+    const std::vector<BodyHandle>& handles = session.handles;
+    const SpaceSettings& settings = space.settings();
+    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(session.jobs.get());
     std::vector<GameSpan> frames;  // the game thread's side of the trace
     if (o.trace_file) {
         if (!scheduler)
@@ -168,22 +165,12 @@ int run(const RunOptions& o) {
         scheduler->enable_trace(true);
         frames.reserve(static_cast<std::size_t>(o.seconds * o.render_hz) + 16);
     }
-    SpaceSettings settings = scene.settings;
-    settings.time_step.use_internal_time_stepping = true;
-    Space space(settings, jobs.get());
-    const std::vector<BodyHandle> handles = build(scene, space);
     std::vector<std::uint32_t> moving;
     for (std::uint32_t i = 0; i < scene.bodies.size(); ++i) {
         if (scene.bodies[i].desc.type != MotionType::Static) moving.push_back(i);
     }
-    const std::size_t dynamic = scene.dynamic_body_count();
-    std::printf("scene %s (%s): %zu dynamic + %zu other bodies; %s\n", scene.name.c_str(), scene.source.c_str(),
-                dynamic, scene.bodies.size() - dynamic, scene.description.c_str());
-    std::printf("layout %s (%s):\n%s", layout.name.c_str(), layout.source.c_str(), mapping.describe().c_str());
-    std::fflush(stdout);
 
-    AsyncRunnerOptions runner_options;
-    runner_options.physics_pu = mapping.physics.real_pu;
+    AsyncRunnerOptions runner_options = session.runner_options();
     runner_options.sleep_when_idle = o.idle == "sleep";
     PhysicsProbe probe;  // before the runner: its posted function points at the probe
     AsyncRunner runner(space, runner_options);
