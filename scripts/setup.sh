@@ -7,6 +7,7 @@ packages=(
   g++ cmake make pkg-config
   libeigen3-dev libhwloc-dev libtomlplusplus-dev
   libcli11-dev               # the spindle program's command line
+  libcpp-httplib-dev libjs-three  # spindle view: its HTTP server, and three.js for its page
   libgtest-dev libgmock-dev libbenchmark-dev
   libtbb-dev libbullet-dev   # bench-only peers
   gnuplot-nox                # docs/accuracy.png

@@ -37,11 +37,6 @@
 namespace spindle::app {
 namespace {
 
-// --idle poll: the physics loop updates at most this often between steps. A frame at
-// 60 Hz then sees a publish at most 0.5 ms old (3% of the frame), for a few percent of
-// a hardware thread instead of all of it.
-constexpr double kPollInterval = 0.5e-3;
-
 struct RunOptions {
     std::string scene{kDefaultScene};
     std::optional<std::string> layout_file;
@@ -61,16 +56,6 @@ struct GameStats {
     double frame_ms_max = 0;
     double frame_ms_sum = 0;
 };
-
-// Sleeps until `deadline` on the stopwatch, the last stretch with yields: a sleeping
-// thread wakes up to a scheduler tick late, and that lateness would show as jitter in
-// the interpolated poses (a display refreshes on time; a late read shows a later pose).
-void wait_until(const Stopwatch& wall, double deadline) {
-    constexpr double kSpinSeconds = 1e-3;
-    const double sleep = deadline - kSpinSeconds - wall.elapsed_seconds();
-    if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
-    while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
-}
 
 void print_smoothness(const char* name, const SmoothnessReport& r) {
     std::printf("    %-13s %10.3f mm %11.4f mm %9.3f %8llu of %llu\n", name, r.mean_step_m * 1e3, r.jerk_rms_m * 1e3,

@@ -5,7 +5,9 @@
 #include <spindle/platform/thread.hpp>
 #include <spindle/platform/topology.hpp>
 
+#include <chrono>
 #include <cstdio>
+#include <thread>
 
 #include "jobs.hpp"
 #include "scenes.hpp"
@@ -41,6 +43,13 @@ AsyncRunnerOptions Session::runner_options() const {
     AsyncRunnerOptions options;
     options.physics_pu = mapping.physics.real_pu;
     return options;
+}
+
+void wait_until(const Stopwatch& wall, double deadline) {
+    constexpr double kSpinSeconds = 1e-3;
+    const double sleep = deadline - kSpinSeconds - wall.elapsed_seconds();
+    if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
+    while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
 }
 
 }  // namespace spindle::app

@@ -11,6 +11,7 @@
 
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/space.hpp>
+#include <spindle/platform/clock.hpp>
 #include <spindle/platform/layout.hpp>
 #include <spindle/scene/scene.hpp>
 #include <spindle/scheduler/job_system.hpp>
@@ -37,5 +38,10 @@ struct Session {
     // The physics loop's placement for an AsyncRunner over `space`.
     AsyncRunnerOptions runner_options() const;
 };
+
+// Sleeps until `deadline` on the stopwatch, the last stretch with yields: a sleeping
+// thread wakes up to a scheduler tick late, and that lateness would show as jitter in
+// the interpolated poses (a display refreshes on time; a late read shows a later pose).
+void wait_until(const Stopwatch& wall, double deadline);
 
 }  // namespace spindle::app
