@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs whatever Spindle needs from Debian's packages. Idempotent, and silent when
-# everything is already there.
+# everything is already there. `setup.sh --test` adds what only `make test` needs.
 set -euo pipefail
 
 packages=(
@@ -14,6 +14,12 @@ packages=(
   python3                    # test helpers (JSON checks)
   clang-format clang-tidy    # make format / format-check (part of make test), make tidy
 )
+if [[ ${1:-} == --test ]]; then
+  packages+=(chromium)       # the view page's test in a real (headless) browser
+elif [[ $# -gt 0 ]]; then
+  echo "setup: unknown argument '$1' (only --test: also install make test's packages)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do

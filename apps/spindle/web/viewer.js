@@ -14,7 +14,7 @@ const BODY_FLOATS = 8, CONTACT_FLOATS = 7, HEADER_BYTES = 40;
 const state = {
   frames: 0, sceneVersion: 0, sceneBodies: 0, drawnBodies: 0, asleep: 0, moved: 0, shots: 0,
   commandsRefused: 0, lastError: '', flags: 0, replay: false, test: '', testDone: false, shotGrew: false,
-};
+};  // moved: the furthest a body has gone from where it was first drawn
 window.spindleView = state;
 
 const canvas = document.getElementById('view');
@@ -163,6 +163,7 @@ function buildScene(desc) {
     }
     object.userData.body = i;
     object.userData.moving = !!moving;
+    object.userData.projectile = !!projectile;
     world.add(object);
     meshes.push(object);
     awakeMaterial.push(material);
@@ -212,9 +213,10 @@ function applyFrame(f) {
     }
   }
   if (!firstPositions) {
-    firstPositions = meshes.map((m) => m.position.clone());
+    firstPositions = [];
     frameCamera();
   }
+  for (let i = firstPositions.length; i < f.bodies; i++) firstPositions.push(meshes[i].position.clone());
   let moved = state.moved;
   for (let i = 0; i < Math.min(firstPositions.length, f.bodies); i++) {
     moved = Math.max(moved, meshes[i].position.distanceTo(firstPositions[i]));
@@ -222,8 +224,10 @@ function applyFrame(f) {
   state.moved = moved;
   state.asleep = asleep;
   state.flags = f.flags;
-  state.replay = (f.flags & FLAG_REPLAY) !== 0;
-  document.body.classList.toggle('replay', state.replay);
+  const replay = (f.flags & FLAG_REPLAY) !== 0;
+  if (replay && !state.replay) fillSpeeds([0.25, 0.5, 1, 2, 4]);  // a replay may also run fast
+  state.replay = replay;
+  document.body.classList.toggle('replay', replay);
   const points = [], lines = [];
   if (showContacts.checked) {
     const c0 = f.bodies * BODY_FLOATS;
@@ -238,14 +242,15 @@ function applyFrame(f) {
   state.frames += 1;
 }
 
-// Aims the camera at the moving bodies once, when the first frame arrives.
+// Aims the camera at the scene's moving bodies once, when the first frame arrives (not
+// at balls shot earlier, which may be far off by now).
 function frameCamera() {
   const box = new THREE.Box3();
-  meshes.forEach((m) => { if (m.userData.moving) box.expandByPoint(m.position); });
+  meshes.forEach((m) => { if (m.userData.moving && !m.userData.projectile) box.expandByPoint(m.position); });
   if (box.isEmpty()) return;
   const size = box.getSize(new THREE.Vector3()).length();
   box.getCenter(orbit.target);
-  orbit.distance = Math.max(6, 1.2 * size + 3);
+  orbit.distance = Math.max(6, 1.6 * size + 4);
   placeCamera();
 }
 
@@ -417,22 +422,22 @@ function draw() {
   requestAnimationFrame(draw);
 }
 
-// ?test=shoot: once frames arrive and bodies move, shoot one ball through the middle of the
-// view (as a click there would) and note whether the body count grew. The browser test
-// (tests/apps/viewer_browser_test.py) reads the outcome from #state.
+// ?test=shoot: once frames arrive, shoot one ball through the middle of the view (as a
+// click there would: at the scene's moving bodies) and note whether the body count grew
+// and bodies moved (the ball flies, what it hits is pushed). The browser test (tests/apps/viewer_test.py) reads the
+// outcome from #state.
 async function selfTest() {
   state.test = new URLSearchParams(location.search).get('test') || '';
   if (state.test !== 'shoot') return;
   const until = async (ok) => { while (!ok()) await new Promise((r) => setTimeout(r, 50)); };
-  await until(() => state.frames >= 20 && state.moved > 0.01);
+  await until(() => state.frames >= 20);
   const before = state.drawnBodies;
   state.bodiesBeforeShot = before;
-  const ray = new THREE.Ray();
   raycaster.setFromCamera(new THREE.Vector2(0, 0), camera);
-  ray.copy(raycaster.ray);
-  await shoot(ray);
+  await shoot(raycaster.ray.clone());
   await until(() => state.drawnBodies > before);
   state.shotGrew = true;
+  await until(() => state.moved > 0.5);
   state.testDone = true;
 }
 

@@ -1,0 +1,262 @@
+#!/usr/bin/env python3
+"""`spindle view` end to end (issue 20), two ctest tests in one file:
+
+  viewer_test.py http SPINDLE
+      hostile requests (malformed, out-of-range, oversized, binary, wrong mode) each get
+      an error status with a reason, are logged on stderr, and leave the program serving
+      and accepting good commands; SIGTERM then stops it cleanly (exit 0).
+  viewer_test.py browser SPINDLE [--screenshot-out PNG]
+      headless Chromium loads the page of `spindle view stack`, waits for frames, and the
+      page's own state (#state, read with --dump-dom) must show the scene's body count
+      drawn, a shot that made the count grow and bodies that moved; a screenshot must not
+      be blank. Exits 77 (ctest SKIP) when chromium is not installed, and only then.
+"""
+import json
+import os
+import re
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+import zlib
+
+SKIP = 77
+CHROMIUM_FLAGS = ["--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                  "--window-size=960,540", "--hide-scrollbars"]
+
+
+def fail(message):
+    print("FAIL: " + message, file=sys.stderr)
+    sys.exit(1)
+
+
+class View:
+    """A running `spindle view ... --port 0`, its URL read from its first lines."""
+
+    def __init__(self, spindle, *args):
+        self.err = tempfile.TemporaryFile()
+        self.proc = subprocess.Popen([spindle, "view", *args, "--port", "0"], stdout=subprocess.PIPE,
+                                     stderr=self.err, text=True)
+        self.out = []
+        deadline = time.time() + 120  # a loaded machine starts slowly
+        while time.time() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                break
+            self.out.append(line)
+            m = re.search(r"view: (http://127\.0\.0\.1:\d+/)", line)
+            if m:
+                self.url = m.group(1)
+                return
+        self.proc.kill()
+        fail("spindle view printed no URL:\n" + "".join(self.out) + self.stderr())
+
+    def stderr(self):
+        self.err.seek(0)
+        return self.err.read().decode(errors="replace")
+
+    def request(self, path, body=None):
+        """(status, reply body) of a GET, or of a POST when body is given."""
+        req = urllib.request.Request(self.url + path, data=body, method="POST" if body is not None else "GET")
+        try:
+            with urllib.request.urlopen(req, timeout=30) as reply:
+                return reply.status, reply.read()
+        except urllib.error.HTTPError as e:
+            return e.code, e.read()
+
+    def stop(self):
+        """SIGTERM, as Ctrl-C; the program must end cleanly and say so."""
+        self.proc.send_signal(signal.SIGTERM)
+        try:
+            rest, _ = self.proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            fail("spindle view did not stop on SIGTERM")
+        self.out.append(rest)
+        if self.proc.returncode != 0:
+            fail("spindle view exited %d on SIGTERM:\n%s%s" % (self.proc.returncode, "".join(self.out), self.stderr()))
+        return "".join(self.out)
+
+
+def test_http(spindle):
+    view = View(spindle, "stack")
+    hostile = [
+        (b"", 400, "empty command"),
+        (b"launch 1 2 3", 400, "unknown command 'launch'"),
+        (b"shoot 1 2 3", 400, "takes 6 values, got 3"),
+        (b"shoot 0 1 2 0 0 nan", 400, "is not a finite number"),
+        (b"shoot 0 1 2 0 0 1e999", 400, "is not a finite number"),
+        (b"shoot 0 1 2 0 0 0", 400, "direction has no length"),
+        (b"shoot 1e9 0 0 0 0 1", 400, "origin is further than"),
+        (b"speed 5", 400, "'speed' must be in 0.01..1"),
+        (b"speed -1", 400, "'speed' must be in"),
+        (b"interpolate maybe", 400, "takes on or off"),
+        (b"seek 3", 400, "is only for a replay"),
+        (b"pause\x00\xff", 400, "not printable ASCII"),
+        (b"step " + b"9" * 300, 400, "at most 256 allowed"),
+        (b"shoot " * 2000, 413, "request body over 4096 bytes"),
+    ]
+    for body, status, reason in hostile:
+        got, reply = view.request("command", body)
+        if got != status or reason.encode() not in reply:
+            fail("POST %r: expected %d '%s', got %d %r" % (body[:40], status, reason, got, reply[:200]))
+    got, reply = view.request("no/such/page")
+    if got != 404:
+        fail("GET of an unknown path: expected 404, got %d" % got)
+    refused = len(hostile) + 1
+
+    # Still serving, and still taking good commands.
+    got, frame = view.request("frame")
+    if got != 200 or struct.unpack_from("<I", frame)[0] != 0x46565053:
+        fail("after the hostile requests GET /frame gave %d %r" % (got, frame[:8]))
+    bodies = struct.unpack_from("<I", frame, 8)[0]
+    if view.request("command", b"shoot 0 3 15 0 0 -1")[0] != 200:
+        fail("a good shot was refused after the hostile requests")
+    deadline = time.time() + 60
+    while time.time() < deadline:
+        frame = view.request("frame")[1]
+        if struct.unpack_from("<I", frame, 8)[0] > bodies:
+            break
+        time.sleep(0.1)
+    else:
+        fail("the shot ball never appeared in the frames (still %d bodies)" % bodies)
+    deadline = time.time() + 30
+    while time.time() < deadline:  # the stats are published twice a second
+        stats = json.loads(view.request("stats")[1])
+        if stats["refused"] >= refused:
+            break
+        time.sleep(0.2)
+    if stats["refused"] != refused:
+        fail("the program counted %d refused requests, expected %d" % (stats["refused"], refused))
+
+    out = view.stop()
+    log = view.stderr()
+    logged = log.count("spindle view: refused ")
+    if logged != refused:
+        fail("expected %d refused requests logged, found %d:\n%s" % (refused, logged, log))
+    if "unknown command 'launch'" not in log:
+        fail("the log does not say why 'launch' was refused:\n" + log)
+    if "requests refused" not in out:
+        fail("no closing line after SIGTERM:\n" + out)
+    print("ok: %d hostile requests refused with a reason and logged; the program kept serving" % refused)
+
+
+def read_png(path):
+    """(width, height, rows of RGB(A) bytes) of an 8-bit RGB or RGBA PNG."""
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        fail(path + " is not a PNG")
+    pos, idat, width, height, channels = 8, b"", 0, 0, 0
+    while pos < len(data):
+        length, kind = struct.unpack_from(">I4s", data, pos)
+        chunk = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, color = struct.unpack_from(">IIBB", chunk)
+            if depth != 8 or color not in (2, 6):
+                fail("%s: expected 8-bit RGB or RGBA, got depth %d color type %d" % (path, depth, color))
+            channels = 3 if color == 2 else 4
+        elif kind == b"IDAT":
+            idat += chunk
+        pos += 12 + length
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    rows, previous = [], bytearray(stride)
+    for y in range(height):
+        kind = raw[y * (stride + 1)]
+        row = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            left = row[i - channels] if i >= channels else 0
+            up = previous[i]
+            corner = previous[i - channels] if i >= channels else 0
+            if kind == 1:
+                row[i] = (row[i] + left) & 255
+            elif kind == 2:
+                row[i] = (row[i] + up) & 255
+            elif kind == 3:
+                row[i] = (row[i] + (left + up) // 2) & 255
+            elif kind == 4:
+                p = left + up - corner
+                pa, pb, pc = abs(p - left), abs(p - up), abs(p - corner)
+                row[i] = (row[i] + (left if pa <= pb and pa <= pc else up if pb <= pc else corner)) & 255
+        rows.append(row)
+        previous = row
+    return width, height, channels, rows
+
+
+def chromium(url, *extra, timeout=600):
+    return subprocess.run(["chromium", *CHROMIUM_FLAGS, *extra, url], capture_output=True, text=True, timeout=timeout)
+
+
+def test_browser(spindle, screenshot_out):
+    if not shutil.which("chromium"):
+        print("chromium is not installed (scripts/setup.sh --test installs it): skipped")
+        sys.exit(SKIP)
+    view = View(spindle, "stack")
+    scene_line = next((l for l in view.out if l.startswith("scene stack")), "")
+    m = re.search(r"(\d+) dynamic \+ (\d+) other bodies", scene_line)
+    if not m:
+        fail("no scene line in the program's output:\n" + "".join(view.out))
+    scene_bodies = int(m.group(1)) + int(m.group(2))
+
+    # Virtual time runs only while the page waits on no request; the frames keep it
+    # waiting often, so 20 s of it is a minute or so of wall time on a slow machine.
+    dom = chromium(view.url + "?test=shoot", "--virtual-time-budget=20000", "--dump-dom").stdout
+    m = re.search(r'<pre id="state">([^<]*)</pre>', dom)
+    if not m:
+        fail("no #state in the page chromium dumped:\n" + dom[:2000])
+    state = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+    print("page state:", json.dumps(state))
+    if state["frames"] < 20:
+        fail("the page drew %d frames, expected at least 20" % state["frames"])
+    if state.get("bodiesBeforeShot") != scene_bodies:
+        fail("the page drew %s bodies before the shot; scene stack has %d" % (state.get("bodiesBeforeShot"),
+                                                                               scene_bodies))
+    if not state["shotGrew"] or state["drawnBodies"] <= scene_bodies:
+        fail("the shot did not add a body: %d drawn, scene has %d" % (state["drawnBodies"], scene_bodies))
+    if not state["moved"] > 0.5:
+        fail("no body moved as far as the shot ball flies (furthest %.4f m)" % state["moved"])
+    if state["lastError"]:
+        fail("the page reported an error: " + state["lastError"])
+
+    shot = os.path.join(tempfile.mkdtemp(), "viewer.png")
+    chromium(view.url + "?test=shoot", "--virtual-time-budget=8000", "--screenshot=" + shot)
+    if not os.path.exists(shot):
+        fail("chromium wrote no screenshot")
+    width, height, channels, rows = read_png(shot)
+    # Right of the panel only: the 3D view must not be one colour (without WebGL the page
+    # shows its background alone), and more than a sliver of it must differ from that.
+    counts = {}
+    for y in range(0, height, 2):
+        row = rows[y]
+        for x in range(width // 3, width, 2):
+            colour = bytes(row[x * channels:x * channels + 3])
+            counts[colour] = counts.get(colour, 0) + 1
+    colours = counts
+    drawn = 1 - max(counts.values()) / sum(counts.values())
+    if len(counts) < 8 or drawn < 0.05:
+        fail("the screenshot's 3D view is blank: %d colours, %.1f%% not background" % (len(counts), 100 * drawn))
+    if screenshot_out:
+        shutil.copyfile(shot, screenshot_out)
+    view.stop()
+    print("ok: %d frames, %d bodies drawn of %d, moved %.2f m; screenshot %dx%d with %d colours" %
+          (state["frames"], state["drawnBodies"], scene_bodies, state["moved"], width, height, len(colours)))
+
+
+def main():
+    if len(sys.argv) < 3 or sys.argv[1] not in ("http", "browser"):
+        print("usage: viewer_test.py http|browser SPINDLE [--screenshot-out PNG]", file=sys.stderr)
+        sys.exit(2)
+    if sys.argv[1] == "http":
+        test_http(sys.argv[2])
+    else:
+        out = sys.argv[sys.argv.index("--screenshot-out") + 1] if "--screenshot-out" in sys.argv else None
+        test_browser(sys.argv[2], out)
+
+
+if __name__ == "__main__":
+    main()
