@@ -5,8 +5,8 @@
       hostile requests (malformed, out-of-range, oversized, binary, wrong mode) each get
       an error status with a reason, are logged on stderr, and leave the program serving
       and accepting good commands; SIGTERM then stops it cleanly (exit 0).
-  viewer_test.py browser SPINDLE [--screenshot-out PNG]
-      headless Chromium loads the page of `spindle view stack`, waits for frames, and the
+  viewer_test.py browser SPINDLE [--scene NAME] [--screenshot-out PNG]
+      headless Chromium loads the page of `spindle view stack` (or NAME), waits for frames, and the
       page's own state (#state, read with --dump-dom) must show the scene's body count
       drawn, a shot that made the count grow and bodies that moved; a screenshot must not
       be blank. Exits 77 (ctest SKIP) when chromium is not installed, and only then.
@@ -192,16 +192,37 @@ def chromium(url, *extra, timeout=600):
     return subprocess.run(["chromium", *CHROMIUM_FLAGS, *extra, url], capture_output=True, text=True, timeout=timeout)
 
 
-def test_browser(spindle, screenshot_out):
+def test_browser(spindle, scene, screenshot_out):
     if not shutil.which("chromium"):
         print("chromium is not installed (scripts/setup.sh --test installs it): skipped")
         sys.exit(SKIP)
-    view = View(spindle, "stack")
-    scene_line = next((l for l in view.out if l.startswith("scene stack")), "")
+    view = View(spindle, scene)
+    scene_line = next((l for l in view.out if l.startswith("scene ")), "")
     m = re.search(r"(\d+) dynamic \+ (\d+) other bodies", scene_line)
     if not m:
         fail("no scene line in the program's output:\n" + "".join(view.out))
     scene_bodies = int(m.group(1)) + int(m.group(2))
+
+    # The screenshot first, while the scene is young and moving (no shot: the page's own
+    # test below counts the bodies before its shot).
+    shot = os.path.join(tempfile.mkdtemp(), "viewer.png")
+    chromium(view.url, "--virtual-time-budget=5000", "--screenshot=" + shot)
+    if not os.path.exists(shot):
+        fail("chromium wrote no screenshot")
+    width, height, channels, rows = read_png(shot)
+    # Right of the panel only: the 3D view must not be one colour (without WebGL the page
+    # shows its background alone), and more than a sliver of it must differ from that.
+    counts = {}
+    for y in range(0, height, 2):
+        row = rows[y]
+        for x in range(width // 3, width, 2):
+            colour = bytes(row[x * channels:x * channels + 3])
+            counts[colour] = counts.get(colour, 0) + 1
+    drawn = 1 - max(counts.values()) / sum(counts.values())
+    if len(counts) < 8 or drawn < 0.05:
+        fail("the screenshot's 3D view is blank: %d colours, %.1f%% not background" % (len(counts), 100 * drawn))
+    if screenshot_out:
+        shutil.copyfile(shot, screenshot_out)
 
     # Virtual time runs only while the page waits on no request; the frames keep it
     # waiting often, so 20 s of it is a minute or so of wall time on a slow machine.
@@ -214,8 +235,8 @@ def test_browser(spindle, screenshot_out):
     if state["frames"] < 20:
         fail("the page drew %d frames, expected at least 20" % state["frames"])
     if state.get("bodiesBeforeShot") != scene_bodies:
-        fail("the page drew %s bodies before the shot; scene stack has %d" % (state.get("bodiesBeforeShot"),
-                                                                               scene_bodies))
+        fail("the page drew %s bodies before the shot; scene %s has %d" % (state.get("bodiesBeforeShot"), scene,
+                                                                            scene_bodies))
     if not state["shotGrew"] or state["drawnBodies"] <= scene_bodies:
         fail("the shot did not add a body: %d drawn, scene has %d" % (state["drawnBodies"], scene_bodies))
     if not state["moved"] > 0.5:
@@ -223,39 +244,21 @@ def test_browser(spindle, screenshot_out):
     if state["lastError"]:
         fail("the page reported an error: " + state["lastError"])
 
-    shot = os.path.join(tempfile.mkdtemp(), "viewer.png")
-    chromium(view.url + "?test=shoot", "--virtual-time-budget=8000", "--screenshot=" + shot)
-    if not os.path.exists(shot):
-        fail("chromium wrote no screenshot")
-    width, height, channels, rows = read_png(shot)
-    # Right of the panel only: the 3D view must not be one colour (without WebGL the page
-    # shows its background alone), and more than a sliver of it must differ from that.
-    counts = {}
-    for y in range(0, height, 2):
-        row = rows[y]
-        for x in range(width // 3, width, 2):
-            colour = bytes(row[x * channels:x * channels + 3])
-            counts[colour] = counts.get(colour, 0) + 1
-    colours = counts
-    drawn = 1 - max(counts.values()) / sum(counts.values())
-    if len(counts) < 8 or drawn < 0.05:
-        fail("the screenshot's 3D view is blank: %d colours, %.1f%% not background" % (len(counts), 100 * drawn))
-    if screenshot_out:
-        shutil.copyfile(shot, screenshot_out)
     view.stop()
     print("ok: %d frames, %d bodies drawn of %d, moved %.2f m; screenshot %dx%d with %d colours" %
-          (state["frames"], state["drawnBodies"], scene_bodies, state["moved"], width, height, len(colours)))
+          (state["frames"], state["drawnBodies"], scene_bodies, state["moved"], width, height, len(counts)))
 
 
 def main():
     if len(sys.argv) < 3 or sys.argv[1] not in ("http", "browser"):
-        print("usage: viewer_test.py http|browser SPINDLE [--screenshot-out PNG]", file=sys.stderr)
+        print("usage: viewer_test.py http|browser SPINDLE [--scene NAME] [--screenshot-out PNG]", file=sys.stderr)
         sys.exit(2)
     if sys.argv[1] == "http":
         test_http(sys.argv[2])
     else:
-        out = sys.argv[sys.argv.index("--screenshot-out") + 1] if "--screenshot-out" in sys.argv else None
-        test_browser(sys.argv[2], out)
+        def option(name, default):
+            return sys.argv[sys.argv.index(name) + 1] if name in sys.argv[:-1] else default
+        test_browser(sys.argv[2], option("--scene", "stack"), option("--screenshot-out", None))
 
 
 if __name__ == "__main__":

@@ -134,9 +134,9 @@ function geometryOf(shape) {
   }
 }
 
-const staticMaterial = new THREE.MeshLambertMaterial({ color: 0x5d6470 });
+const staticMaterial = new THREE.MeshLambertMaterial({ color: 0x74806f });
 const groundMaterial = new THREE.MeshLambertMaterial({ color: 0x2f343c, side: THREE.DoubleSide });
-const sleepingMaterial = new THREE.MeshLambertMaterial({ color: 0x4b5a78 });
+const sleepingMaterial = new THREE.MeshLambertMaterial({ color: 0x34405c });  // dark: asleep
 const projectileMaterial = new THREE.MeshLambertMaterial({ color: 0xff8a3d });
 const movingMaterials = [0xd9a441, 0x6cb86a, 0x5aa7d6, 0xc86f8f, 0xa58ad8, 0xd6d06a].map(
   (c) => new THREE.MeshLambertMaterial({ color: c }));
