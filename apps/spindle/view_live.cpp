@@ -62,6 +62,9 @@ LiveView::LiveView(Session& session, ViewServer& server, double render_hz)
     m_ball_shape = add_shape(sphere_spec(kBallRadius));
     m_crate_shape = add_shape(box_spec(Vec3(0.3, 0.3, 0.3)));
     m_probe.attach(m_runner, kPollInterval);
+    // Something to serve before the first frame's turn: the URL is printed before run().
+    publish_frame(0);
+    publish_stats(0);
 }
 
 std::uint32_t LiveView::add_shape(const ShapeSpec& shape) {

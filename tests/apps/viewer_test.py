@@ -5,12 +5,21 @@
       hostile requests (malformed, out-of-range, oversized, binary, wrong mode) each get
       an error status with a reason, are logged on stderr, and leave the program serving
       and accepting good commands; SIGTERM then stops it cleanly (exit 0).
+  viewer_test.py controls SPINDLE
+      the page's controls over HTTP, as its buttons and mouse send them: pause holds the
+      steps, step takes one, slow motion and resume, interpolation off (the frame's flag),
+      drop adds bodies, grab + drag lifts a body along the cursor's ray, release lets go.
+  viewer_test.py replay SPINDLE
+      `spindle view --replay` of a `spindle run --record` file serves its frames (replay
+      flag, the recorded poses), seeks and steps; a malformed record is refused (exit 1,
+      file:line) before any port opens.
   viewer_test.py browser SPINDLE [--scene NAME] [--screenshot-out PNG]
       headless Chromium loads the page of `spindle view stack` (or NAME), waits for frames, and the
       page's own state (#state, read with --dump-dom) must show the scene's body count
       drawn, a shot that made the count grow and bodies that moved; a screenshot must not
       be blank. Exits 77 (ctest SKIP) when chromium is not installed, and only then.
 """
+import atexit
 import json
 import os
 import re
@@ -30,6 +39,16 @@ CHROMIUM_FLAGS = ["--headless=new", "--no-sandbox", "--use-angle=swiftshader", "
                   "--window-size=960,540", "--hide-scrollbars"]
 
 
+RUNNING = []  # views to kill when the test ends early (a failed check, an exception)
+
+
+@atexit.register
+def kill_views():
+    for proc in RUNNING:
+        if proc.poll() is None:
+            proc.kill()
+
+
 def fail(message):
     print("FAIL: " + message, file=sys.stderr)
     sys.exit(1)
@@ -40,8 +59,10 @@ class View:
 
     def __init__(self, spindle, *args):
         self.err = tempfile.TemporaryFile()
-        self.proc = subprocess.Popen([spindle, "view", *args, "--port", "0"], stdout=subprocess.PIPE,
-                                     stderr=self.err, text=True)
+        # --seconds: a view the test lost track of still ends by itself.
+        self.proc = subprocess.Popen([spindle, "view", *args, "--port", "0", "--seconds", "900"],
+                                     stdout=subprocess.PIPE, stderr=self.err, text=True)
+        RUNNING.append(self.proc)
         self.out = []
         deadline = time.time() + 120  # a loaded machine starts slowly
         while time.time() < deadline:
@@ -144,6 +165,128 @@ def test_http(spindle):
     if "requests refused" not in out:
         fail("no closing line after SIGTERM:\n" + out)
     print("ok: %d hostile requests refused with a reason and logged; the program kept serving" % refused)
+
+
+def frame_of(view):
+    """(flags, simulated seconds, steps, [(x, y, z) per body]) of the newest frame."""
+    status, frame = view.request("frame")
+    if status != 200 or struct.unpack_from("<I", frame)[0] != 0x46565053:
+        fail("GET /frame gave %d %r" % (status, frame[:8]))
+    bodies = struct.unpack_from("<I", frame, 8)[0]
+    flags = struct.unpack_from("<I", frame, 16)[0]
+    seconds, steps = struct.unpack_from("<dd", frame, 24)
+    return flags, seconds, steps, [struct.unpack_from("<3f", frame, 40 + 32 * i) for i in range(bodies)]
+
+
+def command(view, text):
+    status, reply = view.request("command", text.encode())
+    if status != 200:
+        fail("command %r refused: %d %r" % (text, status, reply))
+
+
+def wait_for(what, ok, seconds=60):
+    """Polls ok() until it holds; a slow machine gets a generous deadline, never a timing assert."""
+    deadline = time.time() + seconds
+    while time.time() < deadline:
+        value = ok()
+        if value:
+            return value
+        time.sleep(0.1)
+    fail("waited %d s for %s" % (seconds, what))
+
+
+def test_controls(spindle):
+    view = View(spindle, "pile")
+    stats = lambda: json.loads(view.request("stats")[1])
+
+    command(view, "pause")
+    wait_for("the paused mode", lambda: stats()["mode"] == "paused")
+    held = frame_of(view)[2]
+    time.sleep(1)
+    if frame_of(view)[2] != held:
+        fail("steps went on while paused: %d then %d" % (held, frame_of(view)[2]))
+    command(view, "step")
+    wait_for("one step", lambda: frame_of(view)[2] == held + 1)
+    time.sleep(0.5)
+    if frame_of(view)[2] != held + 1:
+        fail("a step while paused took more than one step")
+
+    command(view, "speed 0.25")
+    command(view, "resume")
+    wait_for("slow motion", lambda: stats()["mode"] == "slow")
+    wait_for("steps in slow motion", lambda: frame_of(view)[2] > held + 5)
+    command(view, "speed 1")
+    wait_for("running again", lambda: stats()["mode"] == "running")
+
+    command(view, "interpolate off")
+    wait_for("raw frames", lambda: frame_of(view)[0] & 2 == 0)
+    command(view, "interpolate on")
+    wait_for("interpolated frames", lambda: frame_of(view)[0] & 2 == 2)
+
+    bodies = len(frame_of(view)[3])
+    command(view, "drop")
+    wait_for("the dropped bodies", lambda: len(frame_of(view)[3]) == bodies + 8)
+
+    # Grab a scene body from 5 m above it, then move the ray 3 m up: the body must follow.
+    scene = json.loads(view.request("scene")[1])
+    moving = [i for i, (shape, is_moving, projectile) in enumerate(scene["bodies"]) if is_moving and not projectile]
+    command(view, "pause")  # hold everything still while choosing, so the ray meets the body where it is
+    wait_for("the paused mode", lambda: stats()["mode"] == "paused")
+    positions = frame_of(view)[3]
+    body = max(moving, key=lambda i: positions[i][1])  # the highest: nothing above it
+    x, y, z = positions[body]
+    command(view, "grab %f %f %f 0 -1 0" % (x, y + 5, z))
+    wait_for("the grab", lambda: stats()["grabbing"])
+    command(view, "drag %f %f %f 0 -1 0" % (x, y + 8, z))
+    command(view, "resume")
+    wait_for("the body lifted toward the cursor", lambda: frame_of(view)[3][body][1] > y + 2)
+    command(view, "release")
+    wait_for("the release", lambda: not stats()["grabbing"])
+    view.stop()
+    print("ok: pause, step, slow motion, interpolation, drop and drag act as the page asks")
+
+
+def test_replay(spindle):
+    record = os.path.join(tempfile.mkdtemp(), "stack.csv")
+    run = subprocess.run([spindle, "run", "stack", "--seconds", "1", "--record", record], capture_output=True,
+                         text=True, timeout=300)
+    if run.returncode != 0:
+        fail("spindle run --record failed:\n" + run.stdout + run.stderr)
+    rows = open(record).read().splitlines()
+    last = rows[-1].split(",")
+    recorded_top = [float(v) for v in last[3:6]]  # the last frame's last body: the top cube
+    duration = float(last[1]) - float(rows[1].split(",")[1])
+
+    view = View(spindle, "--replay", record, "stack")
+    flags, _, _, positions = frame_of(view)
+    if not flags & 4:
+        fail("replay frames carry no replay flag (flags %d)" % flags)
+    if len(positions) != 21:
+        fail("the replay has %d bodies, stack has 21" % len(positions))
+    if view.request("command", b"shoot 0 1 10 0 0 -1")[0] != 400:
+        fail("a replay accepted a shot")
+    command(view, "seek %f" % (duration + 1))  # past the end: the last frame
+    wait_for("the last frame", lambda: frame_of(view)[1] >= duration - 1e-6)
+    top = frame_of(view)[3][20]
+    if max(abs(a - b) for a, b in zip(top, recorded_top)) > 1e-4:
+        fail("the last replayed frame puts the top cube at %s, the record at %s" % (top, recorded_top))
+    command(view, "seek 0")
+    command(view, "pause")
+    wait_for("the start, paused", lambda: frame_of(view)[1] == 0 and frame_of(view)[0] & 1)
+    command(view, "step")
+    wait_for("the second frame", lambda: frame_of(view)[2] == 1)
+    view.stop()
+
+    bad = os.path.join(tempfile.mkdtemp(), "bad.csv")
+    with open(bad, "w") as f:
+        f.write(rows[0] + "\n" + rows[1] + "\n0,0,1,oops\n")
+    result = subprocess.run([spindle, "view", "--replay", bad, "stack", "--port", "0"], capture_output=True,
+                            text=True, timeout=120)
+    if result.returncode != 1 or bad + ":3: expected 13 comma-separated numbers" not in result.stderr:
+        fail("a malformed record: expected exit 1 naming %s:3, got %d %r" % (bad, result.returncode, result.stderr))
+    if "view: http" in result.stdout:
+        fail("a malformed record opened the port first")
+    print("ok: the replay serves, seeks and steps through the record; a malformed record is refused")
 
 
 def read_png(path):
@@ -250,11 +393,16 @@ def test_browser(spindle, scene, screenshot_out):
 
 
 def main():
-    if len(sys.argv) < 3 or sys.argv[1] not in ("http", "browser"):
-        print("usage: viewer_test.py http|browser SPINDLE [--scene NAME] [--screenshot-out PNG]", file=sys.stderr)
+    if len(sys.argv) < 3 or sys.argv[1] not in ("http", "controls", "replay", "browser"):
+        print("usage: viewer_test.py http|controls|replay|browser SPINDLE [--scene NAME] [--screenshot-out PNG]",
+              file=sys.stderr)
         sys.exit(2)
     if sys.argv[1] == "http":
         test_http(sys.argv[2])
+    elif sys.argv[1] == "controls":
+        test_controls(sys.argv[2])
+    elif sys.argv[1] == "replay":
+        test_replay(sys.argv[2])
     else:
         def option(name, default):
             return sys.argv[sys.argv.index(name) + 1] if name in sys.argv[:-1] else default
