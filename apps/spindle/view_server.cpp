@@ -4,6 +4,7 @@
 #include <spindle/platform/error.hpp>
 
 #include <httplib.h>
+#include <sys/socket.h>
 
 #include <cstdio>
 #include <fstream>
@@ -37,9 +38,18 @@ ViewServer::ViewServer(int port, ViewAssets assets, bool replay)
     m_http->new_task_queue = [] { return new httplib::ThreadPool(kServerThreads); };
     m_http->set_payload_max_length(kMaxPayload);
     m_http->set_keep_alive_timeout(2);
+    // SO_REUSEADDR (a restarted view gets its port back at once) without httplib's default
+    // SO_REUSEPORT, which would let a second view share a port the first one holds.
+    m_http->set_socket_options([](socket_t sock) {
+        int yes = 1;
+        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     route();
     m_port = port == 0 ? m_http->bind_to_any_port(kLocalhost) : (m_http->bind_to_port(kLocalhost, port) ? port : -1);
-    if (m_port <= 0) throw Error("cannot listen on " + std::string(kLocalhost) + ":" + std::to_string(port));
+    if (m_port <= 0) {
+        throw Error("cannot listen on " + std::string(kLocalhost) + ":" + std::to_string(port) +
+                    " (is another program using it? --port 0 picks a free port)");
+    }
     m_thread = std::thread([this] { m_http->listen_after_bind(); });
 }
 

@@ -155,6 +155,14 @@ def test_http(spindle):
     if stats["refused"] != refused:
         fail("the program counted %d refused requests, expected %d" % (stats["refused"], refused))
 
+    # A second view on the same port is refused, not let in beside the first.
+    port = view.url.rsplit(":", 1)[1].strip("/")
+    second = subprocess.run([spindle, "view", "stack", "--port", port, "--seconds", "5"], capture_output=True,
+                            text=True, timeout=120)
+    if second.returncode != 1 or "cannot listen on 127.0.0.1:" + port not in second.stderr:
+        fail("a second view on port %s: expected exit 1 'cannot listen', got %d %r" % (port, second.returncode,
+                                                                                      second.stderr))
+
     out = view.stop()
     log = view.stderr()
     logged = log.count("spindle view: refused ")
