@@ -365,6 +365,24 @@ const seekbar = document.getElementById('seekbar');
 seekbar.oninput = () => { seeking = true; };
 seekbar.onchange = async () => { await send('seek ' + seekbar.value); seeking = false; };
 
+// One drag in flight at a time, the newest waiting: a fast mouse must not queue up
+// requests the program would only replace one after another.
+let dragBusy = false, dragNext = null;
+async function sendDrag(text) {
+  if (dragBusy) {
+    dragNext = text;
+    return;
+  }
+  dragBusy = true;
+  await send(text);
+  dragBusy = false;
+  if (dragNext) {
+    const next = dragNext;
+    dragNext = null;
+    sendDrag(next);
+  }
+}
+
 // ---- mouse: click shoots, a drag that starts on a moving body pulls it, else orbits ----
 let press = null;
 canvas.addEventListener('contextmenu', (e) => e.preventDefault());
@@ -385,7 +403,7 @@ window.addEventListener('mousemove', (e) => {
   press.lastY = e.clientY;
   if (Math.abs(e.clientX - press.x) + Math.abs(e.clientY - press.y) > 4) press.moved = true;
   if (press.grab) {
-    send('drag ' + rayText(rayAt(e.clientX, e.clientY)));
+    sendDrag('drag ' + rayText(rayAt(e.clientX, e.clientY)));
   } else if (press.button === 2) {  // pan in the view plane
     const scale = orbit.distance / window.innerHeight;
     const right = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
