@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""`spindle view` end to end (issue 20), two ctest tests in one file:
+"""`spindle view` end to end (issue 20), one ctest test per mode:
 
   viewer_test.py http SPINDLE
       hostile requests (malformed, out-of-range, oversized, binary, wrong mode) each get
@@ -14,10 +14,11 @@
       flag, the recorded poses), seeks and steps; a malformed record is refused (exit 1,
       file:line) before any port opens.
   viewer_test.py browser SPINDLE [--scene NAME] [--screenshot-out PNG]
-      headless Chromium loads the page of `spindle view stack` (or NAME), waits for frames, and the
-      page's own state (#state, read with --dump-dom) must show the scene's body count
-      drawn, a shot that made the count grow and bodies that moved; a screenshot must not
-      be blank. Exits 77 (ctest SKIP) when chromium is not installed, and only then.
+      headless Chromium loads the page of `spindle view stack` (or NAME), waits for
+      frames, and the page's own state (#state, read with --dump-dom) must show the scene's body count
+      drawn, a click that shot a ball (the count grew), bodies that moved, and a body
+      dragged up by the mouse; a screenshot must not be blank. Exits 77 (ctest SKIP)
+      when chromium is not installed, and only then.
 """
 import atexit
 import json
@@ -392,6 +393,8 @@ def test_browser(spindle, scene, screenshot_out):
         fail("the shot did not add a body: %d drawn, scene has %d" % (state["drawnBodies"], scene_bodies))
     if not state["moved"] > 0.5:
         fail("no body moved as far as the shot ball flies (furthest %.4f m)" % state["moved"])
+    if not state.get("dragLifted", 0) > 0.3:
+        fail("dragging the highest body up did not lift it (rose %s m)" % state.get("dragLifted"))
     if state["lastError"]:
         fail("the page reported an error: " + state["lastError"])
 

@@ -440,22 +440,56 @@ function draw() {
   requestAnimationFrame(draw);
 }
 
-// ?test=shoot: once frames arrive, shoot one ball through the middle of the view (as a
-// click there would: at the scene's moving bodies) and note whether the body count grew
-// and bodies moved (the ball flies, what it hits is pushed). The browser test (tests/apps/viewer_test.py) reads the
-// outcome from #state.
+// ?test=shoot: the page tests itself through its own mouse handlers, with synthetic
+// events. Once frames arrive it clicks where no moving body is (a shot, as a user's click)
+// and notes whether the body count grew and bodies moved; then it presses on the highest
+// body, moves the mouse up and notes how far the body rose (a drag). The browser test
+// (tests/apps/viewer_test.py) reads the outcome from #state.
+function clientAt(ndc) {
+  const r = canvas.getBoundingClientRect();
+  return { x: r.left + ((ndc.x + 1) / 2) * r.width, y: r.top + ((1 - ndc.y) / 2) * r.height };
+}
+function mouse(type, at) {
+  canvas.dispatchEvent(new MouseEvent(type, { clientX: at.x, clientY: at.y, button: 0, bubbles: true }));
+}
+function movingAt(at) {
+  rayAt(at.x, at.y);
+  return raycaster.intersectObjects(meshes.filter((m) => m.userData.moving && m.isMesh), false);
+}
 async function selfTest() {
   state.test = new URLSearchParams(location.search).get('test') || '';
   if (state.test !== 'shoot') return;
-  const until = async (ok) => { while (!ok()) await new Promise((r) => setTimeout(r, 50)); };
+  const pause = (ms) => new Promise((r) => setTimeout(r, ms));
+  const until = async (ok) => { while (!ok()) await pause(50); };
   await until(() => state.frames >= 20);
   const before = state.drawnBodies;
   state.bodiesBeforeShot = before;
-  raycaster.setFromCamera(new THREE.Vector2(0, 0), camera);
-  await shoot(raycaster.ray.clone());
+  const empty = [[0, -0.5], [0.5, -0.5], [-0.5, -0.5], [0, -0.8], [0.8, 0.5]]
+    .map(([x, y]) => clientAt(new THREE.Vector2(x, y))).find((at) => movingAt(at).length === 0);
+  mouse('mousedown', empty);
+  mouse('mouseup', empty);
   await until(() => state.drawnBodies > before);
   state.shotGrew = true;
   await until(() => state.moved > 0.5);
+
+  let top = null;
+  meshes.forEach((m) => {
+    if (m.userData.moving && !m.userData.projectile && m.isMesh && (!top || m.position.y > top.position.y)) top = m;
+  });
+  const from = clientAt(top.position.clone().project(camera));
+  const y0 = top.position.y;
+  state.dragLifted = 0;
+  mouse('mousedown', from);
+  for (let i = 1; i <= 10; i++) {
+    await pause(30);
+    mouse('mousemove', { x: from.x, y: from.y - 8 * i });
+  }
+  for (let i = 0; i < 100 && top.position.y - y0 < 0.5; i++) {
+    await pause(50);
+    state.dragLifted = top.position.y - y0;
+  }
+  state.dragLifted = top.position.y - y0;
+  mouse('mouseup', { x: from.x, y: from.y - 80 });
   state.testDone = true;
 }
 
