@@ -15,8 +15,8 @@
       file:line) before any port opens.
   viewer_test.py browser SPINDLE [--scene NAME] [--screenshot-out PNG]
       headless Chromium loads the page of `spindle view stack` (or NAME), waits for
-      frames, and the page's own state (#state, read with --dump-dom) must show the scene's body count
-      drawn, a click that shot a ball (the count grew), bodies that moved, and a body
+      frames, and the page's own state (#state, read with --dump-dom) must show the
+      scene's body count drawn, a click that shot a ball (the count grew), bodies that moved, and a body
       dragged up by the mouse; a screenshot must not be blank. Exits 77 (ctest SKIP)
       when chromium is not installed, and only then.
 """
@@ -36,6 +36,7 @@ import urllib.request
 import zlib
 
 SKIP = 77
+CHROMIUM = os.environ.get("SPINDLE_CHROMIUM", "chromium")  # another browser binary, or a missing one to see the skip
 CHROMIUM_FLAGS = ["--headless=new", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
                   "--window-size=960,540", "--hide-scrollbars"]
 
@@ -341,11 +342,11 @@ def read_png(path):
 
 
 def chromium(url, *extra, timeout=600):
-    return subprocess.run(["chromium", *CHROMIUM_FLAGS, *extra, url], capture_output=True, text=True, timeout=timeout)
+    return subprocess.run([CHROMIUM, *CHROMIUM_FLAGS, *extra, url], capture_output=True, text=True, timeout=timeout)
 
 
 def test_browser(spindle, scene, screenshot_out):
-    if not shutil.which("chromium"):
+    if not shutil.which(CHROMIUM):
         print("chromium is not installed (scripts/setup.sh --test installs it): skipped")
         sys.exit(SKIP)
     view = View(spindle, scene)
