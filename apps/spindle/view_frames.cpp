@@ -102,7 +102,7 @@ std::string scene_json(std::uint32_t version, std::string_view name, std::span<c
     for (std::size_t i = 0; i < bodies.size(); ++i) {
         if (i) out += ',';
         out += "[" + std::to_string(bodies[i].shape) + "," + (bodies[i].moving ? "1" : "0") + "," +
-               (bodies[i].projectile ? "1" : "0") + "]";
+               (bodies[i].projectile ? "1" : "0") + "," + (bodies[i].sensor ? "1" : "0") + "]";
     }
     out += "]}";
     return out;

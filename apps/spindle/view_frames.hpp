@@ -8,6 +8,8 @@
 //   per body (scene order):  f32 px py pz qx qy qz qw asleep(0|1)
 //   per contact mark:        f32 px py pz nx ny nz age(s)
 // A frame whose scene version is not the page's tells it to fetch the scene again.
+// Scene JSON: {"version", "name", "shapes": [{type, radius, half_height, half_extents,
+// normal, offset, points, indices}], "bodies": [[shape, moving, projectile, sensor]]}.
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,7 @@ struct ViewBody {
     std::uint32_t shape = 0;  // index into the shapes sent with it
     bool moving = false;      // not static: drawn solid, can sleep
     bool projectile = false;  // shot from the page
+    bool sensor = false;      // an overlap volume, not a solid: drawn see-through
 };
 
 enum FrameFlags : std::uint32_t {

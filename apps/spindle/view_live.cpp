@@ -56,7 +56,7 @@ LiveView::LiveView(Session& session, ViewServer& server, double render_hz)
     m_shapes = session.scene.shapes;
     for (std::size_t i = 0; i < session.scene.bodies.size(); ++i) {
         const SceneBody& b = session.scene.bodies[i];
-        m_bodies.push_back({b.shape, b.desc.type != MotionType::Static, false});
+        m_bodies.push_back({b.shape, b.desc.type != MotionType::Static, false, b.desc.sensor});
     }
     m_handles = session.handles;
     m_ball_shape = add_shape(sphere_spec(kBallRadius));

@@ -86,7 +86,9 @@ RecordPlayer::RecordPlayer(const SceneDesc& scene, const std::string& path)
 void RecordPlayer::attach(ViewServer& server) {
     m_server = &server;
     std::vector<ViewBody> bodies;
-    for (const SceneBody& b : m_scene.bodies) bodies.push_back({b.shape, b.desc.type != MotionType::Static, false});
+    for (const SceneBody& b : m_scene.bodies) {
+        bodies.push_back({b.shape, b.desc.type != MotionType::Static, false, b.desc.sensor});
+    }
     server.publish_scene(scene_json(1, m_scene.name + " (replay)", m_scene.shapes, bodies));
     publish();
 }

@@ -239,7 +239,8 @@ def test_controls(spindle):
 
     # Grab a scene body from 5 m above it, then move the ray 3 m up: the body must follow.
     scene = json.loads(view.request("scene")[1])
-    moving = [i for i, (shape, is_moving, projectile) in enumerate(scene["bodies"]) if is_moving and not projectile]
+    moving = [i for i, (shape, is_moving, projectile, sensor) in enumerate(scene["bodies"])
+              if is_moving and not projectile and not sensor]
     command(view, "pause")  # hold everything still while choosing, so the ray meets the body where it is
     wait_for("the paused mode", lambda: stats()["mode"] == "paused")
     positions = frame_of(view)[3]

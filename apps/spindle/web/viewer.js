@@ -138,6 +138,7 @@ const staticMaterial = new THREE.MeshLambertMaterial({ color: 0x74806f });
 const groundMaterial = new THREE.MeshLambertMaterial({ color: 0x2f343c, side: THREE.DoubleSide });
 const sleepingMaterial = new THREE.MeshLambertMaterial({ color: 0x34405c });  // dark: asleep
 const projectileMaterial = new THREE.MeshLambertMaterial({ color: 0xff8a3d });
+const sensorMaterial = new THREE.MeshBasicMaterial({ color: 0x66e0ff, transparent: true, opacity: 0.18, depthWrite: false });
 const movingMaterials = [0xd9a441, 0x6cb86a, 0x5aa7d6, 0xc86f8f, 0xa58ad8, 0xd6d06a].map(
   (c) => new THREE.MeshLambertMaterial({ color: c }));
 
@@ -152,9 +153,10 @@ function buildScene(desc) {
   const geometries = desc.shapes.map((s) => geometryOf(s));
   meshes = [];
   awakeMaterial = [];
-  desc.bodies.forEach(([shapeIndex, moving, projectile], i) => {
+  desc.bodies.forEach(([shapeIndex, moving, projectile, sensor], i) => {
     const shape = desc.shapes[shapeIndex];
-    let material = !moving ? staticMaterial : projectile ? projectileMaterial : movingMaterials[i % movingMaterials.length];
+    const material = sensor ? sensorMaterial : !moving ? staticMaterial : projectile ? projectileMaterial
+      : movingMaterials[i % movingMaterials.length];
     let object;
     if (shape.type === 'plane') {
       object = planeObject(shape, groundMaterial);
@@ -162,7 +164,7 @@ function buildScene(desc) {
       object = new THREE.Mesh(geometries[shapeIndex], material);
     }
     object.userData.body = i;
-    object.userData.moving = !!moving;
+    object.userData.moving = !!moving && !sensor;  // a sensor is neither grabbed nor drawn asleep
     object.userData.projectile = !!projectile;
     world.add(object);
     meshes.push(object);
