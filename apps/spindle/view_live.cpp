@@ -7,13 +7,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <utility>
 
 #include "jobs.hpp"
 
 namespace spindle::app {
 namespace {
 
-constexpr std::size_t kMaxShots = 100;  // the oldest shot ball is retired beyond this
+constexpr std::size_t kMaxShots = 100;   // the oldest shot ball is retired beyond this
+constexpr std::size_t kMaxCrates = 400;  // and the oldest dropped crate beyond this
 constexpr Real kBallRadius = 0.25;
 constexpr Real kShotSpeed = 25;          // m/s
 constexpr Real kRayLength = 1000;        // m: picks and shots reach this far
@@ -38,8 +40,6 @@ ShapeSpec box_spec(const Vec3& half) {
     s.half_extents = half;
     return s;
 }
-
-const char* mode_name(bool paused, bool slow) { return paused ? "paused" : slow ? "slow" : "running"; }
 
 }  // namespace
 
@@ -79,7 +79,7 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
     while (!stop_requested.load(std::memory_order_relaxed) && (!seconds || deadline < *seconds)) {
         wait_until(wall, deadline);
         const double now = wall.elapsed_seconds();
-        for (const ViewCommand& command : m_server.take_commands()) apply(command, now);
+        for (const ViewCommand& command : m_server.take_commands()) apply(command);
         if (m_mode == Mode::Slow) step_here(m_period * m_speed);
         collect_created();
         pull_grabbed();
@@ -93,7 +93,7 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
     if (m_runner.running()) m_runner.stop();
 }
 
-void LiveView::apply(const ViewCommand& command, double now) {
+void LiveView::apply(const ViewCommand& command) {
     switch (command.action) {
         case ViewAction::Pause:
             set_running(false);
@@ -123,7 +123,14 @@ void LiveView::apply(const ViewCommand& command, double now) {
         case ViewAction::Drop: drop(); break;
         case ViewAction::Seek: break;  // the parser keeps it for replays
     }
-    (void)now;
+}
+
+const char* LiveView::mode_name() const noexcept {
+    switch (m_mode) {
+        case Mode::Paused: return "paused";
+        case Mode::Slow: return "slow";
+        default: return "running";
+    }
 }
 
 void LiveView::set_running(bool running) {
@@ -179,15 +186,17 @@ void LiveView::collect_created() {
         const BodyHandle handle = next.handle.get();  // rethrows a rejected creation: a bug, not input
         m_handles.push_back(handle);
         m_bodies.push_back(next.body);
-        if (next.body.projectile) m_shots.push_back(handle);
+        (next.body.projectile ? m_shots : m_crates).push_back(handle);
         m_pending.pop_front();
         m_version += 1;
         m_scene_dirty = true;
     }
-    while (m_shots.size() > kMaxShots) {
-        const BodyHandle oldest = m_shots.front();
-        m_shots.pop_front();
-        destroy(oldest);
+    for (auto [added, cap] : {std::pair{&m_shots, kMaxShots}, std::pair{&m_crates, kMaxCrates}}) {
+        while (added->size() > cap) {
+            const BodyHandle oldest = added->front();
+            added->pop_front();
+            destroy(oldest);
+        }
     }
 }
 
@@ -332,7 +341,7 @@ void LiveView::publish_stats(double now) {
         return std::string(number);
     };
     std::string json = "{\"mode\":\"";
-    json += mode_name(m_mode == Mode::Paused, m_mode == Mode::Slow);
+    json += mode_name();
     json += "\",\"speed\":" + num(m_speed) + ",\"interpolate\":" + (m_interpolate ? "true" : "false");
     json += ",\"steps\":" + std::to_string(steps) + ",\"steps_per_second\":" + num(m_steps_per_second);
     json += ",\"bodies\":" + std::to_string(m_handles.size()) + ",\"awake\":" + std::to_string(m_probe.awake_bodies());

@@ -50,7 +50,7 @@ private:
         Vec3 target = Vec3::Zero();
     };
 
-    void apply(const ViewCommand& command, double now);
+    void apply(const ViewCommand& command);
     void set_running(bool running);
     void step_here(double dt);
     void create(const BodyDesc& desc, ViewBody body);
@@ -65,6 +65,7 @@ private:
     void read_hits(double now);
     void publish_frame(double now);
     void publish_stats(double now);
+    const char* mode_name() const noexcept;
     std::uint32_t add_shape(const ShapeSpec& shape);
 
     Session& m_session;
@@ -85,8 +86,10 @@ private:
     bool m_scene_dirty = true;
     std::uint32_t m_ball_shape = 0, m_crate_shape = 0;
 
-    std::deque<Pending> m_pending;   // posted creations, oldest first
-    std::deque<BodyHandle> m_shots;  // oldest first, retired beyond a cap
+    std::deque<Pending> m_pending;  // posted creations, oldest first
+    // What the page added, oldest first; the oldest are retired beyond a cap each, so
+    // no number of clicks makes the scene grow without bound.
+    std::deque<BodyHandle> m_shots, m_crates;
     std::optional<Grab> m_grab;
     std::mt19937 m_random{20};
 

@@ -236,6 +236,12 @@ def test_controls(spindle):
     bodies = len(frame_of(view)[3])
     command(view, "drop")
     wait_for("the dropped bodies", lambda: len(frame_of(view)[3]) == bodies + 8)
+    for _ in range(59):  # 480 crates asked for: the oldest go beyond 400, however many are asked for
+        command(view, "drop")
+    wait_for("the cap on dropped bodies", lambda: len(frame_of(view)[3]) == bodies + 400)
+    time.sleep(1)
+    if len(frame_of(view)[3]) != bodies + 400:
+        fail("dropped bodies beyond the cap of 400: %d" % (len(frame_of(view)[3]) - bodies))
 
     # Grab a scene body from 5 m above it, then move the ray 3 m up: the body must follow.
     scene = json.loads(view.request("scene")[1])
