@@ -148,6 +148,15 @@ def test_http(spindle):
         time.sleep(0.1)
     else:
         fail("the shot ball never appeared in the frames (still %d bodies)" % bodies)
+
+    # The ball's hit on the stack is marked in the frames: a point and a unit normal.
+    def hit_mark():
+        frame = view.request("frame")[1]
+        n, marks = struct.unpack_from("<II", frame, 8)
+        return struct.unpack_from("<7f", frame, 40 + 32 * n) if marks else None
+    mark = wait_for("a contact mark of the shot's hit", hit_mark)
+    if abs(sum(v * v for v in mark[3:6]) - 1) > 1e-3 or not 0 <= mark[6] <= 1.5:
+        fail("a contact mark with normal %s and age %s" % (mark[3:6], mark[6]))
     deadline = time.time() + 30
     while time.time() < deadline:  # the stats are published twice a second
         stats = json.loads(view.request("stats")[1])
