@@ -26,6 +26,9 @@ constexpr double kSurveyInterval = 0.2;  // s between sleep surveys
 constexpr double kHitShown = 1.0;        // s a hit stays marked
 constexpr std::size_t kMaxHits = 256;
 constexpr double kStatsInterval = 0.5;  // s
+// Single steps a frame takes at most: each is a whole update on this thread, and a page
+// sending a flood of them must not stall the frames (the rest are dropped and logged).
+constexpr int kMaxStepsPerFrame = 4;
 
 ShapeSpec sphere_spec(Real radius) {
     ShapeSpec s;
@@ -79,6 +82,7 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
     while (!stop_requested.load(std::memory_order_relaxed) && (!seconds || deadline < *seconds)) {
         wait_until(wall, deadline);
         const double now = wall.elapsed_seconds();
+        m_steps_this_frame = 0;
         for (const ViewCommand& command : m_server.take_commands()) apply(command);
         if (m_mode == Mode::Slow) step_here(m_period * m_speed);
         collect_created();
@@ -106,7 +110,11 @@ void LiveView::apply(const ViewCommand& command) {
         case ViewAction::Step:
             set_running(false);
             m_mode = Mode::Paused;
-            step_here(m_space.settings().time_step.duration);
+            if (++m_steps_this_frame <= kMaxStepsPerFrame) {
+                step_here(m_space.settings().time_step.duration);
+            } else if (m_steps_this_frame == kMaxStepsPerFrame + 1) {
+                std::fprintf(stderr, "spindle view: dropped single steps beyond %d in one frame\n", kMaxStepsPerFrame);
+            }
             break;
         case ViewAction::Speed:
             m_speed = command.value;

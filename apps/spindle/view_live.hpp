@@ -77,6 +77,7 @@ private:
     Mode m_mode = Mode::Running;
     double m_speed = 1;
     bool m_interpolate = true;
+    int m_steps_this_frame = 0;
 
     // What the page draws, in its order: the scene's bodies, then what the page added.
     std::vector<ShapeSpec> m_shapes;
