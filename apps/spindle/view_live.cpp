@@ -84,6 +84,8 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
         const double now = wall.elapsed_seconds();
         m_steps_this_frame = 0;
         for (const ViewCommand& command : m_server.take_commands()) apply(command);
+        // Once a frame, however many pauses and resumes came: each is a thread stopped or started.
+        set_running(m_mode == Mode::Running);
         if (m_mode == Mode::Slow) step_here(m_period * m_speed);
         collect_created();
         pull_grabbed();
@@ -99,14 +101,8 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
 
 void LiveView::apply(const ViewCommand& command) {
     switch (command.action) {
-        case ViewAction::Pause:
-            set_running(false);
-            m_mode = Mode::Paused;
-            break;
-        case ViewAction::Resume:
-            m_mode = m_speed < 1 ? Mode::Slow : Mode::Running;
-            set_running(m_mode == Mode::Running);
-            break;
+        case ViewAction::Pause: m_mode = Mode::Paused; break;
+        case ViewAction::Resume: m_mode = m_speed < 1 ? Mode::Slow : Mode::Running; break;
         case ViewAction::Step:
             set_running(false);
             m_mode = Mode::Paused;
@@ -118,10 +114,7 @@ void LiveView::apply(const ViewCommand& command) {
             break;
         case ViewAction::Speed:
             m_speed = command.value;
-            if (m_mode != Mode::Paused) {
-                m_mode = m_speed < 1 ? Mode::Slow : Mode::Running;
-                set_running(m_mode == Mode::Running);
-            }
+            if (m_mode != Mode::Paused) m_mode = m_speed < 1 ? Mode::Slow : Mode::Running;
             break;
         case ViewAction::Interpolate: m_interpolate = command.value != 0; break;
         case ViewAction::Shoot: shoot(command.origin, command.direction); break;
