@@ -14,10 +14,14 @@ CXX_SOURCES = git ls-files -- $(foreach d,$(SOURCE_DIRS),'$(d)/*.cpp' '$(d)/*.hp
 CLANG_FORMAT ?= clang-format
 CLANG_TIDY ?= clang-tidy
 
-.PHONY: setup configure-release release run test test-release test-asan test-tsan format format-check tidy bench accuracy clean
+.PHONY: setup setup-test configure-release release run test test-release test-asan test-tsan format format-check tidy bench accuracy clean
 
 setup:
 	@bash scripts/setup.sh
+
+# make test's packages besides setup's (a headless browser for the view page's test).
+setup-test:
+	@bash scripts/setup.sh --test
 
 configure-release: setup
 	@cmake -S . -B $(BUILD)/release -DCMAKE_BUILD_TYPE=Release $(CMAKE_COMMON) >/dev/null
@@ -48,7 +52,7 @@ tidy: configure-release
 	@git ls-files -- $(foreach d,$(SOURCE_DIRS),'$(d)/*.cpp') | xargs -r -P$(JOBS) -n1 $(CLANG_TIDY) -p $(BUILD)/release --quiet \
 		--extra-arg=-Wno-unknown-warning-option --extra-arg=-Wno-error
 
-test-release: release
+test-release: setup-test release
 	cd $(BUILD)/release && ctest --output-on-failure -j$(JOBS)
 
 test-asan: setup

@@ -1,18 +1,25 @@
 #!/usr/bin/env bash
 # Installs whatever Spindle needs from Debian's packages. Idempotent, and silent when
-# everything is already there.
+# everything is already there. `setup.sh --test` adds what only `make test` needs.
 set -euo pipefail
 
 packages=(
   g++ cmake make pkg-config
   libeigen3-dev libhwloc-dev libtomlplusplus-dev
   libcli11-dev               # the spindle program's command line
+  libcpp-httplib-dev libjs-three  # spindle view: its HTTP server, and three.js for its page
   libgtest-dev libgmock-dev libbenchmark-dev
   libtbb-dev libbullet-dev   # bench-only peers
   gnuplot-nox                # docs/accuracy.png
   python3                    # test helpers (JSON checks)
   clang-format clang-tidy    # make format / format-check (part of make test), make tidy
 )
+if [[ ${1:-} == --test ]]; then
+  packages+=(chromium)       # the view page's test in a real (headless) browser
+elif [[ $# -gt 0 ]]; then
+  echo "setup: unknown argument '$1' (only --test: also install make test's packages)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -21,5 +21,6 @@ Command add_run_command(CLI::App& program);     // run.cpp
 Command add_bench_command(CLI::App& program);   // bench.cpp
 Command add_scenes_command(CLI::App& program);  // scenes.cpp
 Command add_layout_command(CLI::App& program);  // layout.cpp
+Command add_view_command(CLI::App& program);    // view.cpp
 
 }  // namespace spindle::app

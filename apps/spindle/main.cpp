@@ -1,5 +1,5 @@
 // The spindle console program: the command line (CLI11) of the commands run, bench,
-// scenes, layout and help, and their errors turned into a message and an exit code.
+// scenes, layout, view and help, and their errors turned into a message and an exit code.
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
     formatter->label("Positionals", "Arguments");
 
     const std::vector<Command> commands = {add_run_command(program), add_bench_command(program),
-                                           add_scenes_command(program), add_layout_command(program)};
+                                           add_scenes_command(program), add_layout_command(program),
+                                           add_view_command(program)};
     std::string help_topic;
     const CLI::App* help = add_help_command(program, help_topic);
     for (CLI::App* sub : program.get_subcommands({})) sub->group("Commands");

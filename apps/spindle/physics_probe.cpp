@@ -32,7 +32,20 @@ void PhysicsProbe::sample(const UpdateStats& stats) {
     double seconds = 0;
     for (std::size_t i = 0; i < stats.stage_seconds.size(); ++i) {
         m_totals.stage_seconds[i] += stats.stage_seconds[i];
+        m_window_seconds[i] += stats.stage_seconds[i];
         seconds += stats.stage_seconds[i];
+    }
+    m_window_steps += static_cast<std::uint64_t>(stats.steps);
+    constexpr std::int64_t kWindowNs = 500'000'000;
+    const std::int64_t now = now_nanoseconds();
+    if (now - m_window_start_ns >= kWindowNs && m_window_steps > 0) {
+        for (std::size_t i = 0; i < m_window_seconds.size(); ++i) {
+            m_recent_stage_ms[i].store(m_window_seconds[i] * 1e3 / static_cast<double>(m_window_steps),
+                                       std::memory_order_relaxed);
+            m_window_seconds[i] = 0;
+        }
+        m_window_steps = 0;
+        m_window_start_ns = now;
     }
     m_totals.updates += 1;
     m_totals.steps += static_cast<std::uint64_t>(stats.steps);

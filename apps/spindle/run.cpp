@@ -9,8 +9,6 @@
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 #include <spindle/platform/layout.hpp>
-#include <spindle/platform/thread.hpp>
-#include <spindle/platform/topology.hpp>
 #include <spindle/scene/scene.hpp>
 
 #include <unistd.h>
@@ -33,15 +31,12 @@
 #include "progress.hpp"
 #include "recorder.hpp"
 #include "scenes.hpp"
+#include "session.hpp"
 #include "trace.hpp"
 
 namespace spindle::app {
 namespace {
 
-// --idle poll: the physics loop updates at most this often between steps. A frame at
-// 60 Hz then sees a publish at most 0.5 ms old (3% of the frame), for a few percent of
-// a hardware thread instead of all of it.
-constexpr double kPollInterval = 0.5e-3;
 // Moving bodies whose rendered motion is set beside the recorded steps (spread evenly).
 constexpr std::size_t kTruthBodies = 64;
 
@@ -64,16 +59,6 @@ struct GameStats {
     double frame_ms_max = 0;
     double frame_ms_sum = 0;
 };
-
-// Sleeps until `deadline` on the stopwatch, the last stretch with yields: a sleeping
-// thread wakes up to a scheduler tick late, and that lateness would show as jitter in
-// the interpolated poses (a display refreshes on time; a late read shows a later pose).
-void wait_until(const Stopwatch& wall, double deadline) {
-    constexpr double kSpinSeconds = 1e-3;
-    const double sleep = deadline - kSpinSeconds - wall.elapsed_seconds();
-    if (sleep > 0) std::this_thread::sleep_for(std::chrono::duration<double>(sleep));
-    while (wall.elapsed_seconds() < deadline) std::this_thread::yield();
-}
 
 void print_truth(ShownAs shown, const TruthReport& r) {
     std::printf("    %-16s %8.3f mm %8.3f mm %10.2f ms %9.2f ms %8llu\n", to_string(shown), r.error_mean_m * 1e3,
@@ -140,12 +125,7 @@ void print_summary(const SceneDesc& scene, const Layout& layout, const RunOption
 }
 
 int run(const RunOptions& o) {
-    const SceneDesc scene = resolve_scene(o.scene);
-
-    const Topology real = Topology::from_system();
-    const Layout layout = o.layout_file ? Layout::load(*o.layout_file, &real) : Layout::native(real);
-    const Topology model = layout.model_topology(real);
-    const LayoutMapping mapping = map_layout(layout, model, real);
+    Session session = Session::load(o.scene, o.layout_file);
 
     // Outputs are opened before anything runs, so a bad path fails at once.
     std::ofstream trace_out;
@@ -156,11 +136,14 @@ int run(const RunOptions& o) {
     std::optional<MotionRecorder> recorder;
     if (o.record_file) recorder.emplace(*o.record_file);
 
-    set_current_thread_name("spindle-game");
-    pin_current_thread(mapping.game.real_pu);
-
-    std::unique_ptr<JobSystem> jobs = make_jobs(mapping);
-    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
+    session.build();
+    const SceneDesc& scene = session.scene;
+    const Layout& layout = session.layout;
+    const LayoutMapping& mapping = session.mapping;
+    Space& space = *session.space;
+    const std::vector<BodyHandle>& handles = session.handles;
+    const SpaceSettings& settings = space.settings();
+    auto* const scheduler = dynamic_cast<WorkStealingJobSystem*>(session.jobs.get());
     std::vector<GameSpan> frames;  // the game thread's side of the trace
     if (o.trace_file) {
         if (!scheduler)
@@ -168,22 +151,12 @@ int run(const RunOptions& o) {
         scheduler->enable_trace(true);
         frames.reserve(static_cast<std::size_t>(o.seconds * o.render_hz) + 16);
     }
-    SpaceSettings settings = scene.settings;
-    settings.time_step.use_internal_time_stepping = true;
-    Space space(settings, jobs.get());
-    const std::vector<BodyHandle> handles = build(scene, space);
     std::vector<std::uint32_t> moving;
     for (std::uint32_t i = 0; i < scene.bodies.size(); ++i) {
         if (scene.bodies[i].desc.type != MotionType::Static) moving.push_back(i);
     }
-    const std::size_t dynamic = scene.dynamic_body_count();
-    std::printf("scene %s (%s): %zu dynamic + %zu other bodies; %s\n", scene.name.c_str(), scene.source.c_str(),
-                dynamic, scene.bodies.size() - dynamic, scene.description.c_str());
-    std::printf("layout %s (%s):\n%s", layout.name.c_str(), layout.source.c_str(), mapping.describe().c_str());
-    std::fflush(stdout);
 
-    AsyncRunnerOptions runner_options;
-    runner_options.physics_pu = mapping.physics.real_pu;
+    AsyncRunnerOptions runner_options = session.runner_options();
     runner_options.sleep_when_idle = o.idle == "sleep";
     PhysicsProbe probe;  // before the runner: its posted function points at the probe
     AsyncRunner runner(space, runner_options);

@@ -300,7 +300,9 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
         std::vector<std::string> options;
     };
     const std::vector<Case> cases = {
-        {"--help", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help", "exit codes"}},
+        {"--help",
+         "usage: spindle [OPTIONS] [COMMAND]",
+         {"run", "bench", "scenes", "layout", "view", "help", "exit codes"}},
         {"-h", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help"}},
         {"help", "usage: spindle [OPTIONS] [COMMAND]", {"run", "bench", "scenes", "layout", "help"}},
         {"run --help",
@@ -313,6 +315,9 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
          {"SCENE", "--threads N", "--steps N", "--substeps N", "--stages", "steps_per_s"}},
         {"scenes --help", "usage: spindle scenes [OPTIONS]", {"-h,--help"}},
         {"layout --help", "usage: spindle layout [OPTIONS] FILE", {"FILE", "configs/layouts"}},
+        {"view --help",
+         "usage: spindle view [OPTIONS] [SCENE]",
+         {"SCENE", "--layout FILE", "--port P", "--render-hz HZ", "--seconds S", "--replay FILE"}},
         {"help --help", "usage: spindle help [OPTIONS] [COMMAND]", {"COMMAND"}},
         // Help wins over what else is on the line, as long as that parses.
         {"run stack --seconds 3 --help", "usage: spindle run", {"--seconds S"}},
@@ -325,7 +330,7 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
         for (const std::string& option : c.options) expect_contains(r.output, option);
     }
     // `help COMMAND` is the command's --help.
-    for (const char* command : {"run", "bench", "scenes", "layout", "help"}) {
+    for (const char* command : {"run", "bench", "scenes", "layout", "view", "help"}) {
         SCOPED_TRACE(command);
         const Result help = spindle(std::string("help ") + command, true);
         const Result flag = spindle(std::string(command) + " --help", true);
@@ -425,7 +430,7 @@ void expect_failures(const std::vector<BadCase>& cases, int exit_code) {
         EXPECT_EQ(r.exit_code, exit_code) << r.output;
         expect_contains(r.output, c.message);
         const std::vector<std::string> w = words(c.args);
-        const std::vector<std::string> commands = {"run", "bench", "scenes", "layout", "help"};
+        const std::vector<std::string> commands = {"run", "bench", "scenes", "layout", "view", "help"};
         const bool command = !w.empty() && std::find(commands.begin(), commands.end(), w[0]) != commands.end();
         const std::string name = command ? "spindle " + w[0] : "spindle";
         EXPECT_EQ(r.output.rfind(name + ": ", 0), 0u) << r.output;
@@ -504,6 +509,15 @@ TEST(SpindleProgram, BadCommandLines_ExitTwoNamingTheCommandAndWhatWasWrong) {
             // a flag given a value
             {"bench stack --stages=yes", "--stages: takes no value, got 'yes'"},
             {"bench stack --stages=0", "--stages: takes no value, got '0'"},
+            // spindle view's
+            {"view --port 70000", "--port: expected an integer in [0, 65535], got 70000"},
+            {"view --port -1", "--port: expected an integer in [0, 65535], got -1"},
+            {"view --port http", "--port: expected an integer, got 'http'"},
+            {"view --render-hz 0", "--render-hz: expected a number in [1, 1000], got 0"},
+            {"view --seconds 0", "--seconds: expected a number in [0.01, 1000000], got 0"},
+            {"view --replay", "--replay: 1 required TEXT missing"},
+            {"view nope", "SCENE: unknown scene 'nope' (built-in scenes: "},
+            {"view stack extra", "unexpected argument 'extra'"},
             // an option given twice
             {"run --seconds 1 --seconds 2", "--seconds: At Most 1 required but received 2"},
         },
@@ -526,6 +540,10 @@ TEST(SpindleProgram, BadFilesAndValues_ExitOneNamingTheCommandAndTheFile) {
             {"bench '" + bad.string() + "' --steps 1", bad.string() + ":3:12: body.friction"},
             {"layout /nonexistent/layout.toml", "/nonexistent/layout.toml: cannot open layout file"},
             {"layout '" + bad.string() + "'", "unknown key"},
+            {"view --layout /nonexistent/layout.toml", "/nonexistent/layout.toml: cannot open layout file"},
+            {"view '" + bad.string() + "'", bad.string() + ":3:12: body.friction"},
+            {"view --replay /nonexistent/record.csv stack", "/nonexistent/record.csv: cannot read the record file"},
+            {"view --replay '" + bad.string() + "' stack", bad.string() + ":1: not a `spindle run --record` file"},
         },
         1);
     fs::remove(bad);
