@@ -41,7 +41,8 @@ void MotionTruthMeter::add_frame(
     if (!m_steps.contains(time.steps)) m_steps.emplace(time.steps, sample(shown[raw]));
 
     Frame f;
-    f.instant = (newest + time.banked_alpha) * step + static_cast<double>(at_ns - time.clock_ns) * 1e-9;
+    f.instant = (newest + time.banked_alpha) * step +
+                static_cast<double>(at_ns - time.clock_ns) * 1e-9 * time.clock_rate;
     auto blended_instant = [&](double alpha) { return alpha < 1 ? (newest - 1 + alpha) * step : newest * step; };
     f.shown_instant[static_cast<std::size_t>(ShownAs::ReadClock)] = blended_instant(read_alpha);
     f.shown_instant[static_cast<std::size_t>(ShownAs::UpdateClock)] = blended_instant(time.banked_alpha);

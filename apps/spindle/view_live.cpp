@@ -26,8 +26,8 @@ constexpr double kSurveyInterval = 0.2;  // s between sleep surveys
 constexpr double kHitShown = 1.0;        // s a hit stays marked
 constexpr std::size_t kMaxHits = 256;
 constexpr double kStatsInterval = 0.5;  // s
-// Single steps a frame takes at most: each is a whole update on this thread, and a page
-// sending a flood of them must not stall the frames (the rest are dropped and logged).
+// Single steps a frame asks the runner for at most: a page sending a flood of them must
+// not queue physics time without end (the rest are dropped and logged).
 constexpr int kMaxStepsPerFrame = 4;
 
 ShapeSpec sphere_spec(Real radius) {
@@ -84,9 +84,8 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
         const double now = wall.elapsed_seconds();
         m_steps_this_frame = 0;
         for (const ViewCommand& command : m_server.take_commands()) apply(command);
-        // Once a frame, however many pauses and resumes came: each is a thread stopped or started.
-        set_running(m_mode == Mode::Running);
-        if (m_mode == Mode::Slow) step_here(m_period * m_speed);
+        // Pause and slow motion are the runner's clock: physics stays on its own thread.
+        m_runner.set_time_scale(m_mode == Mode::Paused ? 0 : m_speed);
         collect_created();
         pull_grabbed();
         survey_sleep(now);
@@ -104,10 +103,10 @@ void LiveView::apply(const ViewCommand& command) {
         case ViewAction::Pause: m_mode = Mode::Paused; break;
         case ViewAction::Resume: m_mode = m_speed < 1 ? Mode::Slow : Mode::Running; break;
         case ViewAction::Step:
-            set_running(false);
             m_mode = Mode::Paused;
+            m_runner.set_time_scale(0);  // before the step's time, so the loop adds nothing more
             if (++m_steps_this_frame <= kMaxStepsPerFrame) {
-                step_here(m_space.settings().time_step.duration);
+                m_runner.advance(m_space.settings().time_step.duration);
             } else if (m_steps_this_frame == kMaxStepsPerFrame + 1) {
                 std::fprintf(stderr, "spindle view: dropped single steps beyond %d in one frame\n", kMaxStepsPerFrame);
             }
@@ -134,22 +133,8 @@ const char* LiveView::mode_name() const noexcept {
     }
 }
 
-void LiveView::set_running(bool running) {
-    if (running == m_runner.running()) return;
-    if (running) {
-        m_runner.start();
-    } else {
-        m_runner.stop();
-    }
-}
-
-// With the runner stopped this thread is the only one updating (the space's rule).
-void LiveView::step_here(double dt) {
-    m_space.update(dt);
-    m_probe.add(m_space.last_update());
-}
-
-// Structure goes through the runner while it runs; stopped, this thread may make it.
+// Structure goes through the runner while it runs; once it has stopped (after a failure)
+// this thread may make it.
 void LiveView::create(const BodyDesc& desc, ViewBody body) {
     if (m_runner.running()) {
         m_pending.push_back({m_runner.post([desc](Space& space) { return space.create_body(desc); }), body});

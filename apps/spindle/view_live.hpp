@@ -5,9 +5,9 @@
 // bodies are created and destroyed by functions posted to the runner, velocities are
 // buffered writes, picks are ray casts against the published step.
 //
-// Pause stops the runner; a step or slow motion then updates the space on this thread
-// (AsyncRunner takes the wall clock's time as it is: it has no time scale), and resume
-// starts the runner again.
+// Pause, single steps and slow motion are the runner's clock (AsyncRunner::set_time_scale
+// and advance): physics stays on its own thread throughout, and reads blend at the scaled
+// rate, so slow motion is interpolated like real time.
 #pragma once
 
 #include <spindle/engine/async_runner.hpp>
@@ -51,8 +51,6 @@ private:
     };
 
     void apply(const ViewCommand& command);
-    void set_running(bool running);
-    void step_here(double dt);
     void create(const BodyDesc& desc, ViewBody body);
     void destroy(BodyHandle body);
     void collect_created();

@@ -276,9 +276,11 @@ struct World {
     Real accumulator = 0;
     std::uint64_t steps = 0;
     // now_nanoseconds() at the instant the accumulator was measured up to, when updates
-    // follow the real clock (an AsyncRunner's loop sets it); 0 when they do not. And the
+    // follow the real clock (an AsyncRunner's loop sets it); 0 when they do not; the
+    // simulated seconds per real second it runs at (the runner's time scale). And the
     // clock that reads naming none blend by (the runner's options).
     std::int64_t update_clock_ns = 0;
+    double update_clock_rate = 1;
     BlendClock read_blend = BlendClock::Update;
     // The awake bodies' state version (bumped by every flip after a step, a write or a
     // direct change) and the version each published buffer's awake entries were filled at

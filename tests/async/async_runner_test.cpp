@@ -14,10 +14,13 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <future>
+#include <limits>
+#include <string>
 #include <thread>
 
 using namespace spindle;
@@ -345,4 +348,76 @@ TEST(AsyncRunner, StatsFromAnyThreadWhileTheLoopChangesTheTimeStep) {
     runner.stop();
     EXPECT_GT(reads.load(), 0u);
     EXPECT_EQ(space.settings().time_step.duration, 1.0 / 60);
+}
+
+TEST(AsyncRunner, TimeScaleSlowsTheSteps) {
+    Space space(async_settings());
+    space.create_body(ball());
+    AsyncRunner runner(space);
+    runner.set_time_scale(0.25);
+    runner.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    runner.stop();
+    const AsyncStats stats = runner.stats();
+    // A quarter of about 36 steps: a loaded machine may take fewer, never more.
+    EXPECT_GE(stats.steps, 1u);
+    EXPECT_LE(static_cast<double>(stats.steps), stats.seconds * 60 * 0.25 + 2);
+    EXPECT_EQ(runner.time_scale(), 0.25);
+}
+
+TEST(AsyncRunner, PausedRunnerRunsPostedFunctionsAndAdvanceTakesOneStep) {
+    Space space(async_settings());
+    BodyDesc moving = ball();
+    moving.linear_velocity = Vec3(1, 0, 0);
+    const BodyHandle body = space.create_body(moving);
+    AsyncRunner runner(space);
+    runner.set_time_scale(0);
+    runner.start();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    auto ran = runner.post([](Space& s) { return s.counters().steps; });
+    ASSERT_TRUE(ready_in_time(ran));
+    EXPECT_EQ(ran.get(), 0u);
+
+    const MotionStateManager& states = space.motion_states();
+    runner.advance(space.settings().time_step.duration);
+    for (int i = 0; i < 1000 && states.published_steps() < 1; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_EQ(states.published_steps(), 1u);
+    // Paused again after the step: reads by the reader's clock stand still too.
+    const MotionState first = states.read(body);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const MotionState later = states.read(body);
+    EXPECT_EQ(states.published_steps(), 1u);
+    EXPECT_EQ(first.position, later.position);
+    // The step was taken (raw), and the blend, standing at the step before, did not run on
+    // to it at the real rate.
+    MotionState raw;
+    states.get_raw_motion_states(std::span(&body, 1), std::span(&raw, 1));
+    EXPECT_GT(raw.position.x(), 0.0);
+    EXPECT_LT(later.position.x(), raw.position.x());
+    runner.stop();
+    EXPECT_EQ(space.counters().steps, 1u);
+}
+
+TEST(AsyncRunner, BadTimeScaleOrAdvanceIsRefusedAndChangesNothing) {
+    Space space(async_settings());
+    AsyncRunner runner(space);
+    runner.set_time_scale(0.5);
+    for (const double bad : {std::nan(""), -1.0, std::numeric_limits<double>::infinity()}) {
+        try {
+            runner.set_time_scale(bad);
+            ADD_FAILURE() << "accepted a time scale of " << bad;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("set_time_scale"), std::string::npos) << e.what();
+        }
+        EXPECT_EQ(runner.time_scale(), 0.5);
+        EXPECT_THROW(runner.advance(bad), Error);
+    }
+    runner.advance(1e308);
+    EXPECT_THROW(runner.advance(1e308), Error);  // the sum would be infinite
+    runner.set_time_scale(0);
+    runner.start();
+    runner.stop();  // the one finite advance was dropped by the step cap, not thrown
+    EXPECT_LE(space.counters().steps, static_cast<std::uint64_t>(space.settings().time_step.max_steps_per_frame));
 }

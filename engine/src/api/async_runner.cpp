@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <utility>
 
 namespace spindle {
@@ -97,6 +98,26 @@ void AsyncRunner::stop() {
     if (failure) std::rethrow_exception(failure);
 }
 
+void AsyncRunner::set_time_scale(double scale) {
+    if (!std::isfinite(scale) || scale < 0) {
+        throw Error("AsyncRunner::set_time_scale: the scale must be finite and >= 0, got " + std::to_string(scale));
+    }
+    m_time_scale.store(scale, std::memory_order_relaxed);
+}
+
+void AsyncRunner::advance(double seconds) {
+    if (!std::isfinite(seconds) || seconds < 0) {
+        throw Error("AsyncRunner::advance: the time must be finite and >= 0 seconds, got " + std::to_string(seconds));
+    }
+    double pending = m_advance.load(std::memory_order_relaxed);
+    do {
+        if (!std::isfinite(pending + seconds)) {
+            throw Error("AsyncRunner::advance: " + std::to_string(seconds) +
+                        " s more would make the time not yet taken infinite");
+        }
+    } while (!m_advance.compare_exchange_weak(pending, pending + seconds, std::memory_order_relaxed));
+}
+
 void AsyncRunner::enqueue(std::function<void(Space&)> fn) {
     std::scoped_lock guard(m_posted_lock);
     if (m_failure) std::rethrow_exception(m_failure);
@@ -133,9 +154,11 @@ void AsyncRunner::loop(std::promise<void>* started) {
     const Stopwatch total;
     try {
         while (!m_stop.load(std::memory_order_acquire)) {
-            const double dt = since_last.lap();
+            const double scale = m_time_scale.load(std::memory_order_relaxed);
+            const double dt = since_last.lap() * scale + m_advance.exchange(0, std::memory_order_relaxed);
             // The instant dt runs to: the banked time's clock, for reads that blend by theirs.
             m_space.m_world->update_clock_ns = since_last.started_nanoseconds();
+            m_space.m_world->update_clock_rate = scale;
             m_space.m_world->read_blend = m_options.blend_clock;
             {
                 std::scoped_lock guard(m_posted_lock);
@@ -156,8 +179,12 @@ void AsyncRunner::loop(std::promise<void>* started) {
             }
 
             if (m_options.sleep_when_idle && ts.use_internal_time_stepping) {
-                // Sleep until the next step is due (what is banked subtracts from it).
-                const double due = ts.duration - m_space.accumulated_time() - since_last.elapsed_seconds();
+                // Sleep until the next step is due (what is banked subtracts from it), on
+                // the scaled clock; at most a step's real time, so that posted functions and
+                // advance() wait no longer in slow motion or a pause than at full speed.
+                const double banked = ts.duration - m_space.accumulated_time();
+                const double due = std::min(scale > 0 ? banked / scale : ts.duration, ts.duration) -
+                                   since_last.elapsed_seconds();
                 if (due > 0) std::this_thread::sleep_for(std::chrono::duration<double>(due));
             }
         }
@@ -170,6 +197,7 @@ void AsyncRunner::loop(std::promise<void>* started) {
     m_space.m_world->gate.claim(std::thread::id{});
     // Later updates (stop's flush, the game's own) follow no clock.
     m_space.m_world->update_clock_ns = 0;
+    m_space.m_world->update_clock_rate = 1;
     m_space.m_world->read_blend = BlendClock::Update;
     m_running.store(false, std::memory_order_release);
     m_loop_thread.store(std::thread::id{}, std::memory_order_release);

@@ -77,7 +77,7 @@ void MotionStateManager::SlotGenerations::store(std::uint32_t slot, std::uint32_
 double MotionStateManager::alpha_locked(BlendClock clock) const noexcept {
     const PublishedTime& t = m_time;
     if (clock == BlendClock::Update || t.clock_ns == 0 || t.banked_alpha >= 1) return t.banked_alpha;
-    const double grown = static_cast<double>(m_lock.taken_at_ns() - t.clock_ns) * 1e-9 / t.step_seconds;
+    const double grown = static_cast<double>(m_lock.taken_at_ns() - t.clock_ns) * 1e-9 * t.clock_rate / t.step_seconds;
     return std::clamp(t.banked_alpha + grown, t.banked_alpha, 1.0);
 }
 

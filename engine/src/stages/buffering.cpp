@@ -285,7 +285,11 @@ void flip_read_buffers(World& world) {
     // islands stage, so nothing is missed.
 
     const Real step = world.settings.time_step.duration;
-    const PublishedTime time{world.steps, interpolating ? world.accumulator / step : 1.0, world.update_clock_ns, step,
+    const PublishedTime time{world.steps,
+                             interpolating ? world.accumulator / step : 1.0,
+                             world.update_clock_ns,
+                             step,
+                             world.update_clock_rate,
                              world.read_blend};
     world.stats.flip_lock_seconds = manager.flip(time, world.query_scenes[k]);
     // After the swap the new back buffer may be shorter than the body slots.

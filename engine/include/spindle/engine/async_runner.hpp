@@ -96,6 +96,20 @@ public:
         return result;
     }
 
+    // Simulated seconds per real second: below 1 slow motion, 0 a pause (the loop goes on
+    // running posted functions and publishing, taking no step), above 1 faster than real
+    // time (the update's step cap still drops what it cannot take). Reads blending by the
+    // reader's clock move on at the same rate (PublishedTime::clock_rate). Any thread,
+    // before or after start(); the loop's next iteration runs at it. Throws spindle::Error
+    // naming the value if it is NaN, infinite or negative (the scale is left as it was).
+    void set_time_scale(double scale);
+    double time_scale() const noexcept { return m_time_scale.load(std::memory_order_relaxed); }
+    // Adds simulated seconds to the next update on top of the scaled clock: while paused,
+    // advance(step duration) takes exactly one step. Any thread; never waits for the loop.
+    // Throws spindle::Error naming the value if it is NaN, infinite or negative, or if the
+    // time not yet taken would no longer be finite (nothing is added then).
+    void advance(double seconds);
+
     // Totals and latencies so far. Any thread; reads only the runner's own copies, taken
     // by the loop under its stats lock (never the space, which the loop is changing).
     // Throws the loop's failure until stop().
@@ -114,6 +128,8 @@ private:
     std::atomic<std::thread::id> m_loop_thread{};  // while the loop runs
     std::atomic<bool> m_running{false};
     std::atomic<bool> m_stop{false};
+    std::atomic<double> m_time_scale{1};
+    std::atomic<double> m_advance{0};  // simulated seconds the next update takes besides the clock's
 
     // Posted functions (each wraps a packaged_task, so running one never throws), and
     // the exception that ended the loop, under one lock.

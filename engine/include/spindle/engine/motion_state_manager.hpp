@@ -36,6 +36,7 @@ struct PublishedTime {
     double banked_alpha = 1;                // the newest step's weight under BlendClock::Update (1: no blending)
     std::int64_t clock_ns = 0;              // now_nanoseconds() when the update measured the banked time; 0: unknown
     double step_seconds = 0;                // the fixed step
+    double clock_rate = 1;                  // simulated seconds per real second (AsyncRunner::set_time_scale)
     BlendClock reads = BlendClock::Update;  // the clock of reads that do not name one
 };
 
