@@ -17,7 +17,7 @@ struct Verb {
     bool replay;  // meaningful in a replay
 };
 
-constexpr std::array<Verb, 11> kVerbs = {{
+constexpr std::array<Verb, 12> kVerbs = {{
     {"pause", ViewAction::Pause, 0, true, true},
     {"resume", ViewAction::Resume, 0, true, true},
     {"step", ViewAction::Step, 0, true, true},
@@ -25,6 +25,7 @@ constexpr std::array<Verb, 11> kVerbs = {{
     {"release", ViewAction::Release, 0, true, false},
     {"speed", ViewAction::Speed, 1, true, true},
     {"interpolate", ViewAction::Interpolate, 1, true, false},  // on|off, read as 1|0
+    {"contacts", ViewAction::Contacts, 1, true, false},        // on|off, read as 1|0
     {"shoot", ViewAction::Shoot, 6, true, false},
     {"grab", ViewAction::Grab, 6, true, false},
     {"drag", ViewAction::Drag, 6, true, false},
@@ -86,9 +87,9 @@ ParsedCommand parse_view_command(std::string_view text, bool replay) {
 
     ViewCommand command;
     command.action = found->action;
-    if (found->action == ViewAction::Interpolate) {
+    if (found->action == ViewAction::Interpolate || found->action == ViewAction::Contacts) {
         if (words[1] != "on" && words[1] != "off") {
-            return fail("'interpolate' takes on or off, got '" + std::string(words[1]) + "'");
+            return fail("'" + verb + "' takes on or off, got '" + std::string(words[1]) + "'");
         }
         command.value = words[1] == "on" ? 1 : 0;
         return {true, command, {}};

@@ -7,6 +7,7 @@
 //   pause | resume | step | drop | release
 //   speed S                       live: 0.01..1 (slow motion); replay: 0.01..8
 //   interpolate on|off            live only: blended or newest-step reads
+//   contacts on|off               live only: the touching points in every frame, or none
 //   shoot OX OY OZ DX DY DZ       live only: a ball from O along D (a camera ray)
 //   grab OX OY OZ DX DY DZ        live only: take the body the ray hits
 //   drag OX OY OZ DX DY DZ        live only: move the grabbed body toward the ray
@@ -21,13 +22,13 @@
 
 namespace spindle::app {
 
-enum class ViewAction { Pause, Resume, Step, Drop, Release, Speed, Interpolate, Shoot, Grab, Drag, Seek };
+enum class ViewAction { Pause, Resume, Step, Drop, Release, Speed, Interpolate, Contacts, Shoot, Grab, Drag, Seek };
 
 struct ViewCommand {
     ViewAction action = ViewAction::Pause;
     Vec3 origin = Vec3::Zero();  // shoot, grab, drag: the ray, direction unit length
     Vec3 direction = Vec3::UnitZ();
-    double value = 0;  // speed, seek (seconds), interpolate (1 on, 0 off)
+    double value = 0;  // speed, seek (seconds), interpolate and contacts (1 on, 0 off)
 };
 
 // Longer requests are refused before they are read as a command.

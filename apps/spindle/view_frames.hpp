@@ -46,7 +46,8 @@ struct FrameHeader {
     double steps = 0;
 };
 
-// A contact the page marks for a moment (a hit event: where, its normal, how old).
+// A contact the page marks: a hit event for a moment (where, its normal, how old), or
+// a touching point of the newest step (age 0) while the page asks for them.
 struct ContactMark {
     Vec3 point = Vec3::Zero();
     Vec3 normal = Vec3::UnitY();

@@ -25,7 +25,8 @@ constexpr Real kDragMaxSpeed = 30;       // m/s
 constexpr double kSurveyInterval = 0.2;  // s between sleep surveys
 constexpr double kHitShown = 1.0;        // s a hit stays marked
 constexpr std::size_t kMaxHits = 256;
-constexpr double kStatsInterval = 0.5;  // s
+constexpr std::uint32_t kMaxPointsShown = 1u << 13;  // touching points per frame
+constexpr double kStatsInterval = 0.5;               // s
 // Single steps a frame asks the runner for at most: a page sending a flood of them must
 // not queue physics time without end (the rest are dropped and logged).
 constexpr int kMaxStepsPerFrame = 4;
@@ -84,8 +85,7 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
         const double now = wall.elapsed_seconds();
         m_steps_this_frame = 0;
         for (const ViewCommand& command : m_server.take_commands()) apply(command);
-        // Pause and slow motion are the runner's clock: physics stays on its own thread.
-        m_runner.set_time_scale(m_mode == Mode::Paused ? 0 : m_speed);
+        set_time_scale(m_mode == Mode::Paused ? 0 : m_speed);
         collect_created();
         pull_grabbed();
         survey_sleep(now);
@@ -104,7 +104,7 @@ void LiveView::apply(const ViewCommand& command) {
         case ViewAction::Resume: m_mode = m_speed < 1 ? Mode::Slow : Mode::Running; break;
         case ViewAction::Step:
             m_mode = Mode::Paused;
-            m_runner.set_time_scale(0);  // before the step's time, so the loop adds nothing more
+            set_time_scale(0);  // before the step's time, so the loop adds nothing more
             if (++m_steps_this_frame <= kMaxStepsPerFrame) {
                 m_runner.advance(m_space.settings().time_step.duration);
             } else if (m_steps_this_frame == kMaxStepsPerFrame + 1) {
@@ -116,6 +116,7 @@ void LiveView::apply(const ViewCommand& command) {
             if (m_mode != Mode::Paused) m_mode = m_speed < 1 ? Mode::Slow : Mode::Running;
             break;
         case ViewAction::Interpolate: m_interpolate = command.value != 0; break;
+        case ViewAction::Contacts: show_contacts(command.value != 0); break;
         case ViewAction::Shoot: shoot(command.origin, command.direction); break;
         case ViewAction::Grab: grab(command.origin, command.direction); break;
         case ViewAction::Drag: drag(command.origin, command.direction); break;
@@ -125,9 +126,24 @@ void LiveView::apply(const ViewCommand& command) {
     }
 }
 
-const char* LiveView::mode_name() const noexcept {
+// Pause and slow motion are the runner's clock: physics stays on its own thread. A pause
+// is shown once an update at scale 0 has begun (a function posted after the change has
+// run): from then on the published steps stand still.
+void LiveView::set_time_scale(double scale) {
+    if (scale == m_runner.time_scale()) return;
+    m_runner.set_time_scale(scale);
+    m_pause_taken.reset();
+    if (scale == 0 && m_runner.running()) m_pause_taken = m_runner.post([](Space&) {});
+}
+
+bool LiveView::paused() const {
+    return m_mode == Mode::Paused &&
+           (!m_pause_taken || m_pause_taken->wait_for(std::chrono::seconds(0)) == std::future_status::ready);
+}
+
+const char* LiveView::mode_name() const {
     switch (m_mode) {
-        case Mode::Paused: return "paused";
+        case Mode::Paused: return paused() ? "paused" : "pausing";
         case Mode::Slow: return "slow";
         default: return "running";
     }
@@ -245,6 +261,25 @@ void LiveView::drop() {
     m_dropped += kDropCount;
 }
 
+// The space publishes its touching points only while the page draws them (a pass over
+// the contacts per update otherwise saved); a settings change is structural: posted.
+void LiveView::show_contacts(bool on) {
+    if (on == m_contacts) return;
+    m_contacts = on;
+    const auto change = [on](Space& space) {
+        EventSettings events = space.settings().events;
+        events.publish_contact_points = on;
+        events.max_contact_points = kMaxPointsShown;
+        space.set_events(events);
+    };
+    if (m_runner.running()) {
+        m_runner.post(change);
+    } else {
+        change(m_space);
+    }
+    m_points.clear();
+}
+
 void LiveView::survey_sleep(double now) {
     if (m_survey && m_survey->wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
         std::vector<std::uint8_t> asleep = m_survey->get();
@@ -299,11 +334,13 @@ void LiveView::publish_frame(double now) {
         states.get_raw_motion_states(m_handles, m_states);
     }
     std::vector<ContactMark> marks;
-    marks.reserve(m_hits.size());
+    if (m_contacts) m_space.read_contact_points(m_points);
+    marks.reserve(m_hits.size() + m_points.size());
     for (const Hit& h : m_hits) marks.push_back({h.mark.point, h.mark.normal, now - h.time});
+    for (const ContactPointInfo& p : m_points) marks.push_back({p.point, p.normal, 0});
     FrameHeader header;
     header.scene_version = m_version;
-    header.flags = (m_mode == Mode::Paused ? kFramePaused : 0u) | (m_mode == Mode::Slow ? kFrameSlow : 0u) |
+    header.flags = (paused() ? kFramePaused : 0u) | (m_mode == Mode::Slow ? kFrameSlow : 0u) |
                    (m_interpolate ? kFrameInterpolated : 0u);
     const double steps = static_cast<double>(states.published_steps());
     header.steps = steps;
@@ -348,7 +385,8 @@ void LiveView::publish_stats(double now) {
     json += "],\"shots\":" + std::to_string(m_shots_fired) + ",\"dropped\":" + std::to_string(m_dropped) +
             ",\"picks\":" + std::to_string(m_picks) + ",\"grabbing\":" + (m_grab ? "true" : "false") +
             ",\"begins\":" + std::to_string(m_begins) + ",\"ends\":" + std::to_string(m_ends) +
-            ",\"hits\":" + std::to_string(m_hit_count) + ",\"refused\":" + std::to_string(m_server.refused()) + "}";
+            ",\"hits\":" + std::to_string(m_hit_count) + ",\"contact_points\":" + std::to_string(m_points.size()) +
+            ",\"refused\":" + std::to_string(m_server.refused()) + "}";
     m_server.publish_stats(std::move(json));
 }
 

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <spindle/engine/async_runner.hpp>
+#include <spindle/engine/events.hpp>
 
 #include <cstdint>
 #include <deque>
@@ -58,12 +59,15 @@ private:
     void grab(const Vec3& origin, const Vec3& direction);
     void drag(const Vec3& origin, const Vec3& direction);
     void drop();
+    void show_contacts(bool on);
     void pull_grabbed();
     void survey_sleep(double now);
     void read_hits(double now);
     void publish_frame(double now);
     void publish_stats(double now);
-    const char* mode_name() const noexcept;
+    void set_time_scale(double scale);
+    bool paused() const;  // asked for, and no update at the old scale left
+    const char* mode_name() const;
     std::uint32_t add_shape(const ShapeSpec& shape);
 
     Session& m_session;
@@ -74,7 +78,10 @@ private:
     AsyncRunner m_runner;
     Mode m_mode = Mode::Running;
     double m_speed = 1;
+    std::optional<std::future<void>> m_pause_taken;  // posted after the scale turned 0
     bool m_interpolate = true;
+    bool m_contacts = false;                 // the page asked for the touching points
+    std::vector<ContactPointInfo> m_points;  // the newest step's, when m_contacts
     int m_steps_this_frame = 0;
 
     // What the page draws, in its order: the scene's bodies, then what the page added.

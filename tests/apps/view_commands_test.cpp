@@ -41,6 +41,11 @@ TEST(ViewCommand_Parse, GoodCommandsSayWhatTheyMean) {
     ASSERT_TRUE(p.ok) << p.error;
     EXPECT_EQ(p.command.value, 0);
     EXPECT_TRUE(live("interpolate on").ok);
+    p = live("contacts on");
+    ASSERT_TRUE(p.ok) << p.error;
+    EXPECT_EQ(p.command.action, ViewAction::Contacts);
+    EXPECT_EQ(p.command.value, 1);
+    EXPECT_EQ(live("contacts off").command.value, 0);
     for (const char* word : {"pause", "resume", "step", "drop", "release"}) EXPECT_TRUE(live(word).ok) << word;
 
     p = replay("seek 2.5");
@@ -66,6 +71,7 @@ TEST(ViewCommand_Parse, MalformedCommandsAreRefusedWithTheReason) {
     expect_refused(live("shoot 1 2 3 0 0 0"), "direction has no length");
     expect_refused(live("grab 1e9 0 0 0 0 1"), "origin is further than");
     expect_refused(live("interpolate yes"), "takes on or off, got 'yes'");
+    expect_refused(live("contacts 1"), "'contacts' takes on or off, got '1'");
 }
 
 TEST(ViewCommand_Parse, ValuesOutOfRangeAreRefused) {
@@ -78,8 +84,8 @@ TEST(ViewCommand_Parse, ValuesOutOfRangeAreRefused) {
 
 TEST(ViewCommand_Parse, CommandsOfTheOtherModeAreRefused) {
     expect_refused(live("seek 1"), "'seek' is only for a replay");
-    for (const char* text :
-         {"shoot 0 0 0 0 0 1", "grab 0 0 0 0 0 1", "drag 0 0 0 0 0 1", "drop", "release", "interpolate on"}) {
+    for (const char* text : {"shoot 0 0 0 0 0 1", "grab 0 0 0 0 0 1", "drag 0 0 0 0 0 1", "drop", "release",
+                             "interpolate on", "contacts on"}) {
         expect_refused(replay(text), "is not for a replay");
     }
 }

@@ -8,6 +8,7 @@
   viewer_test.py controls SPINDLE
       the page's controls over HTTP, as its buttons and mouse send them: pause holds the
       steps, step takes one, slow motion and resume, interpolation off (the frame's flag),
+      contact points on and off,
       drop adds bodies, grab + drag lifts a body along the cursor's ray, release lets go.
   viewer_test.py replay SPINDLE
       `spindle view --replay` of a `spindle run --record` file serves its frames (replay
@@ -22,6 +23,7 @@
 """
 import atexit
 import json
+import math
 import os
 import re
 import shutil
@@ -197,6 +199,13 @@ def frame_of(view):
     return flags, seconds, steps, [struct.unpack_from("<3f", frame, 40 + 32 * i) for i in range(bodies)]
 
 
+def contact_marks(view):
+    """[(px, py, pz, nx, ny, nz, age) per contact mark] of the newest frame."""
+    status, frame = view.request("frame")
+    bodies, marks = struct.unpack_from("<II", frame, 8)
+    return [struct.unpack_from("<7f", frame, 40 + 32 * bodies + 28 * k) for k in range(marks)]
+
+
 def command(view, text):
     status, reply = view.request("command", text.encode())
     if status != 200:
@@ -242,6 +251,19 @@ def test_controls(spindle):
     command(view, "interpolate on")
     wait_for("interpolated frames", lambda: frame_of(view)[0] & 2 == 2)
 
+    # Touching points on demand: none while off (no body in pile asks for hit events),
+    # the resting pile's points with unit normals while on, none again once off.
+    if contact_marks(view):
+        fail("contact marks before the page asked for them")
+    command(view, "contacts on")
+    marks = wait_for("touching points in the frames", lambda: contact_marks(view))
+    for m in marks:
+        if abs(math.sqrt(m[3] ** 2 + m[4] ** 2 + m[5] ** 2) - 1) > 1e-3:
+            fail("a contact point's normal is not unit length: %r" % (m,))
+    wait_for("the points counted in the stats", lambda: stats()["contact_points"] > 0)
+    command(view, "contacts off")
+    wait_for("no touching points", lambda: not contact_marks(view) and stats()["contact_points"] == 0)
+
     bodies = len(frame_of(view)[3])
     command(view, "drop")
     wait_for("the dropped bodies", lambda: len(frame_of(view)[3]) == bodies + 8)
@@ -269,7 +291,7 @@ def test_controls(spindle):
     command(view, "release")
     wait_for("the release", lambda: not stats()["grabbing"])
     view.stop()
-    print("ok: pause, step, slow motion, interpolation, drop and drag act as the page asks")
+    print("ok: pause, step, slow motion, interpolation, contact points, drop and drag act as the page asks")
 
 
 def test_replay(spindle):

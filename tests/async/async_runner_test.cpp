@@ -400,6 +400,38 @@ TEST(AsyncRunner, PausedRunnerRunsPostedFunctionsAndAdvanceTakesOneStep) {
     EXPECT_EQ(space.counters().steps, 1u);
 }
 
+TEST(AsyncRunner, AScaleSetWhileAPostedFunctionRunsTakesItsUpdate) {
+    // The loop sleeps until a step is due, so each iteration's update would take one. A
+    // posted function holds an iteration until the scale is 0: that iteration's update
+    // must already take no step (a function posted after set_time_scale runs in an
+    // iteration at the new scale), and no later one either.
+    Space space(async_settings());
+    space.create_body(ball());
+    AsyncRunner runner(space);
+    runner.start();
+    const MotionStateManager& states = space.motion_states();
+    for (int round = 0; round < 10; ++round) {
+        std::promise<void> release;
+        std::promise<std::uint64_t> running;
+        std::shared_future<void> released = release.get_future().share();
+        auto held = runner.post([&running, released](Space& s) {
+            running.set_value(s.counters().steps);
+            released.wait();
+        });
+        const std::uint64_t steps = running.get_future().get();
+        runner.set_time_scale(0);
+        release.set_value();
+        ASSERT_TRUE(ready_in_time(held));
+        auto after = runner.post([](Space& s) { return s.counters().steps; });
+        ASSERT_TRUE(ready_in_time(after));
+        EXPECT_EQ(after.get(), steps) << "round " << round;
+        EXPECT_EQ(states.published_steps(), steps) << "round " << round;
+        runner.set_time_scale(1);
+        std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    }
+    runner.stop();
+}
+
 TEST(AsyncRunner, BadTimeScaleOrAdvanceIsRefusedAndChangesNothing) {
     Space space(async_settings());
     AsyncRunner runner(space);

@@ -177,7 +177,7 @@ function buildScene(desc) {
   document.getElementById('title').textContent = 'spindle view: ' + desc.name;
 }
 
-// ---- contact marks (hit events: point and normal) ----
+// ---- contact marks (hit events and, while the box is ticked, the touching points) ----
 const contactLines = new THREE.LineSegments(new THREE.BufferGeometry(),
   new THREE.LineBasicMaterial({ color: 0xff4f4f }));
 const contactPoints = new THREE.Points(new THREE.BufferGeometry(),
@@ -311,6 +311,7 @@ function showStats(s) {
     ['steps/s', s.steps_per_second.toFixed(1)], ['steps', s.steps],
     ['bodies (awake)', `${s.bodies} (${s.awake})`], ['contacts', s.contacts],
     ['contact events', `${s.begins} begin, ${s.ends} end, ${s.hits} hit`],
+    ['contact points drawn', s.contact_points],
     ['shots, drops, picks', `${s.shots}, ${s.dropped}, ${s.picks}`],
     ['layout ' + s.layout, `game PU ${s.game_pu}, physics PU ${s.physics_pu}`],
     ['worker PUs', s.worker_pus.join(' ')], ['refused requests', s.refused],
@@ -356,6 +357,7 @@ document.getElementById('resume').onclick = () => send('resume');
 document.getElementById('step').onclick = () => send('step');
 document.getElementById('drop').onclick = () => send('drop');
 document.getElementById('interpolate').onchange = (e) => send('interpolate ' + (e.target.checked ? 'on' : 'off'));
+showContacts.onchange = (e) => { if (!state.replay) send('contacts ' + (e.target.checked ? 'on' : 'off')); };
 const speed = document.getElementById('speed');
 function fillSpeeds(list) {
   speed.innerHTML = list.map((s) => `<option value="${s}"${s === 1 ? ' selected' : ''}>${s}x</option>`).join('');

@@ -154,17 +154,20 @@ void AsyncRunner::loop(std::promise<void>* started) {
     const Stopwatch total;
     try {
         while (!m_stop.load(std::memory_order_acquire)) {
-            const double scale = m_time_scale.load(std::memory_order_relaxed);
-            const double dt = since_last.lap() * scale + m_advance.exchange(0, std::memory_order_relaxed);
+            const double elapsed = since_last.lap();
             // The instant dt runs to: the banked time's clock, for reads that blend by theirs.
             m_space.m_world->update_clock_ns = since_last.started_nanoseconds();
-            m_space.m_world->update_clock_rate = scale;
             m_space.m_world->read_blend = m_options.blend_clock;
             {
                 std::scoped_lock guard(m_posted_lock);
                 posted.swap(m_posted);
             }
             run_posted(posted);
+            // The scale is read after the posted functions: one posted after set_time_scale
+            // runs in an iteration whose update already takes the new scale.
+            const double scale = m_time_scale.load(std::memory_order_relaxed);
+            const double dt = elapsed * scale + m_advance.exchange(0, std::memory_order_relaxed);
+            m_space.m_world->update_clock_rate = scale;
 
             const std::int64_t begin = now_nanoseconds();
             m_space.update(dt);

@@ -25,6 +25,14 @@ std::uint64_t Space::dropped_contact_events() const {
     return events.dropped;
 }
 
+std::uint64_t Space::read_contact_points(std::vector<ContactPointInfo>& out, std::size_t* left_out) const {
+    const ContactEvents& events = *m_world->events;
+    const std::lock_guard<std::mutex> lock(events.mutex);
+    out.assign(events.points.begin(), events.points.end());
+    if (left_out) *left_out = events.points_left_out;
+    return events.points_step;
+}
+
 void Space::set_events(const EventSettings& settings) {
     const AccessGate::Structure access(m_world->gate, "set_events");
     validate(settings);

@@ -106,6 +106,9 @@ void validate(const EventSettings& s) {
     const char* who = "events";
     check_non_negative(s.hit_speed, who, "hit_speed");
     if (s.max_queued < 1) reject_field(who, "max_queued", "must be >= 1", std::to_string(s.max_queued));
+    if (s.max_contact_points < 1) {
+        reject_field(who, "max_contact_points", "must be >= 1", std::to_string(s.max_contact_points));
+    }
 }
 
 void validate_gravity(const Vec3& gravity) {

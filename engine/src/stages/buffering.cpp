@@ -296,6 +296,7 @@ void flip_read_buffers(World& world) {
     if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());
     publish_contact_events(world);  // under the events' own lock, not the motion-state lock
+    publish_contact_points(world);
 }
 
 }  // namespace spindle

@@ -126,6 +126,48 @@ void note_hits(World& world) {
     events.hit_candidates.clear();
 }
 
+void publish_contact_points(World& world) {
+    ContactEvents& events = *world.events;
+    const EventSettings& settings = world.settings.events;
+    if (!settings.publish_contact_points && !events.points_shown) return;  // off: no work, no lock
+    events.points_shown = settings.publish_contact_points;
+    std::vector<ContactPointInfo>& gathered = events.points_pending;
+    gathered.clear();
+    std::size_t left_out = 0;
+    if (settings.publish_contact_points) {
+        const Bodies& b = world.bodies;
+        for (const Contact& contact : world.contacts) {
+            if ((contact.events & kContactSensor) != 0) continue;
+            const BodyHandle body_a{contact.body_a, b.generation[contact.body_a]};
+            const BodyHandle body_b{contact.body_b, b.generation[contact.body_b]};
+            for (int m = 0; m < contact.manifold_count; ++m) {
+                const ContactManifold& manifold = contact.manifold_at(m);
+                for (int j = 0; j < manifold.point_count; ++j) {
+                    const ContactPoint& p = manifold.points[j];
+                    // Speculative points that pushed nothing are not touching.
+                    if (p.geometry.separation > 0 && p.normal_impulse <= 0) continue;
+                    if (gathered.size() >= settings.max_contact_points) {
+                        left_out += 1;
+                        continue;
+                    }
+                    ContactPointInfo& info = gathered.emplace_back();
+                    info.body_a = body_a;
+                    info.body_b = body_b;
+                    info.point = (b.x[contact.body_a] + p.anchor_a + b.x[contact.body_b] + p.anchor_b) / 2;
+                    info.normal = manifold.normal;
+                    info.separation = p.geometry.separation;
+                    info.normal_impulse = p.normal_impulse;
+                }
+            }
+        }
+        world.counters.contact_points_published += gathered.size();
+    }
+    const std::lock_guard<std::mutex> lock(events.mutex);
+    events.points.swap(gathered);  // the old ones come back as the next gathering's buffer
+    events.points_left_out = left_out;
+    events.points_step = settings.publish_contact_points ? world.steps : 0;
+}
+
 void publish_contact_events(World& world) {
     ContactEvents& events = *world.events;
     if (events.pending.empty() && events.pending_dropped == 0) return;

@@ -27,6 +27,14 @@ struct ContactEvents {
     mutable std::mutex mutex;
     std::vector<ContactEvent> published;  // guarded by mutex
     std::uint64_t dropped = 0;            // guarded by mutex
+
+    // Touching points for read_contact_points (EventSettings::publish_contact_points):
+    // gathered into `points_pending` by the physics thread, swapped in at the flip.
+    std::vector<ContactPointInfo> points_pending;
+    bool points_shown = false;             // update thread: `points` holds a publication
+    std::vector<ContactPointInfo> points;  // guarded by mutex
+    std::size_t points_left_out = 0;       // guarded by mutex
+    std::uint64_t points_step = 0;         // guarded by mutex
 };
 
 // Whether any point of the contact's manifolds is at zero separation or deeper.
@@ -48,5 +56,8 @@ void note_touch_changes(World& world);
 void note_hits(World& world);
 // FlipReadBuffers: pending -> published, under the events' lock.
 void publish_contact_events(World& world);
+// FlipReadBuffers: every touching point of the live contacts, replacing the last ones
+// published, when EventSettings::publish_contact_points (else clears them once).
+void publish_contact_points(World& world);
 
 }  // namespace spindle

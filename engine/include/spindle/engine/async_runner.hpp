@@ -100,7 +100,9 @@ public:
     // running posted functions and publishing, taking no step), above 1 faster than real
     // time (the update's step cap still drops what it cannot take). Reads blending by the
     // reader's clock move on at the same rate (PublishedTime::clock_rate). Any thread,
-    // before or after start(); the loop's next iteration runs at it. Throws spindle::Error
+    // before or after start(); the loop's next iteration runs at it, and a function posted
+    // after the call runs in an iteration whose update does: once its future is ready no
+    // update at the old scale is left (after set_time_scale(0): no step). Throws spindle::Error
     // naming the value if it is NaN, infinite or negative (the scale is left as it was).
     void set_time_scale(double scale);
     double time_scale() const noexcept { return m_time_scale.load(std::memory_order_relaxed); }

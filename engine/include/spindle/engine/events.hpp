@@ -32,4 +32,15 @@ struct ContactEvent {
     Real speed = 0;
 };
 
+// A point where two bodies touch, as the newest published step left it
+// (Space::read_contact_points; for drawing and debugging, off unless
+// EventSettings::publish_contact_points). body_a is the body with the lower slot.
+struct ContactPointInfo {
+    BodyHandle body_a, body_b;
+    Vec3 point = Vec3::Zero();   // world, midway between the surfaces at the step's poses
+    Vec3 normal = Vec3::Zero();  // from body_a towards body_b
+    Real separation = 0;         // along the normal when last collided; < 0: overlapping
+    Real normal_impulse = 0;     // N s, what the point pushed with in the step's last substep
+};
+
 }  // namespace spindle

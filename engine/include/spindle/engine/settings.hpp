@@ -68,6 +68,13 @@ struct EventSettings {
     // Events kept for the game to read. Events beyond it are dropped, newest first, and
     // counted (Space::dropped_contact_events): the queue's memory is bounded.
     std::uint32_t max_queued = 1u << 16;
+    // Publish every touching point of every contact at each flip, for
+    // Space::read_contact_points (debug drawing). Off: no work. On: one pass over the
+    // contacts per update on the physics thread, and a copy under the events' lock.
+    bool publish_contact_points = false;
+    // The most points one publication keeps (the rest are counted in
+    // Space::read_contact_points's `left_out`): a huge scene's debug copy stays bounded.
+    std::uint32_t max_contact_points = 1u << 16;
 };
 
 struct SpaceSettings {

@@ -212,6 +212,13 @@ public:
     // Events thrown away since creation because EventSettings::max_queued were waiting
     // unread (never silent). Any thread.
     std::uint64_t dropped_contact_events() const;
+    // The touching points of the newest published step (EventSettings::publish_contact_points;
+    // none while it is off), replacing `out`'s contents: pairs in contact order, the points
+    // of each manifold, sensors left out. Returns the number of the step they belong to
+    // (as ContactEvent::step; 0: none published yet); points beyond
+    // EventSettings::max_contact_points are counted in `left_out` when given. Any thread,
+    // any time: holds the events' small lock, never waits for a step.
+    std::uint64_t read_contact_points(std::vector<ContactPointInfo>& out, std::size_t* left_out = nullptr) const;
 
     // ---- internal accessors (update thread, between updates) ----
     MotionState internal_motion_state(BodyHandle body) const;

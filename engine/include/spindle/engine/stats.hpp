@@ -66,6 +66,8 @@ struct WorkCounters {
     // Contact-steps checked for events (touch changes after the narrowphase, hits after
     // the solver): only pairs with a body that asked for events or is a sensor.
     std::uint64_t contact_event_checks = 0;
+    // Points copied for Space::read_contact_points (EventSettings::publish_contact_points).
+    std::uint64_t contact_points_published = 0;
 };
 
 }  // namespace spindle
