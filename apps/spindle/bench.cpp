@@ -32,7 +32,38 @@ struct BenchOptions {
     std::int64_t steps = 300;
     std::optional<std::int64_t> substeps;  // none: the scene's
     bool stages = false;
+    bool joint_errors = false;
 };
+
+// The worst error of one joint type's joints at the end of a run.
+struct WorstJointError {
+    int count = 0;
+    Real linear = 0;   // m: Space::internal_joint_error's linear
+    Real angular = 0;  // rad: its angular (hinge: axes apart; swing-twist: outside the cone or twist range)
+    Real limit = 0;    // rad: a limited hinge's angle outside its range
+};
+
+void print_joint_errors(const Space& space, const std::vector<JointHandle>& joints) {
+    std::array<WorstJointError, static_cast<int>(JointType::Motor) + 1> worst{};
+    for (JointHandle joint : joints) {
+        const JointDesc desc = space.joint_desc(joint);
+        WorstJointError& w = worst[static_cast<std::size_t>(desc.type)];
+        const JointError error = space.internal_joint_error(joint);
+        w.count += 1;
+        w.linear = std::max(w.linear, error.linear);
+        w.angular = std::max(w.angular, error.angular);
+        if (desc.type == JointType::Hinge && desc.hinge.enable_limit) {
+            const Real angle = space.internal_hinge_angle(joint);
+            w.limit = std::max({w.limit, desc.hinge.lower_angle - angle, angle - desc.hinge.upper_angle});
+        }
+    }
+    for (std::size_t t = 0; t < worst.size(); ++t) {
+        const WorstJointError& w = worst[t];
+        if (w.count == 0) continue;
+        std::printf("joint_errors type=%s joints=%d linear_m=%.5f angular_rad=%.4f hinge_limit_rad=%.4f\n",
+                    to_string(static_cast<JointType>(t)), w.count, w.linear, w.angular, w.limit);
+    }
+}
 
 int bench(const BenchOptions& o) {
     const SceneDesc scene = resolve_scene(o.scene);
@@ -47,7 +78,8 @@ int bench(const BenchOptions& o) {
     settings.time_step.duration = kBenchStep;
     settings.time_step.use_internal_time_stepping = false;
     Space space(settings, jobs.get());
-    const std::vector<BodyHandle> handles = build(scene, space);
+    std::vector<JointHandle> joints;
+    const std::vector<BodyHandle> handles = build(scene, space, &joints);
     TimeStepSettings time_step = space.settings().time_step;
     time_step.duration = kBenchStep;  // build() applied the scene's
     space.set_time_step(time_step);
@@ -86,6 +118,7 @@ int bench(const BenchOptions& o) {
         }
         std::printf("\n");
     }
+    if (o.joint_errors) print_joint_errors(space, joints);
     return 0;
 }
 
@@ -111,6 +144,10 @@ Command add_bench_command(CLI::App& program) {
     cli->add_flag("--stages", o->stages,
                   "a second line: milliseconds per step in each stage that took time,\n"
                   "e.g. stages_ms Broadphase=0.14 Narrowphase=0.35 Solver=2.6")
+        ->check(no_value());
+    cli->add_flag("--joint-errors", o->joint_errors,
+                  "a line per joint type at the end: its joints' worst error (Space::internal_joint_error),\n"
+                  "e.g. joint_errors type=hinge joints=640 linear_m=0.0046 angular_rad=0.08 hinge_limit_rad=0.01")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")
         ->required()

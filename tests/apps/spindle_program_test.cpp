@@ -266,6 +266,30 @@ TEST(SpindleProgram, BenchStages_PrintsMillisecondsPerStage) {
     expect_contains(bad.output, "--stages: takes no value");
 }
 
+// A line per joint type the scene has, none for a scene without joints.
+TEST(SpindleProgram, BenchJointErrors_PrintsTheWorstErrorOfEachJointType) {
+    const Result r = spindle("bench chains --steps 30 --joint-errors", true);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::vector<std::string> lines;
+    for (std::size_t at = 0, end; (end = r.output.find('\n', at)) != std::string::npos; at = end + 1)
+        lines.push_back(r.output.substr(at, end - at));
+    ASSERT_EQ(lines.size(), 3u) << r.output;  // the results, ball-socket, hinge
+    for (const auto& [line, type] : {std::pair{lines[1], "ball-socket"}, {lines[2], "hinge"}}) {
+        const std::vector<std::string> w = words(line);
+        ASSERT_EQ(w.size(), 6u) << line;
+        EXPECT_EQ(w[0], "joint_errors");
+        EXPECT_EQ(w[1], std::string("type=") + type);
+        EXPECT_EQ(w[2].rfind("joints=", 0), 0u);
+        EXPECT_GT(std::stoi(w[2].substr(7)), 0) << line;
+        EXPECT_EQ(w[3].rfind("linear_m=", 0), 0u) << line;
+        EXPECT_EQ(w[4].rfind("angular_rad=", 0), 0u) << line;
+        EXPECT_EQ(w[5].rfind("hinge_limit_rad=", 0), 0u) << line;
+    }
+    const Result none = spindle("bench stack --steps 3 --joint-errors", true);
+    ASSERT_EQ(none.exit_code, 0) << none.output;
+    EXPECT_EQ(std::count(none.output.begin(), none.output.end(), '\n'), 1) << none.output;
+}
+
 // Same scene, same steps: the same state, bit for bit, whatever the worker count.
 TEST(SpindleProgram, BenchHash_IsTheSameForOneAndTwoThreads) {
     const Result one = spindle("bench dominoes --steps 60 --threads 1", true);
@@ -312,7 +336,7 @@ TEST(SpindleProgram, Help_ForEveryCommand_ListsItsOptionsOnStdoutAndExitsZero) {
         {"run -h", "usage: spindle run [OPTIONS] [SCENE]", {"--seconds S"}},
         {"bench --help",
          "usage: spindle bench [OPTIONS] SCENE",
-         {"SCENE", "--threads N", "--steps N", "--substeps N", "--stages", "steps_per_s"}},
+         {"SCENE", "--threads N", "--steps N", "--substeps N", "--stages", "--joint-errors", "steps_per_s"}},
         {"scenes --help", "usage: spindle scenes [OPTIONS]", {"-h,--help"}},
         {"layout --help", "usage: spindle layout [OPTIONS] FILE", {"FILE", "configs/layouts"}},
         {"view --help",
@@ -377,6 +401,7 @@ TEST(SpindleProgram, EveryOption_IsAcceptedAndTakesEffect) {
         {"run stack --idle sleep --seconds 0.01 --render-hz 1", {"idle sleep", " 1 frames at 1 Hz"}},
         {"bench stack --threads 2 --steps 7 --substeps 3 --stages",
          {"scene=stack bodies=20 threads=2 steps=7 ", "stages_ms "}},
+        {"bench chains --steps 2 --joint-errors", {"joint_errors type=hinge "}},
         {"bench stack --threads=1 --steps=3 --substeps=1000", {"threads=1 steps=3 "}},
         {"bench stack --steps 010", {"steps=10 "}},  // decimal, not octal
         {"scenes", {"pyramid ", "pile "}},

@@ -116,6 +116,16 @@ void require_ordered(Real lower, Real upper, const char* lower_field, const char
 
 [[noreturn]] void reject(const std::string& what) { throw Error("create_joint: " + what); }
 
+// In the World frame both bodies' axes are one world axis (hinge, swing-twist): given
+// twice, the two must agree (after normalising). In the Local frame each is its body's.
+void require_same_world_axis(const JointDesc& d, const Vec3& a, const Vec3& b, const char* field_a,
+                             const char* field_b) {
+    constexpr Real kSameAxis = 1e-6;  // between the unit axes
+    if (d.anchors.frame != JointFrame::World || (a.normalized() - b.normalized()).norm() <= kSameAxis) return;
+    reject(std::string(field_b) + " must be the same world axis as " + field_a + " with World anchors, got " + vec(b) +
+           " and " + vec(a));
+}
+
 void validate(const World& world, const JointDesc& d) {
     const Bodies& b = world.bodies;
     if (!b.is_live(d.body_a))
@@ -140,6 +150,7 @@ void validate(const World& world, const JointDesc& d) {
         const HingeParams& h = d.hinge;
         require_axis(h.axis_a, "hinge.axis_a");
         require_axis(h.axis_b, "hinge.axis_b");
+        require_same_world_axis(d, h.axis_a, h.axis_b, "hinge.axis_a", "hinge.axis_b");
         if (h.enable_limit) {
             for (auto [value, field] :
                  {std::pair{h.lower_angle, "hinge.lower_angle"}, {h.upper_angle, "hinge.upper_angle"}}) {
@@ -156,6 +167,8 @@ void validate(const World& world, const JointDesc& d) {
         const SwingTwistParams& p = d.swing_twist;
         require_axis(p.twist_axis_a, "swing_twist.twist_axis_a");
         require_axis(p.twist_axis_b, "swing_twist.twist_axis_b");
+        require_same_world_axis(d, p.twist_axis_a, p.twist_axis_b, "swing_twist.twist_axis_a",
+                                "swing_twist.twist_axis_b");
         require(std::isfinite(p.cone_half_angle) && p.cone_half_angle >= 0 && p.cone_half_angle <= kPi,
                 "swing_twist.cone_half_angle", "must be in [0, pi]", number(p.cone_half_angle));
         for (auto [value, field] :

@@ -10,7 +10,13 @@ namespace spindle {
 
 struct Joint;
 
-Mat3 skew(const Vec3& v);
+// Inline, as the point row's effective mass below: the point row is most of a chain's
+// solve, and these inlined into it when they were local to joint_solver.cpp.
+inline Mat3 skew(const Vec3& v) {
+    Mat3 m;
+    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return m;
+}
 
 // Inverse of an effective-mass matrix, or zero when nothing can move along it. With a
 // dynamic body in the joint K is positive definite (however heavy the body).
@@ -60,7 +66,15 @@ void solve_point(JointConstraint& jc, const SolverBody& A, const SolverBody& B, 
                  const JointSolveParams& p);
 
 // The 3x3 effective mass of a point row with levers ra, rb (pseudo-inverse with locks).
-Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb);
+inline Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
+    const Mat3 sa = skew(ra), sb = skew(rb);
+    // Inverse masses per world axis: zero along a locked one.
+    const Vec3 linear = project_linear(Vec3::Constant(A.inv_mass), A.locks) +
+                        project_linear(Vec3::Constant(B.inv_mass), B.locks);
+    const Mat3 k = Mat3(linear.asDiagonal()) + sa * A.inv_inertia * sa.transpose() +
+                   sb * B.inv_inertia * sb.transpose();
+    return inverse_or_pseudo(k, has_locks(A, B));
+}
 // Rotation vector of B away from its target orientation relative to A (jc.rotation_error
 // at the step's start, turned by the substeps' deltas).
 Vec3 rotation_error(const JointConstraint& jc, const Quat& dqa, const Quat& dqb);

@@ -11,12 +11,6 @@
 
 namespace spindle {
 
-Mat3 skew(const Vec3& v) {
-    Mat3 m;
-    m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return m;
-}
-
 Vec3 perpendicular(const Vec3& n) {
     const Vec3 t = std::abs(n.x()) < 0.57735 ? Vec3::UnitX() : Vec3::UnitY();
     return (t - n * n.dot(t)).normalized();
@@ -41,20 +35,6 @@ Real limit_impulse(Real c, Real cdot, Real mass, Real& accumulated, const JointS
 namespace {
 
 constexpr std::uint32_t kJointGrain = 32;
-
-}  // namespace
-
-Mat3 point_mass(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb) {
-    const Mat3 sa = skew(ra), sb = skew(rb);
-    // Inverse masses per world axis: zero along a locked one.
-    const Vec3 linear = project_linear(Vec3::Constant(A.inv_mass), A.locks) +
-                        project_linear(Vec3::Constant(B.inv_mass), B.locks);
-    const Mat3 k = Mat3(linear.asDiagonal()) + sa * A.inv_inertia * sa.transpose() +
-                   sb * B.inv_inertia * sb.transpose();
-    return inverse_or_pseudo(k, has_locks(A, B));
-}
-
-namespace {
 
 // The hinge's two alignment rows: C = (a1.b2, a1.c2) with a1 A's axis and b2, c2
 // perpendicular to B's; Cdot = u.(wB - wA) with u = b2 x a1, c2 x a1.

@@ -179,6 +179,9 @@ void update_narrowphase(World& world) {
     // where a phase's first block (half a share) could hold all the expensive pairs.
     world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         Manifold found[kMaxManifolds];
+        // Per range, not per pair, and reset only as far as used: a convex pair fills one
+        // of the kMaxManifolds a compound may need.
+        ContactManifold fresh[kMaxManifolds];
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
             Contact& contact = world.contacts[awake[k]];
@@ -201,8 +204,8 @@ void update_narrowphase(World& world) {
             const Shape& shape_a = b.desc[a].shape;
             const Shape& shape_b = b.desc[bb].shape;
             const int n = collide(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds);
-            ContactManifold fresh[kMaxManifolds];
             for (int m = 0; m < n; ++m) {
+                fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;
                 fresh[m].point_count = found[m].point_count;
                 fresh[m].part_a = found[m].part_a;

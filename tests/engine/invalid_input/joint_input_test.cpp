@@ -215,6 +215,35 @@ TEST(InvalidJoint, SwingTwistFieldsFollowTheirRules) {
         false, "swing_twist.twist_min", "above twist_max");
 }
 
+// With World anchors a hinge's or swing-twist's axis is one world axis, given for each
+// body: two different ones (a joint born bent or swung) are rejected, one given at two
+// lengths is accepted. In the Local frame each body's axis is its own.
+TEST(InvalidJoint, WorldFrameAxesMustBeOneAxis) {
+    for (JointType type : {JointType::Hinge, JointType::SwingTwist}) {
+        const bool hinge = type == JointType::Hinge;
+        const std::string field_b = hinge ? "hinge.axis_b" : "swing_twist.twist_axis_b";
+        auto set = [hinge](JointDesc& d, const Vec3& a, const Vec3& b) {
+            (hinge ? d.hinge.axis_a : d.swing_twist.twist_axis_a) = a;
+            (hinge ? d.hinge.axis_b : d.swing_twist.twist_axis_b) = b;
+        };
+        try_joint(
+            type, [&](JointDesc& d) { set(d, Vec3(0, 1, 0), Vec3(1, 0, 0)); }, false, field_b, "perpendicular");
+        try_joint(
+            type, [&](JointDesc& d) { set(d, Vec3(0, 1, 0), Vec3(0, -1, 0)); }, false, field_b, "opposite");
+        try_joint(
+            type, [&](JointDesc& d) { set(d, Vec3(0, 1, 0), Vec3(0, 1, 1e-3)); }, false, field_b, "1 mrad off");
+        try_joint(
+            type, [&](JointDesc& d) { set(d, Vec3(0, 1, 0), Vec3(0, 3, 0)); }, true, field_b, "longer");
+        try_joint(
+            type,
+            [&](JointDesc& d) {
+                d.anchors = JointAnchors::local(Vec3::Zero(), Vec3::Zero());
+                set(d, Vec3(0, 1, 0), Vec3(1, 0, 0));
+            },
+            true, field_b, "local frame");
+    }
+}
+
 TEST(InvalidJoint, PrismaticFieldsFollowTheirRules) {
     for (int axis = 0; axis < 3; ++axis) {
         for (const Trial& t : kTrials) {

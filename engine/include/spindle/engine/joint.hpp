@@ -165,9 +165,9 @@ struct JointDesc {
 // How far a joint is from satisfied, from the bodies' current poses.
 struct JointError {
     // m: anchor separation; distance joint: length outside what it allows; prismatic: B's
-    // anchor off the axis, plus how far the translation is outside its limits
+    // anchor off the axis, plus how far the translation is outside its limits; motor: B's
+    // anchor from its target
     Real linear = 0;
-    // motor: B's anchor from its target
     // rad: hinge axis misalignment, fixed and prismatic joint rotation error; motor: B's
     // turn from its target (0 with max_torque 0); swing-twist: how far the
     // swing is outside its cone or the twist outside its range, whichever is more
