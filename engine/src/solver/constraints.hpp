@@ -180,6 +180,17 @@ struct SolverPhase {
     int color = 0;
 };
 
+// Support mass scaling (support_scales.cpp): the factors a manifold's rows multiply each
+// body's inverse mass and inertia by; 1 but for a light body carrying a heavier one.
+struct SupportScale {
+    Real a = 1, b = 1;
+};
+// A support contact: manifold ref k's upper body rests on its lower one.
+struct SupportEdge {
+    std::uint32_t ref = 0;
+    std::uint32_t lower = 0, upper = 0;  // solver bodies
+};
+
 struct SolverScratch {
     std::vector<SolverBody> bodies;      // awake bodies, then the static body
     std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
@@ -199,8 +210,13 @@ struct SolverScratch {
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
     std::vector<std::uint32_t> joint_overflow;
     std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
-    std::vector<Phase> phases;               // the step's solver loop, run by run_phases
-    std::vector<SolverPhase> plan;           // what each phase does
+    // Per manifold ref, or empty when every scale is 1 (most steps of most scenes).
+    std::vector<SupportScale> support_scales;
+    std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity
+    std::vector<std::uint32_t> support_first, support_by_lower, support_queue;
+    std::vector<std::uint8_t> supported;
+    std::vector<Phase> phases;      // the step's solver loop, run by run_phases
+    std::vector<SolverPhase> plan;  // what each phase does
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,
@@ -220,6 +236,9 @@ struct ContactSolveParams {
 };
 
 inline Real held_per_impulse(const Softness& soft) { return soft.impulse_scale / (soft.mass_scale * soft.bias_rate); }
+
+// support_scales.cpp: fills scratch.support_scales from the step's manifolds and bodies.
+void find_support_scales(const World& world, SolverScratch& scratch);
 
 // contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide
 // (which manifold and bodies each lane holds); prepare_contacts fills in the rest from

@@ -98,7 +98,8 @@ inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide
 }
 
 // The lanes' inverse masses per world axis (zero along a locked one), for a wide
-// contact with a locked body; the unlocked passes never build them.
+// contact with a locked body; the unlocked passes never build them. From the lanes'
+// own inverse masses: a support contact may scale one (support_scales.cpp).
 struct WideAxisMasses {
     Wide3 a, b;
 };
@@ -108,8 +109,8 @@ inline WideAxisMasses axis_masses(const WideContact& wc, const SolverBody* bodie
     for (int l = 0; l < kLanes; ++l) {
         const SolverBody& A = bodies[wc.a[l]];
         const SolverBody& B = bodies[wc.b[l]];
-        m.a.set_lane(l, project_linear(Vec3::Constant(A.inv_mass), A.locks));
-        m.b.set_lane(l, project_linear(Vec3::Constant(B.inv_mass), B.locks));
+        m.a.set_lane(l, project_linear(Vec3::Constant(wc.inv_mass_a[l]), A.locks));
+        m.b.set_lane(l, project_linear(Vec3::Constant(wc.inv_mass_b[l]), B.locks));
     }
     return m;
 }
@@ -220,6 +221,15 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
     wc.twist_impulse[l] = m.twist_impulse;
 }
 
+// The body, or (scale != 1) a copy of it in `copy` with its inverse mass and inertia scaled.
+const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
+    if (scale == 1) return body;
+    copy = body;
+    copy.inv_mass *= scale;
+    copy.inv_inertia *= scale;
+    return copy;
+}
+
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
 void prepare_wide(const World& world, const SolverScratch& scratch, const ContactSolveParams& params, WideContact& wc) {
@@ -249,8 +259,11 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
         const ContactManifold& m = contact.manifold_at(static_cast<int>(ref.manifold));
-        const SolverBody& A = scratch.bodies[ref.a];
-        const SolverBody& B = scratch.bodies[ref.b];
+        // A light body carrying a heavier one is solved heavier here (support_scales.cpp).
+        const SupportScale scale = scratch.support_scales.empty() ? SupportScale{} : scratch.support_scales[wc.ref[l]];
+        SolverBody scaled_a, scaled_b;
+        const SolverBody& A = scaled(scratch.bodies[ref.a], scale.a, scaled_a);
+        const SolverBody& B = scaled(scratch.bodies[ref.b], scale.b, scaled_b);
         Vec3 tangent[2];
         tangent_basis(m.normal, tangent[0], tangent[1]);
         wc.normal.set_lane(l, m.normal);
@@ -339,6 +352,13 @@ void pack_contacts(SolverScratch& scratch) {
 
 namespace {
 
+// A lane's body (side 0: A, 1: B) with the masses the lane's rows see: a support contact
+// may scale one (support_scales.cpp). For the rare per-lane push-out rows.
+const SolverBody& lane_body(const WideContact& wc, int lane, int side, const SolverBody& body, SolverBody& copy) {
+    const Real lane_inv_mass = side == 0 ? wc.inv_mass_a[lane] : wc.inv_mass_b[lane];
+    return scaled(body, body.inv_mass > 0 ? lane_inv_mass / body.inv_mass : 1, copy);
+}
+
 // Deep overlap is pushed out by a soft constraint on the push-out velocities (split
 // impulse), never by real speed, so a chain of deep overlaps separates without
 // launching anything. One row per manifold, through the overlap's depth-weighted centre,
@@ -349,13 +369,16 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
     SolverBody& B = bodies[wc.b[lane]];
     const Vec3 normal = wc.normal.lane(lane);
     Real& impulse = wc.push_impulse[lane];
-    const Real mass = make_row(A, B, ra, rb, normal, row);
+    SolverBody copy_a, copy_b;
+    const SolverBody& Am = lane_body(wc, lane, 0, A, copy_a);
+    const SolverBody& Bm = lane_body(wc, lane, 1, B, copy_b);
+    const Real mass = make_row(Am, Bm, ra, rb, normal, row);
     Velocities push = load_push(A, B);
     const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
     const Real speed = row_speed(push, normal, row);
     const Real total = std::max(
         impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * impulse, Real(0));
-    apply_row(A, B, push, normal, row, total - impulse);
+    apply_row(Am, Bm, push, normal, row, total - impulse);
     impulse = total;
     store_push(A, B, push);
 }
@@ -502,8 +525,10 @@ void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* b
         if (wc.push_impulse[l] <= 0) continue;
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
+        SolverBody copy_a, copy_b;
         Velocities push = load_push(A, B);
-        apply_row(A, B, push, wc.normal.lane(l), push_rows[l], wc.push_impulse[l]);
+        apply_row(lane_body(wc, l, 0, A, copy_a), lane_body(wc, l, 1, B, copy_b), push, wc.normal.lane(l), push_rows[l],
+                  wc.push_impulse[l]);
         store_push(A, B, push);
     }
 }

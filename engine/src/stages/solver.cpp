@@ -256,7 +256,8 @@ void solve(World& world, Real dt) {
 
     prepare_bodies(world, scratch);
     const bool restitution = list_manifolds(world, scratch);
-    prepare_joints(world, scratch, h);  // nothing to do in a scene without joints
+    find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
+    prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
         pack_contacts(scratch);

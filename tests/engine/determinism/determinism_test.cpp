@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 
 #include "work_stealing_jobs.hpp"
@@ -23,15 +24,20 @@ constexpr int kSteps = 120;
 constexpr int kSteps = 300;
 #endif
 
+// A static floor box, its top at y = 0, half_width to each side.
+void add_floor(Space& space, Real half_width) {
+    BodyDesc floor;
+    floor.type = MotionType::Static;
+    floor.shape = Shape::box(Vec3(half_width, 1, half_width));
+    floor.position = Vec3(0, -1, 0);
+    space.create_body(floor);
+}
+
 // Boxes, spheres, capsules and hulls falling into a pile, a resting row that falls
 // asleep, on a static floor box.
 std::uint64_t run_mixed_scene(JobSystem& jobs) {
     Space space(SpaceSettings{}, &jobs);
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(20, 1, 20));
-    floor.position = Vec3(0, -1, 0);
-    space.create_body(floor);
+    add_floor(space, 20);
     const Vec3 hull_points[] = {{0.5, 0, 0}, {-0.5, 0, 0}, {0, 0.6, 0}, {0, -0.4, 0.3}, {0, 0, -0.5}, {0.2, 0.3, 0.4}};
     const Shape shapes[] = {Shape::box(Vec3(0.4, 0.3, 0.5)), Shape::sphere(0.4), Shape::capsule(0.3, 0.25),
                             Shape::convex_hull(hull_points)};
@@ -205,29 +211,65 @@ copies = { count = [2, 3, 2], step = [3, 0.6, 3] }
     return space.state_hash();
 }
 
+// Light boxes carrying heavier ones (support mass scaling, support_scales.cpp): columns
+// of rising masses, planks across light cubes, and heavy boxes dropped on light ones,
+// some onto the columns and some in the air.
+std::uint64_t run_heavy_on_light_scene(JobSystem& jobs) {
+    Space space(SpaceSettings{}, &jobs);
+    add_floor(space, 30);
+    auto box = [&](const Vec3& half, const Vec3& position, double mass, const Vec3& velocity = Vec3::Zero()) {
+        BodyDesc d;
+        d.shape = Shape::box(half);
+        d.position = position;
+        d.mass = mass;
+        d.linear_velocity = velocity;
+        d.orientation = Quat(Eigen::AngleAxisd(0.05 * (position.x() - position.z()), Vec3::UnitY()));
+        space.create_body(d);
+    };
+    for (int i = 0; i < 6; ++i) {
+        for (int k = 0; k < 6; ++k) {
+            const Vec3 base(i * 3.0 - 7.5, 0, k * 3.0 - 7.5);
+            const double ratio = 2.0 + 7 * ((i + k) % 4);
+            for (int level = 0; level < 3; ++level) {
+                box(Vec3::Constant(0.4), base + Vec3(0, 0.4 + 0.8 * level, 0), std::pow(ratio, level));
+            }
+            box(Vec3::Constant(0.3), base + Vec3(0.1, 4 + 0.5 * ((i * 6 + k) % 3), 0), 500);  // dropped on it
+        }
+    }
+    for (int i = 0; i < 4; ++i) {
+        const double z = 12 + 2.5 * i;
+        box(Vec3::Constant(0.4), Vec3(-3, 0.4, z), 1);
+        box(Vec3::Constant(0.4), Vec3(3, 0.4, z), 1);
+        box(Vec3(4, 0.2, 0.6), Vec3(0, 1.0, z), 200.0 * (i + 1));
+        box(Vec3::Constant(0.4), Vec3(-12, 6 + i, z), 1);                    // in the air,
+        box(Vec3::Constant(0.4), Vec3(-12, 7 + i, z), 100, Vec3(0, -4, 0));  // hit from above
+    }
+    for (int i = 0; i < kSteps; ++i) space.update();
+    return space.state_hash();
+}
+
+// A scene's hash on work stealing with each worker count equals the single-threaded one.
+void expect_hash_of_single_thread(std::uint64_t (*run)(JobSystem&),
+                                  std::initializer_list<unsigned> worker_counts = {1u, 2u, 3u, 4u}) {
+    const std::uint64_t reference = [&] {
+        SingleThreadedJobSystem single;
+        return run(single);
+    }();
+    for (unsigned workers : worker_counts) {
+        auto jobs = jobs_for(workers);
+        EXPECT_EQ(run(*jobs), reference) << workers << " workers";
+    }
+}
+
 }  // namespace
 
-TEST(Determinism, LimbSceneHashIsTheSameForOneToFourWorkers) {
-    const std::uint64_t reference = [] {
-        SingleThreadedJobSystem single;
-        return run_limb_scene(single);
-    }();
-    for (unsigned workers : {1u, 2u, 3u, 4u}) {
-        auto jobs = jobs_for(workers);
-        EXPECT_EQ(run_limb_scene(*jobs), reference) << workers << " workers";
-    }
+TEST(Determinism, HeavyOnLightSceneHashIsTheSameForOneToFourWorkers) {
+    expect_hash_of_single_thread(run_heavy_on_light_scene);
 }
 
-TEST(Determinism, MixedSceneHashIsTheSameForOneToFourWorkers) {
-    const std::uint64_t reference = [] {
-        SingleThreadedJobSystem single;
-        return run_mixed_scene(single);
-    }();
-    for (unsigned workers : {1u, 2u, 3u, 4u}) {
-        auto jobs = jobs_for(workers);
-        EXPECT_EQ(run_mixed_scene(*jobs), reference) << workers << " workers";
-    }
-}
+TEST(Determinism, LimbSceneHashIsTheSameForOneToFourWorkers) { expect_hash_of_single_thread(run_limb_scene); }
+
+TEST(Determinism, MixedSceneHashIsTheSameForOneToFourWorkers) { expect_hash_of_single_thread(run_mixed_scene); }
 
 TEST(Determinism, RunToRunIsIdentical) {
     auto jobs = jobs_for(2);
@@ -236,23 +278,7 @@ TEST(Determinism, RunToRunIsIdentical) {
 }
 
 TEST(Determinism, JointedSceneHashIsTheSameForOneToFourWorkers) {
-    const std::uint64_t reference = [] {
-        SingleThreadedJobSystem single;
-        return run_jointed_scene(single);
-    }();
-    for (unsigned workers : {2u, 3u, 4u}) {
-        auto jobs = jobs_for(workers);
-        EXPECT_EQ(run_jointed_scene(*jobs), reference) << workers << " workers";
-    }
+    expect_hash_of_single_thread(run_jointed_scene, {2u, 3u, 4u});
 }
 
-TEST(Determinism, RagdollSceneHashIsTheSameForOneToFourWorkers) {
-    const std::uint64_t reference = [] {
-        SingleThreadedJobSystem single;
-        return run_ragdoll_scene(single);
-    }();
-    for (unsigned workers : {1u, 2u, 3u, 4u}) {
-        auto jobs = jobs_for(workers);
-        EXPECT_EQ(run_ragdoll_scene(*jobs), reference) << workers << " workers";
-    }
-}
+TEST(Determinism, RagdollSceneHashIsTheSameForOneToFourWorkers) { expect_hash_of_single_thread(run_ragdoll_scene); }

@@ -41,7 +41,7 @@ constexpr Golden kGolden[] = {
     {"pyramid",     30, 0x504d093815fdcd88ull},
     {"chains",     120, 0x3c5eb077793d1c6aull},
     {"pile",       120, 0xc12f5f6c09603265ull},
-    {"mass_ratio", 120, 0x9c02eed9c50e40a5ull},
+    {"mass_ratio", 120, 0xd487620caf93fd4full},
     {"dominoes",   120, 0x3717827d8038569full},
 };
 // clang-format on
