@@ -309,7 +309,7 @@ function showStats(s) {
   rows(numbers, [
     ['mode', s.mode + (s.speed !== 1 ? ' x' + s.speed : '') + (s.interpolate ? ', interpolated' : ', raw steps')],
     ['steps/s', s.steps_per_second.toFixed(1)], ['steps', s.steps],
-    ['bodies (awake)', `${s.bodies} (${s.awake})`], ['contacts', s.contacts],
+    ['bodies (awake)', `${s.bodies} (${s.awake})`], ['touching pairs (awake)', s.contacts],
     ['contact events', `${s.begins} begin, ${s.ends} end, ${s.hits} hit`],
     ['contact points drawn', s.contact_points],
     ['shots, drops, picks', `${s.shots}, ${s.dropped}, ${s.picks}`],
