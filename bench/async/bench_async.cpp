@@ -22,7 +22,8 @@ namespace {
 
 using namespace spindle;
 
-// n kinematic bodies drifting without contacts: every step publishes all of them.
+// n kinematic bodies drifting and turning without contacts: every step publishes all of
+// them, and a blended read turns each (0.6 to 1.8 rad/s, as tumbling debris).
 std::unique_ptr<Space> make_space(int n, bool interpolate) {
     SpaceSettings settings;
     settings.gravity = Vec3::Zero();
@@ -35,6 +36,7 @@ std::unique_ptr<Space> make_space(int n, bool interpolate) {
         d.shape = Shape::sphere(0.1);
         d.position = Vec3(i % 100, (i / 100) % 100, i / 10000) * 0.5;
         d.linear_velocity = Vec3(0.1, 0, 0);
+        d.angular_velocity = Vec3(0.6, 0.2 * (i % 7), 1.0);
         d.allow_interpolation = interpolate;
         space->create_body(d);
     }

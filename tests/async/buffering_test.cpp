@@ -265,3 +265,37 @@ TEST(MotionStates, CopyOfAllBlendsExactlyTheBodiesThatInterpolate) {
     EXPECT_EQ(blended, 4);  // bodies 0, 2, 5, 6 interpolate (3 was destroyed)
     EXPECT_EQ(handles[3], made[4]);
 }
+
+// The same without a hole, where the copy takes all slots at once when nothing blends:
+// the handles are the bodies made, in order, and each state is that body's own read,
+// blended where the body interpolates and raw where none does.
+TEST(MotionStates, CopyOfAllWithoutHolesBlendsOnlyWhereNeeded) {
+    for (const bool any_interpolates : {true, false}) {
+        Space space(async_settings());
+        space.destroy_body(space.create_body(ball(Vec3::Zero())));
+        space.update();  // slot 0 is free again: its next body has generation 2
+        std::vector<BodyHandle> made;
+        for (int i = 0; i < 6; ++i) {
+            BodyDesc d = ball(Vec3(i, 0, 0));
+            d.linear_velocity = Vec3(1 + i, 0, 0);
+            d.angular_velocity = Vec3(0, 0, 2);
+            d.allow_interpolation = any_interpolates && i % 2 == 0;
+            made.push_back(space.create_body(d));
+        }
+        const Real dt = space.settings().time_step.duration;
+        space.update(2.5 * dt);  // alpha 0.5
+        std::vector<BodyHandle> handles;
+        std::vector<MotionState> states;
+        ASSERT_EQ(space.motion_states().get_all_motion_states(handles, states), 6u);
+        EXPECT_EQ(handles, made);
+        EXPECT_EQ(made[0].generation, 2u);
+        int blended = 0;
+        for (std::size_t k = 0; k < handles.size(); ++k) {
+            const MotionState own = space.motion_state(made[k]);
+            EXPECT_EQ(states[k].position, own.position) << k;
+            EXPECT_EQ(states[k].orientation.coeffs(), own.orientation.coeffs()) << k;
+            blended += states[k].position != space.internal_position(made[k]);
+        }
+        EXPECT_EQ(blended, any_interpolates ? 3 : 0);
+    }
+}

@@ -4,6 +4,8 @@
 #include <spindle/platform/clock.hpp>
 #include <spindle/platform/error.hpp>
 
+#include "query/slerp_series.hpp"
+
 #include <algorithm>
 #include <bit>
 
@@ -81,16 +83,31 @@ double MotionStateManager::alpha_locked(BlendClock clock) const noexcept {
     return std::clamp(t.banked_alpha + grown, t.banked_alpha, 1.0);
 }
 
-MotionState MotionStateManager::blend_locked(std::uint32_t i, double alpha) const {
-    const PublishedBuffer& front = *m_front;
-    if (!front.interpolate[i] || alpha >= 1) return front.current[i];
+namespace {
+
+// Slot i of a published buffer as reads return it: blended where it interpolates (the
+// caller leaves out alpha = 1, where every slot reads as its newest state).
+struct Blend {
+    explicit Blend(double alpha) : t(alpha), turn(alpha) {}
+    Real t;
+    SlerpSeries turn;
+};
+
+MotionState blended(const PublishedBuffer& front, std::uint32_t i, const Blend& blend) {
+    if (!front.interpolate[i]) return front.current[i];
     const PublishedHistory& before = front.previous[i];
     MotionState s = front.current[i];
-    const Real t = alpha;
-    s.position = before.position + (s.position - before.position) * t;
-    s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * t;
-    s.orientation = slerp_shortest(before.orientation, s.orientation, t);
+    s.position = before.position + (s.position - before.position) * blend.t;
+    s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * blend.t;
+    s.orientation = blend.turn(before.orientation, s.orientation);
     return s;
+}
+
+}  // namespace
+
+MotionState MotionStateManager::blend_locked(std::uint32_t i, double alpha) const {
+    if (alpha >= 1) return m_front->current[i];
+    return blended(*m_front, i, Blend(alpha));
 }
 
 void MotionStateManager::check_locked(BodyHandle body) const {
@@ -120,27 +137,37 @@ std::uint64_t MotionStateManager::read_user_data(BodyHandle body) const {
 }
 
 // Runs of live slots that need no blending (all of them at alpha 1, else those that do
-// not interpolate) are copied as runs, which streams like a memcpy; the others are
-// blended one by one.
+// not interpolate) are copied as runs, which streams like a memcpy (all slots as one
+// run when none is empty); the others are blended one by one.
 std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& handles,
                                                       std::vector<MotionState>& states) const {
     const MotionStateLock::Hold guard(m_lock);
     const PublishedBuffer& front = *m_front;
     const auto slots = static_cast<std::uint32_t>(front.size());
-    std::size_t count = 0;
-    for (std::uint32_t i = 0; i < slots; ++i) count += front.generation[i] != 0;
+    std::size_t count = 0, interpolating = 0;
+    for (std::uint32_t i = 0; i < slots; ++i) {
+        const bool live = front.generation[i] != 0;
+        count += live;
+        interpolating += live & (front.interpolate[i] != 0);
+    }
     handles.resize(count);
     states.resize(count);
     const double alpha = alpha_locked();
-    const bool blending = alpha < 1;
+    const bool blending = alpha < 1 && interpolating > 0;
+    if (!blending && count == slots) {  // no holes, nothing to blend: one copy
+        for (std::uint32_t i = 0; i < slots; ++i) handles[i] = BodyHandle{i, front.generation[i]};
+        std::copy(front.current.begin(), front.current.end(), states.begin());
+        return count;
+    }
     auto copied = [&](std::uint32_t i) { return front.generation[i] != 0 && !(blending && front.interpolate[i]); };
+    const Blend blend(blending ? alpha : 0.0);
     std::size_t k = 0;
     for (std::uint32_t i = 0; i < slots;) {
         if (front.generation[i] == 0) {
             ++i;
         } else if (!copied(i)) {
             handles[k] = BodyHandle{i, front.generation[i]};
-            states[k++] = blend_locked(i++, alpha);
+            states[k++] = blended(front, i++, blend);
         } else {
             std::uint32_t end = i;
             while (end < slots && copied(end)) {
@@ -166,7 +193,12 @@ void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, s
     const MotionStateLock::Hold guard(m_lock);
     for (BodyHandle b : bodies) check_locked(b);
     const double alpha = alpha_locked(clock);
-    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blend_locked(bodies[i].index, alpha);
+    if (alpha >= 1) {
+        for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = m_front->current[bodies[i].index];
+        return;
+    }
+    const Blend blend(alpha);
+    for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blended(*m_front, bodies[i].index, blend);
 }
 
 void MotionStateManager::get_raw_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {

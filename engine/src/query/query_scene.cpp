@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "collision/cast.hpp"
+#include "query/slerp_series.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -31,12 +32,12 @@ bool same_shape(const Shape& a, const Shape& b) {
 
 }  // namespace
 
-// The same arithmetic as MotionStateManager::blend, so a ray meets a body where its
-// motion state puts it, to the bit.
+// The same arithmetic as the published reads (api/motion_state_manager.cpp), so a ray
+// meets a body where its motion state puts it, to the bit.
 Transform QueryBody::pose(double alpha) const {
     if (!interpolate || alpha >= 1) return current;
     const Real t = alpha;
-    return {previous.p + (current.p - previous.p) * t, slerp_shortest(previous.q, current.q, t)};
+    return {previous.p + (current.p - previous.p) * t, SlerpSeries(t)(previous.q, current.q)};
 }
 
 QueryScene::QueryScene() : m_tree(query_tree_settings()) {}
