@@ -274,7 +274,7 @@ std::string heavy_on_light_section() {
 std::string delicate_section() {
     return "## Delicate structures: the sag is the contact springs' own\n"
            "\n"
-           "Measured 2026-12-03 (05:55-06:25 UTC) on AMD EPYC, 2 logical CPUs shared with other builds, g++ "
+           "Measured 2026-12-03 (05:55-06:10 UTC) on AMD EPYC, 2 logical CPUs shared with other builds, g++ "
            "12.2.0; Spindle 8dd705a (release build), Box3D 30c67b5 (Release, library only, driven by "
            "`scripts/peers/box3d_delicate.c`, which builds the same scenes body for body). Sleeping off, 600 "
            "steps of 1/60 s. The scenes are `tests/stability/delicate_test.cpp`'s: a 5-level card house (40 "
