@@ -144,9 +144,12 @@ std::vector<BodyHandle> build_arch(Space& space, const Arch& arch) {
 // sinking 1.5 to 2 mm into the edges under them: the soft contacts' compression (load
 // over effective mass over (2 pi 30 Hz)^2; 4.8 mm at 8 substeps, 2.4 mm at 16, so one
 // over the stiffness squared), not the 5 mm linear slop, which no normal row reads.
-// The top pair racks 9.8 degrees (4.5 at 8 substeps; 1.1 with 4 iterations and 4 relax
-// iterations: the Gauss-Seidel passes leave it unconverged); then it rests (1.9 mm more
-// in 9 s, 2e-4 m/s at the end). Box3D (30c67b5, the same house at its defaults, also
+// The top pair racks 9.8 degrees as it lands (4.5 at 8 substeps; 1.1 with 4 iterations
+// and 4 relax iterations): its apex contact takes one card's face normal, 22 degrees off
+// the symmetric push, so friction there carries 0.40 of the push against a 0.5 cone, and
+// with no warm start yet it slides; then it rests (1.9 mm more in 9 s, 2e-4 m/s at the
+// end). It is marginal: built with each card up to 0.5 mm off, 5 houses in 19 lose their
+// top pair (none at 8 substeps). Box3D (30c67b5, the same house at its defaults, also
 // 30 Hz) loses its top pair: it topples (turned over, the top 94 mm down); at 8
 // substeps it drops 12.6 mm (docs/accuracy.md, "Delicate structures"). The 1 cm drop
 // bound chosen before measuring failed; 2 cm and 20 degrees guard the fall, the
