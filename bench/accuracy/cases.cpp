@@ -575,6 +575,48 @@ CaseRun heavy_stack(const Setting& setting) {
     return t.result(worst);
 }
 
+// A thin semicircular arch of 21 voussoirs (hulls between radii 2 and 2.3 m, 1 m deep,
+// 2,500 kg/m^3, friction 0.6) built touching on a box floor, as Delicate's thin arch in
+// tests/stability: a rigid arch stands without sagging, and a soft-contact one sags as
+// its joints compress under the thrust, as one over the contact stiffness squared.
+// Error: the keystone's worst sag over 5 s (about 2 m if the arch falls).
+CaseRun arch_sag(const Setting& setting) {
+    TimedSpace t(setting, Vec3(0, -kGravity, 0));
+    add_floor(t.space());
+    constexpr int kStones = 21;
+    constexpr Real kInner = 2, kOuter = 2.3;
+    BodyHandle keystone;
+    for (int i = 0; i < kStones; ++i) {
+        const Real from = i * kPi / kStones, to = (i + 1) * kPi / kStones, mid = (from + to) / 2;
+        const Vec3 origin = (kInner + kOuter) / 2 * Vec3(std::cos(mid), std::sin(mid), 0);
+        std::vector<Vec3> corners;
+        for (Real r : {kInner, kOuter}) {
+            for (Real angle : {from, to}) {
+                for (Real z : {-0.5, 0.5})
+                    corners.push_back(Vec3(r * std::cos(angle), r * std::sin(angle), z) - origin);
+            }
+        }
+        BodyDesc stone;
+        stone.shape = Shape::convex_hull(corners);
+        stone.position = origin;
+        stone.density = 2500;
+        stone.allow_sleep = false;
+        stone.allow_interpolation = false;
+        const BodyHandle body = t.space().create_body(stone);
+        if (i == kStones / 2) keystone = body;
+    }
+    const Real built = t.space().internal_position(keystone).y();
+    double worst = 0;
+    const int steps = t.steps_for(5);
+    for (int n = 0; n < steps; ++n) {
+        t.step();
+        const double sag = built - t.space().internal_position(keystone).y();
+        if (!std::isfinite(sag)) return t.result(sag);
+        worst = std::max(worst, sag);
+    }
+    return t.result(worst);
+}
+
 constexpr Case kCases[] = {
     {"stack_drift", "10-box stack, 5 s: worst distance of the top box from its ideal position", "m", stack_drift},
     {"stack_sink", "10-box stack at rest: top box below its ideal height (last 1 s of 5)", "m", stack_sink},
@@ -615,6 +657,10 @@ constexpr Case kCases[] = {
      "1, 100 and 10,000 kg unit cubes stacked heaviest on top on a box floor: worst distance of any cube from its "
      "ideal place over the last 2 s of 3",
      "m", heavy_stack},
+    {"arch_sag",
+     "thin arch of 21 voussoirs (radii 2-2.3 m, 1 m deep, 240 kg each) on a box floor: the keystone's worst sag over "
+     "5 s",
+     "m", arch_sag},
 };
 
 }  // namespace
