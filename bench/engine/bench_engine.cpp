@@ -1,8 +1,9 @@
 // bench_engine: Spindle's throughput on named scenes (the table below), each at 1 and 2
 // threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
 // Scenes: Jolt's pyramid, 196 small pyramids, a mixed pile on a terrain mesh, a pile of 100
-// jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), and a 10k
-// box grid awake and asleep.
+// jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), a 10k box grid
+// awake and asleep, and the peers' scenes from configs/scenes (Box3D's rain, trees and
+// large_world, Jolt's ConvexVsMesh), each with its own settings as `spindle bench` runs it.
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
@@ -33,12 +34,13 @@ enum class SceneKind {
     MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
     ChainPile,        // 100 ball-socket chains of 10 capsules landing in a tangle (ragdoll-pile load)
     Ragdolls,         // configs/scenes/ragdolls.toml: 160 ragdolls in 16 piles on a heightfield, from the drop
+    SceneFile,        // configs/scenes/<name>.toml, from its first step
     GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
     GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
 };
 
 struct EngineScene {
-    const char* name;
+    const char* name;  // SceneFile: the built-in scene's name too
     SceneKind kind;
     int steps;  // timed steps per run
 };
@@ -54,6 +56,10 @@ constexpr EngineScene kScenes[] = {
     {"ragdolls", SceneKind::Ragdolls, 300},  // five seconds: dropped, piled and come to rest
     {"grid_10k_awake", SceneKind::GridAwake, 60},
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
+    {"rain", SceneKind::SceneFile, 240},            // the ragdolls land at about step 120
+    {"trees", SceneKind::SceneFile, 300},           // falling, landing and rolling
+    {"large_world", SceneKind::SceneFile, 60},      // a million static boxes: about 10 s to build
+    {"convex_vs_mesh", SceneKind::SceneFile, 300},  // dropped, bouncing, rolling
 };
 
 constexpr int kGridPerSide = 100;  // 10,000 boxes
@@ -84,7 +90,8 @@ struct Built {
 };
 
 // Builds the scene and takes the untimed steps it needs.
-Built build(SceneKind kind, unsigned threads) {
+Built build(const EngineScene& scene_entry, unsigned threads) {
+    const SceneKind kind = scene_entry.kind;
     Built built;
     built.jobs = make_bench_jobs(threads);
     SpaceSettings settings;
@@ -97,7 +104,8 @@ Built build(SceneKind kind, unsigned threads) {
         case SceneKind::GridSleeping: boxes = box_grid_scene(kGridPerSide); break;
         case SceneKind::MixedPileOnMesh:
         case SceneKind::ChainPile:
-        case SceneKind::Ragdolls: break;
+        case SceneKind::Ragdolls:
+        case SceneKind::SceneFile: break;
     }
     built.heap_before = live_heap_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
@@ -106,9 +114,10 @@ Built build(SceneKind kind, unsigned threads) {
         built.bodies = add_mixed_pile_on_mesh(space, kMixedPileBodies);
     } else if (kind == SceneKind::ChainPile) {
         built.bodies = add_chain_pile(space, kChains, kLinksPerChain);
-    } else if (kind == SceneKind::Ragdolls) {
-        // The scene's own settings (sleeping on, as in Jolt's), like `spindle bench ragdolls`.
-        const SceneDesc scene = load_scene(SPINDLE_SOURCE_DIR "/configs/scenes/ragdolls.toml");
+    } else if (kind == SceneKind::Ragdolls || kind == SceneKind::SceneFile) {
+        // The scene's own settings (ragdolls: sleeping on, as in Jolt's), like `spindle bench`.
+        const std::string name = kind == SceneKind::Ragdolls ? "ragdolls" : scene_entry.name;
+        const SceneDesc scene = load_scene(SPINDLE_SOURCE_DIR "/configs/scenes/" + name + ".toml");
         const std::vector<BodyHandle> handles = spindle::build(scene, space, &built.joints);
         for (std::size_t i = 0; i < handles.size(); ++i) {
             if (scene.bodies[i].desc.type == MotionType::Dynamic) built.bodies.push_back(handles[i]);
@@ -152,7 +161,7 @@ WorstJointError worst_joint_error(const Space& space, const std::vector<JointHan
 
 void bm_scene(benchmark::State& state, EngineScene scene) {
     const auto threads = static_cast<unsigned>(state.range(0));
-    Built built = build(scene.kind, threads);
+    Built built = build(scene, threads);
     if (!built.asleep) {
         state.SkipWithError("the grid did not fall asleep within the step cap");
         return;

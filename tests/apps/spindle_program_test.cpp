@@ -308,12 +308,21 @@ TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {
         if (entry.path().extension() == ".toml") expect_contains(r.output, entry.path().stem().string() + " ");
     }
     // name, dynamic bodies, other bodies, description
-    for (const auto& [scene, dynamic] : std::vector<std::pair<std::string, std::string>>{
-             {"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}, {"convex_pile", "5120"}}) {
-        const std::vector<std::string> w = line_starting_with(r.output, scene);
-        ASSERT_GE(w.size(), 3u) << scene << " not listed in\n" << r.output;
-        EXPECT_EQ(w[1], dynamic) << scene;
-        EXPECT_EQ(w[2], "1") << scene;
+    struct Listed {
+        std::string scene, dynamic, other;
+    };
+    for (const Listed& l : std::vector<Listed>{{"pyramid", "1240", "1"},
+                                               {"many_pyramids", "10780", "1"},
+                                               {"stack", "20", "1"},
+                                               {"convex_pile", "5120", "1"},
+                                               {"rain", "3600", "200"},
+                                               {"trees", "50", "1"},
+                                               {"large_world", "100", "1000000"},
+                                               {"convex_vs_mesh", "1764", "1"}}) {
+        const std::vector<std::string> w = line_starting_with(r.output, l.scene);
+        ASSERT_GE(w.size(), 3u) << l.scene << " not listed in\n" << r.output;
+        EXPECT_EQ(w[1], l.dynamic) << l.scene;
+        EXPECT_EQ(w[2], l.other) << l.scene;
     }
 }
 
