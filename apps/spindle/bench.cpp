@@ -40,17 +40,20 @@ struct BenchOptions {
 // Parts of the step shorter than this share of it are left out of --serial's list.
 constexpr double kSerialPartShown = 0.02;
 
-void print_serial(const SerialProfile& p, std::int64_t steps) {
+// The quieter half of the steps' profiles (serial_fraction.hpp), and the fraction of all of them.
+void print_serial(const std::vector<SerialProfile>& steps) {
+    const SerialProfile p = quieter_half(steps);
+    const auto used = static_cast<double>((steps.size() + 1) / 2);
     std::printf("serial_fraction=%.4f serial_work_fraction=%.4f amdahl_4=%.2f amdahl_8=%.2f amdahl_16=%.2f "
-                "traced_steps=%lld\n",
+                "traced_steps=%zu all_steps_serial_fraction=%.4f\n",
                 p.serial_fraction(), p.serial_work_fraction(), amdahl_speedup(p.serial_work_fraction(), 4),
-                amdahl_speedup(p.serial_work_fraction(), 8), amdahl_speedup(p.serial_work_fraction(), 16),
-                static_cast<long long>(steps));
+                amdahl_speedup(p.serial_work_fraction(), 8), amdahl_speedup(p.serial_work_fraction(), 16), steps.size(),
+                sum_profiles(steps).serial_fraction());
     for (const SerialPart& part : p.parts) {
         const double share = p.step_seconds > 0 ? part.seconds / p.step_seconds : 0;
         if (share < kSerialPartShown) break;
-        std::printf("serial_part share=%.4f ms_per_step=%.3f name=\"%s\"\n", share,
-                    1e3 * part.seconds / static_cast<double>(steps), part.name.c_str());
+        std::printf("serial_part share=%.4f ms_per_step=%.3f name=\"%s\"\n", share, 1e3 * part.seconds / used,
+                    part.name.c_str());
     }
 }
 
@@ -115,6 +118,8 @@ int bench(const BenchOptions& o) {
     }
 
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};
+    std::vector<SerialProfile> serial_steps;
+    double analysis_seconds = 0;  // --serial's, left out of the run's time
     const Stopwatch watch;
     double first_step_seconds = 0;
     for (std::int64_t i = 0; i < o.steps; ++i) {
@@ -124,8 +129,14 @@ int bench(const BenchOptions& o) {
         if (i == 0) first_step_seconds = watch.elapsed_seconds();
         const UpdateStats& stats = space.last_update();
         for (std::size_t k = 0; k < stage_seconds.size(); ++k) stage_seconds[k] += stats.stage_seconds[k];
+        if (i >= 1 && o.serial) {
+            const Stopwatch analysis;
+            serial_steps.push_back(serial_profile(traced->trace_events()));
+            traced->clear_trace();
+            analysis_seconds += analysis.elapsed_seconds();
+        }
     }
-    const double seconds = watch.elapsed_seconds();
+    const double seconds = watch.elapsed_seconds() - analysis_seconds;
     if (o.serial) traced->enable_trace(false);
     const double ms_per_step = o.steps > 1 ? 1e3 * (seconds - first_step_seconds) / static_cast<double>(o.steps - 1)
                                            : 0;
@@ -152,7 +163,7 @@ int bench(const BenchOptions& o) {
         std::printf("\n");
     }
     if (o.joint_errors) print_joint_errors(space, joints);
-    if (o.serial) print_serial(serial_profile(traced->trace_events()), o.steps - 1);
+    if (o.serial) print_serial(serial_steps);
     return 0;
 }
 
@@ -186,13 +197,14 @@ Command add_bench_command(CLI::App& program) {
                   "a line per joint type at the end: its joints' worst error (Space::internal_joint_error),\n"
                   "e.g. joint_errors type=hinge joints=640 linear_m=0.0046 angular_rad=0.08 hinge_limit_rad=0.01")
         ->check(no_value());
-    cli->add_flag(
-           "--serial", o->serial,
-           "trace the steps after the first and print the serial fraction of a step (time with at\n"
-           "most one worker working), Amdahl's bound on 4, 8 and 16 workers, and a line per serial\n"
-           "part over 2% of a step; needs --threads 2 or more, e.g.\n"
-           "serial_fraction=0.08 serial_work_fraction=0.04 amdahl_4=3.55 amdahl_8=6.2 amdahl_16=9.9 traced_steps=299\n"
-           "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
+    cli->add_flag("--serial", o->serial,
+                  "trace each step after the first and print the serial fraction of a step (time with\n"
+                  "at most one worker working) over the quieter half of the steps, Amdahl's bound on 4,\n"
+                  "8 and 16 workers, and a line per serial part over 2% of a step; needs --threads 2 or\n"
+                  "more, e.g.\n"
+                  "serial_fraction=0.08 serial_work_fraction=0.04 amdahl_4=3.55 amdahl_8=6.2 amdahl_16=9.9\n"
+                  "  traced_steps=299 all_steps_serial_fraction=0.09\n"
+                  "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")
         ->required()

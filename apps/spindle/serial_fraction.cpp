@@ -46,6 +46,12 @@ std::vector<std::uint32_t> leaf_jobs(std::span<const TraceEvent> events, unsigne
     return leaves;
 }
 
+void sort_longest_first(std::vector<SerialPart>& parts) {
+    std::sort(parts.begin(), parts.end(), [](const SerialPart& a, const SerialPart& b) {
+        return a.seconds != b.seconds ? a.seconds > b.seconds : a.name < b.name;
+    });
+}
+
 }  // namespace
 
 SerialProfile serial_profile(std::span<const TraceEvent> events) {
@@ -92,10 +98,33 @@ SerialProfile serial_profile(std::span<const TraceEvent> events) {
         serial_by_name[name] += dt;
     }
     for (const auto& [name, seconds] : serial_by_name) profile.parts.push_back({name, seconds});
-    std::sort(profile.parts.begin(), profile.parts.end(), [](const SerialPart& a, const SerialPart& b) {
-        return a.seconds != b.seconds ? a.seconds > b.seconds : a.name < b.name;
-    });
+    sort_longest_first(profile.parts);
     return profile;
+}
+
+SerialProfile sum_profiles(std::span<const SerialProfile> steps) {
+    SerialProfile sum;
+    std::map<std::string, double> by_name;
+    for (const SerialProfile& p : steps) {
+        sum.workers = std::max(sum.workers, p.workers);
+        sum.step_seconds += p.step_seconds;
+        sum.serial_seconds += p.serial_seconds;
+        sum.work_seconds += p.work_seconds;
+        for (const SerialPart& part : p.parts) by_name[part.name] += part.seconds;
+    }
+    for (const auto& [name, seconds] : by_name) sum.parts.push_back({name, seconds});
+    sort_longest_first(sum.parts);
+    return sum;
+}
+
+SerialProfile quieter_half(std::span<const SerialProfile> steps) {
+    std::vector<SerialProfile> sorted(steps.begin(), steps.end());
+    // Stable: steps of equal fractions are taken in step order.
+    std::stable_sort(sorted.begin(), sorted.end(), [](const SerialProfile& a, const SerialProfile& b) {
+        return a.serial_fraction() < b.serial_fraction();
+    });
+    sorted.resize((sorted.size() + 1) / 2);
+    return sum_profiles(sorted);
 }
 
 double amdahl_speedup(double serial_work_fraction, unsigned workers) {

@@ -37,6 +37,15 @@ struct SerialProfile {
 // no job running is the stage's own serial code.
 SerialProfile serial_profile(std::span<const TraceEvent> events);
 
+// The steps' profiles added up (times summed, parts merged by name, longest first).
+SerialProfile sum_profiles(std::span<const SerialProfile> steps);
+
+// The steps whose own serial fraction is at most the median's, summed: on a machine that
+// other programs keep busy, a step in which the OS took a worker's core for a while looks
+// serial; the quieter half is the step as it runs when it has its cores. On an idle machine
+// both halves are alike.
+SerialProfile quieter_half(std::span<const SerialProfile> steps);
+
 // Amdahl's bound on the speed-up over one worker with `workers` workers.
 double amdahl_speedup(double serial_work_fraction, unsigned workers);
 

@@ -79,6 +79,31 @@ TEST(SerialFraction, FullyParallelStep_HasNoSerialPart) {
     EXPECT_DOUBLE_EQ(amdahl_speedup(p.serial_work_fraction(), 16), 16.0);
 }
 
+// Three steps: the hand-made one, one fully serial (a worker lost its core to another
+// program) and one fully parallel. The quieter half is the parallel step and the hand-made one.
+TEST(SerialFraction, QuieterHalf_LeavesOutTheStepsThatLookedSerialest) {
+    std::vector<SerialProfile> steps;
+    steps.push_back(serial_profile(two_worker_step()));
+    steps.push_back(serial_profile(
+        std::vector<TraceEvent>{span("stage", "Solver", 0, 100, 0), span("Solver", "Solve", 0, 100, 0)}));
+    steps.push_back(serial_profile(std::vector<TraceEvent>{
+        span("stage", "Solver", 0, 100, 0), span("Solver", "Solve", 0, 100, 0), span("Solver", "Solve", 0, 100, 1)}));
+
+    const SerialProfile all = sum_profiles(steps);
+    EXPECT_NEAR(all.step_seconds, 300e-6, 1e-12);
+    EXPECT_NEAR(all.serial_seconds, 145e-6, 1e-12);
+    ASSERT_FALSE(all.parts.empty());
+    EXPECT_EQ(all.parts[0].name, "Solver Solve");
+    EXPECT_NEAR(all.parts[0].seconds, 120e-6, 1e-12);
+
+    const SerialProfile quiet = quieter_half(steps);
+    EXPECT_NEAR(quiet.step_seconds, 200e-6, 1e-12);
+    EXPECT_NEAR(quiet.serial_seconds, 45e-6, 1e-12);
+    EXPECT_NEAR(quiet.work_seconds, 355e-6, 1e-12);
+    EXPECT_EQ(quiet.parts.size(), 4u);
+    EXPECT_NEAR(quiet.parts[0].seconds, 20e-6, 1e-12);
+}
+
 TEST(SerialFraction, Amdahl_BoundsTheSpeedUp) {
     EXPECT_DOUBLE_EQ(amdahl_speedup(1.0, 8), 1.0);
     EXPECT_NEAR(amdahl_speedup(0.05, 4), 1 / (0.05 + 0.95 / 4), 1e-12);

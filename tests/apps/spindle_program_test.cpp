@@ -276,8 +276,8 @@ TEST(SpindleProgram, BenchLine_HasTheStepTimeAndTheFirstStepApart) {
     EXPECT_GT(field(words(one.output), "first_step_ms"), 0.0) << one.output;
 }
 
-// --serial: the share of the traced steps with at most one worker working, Amdahl's bounds
-// from it, and the serial parts over 2 % of a step, longest first.
+// --serial: the share of the quieter half of the traced steps with at most one worker
+// working, Amdahl's bounds from it, and the serial parts over 2 % of a step, longest first.
 TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const Result r = spindle("bench pyramid --threads 2 --steps 20 --serial", true);
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -286,7 +286,7 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     for (std::string line; std::getline(in, line);) lines.push_back(words(line));
     ASSERT_GE(lines.size(), 2u) << r.output;
     const std::vector<std::string>& summary = lines[1];
-    ASSERT_EQ(summary.size(), 6u) << r.output;
+    ASSERT_EQ(summary.size(), 7u) << r.output;
     const double serial = field(summary, "serial_fraction");
     const double serial_work = field(summary, "serial_work_fraction");
     EXPECT_GT(serial, 0.0);  // at least the stages' own code between jobs
@@ -299,6 +299,7 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     EXPECT_GE(a16, a8);
     EXPECT_LE(a16, 1 / serial_work + 1e-9);
     EXPECT_EQ(field(summary, "traced_steps"), 19.0);
+    EXPECT_GE(field(summary, "all_steps_serial_fraction"), serial - 1e-4);  // the quieter half's is the least
     double previous = 1, sum = 0;
     for (std::size_t i = 2; i < lines.size(); ++i) {
         const std::vector<std::string>& part = lines[i];
