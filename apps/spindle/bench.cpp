@@ -44,11 +44,12 @@ constexpr double kSerialPartShown = 0.02;
 void print_serial(const std::vector<SerialProfile>& steps) {
     const SerialProfile p = quieter_half(steps);
     const auto used = static_cast<double>((steps.size() + 1) / 2);
+    const SerialProfile all = sum_profiles(steps);
     std::printf("serial_fraction=%.4f serial_work_fraction=%.4f amdahl_4=%.2f amdahl_8=%.2f amdahl_16=%.2f "
-                "traced_steps=%zu all_steps_serial_fraction=%.4f\n",
+                "traced_steps=%zu all_steps_serial_fraction=%.4f serial_code_fraction=%.4f\n",
                 p.serial_fraction(), p.serial_work_fraction(), amdahl_speedup(p.serial_work_fraction(), 4),
                 amdahl_speedup(p.serial_work_fraction(), 8), amdahl_speedup(p.serial_work_fraction(), 16), steps.size(),
-                sum_profiles(steps).serial_fraction());
+                all.serial_fraction(), all.serial_code_fraction());
     for (const SerialPart& part : p.parts) {
         const double share = p.step_seconds > 0 ? part.seconds / p.step_seconds : 0;
         if (share < kSerialPartShown) break;
@@ -203,7 +204,7 @@ Command add_bench_command(CLI::App& program) {
                   "8 and 16 workers, and a line per serial part over 2% of a step; needs --threads 2 or\n"
                   "more, e.g.\n"
                   "serial_fraction=0.08 serial_work_fraction=0.04 amdahl_4=3.55 amdahl_8=6.2 amdahl_16=9.9\n"
-                  "  traced_steps=299 all_steps_serial_fraction=0.09\n"
+                  "  traced_steps=299 all_steps_serial_fraction=0.09 serial_code_fraction=0.02\n"
                   "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")

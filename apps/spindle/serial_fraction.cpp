@@ -92,6 +92,7 @@ SerialProfile serial_profile(std::span<const TraceEvent> events) {
         profile.work_seconds += dt * static_cast<double>(std::max<std::size_t>(jobs.size(), 1));
         if (jobs.size() >= 2) continue;
         profile.serial_seconds += dt;
+        if (jobs.empty()) profile.outside_jobs_seconds += dt;
         const TraceEvent& who = events[jobs.empty() ? stages.back() : jobs.front()];
         const std::string name = jobs.empty() ? std::string(who.name) + " outside jobs"
                                               : std::string(who.stage ? who.stage : "") + " " + who.name;
@@ -110,6 +111,7 @@ SerialProfile sum_profiles(std::span<const SerialProfile> steps) {
         sum.step_seconds += p.step_seconds;
         sum.serial_seconds += p.serial_seconds;
         sum.work_seconds += p.work_seconds;
+        sum.outside_jobs_seconds += p.outside_jobs_seconds;
         for (const SerialPart& part : p.parts) by_name[part.name] += part.seconds;
     }
     for (const auto& [name, seconds] : by_name) sum.parts.push_back({name, seconds});

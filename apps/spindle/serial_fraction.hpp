@@ -19,16 +19,21 @@ struct SerialPart {
 };
 
 struct SerialProfile {
-    unsigned workers = 0;           // the trace's worker count (the largest worker index + 1)
-    double step_seconds = 0;        // in stage spans (the union of the physics loop's stages)
-    double serial_seconds = 0;      // of step_seconds, with at most one worker working
-    double work_seconds = 0;        // worker-seconds of work (idle time counted as one worker's)
-    std::vector<SerialPart> parts;  // serial_seconds by name, longest first
+    unsigned workers = 0;             // the trace's worker count (the largest worker index + 1)
+    double step_seconds = 0;          // in stage spans (the union of the physics loop's stages)
+    double serial_seconds = 0;        // of step_seconds, with at most one worker working
+    double work_seconds = 0;          // worker-seconds of work (idle time counted as one worker's)
+    double outside_jobs_seconds = 0;  // of serial_seconds, with no job running: the stages' own code
+    std::vector<SerialPart> parts;    // serial_seconds by name, longest first
 
     // Of the step as it ran: the share of its time with at most one worker working.
     double serial_fraction() const { return step_seconds > 0 ? serial_seconds / step_seconds : 0; }
     // Of the work, as one worker would do it: Amdahl's serial fraction.
     double serial_work_fraction() const { return work_seconds > 0 ? serial_seconds / work_seconds : 0; }
+    // Of the work, the stages' own code alone: a floor under serial_work_fraction that the
+    // OS taking a worker's core in a job does not raise (it counts jobs as parallel work,
+    // whether or not another worker ran beside them).
+    double serial_code_fraction() const { return work_seconds > 0 ? outside_jobs_seconds / work_seconds : 0; }
 };
 
 // Work is the time in leaf spans: a job span that holds other spans of its worker counts

@@ -42,6 +42,9 @@ TEST(SerialFraction, HandMadeStep_HasTheSerialTimeItWasMadeWith) {
     // One worker would take the 45 us plus twice the 55 us both worked.
     EXPECT_NEAR(p.work_seconds, 155e-6, 1e-12);
     EXPECT_NEAR(p.serial_work_fraction(), 45.0 / 155.0, 1e-9);
+    // No job ran in [40, 50) and [70, 75).
+    EXPECT_NEAR(p.outside_jobs_seconds, 15e-6, 1e-12);
+    EXPECT_NEAR(p.serial_code_fraction(), 15.0 / 155.0, 1e-9);
 
     ASSERT_EQ(p.parts.size(), 4u);
     EXPECT_EQ(p.parts[0].name, "Solver Solve");  // [60, 70) and [90, 100)
@@ -100,6 +103,7 @@ TEST(SerialFraction, QuieterHalf_LeavesOutTheStepsThatLookedSerialest) {
     EXPECT_NEAR(quiet.step_seconds, 200e-6, 1e-12);
     EXPECT_NEAR(quiet.serial_seconds, 45e-6, 1e-12);
     EXPECT_NEAR(quiet.work_seconds, 355e-6, 1e-12);
+    EXPECT_NEAR(all.outside_jobs_seconds, 15e-6, 1e-12);  // the serial step ran its one job
     EXPECT_EQ(quiet.parts.size(), 4u);
     EXPECT_NEAR(quiet.parts[0].seconds, 20e-6, 1e-12);
 }

@@ -286,7 +286,7 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     for (std::string line; std::getline(in, line);) lines.push_back(words(line));
     ASSERT_GE(lines.size(), 2u) << r.output;
     const std::vector<std::string>& summary = lines[1];
-    ASSERT_EQ(summary.size(), 7u) << r.output;
+    ASSERT_EQ(summary.size(), 8u) << r.output;
     const double serial = field(summary, "serial_fraction");
     const double serial_work = field(summary, "serial_work_fraction");
     EXPECT_GT(serial, 0.0);  // at least the stages' own code between jobs
@@ -300,6 +300,9 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     EXPECT_LE(a16, 1 / serial_work + 1e-9);
     EXPECT_EQ(field(summary, "traced_steps"), 19.0);
     EXPECT_GE(field(summary, "all_steps_serial_fraction"), serial - 1e-4);  // the quieter half's is the least
+    const double code = field(summary, "serial_code_fraction");
+    EXPECT_GT(code, 0.0);  // the stages' own code between jobs
+    EXPECT_LE(code, field(summary, "all_steps_serial_fraction"));
     double previous = 1, sum = 0;
     for (std::size_t i = 2; i < lines.size(); ++i) {
         const std::vector<std::string>& part = lines[i];
