@@ -34,7 +34,7 @@ enum class SceneKind {
     MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
     ChainPile,        // 100 ball-socket chains of 10 capsules landing in a tangle (ragdoll-pile load)
     Ragdolls,         // configs/scenes/ragdolls.toml: 160 ragdolls in 16 piles on a heightfield, from the drop
-    SceneFile,        // configs/scenes/<name>.toml, from its first step
+    SceneFile,        // configs/scenes/<name>.toml, from its second step
     GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
     GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
 };
@@ -129,6 +129,8 @@ Built build(const EngineScene& scene_entry, unsigned threads) {
         for (int i = 0; i < kGridSettleSteps; ++i) space.update();
     } else if (kind == SceneKind::ChainPile) {
         for (int i = 0; i < kChainSettleSteps; ++i) space.update();
+    } else if (kind == SceneKind::SceneFile) {
+        space.update();  // the first step makes every contact: left out, as the peers' benchmarks do
     } else if (kind == SceneKind::GridSleeping) {
         int steps = 0;
         do {
