@@ -320,6 +320,9 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const Result one = spindle("bench pyramid --threads 1 --serial");
     EXPECT_EQ(one.exit_code, 2) << one.output;
     expect_contains(one.output, "--serial needs --threads 2 or more");
+    const Result untraced = spindle("bench pyramid --threads 2 --steps 1 --serial");  // the first step is not traced
+    EXPECT_EQ(untraced.exit_code, 2) << untraced.output;
+    expect_contains(untraced.output, "--steps 2 or more");
 }
 
 TEST(SpindleProgram, BenchStages_PrintsMillisecondsPerStage) {
