@@ -69,14 +69,17 @@ def main():
 # {TORUS_THICKNESS:g}, {len(triangles)} triangles, Box3D's float32 points) half sunk in it; above every cell a group of
 # {GROUP_SIZE} ragdolls 0.75 m apart along x, the human's position at y = 20 (its pelvis at 20.93); sleeping
 # on, gravity -10 (Box3D's defaults); friction 0.6 and density 1000 (Box3D's defaults).
-# Differs in: Box3D rains its humans in: every 48 steps or so (steps with step & 0x2F == 0) it
-# drops a new column of {GRID_COUNT} groups until all {GRID_COUNT} columns are in (step 256), then destroys
-# a column and drops it again; a scene cannot add or remove bodies while it runs, so here
+# Differs in: Box3D rains its humans in: at the steps with step & 0x2F == 0 (0, 16, 64, 80,
+# 128, ...: two every 64 steps) it drops a new column of {GRID_COUNT} groups until all {GRID_COUNT} columns are in
+# (step 272), then destroys a column and drops it again (steps 320, 336 and 384 of its
+# 400-step benchmark); a scene cannot add or remove bodies while it runs, so here
 # all {humans} ragdolls of the full grid fall together from step 0 and none is removed
 # (`spindle bench` has no per-step script either). The ragdoll is Spindle's [[ragdoll]] (12
 # bodies, 11 joints, friction torques of 5 and 2.5 N m) instead of Box3D's human (14 bodies,
 # 13 joints with 1 Hz springs toward its pose and 5 N m friction motors, rolling resistance
-# 0.2); each ragdoll gets its own collision group, as Box3D's humans do. Box3D's cell is one
+# 0.2); each ragdoll's parts never collide with each other (its own collision group), where
+# Box3D's humans leave out only jointed neighbours, the two thighs (a filter joint) and three
+# parts that share a negative group with the other humans of their cell. Box3D's cell is one
 # static body with the two meshes; here each mesh is a body of its own ({2 * cells} static bodies),
 # the grid a heightfield of the same vertices (flat: its diagonals do not matter).
 # Written by scripts/scenes/rain.py; edit that and regenerate.
