@@ -2,8 +2,9 @@
 // threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
 // Scenes: Jolt's pyramid, 196 small pyramids, a mixed pile on a terrain mesh, a pile of 100
 // jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), a 10k box grid
-// awake and asleep, and the peers' scenes from configs/scenes (Box3D's rain, trees and
-// large_world, Jolt's ConvexVsMesh), each with its own settings as `spindle bench` runs it.
+// awake and asleep, and the peers' scenes from configs/scenes (Box3D's large_pyramid,
+// convex_pile, washer, junkyard, joint_grid, rain, trees and large_world, Jolt's
+// ConvexVsMesh), each with its own settings as `spindle bench` runs it.
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
@@ -45,8 +46,9 @@ struct EngineScene {
     int steps;  // timed steps per run
 };
 
-// Step counts keep the whole default run (both thread counts) under about two minutes even
-// on a loaded machine. The pyramid takes 300 steps here (it stands after ~60); bench_peers
+// Step counts keep the whole default run (both thread counts) to a few minutes even on a
+// loaded machine (the peers' scene files about a minute of it, much of that large_world's
+// million static bodies being built). The pyramid takes 300 steps here (it stands after ~60); bench_peers
 // runs the full 500-step Jolt measure against Bullet.
 constexpr EngineScene kScenes[] = {
     {"pyramid", SceneKind::Pyramid, 300},
@@ -56,6 +58,11 @@ constexpr EngineScene kScenes[] = {
     {"ragdolls", SceneKind::Ragdolls, 300},  // five seconds: dropped, piled and come to rest
     {"grid_10k_awake", SceneKind::GridAwake, 60},
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
+    {"large_pyramid", SceneKind::SceneFile, 100},   // Box3D's: standing from the start
+    {"convex_pile", SceneKind::SceneFile, 100},     // falling hulls
+    {"washer", SceneKind::SceneFile, 60},           // cubes tumbling in the drum
+    {"junkyard", SceneKind::SceneFile, 60},         // rocks falling into the yard
+    {"joint_grid", SceneKind::SceneFile, 60},       // chains swinging down
     {"rain", SceneKind::SceneFile, 240},            // the ragdolls land at about step 120
     {"trees", SceneKind::SceneFile, 300},           // falling, landing and rolling
     {"large_world", SceneKind::SceneFile, 60},      // a million static boxes: about 10 s to build
