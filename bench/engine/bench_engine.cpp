@@ -48,8 +48,8 @@ struct EngineScene {
 
 // Step counts keep the whole default run (both thread counts) to a few minutes even on a
 // loaded machine (the peers' scene files about a minute of it, much of that large_world's
-// million static bodies being built). The pyramid takes 300 steps here (it stands after ~60); bench_peers
-// runs the full 500-step Jolt measure against Bullet.
+// million static bodies being built). The pyramid takes 300 steps here (it stands after
+// ~60); bench_peers runs the full 500-step Jolt measure against Bullet.
 constexpr EngineScene kScenes[] = {
     {"pyramid", SceneKind::Pyramid, 300},
     {"many_pyramids", SceneKind::ManyPyramids, 40},
