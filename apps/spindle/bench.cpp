@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "jobs.hpp"
 #include "scenes.hpp"
+#include "serial_fraction.hpp"
 
 namespace spindle::app {
 namespace {
@@ -33,7 +34,29 @@ struct BenchOptions {
     std::optional<std::int64_t> substeps;  // none: the scene's
     bool stages = false;
     bool joint_errors = false;
+    bool serial = false;
 };
+
+// Parts of the step shorter than this share of it are left out of --serial's list.
+constexpr double kSerialPartShown = 0.02;
+
+// The quieter half of the steps' profiles (serial_fraction.hpp), and the fraction of all of them.
+void print_serial(const std::vector<SerialProfile>& steps) {
+    const SerialProfile p = quieter_half(steps);
+    const auto used = static_cast<double>((steps.size() + 1) / 2);
+    const SerialProfile all = sum_profiles(steps);
+    std::printf("serial_fraction=%.4f serial_work_fraction=%.4f amdahl_4=%.2f amdahl_8=%.2f amdahl_16=%.2f "
+                "traced_steps=%zu all_steps_serial_fraction=%.4f serial_code_fraction=%.4f\n",
+                p.serial_fraction(), p.serial_work_fraction(), amdahl_speedup(p.serial_work_fraction(), 4),
+                amdahl_speedup(p.serial_work_fraction(), 8), amdahl_speedup(p.serial_work_fraction(), 16), steps.size(),
+                all.serial_fraction(), all.serial_code_fraction());
+    for (const SerialPart& part : p.parts) {
+        const double share = p.step_seconds > 0 ? part.seconds / p.step_seconds : 0;
+        if (share < kSerialPartShown) break;
+        std::printf("serial_part share=%.4f ms_per_step=%.3f name=\"%s\"\n", share, 1e3 * part.seconds / used,
+                    part.name.c_str());
+    }
+}
 
 // The worst error of one joint type's joints at the end of a run.
 struct WorstJointError {
@@ -70,6 +93,12 @@ int bench(const BenchOptions& o) {
     const auto threads = static_cast<unsigned>(o.threads);
 
     const std::unique_ptr<JobSystem> jobs = make_jobs(threads);
+    auto* traced = dynamic_cast<WorkStealingJobSystem*>(jobs.get());
+    if (o.serial && (!traced || threads < 2 || o.steps < 2)) {
+        std::cerr << "spindle bench: --serial needs --threads 2 or more (one worker has no parallel part) and "
+                     "--steps 2 or more (the first step is not traced)\n";
+        return 2;
+    }
     if (jobs->worker_count() != threads) {
         std::cerr << "spindle bench: note: " << threads << " threads asked for, the scheduler runs "
                   << jobs->worker_count() << '\n';
@@ -90,13 +119,28 @@ int bench(const BenchOptions& o) {
     }
 
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};
+    std::vector<SerialProfile> serial_steps;
+    double analysis_seconds = 0;  // --serial's, left out of the run's time
     const Stopwatch watch;
+    double first_step_seconds = 0;
     for (std::int64_t i = 0; i < o.steps; ++i) {
+        // The first step makes every contact: timed apart, and left out of --serial's trace.
+        if (i == 1 && o.serial) traced->enable_trace(true);
         space.update();
+        if (i == 0) first_step_seconds = watch.elapsed_seconds();
         const UpdateStats& stats = space.last_update();
         for (std::size_t k = 0; k < stage_seconds.size(); ++k) stage_seconds[k] += stats.stage_seconds[k];
+        if (i >= 1 && o.serial) {
+            const Stopwatch analysis;
+            serial_steps.push_back(serial_profile(traced->trace_events()));
+            traced->clear_trace();
+            analysis_seconds += analysis.elapsed_seconds();
+        }
     }
-    const double seconds = watch.elapsed_seconds();
+    const double seconds = watch.elapsed_seconds() - analysis_seconds;
+    if (o.serial) traced->enable_trace(false);
+    const double ms_per_step = o.steps > 1 ? 1e3 * (seconds - first_step_seconds) / static_cast<double>(o.steps - 1)
+                                           : 0;
 
     double top_y = -std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < handles.size(); ++i) {
@@ -104,10 +148,11 @@ int bench(const BenchOptions& o) {
             top_y = std::max(top_y, space.internal_position(handles[i]).y());
     }
     if (scene.dynamic_body_count() == 0) top_y = 0;
-    std::printf("scene=%s bodies=%zu threads=%u steps=%lld steps_per_s=%.1f top_y=%.4f hash=0x%016llx\n",
+    std::printf("scene=%s bodies=%zu threads=%u steps=%lld steps_per_s=%.1f ms_per_step=%.3f first_step_ms=%.3f "
+                "top_y=%.4f hash=0x%016llx\n",
                 scene.name.c_str(), scene.dynamic_body_count(), jobs->worker_count(), static_cast<long long>(o.steps),
-                seconds > 0 ? static_cast<double>(o.steps) / seconds : 0.0, top_y,
-                static_cast<unsigned long long>(space.state_hash()));
+                seconds > 0 ? static_cast<double>(o.steps) / seconds : 0.0, ms_per_step, 1e3 * first_step_seconds,
+                top_y, static_cast<unsigned long long>(space.state_hash()));
     if (o.stages) {
         std::printf("stages_ms");
         for (std::size_t k = 0; k < stage_seconds.size(); ++k) {
@@ -119,6 +164,7 @@ int bench(const BenchOptions& o) {
         std::printf("\n");
     }
     if (o.joint_errors) print_joint_errors(space, joints);
+    if (o.serial) print_serial(serial_steps);
     return 0;
 }
 
@@ -126,11 +172,14 @@ int bench(const BenchOptions& o) {
 
 Command add_bench_command(CLI::App& program) {
     CLI::App* cli = program.add_subcommand("bench", "step a scene as fast as possible; prints one line of results");
-    cli->footer("Steps SCENE N times by 1/60 s with Space::update(), no async runner and no rendering, and\n"
-                "prints one line:\n"
-                "  scene=NAME bodies=N threads=N steps=N steps_per_s=X top_y=Y hash=0x...\n"
-                "bodies: dynamic bodies; top_y: the highest dynamic body centre at the end (m); hash:\n"
-                "Space::state_hash() of the final state (equal hashes = bitwise equal states).");
+    cli->footer(
+        "Steps SCENE N times by 1/60 s with Space::update(), no async runner and no rendering, and\n"
+        "prints one line:\n"
+        "  scene=NAME bodies=N threads=N steps=N steps_per_s=X ms_per_step=X first_step_ms=X top_y=Y hash=0x...\n"
+        "bodies: dynamic bodies; steps_per_s: over all steps; ms_per_step: the mean step after the\n"
+        "first (0 for one step); first_step_ms: the first step (it makes every contact); top_y: the\n"
+        "highest dynamic body origin at the end (m); hash: Space::state_hash() of the final state\n"
+        "(equal hashes = bitwise equal states).");
     auto o = std::make_shared<BenchOptions>();
     cli->add_option("--threads", o->threads, "scheduler workers, 1 to 1024 (default 1)")
         ->option_text("N")
@@ -148,6 +197,15 @@ Command add_bench_command(CLI::App& program) {
     cli->add_flag("--joint-errors", o->joint_errors,
                   "a line per joint type at the end: its joints' worst error (Space::internal_joint_error),\n"
                   "e.g. joint_errors type=hinge joints=640 linear_m=0.0046 angular_rad=0.08 hinge_limit_rad=0.01")
+        ->check(no_value());
+    cli->add_flag("--serial", o->serial,
+                  "trace each step after the first and print the serial fraction of a step (time with\n"
+                  "at most one worker working) over the quieter half of the steps, Amdahl's bound on 4,\n"
+                  "8 and 16 workers, and a line per serial part over 2% of a step; needs --threads 2 or\n"
+                  "more, e.g.\n"
+                  "serial_fraction=0.08 serial_work_fraction=0.04 amdahl_4=3.55 amdahl_8=6.2 amdahl_16=9.9\n"
+                  "  traced_steps=299 all_steps_serial_fraction=0.09 serial_code_fraction=0.02\n"
+                  "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")
         ->required()

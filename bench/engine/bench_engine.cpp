@@ -1,8 +1,10 @@
 // bench_engine: Spindle's throughput on named scenes (the table below), each at 1 and 2
 // threads; one benchmark iteration is one 60 Hz step. Reports steps/s and heap bytes per body.
 // Scenes: Jolt's pyramid, 196 small pyramids, a mixed pile on a terrain mesh, a pile of 100
-// jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), and a 10k
-// box grid awake and asleep.
+// jointed capsule chains, Jolt's ragdoll piles (the built-in scene `ragdolls`), a 10k box grid
+// awake and asleep, and the peers' scenes from configs/scenes (Box3D's large_pyramid,
+// convex_pile, washer, junkyard, joint_grid, rain, trees and large_world, Jolt's
+// ConvexVsMesh), each with its own settings as `spindle bench` runs it.
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
@@ -33,19 +35,21 @@ enum class SceneKind {
     MixedPileOnMesh,  // four shape types falling onto a terrain mesh, from the drop
     ChainPile,        // 100 ball-socket chains of 10 capsules landing in a tangle (ragdoll-pile load)
     Ragdolls,         // configs/scenes/ragdolls.toml: 160 ragdolls in 16 piles on a heightfield, from the drop
+    SceneFile,        // configs/scenes/<name>.toml, from its second step
     GridAwake,        // 10k resting boxes, sleeping disabled: the full pipeline every step
     GridSleeping,     // the same boxes once asleep: what a sleeping body costs per step
 };
 
 struct EngineScene {
-    const char* name;
+    const char* name;  // SceneFile: the built-in scene's name too
     SceneKind kind;
     int steps;  // timed steps per run
 };
 
-// Step counts keep the whole default run (both thread counts) under about two minutes even
-// on a loaded machine. The pyramid takes 300 steps here (it stands after ~60); bench_peers
-// runs the full 500-step Jolt measure against Bullet.
+// Step counts keep the whole default run (both thread counts) to a few minutes even on a
+// loaded machine (the peers' scene files about a minute of it, much of that large_world's
+// million static bodies being built). The pyramid takes 300 steps here (it stands after
+// ~60); bench_peers runs the full 500-step Jolt measure against Bullet.
 constexpr EngineScene kScenes[] = {
     {"pyramid", SceneKind::Pyramid, 300},
     {"many_pyramids", SceneKind::ManyPyramids, 40},
@@ -54,6 +58,15 @@ constexpr EngineScene kScenes[] = {
     {"ragdolls", SceneKind::Ragdolls, 300},  // five seconds: dropped, piled and come to rest
     {"grid_10k_awake", SceneKind::GridAwake, 60},
     {"grid_10k_sleeping", SceneKind::GridSleeping, 300},
+    {"large_pyramid", SceneKind::SceneFile, 100},   // Box3D's: standing from the start
+    {"convex_pile", SceneKind::SceneFile, 100},     // falling hulls
+    {"washer", SceneKind::SceneFile, 60},           // cubes tumbling in the drum
+    {"junkyard", SceneKind::SceneFile, 60},         // rocks falling into the yard
+    {"joint_grid", SceneKind::SceneFile, 60},       // chains swinging down
+    {"rain", SceneKind::SceneFile, 240},            // the ragdolls land at about step 120
+    {"trees", SceneKind::SceneFile, 300},           // falling, landing and rolling
+    {"large_world", SceneKind::SceneFile, 60},      // a million static boxes: about 10 s to build
+    {"convex_vs_mesh", SceneKind::SceneFile, 300},  // dropped, bouncing, rolling
 };
 
 constexpr int kGridPerSide = 100;  // 10,000 boxes
@@ -84,7 +97,8 @@ struct Built {
 };
 
 // Builds the scene and takes the untimed steps it needs.
-Built build(SceneKind kind, unsigned threads) {
+Built build(const EngineScene& scene_entry, unsigned threads) {
+    const SceneKind kind = scene_entry.kind;
     Built built;
     built.jobs = make_bench_jobs(threads);
     SpaceSettings settings;
@@ -97,7 +111,8 @@ Built build(SceneKind kind, unsigned threads) {
         case SceneKind::GridSleeping: boxes = box_grid_scene(kGridPerSide); break;
         case SceneKind::MixedPileOnMesh:
         case SceneKind::ChainPile:
-        case SceneKind::Ragdolls: break;
+        case SceneKind::Ragdolls:
+        case SceneKind::SceneFile: break;
     }
     built.heap_before = live_heap_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
@@ -106,9 +121,10 @@ Built build(SceneKind kind, unsigned threads) {
         built.bodies = add_mixed_pile_on_mesh(space, kMixedPileBodies);
     } else if (kind == SceneKind::ChainPile) {
         built.bodies = add_chain_pile(space, kChains, kLinksPerChain);
-    } else if (kind == SceneKind::Ragdolls) {
-        // The scene's own settings (sleeping on, as in Jolt's), like `spindle bench ragdolls`.
-        const SceneDesc scene = load_scene(SPINDLE_SOURCE_DIR "/configs/scenes/ragdolls.toml");
+    } else if (kind == SceneKind::Ragdolls || kind == SceneKind::SceneFile) {
+        // The scene's own settings (ragdolls: sleeping on, as in Jolt's), like `spindle bench`.
+        const std::string name = kind == SceneKind::Ragdolls ? "ragdolls" : scene_entry.name;
+        const SceneDesc scene = load_scene(SPINDLE_SOURCE_DIR "/configs/scenes/" + name + ".toml");
         const std::vector<BodyHandle> handles = spindle::build(scene, space, &built.joints);
         for (std::size_t i = 0; i < handles.size(); ++i) {
             if (scene.bodies[i].desc.type == MotionType::Dynamic) built.bodies.push_back(handles[i]);
@@ -120,6 +136,8 @@ Built build(SceneKind kind, unsigned threads) {
         for (int i = 0; i < kGridSettleSteps; ++i) space.update();
     } else if (kind == SceneKind::ChainPile) {
         for (int i = 0; i < kChainSettleSteps; ++i) space.update();
+    } else if (kind == SceneKind::SceneFile) {
+        space.update();  // the first step makes every contact: left out, as the peers' benchmarks do
     } else if (kind == SceneKind::GridSleeping) {
         int steps = 0;
         do {
@@ -152,7 +170,7 @@ WorstJointError worst_joint_error(const Space& space, const std::vector<JointHan
 
 void bm_scene(benchmark::State& state, EngineScene scene) {
     const auto threads = static_cast<unsigned>(state.range(0));
-    Built built = build(scene.kind, threads);
+    Built built = build(scene, threads);
     if (!built.asleep) {
         state.SkipWithError("the grid did not fall asleep within the step cap");
         return;

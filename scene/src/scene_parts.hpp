@@ -16,9 +16,9 @@
 
 namespace spindle::scene_detail {
 
-// The largest scene the loader accepts (a typo such as count = 1000000 fails clearly
-// instead of exhausting memory).
-inline constexpr std::size_t kMaxSceneBodies = 1'000'000;
+// The largest scene the loader accepts (a typo such as count = [1000, 1000, 10] fails
+// clearly instead of exhausting memory); room for Box3D's large_world (1,000,100 bodies).
+inline constexpr std::size_t kMaxSceneBodies = 2'000'000;
 
 // A shape table such as { box = [1, 1, 1] }; `what` is its dotted key ("body.shape").
 ShapeSpec parse_shape(const TomlReader& reader, const toml::node& node, std::string_view what);

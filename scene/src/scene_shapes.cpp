@@ -3,6 +3,7 @@
 #include <spindle/platform/error.hpp>
 #include <spindle/scene/scene.hpp>
 
+#include <array>
 #include <cmath>
 
 #include "scene_parts.hpp"
@@ -56,9 +57,25 @@ ShapeSpec parse_mesh(const TomlReader& r, const toml::node& node, const std::str
     return s;
 }
 
+// A generated heightfield's wavelength: one for both axes, or [along x, along z] (Box3D's
+// wave mesh waves twice as fast along x as along z).
+std::array<Real, 2> parse_wavelength(const TomlReader& r, const toml::node* node, const std::string& what) {
+    if (!node) return {10, 10};
+    if (!node->is_array()) {
+        const Real both = r.positive(*node, what);
+        return {both, both};
+    }
+    const std::vector<Real> v = r.numbers(*node, what, 2, "wx, wz in m");
+    for (std::size_t i = 0; i < 2; ++i) {
+        if (!(v[i] > 0))
+            r.fail(*node->as_array()->get(i), what + ": expected numbers > 0 [wx, wz in m], got " + show(v[i]));
+    }
+    return {v[0], v[1]};
+}
+
 // A terrain as a triangle mesh over a grid in x and z, centred on the body's origin:
 // heights either listed (rows along z, each along x) or a product of sines
-// amplitude * sin(2 pi x / wavelength) * sin(2 pi z / wavelength).
+// amplitude * sin(2 pi x / wx) * sin(2 pi z / wz).
 ShapeSpec parse_heightfield(const TomlReader& r, const toml::node& node, const std::string& what) {
     const toml::table& t = r.table(node, what,
                                    "{ size = [sx, sz], cells = [nx, nz], amplitude = a, wavelength = w } or "
@@ -95,14 +112,14 @@ ShapeSpec parse_heightfield(const TomlReader& r, const toml::node& node, const s
         const std::int64_t nx = r.integer(*cells.get(0), what + ".cells", 1, kMaxHeightfieldCells);
         const std::int64_t nz = r.integer(*cells.get(1), what + ".cells", 1, kMaxHeightfieldCells);
         const Real amplitude = t.get("amplitude") ? r.number(*t.get("amplitude"), what + ".amplitude") : 0;
-        const Real wavelength = t.get("wavelength") ? r.positive(*t.get("wavelength"), what + ".wavelength") : 10;
+        const std::array<Real, 2> wavelength = parse_wavelength(r, t.get("wavelength"), what + ".wavelength");
         for (std::int64_t iz = 0; iz <= nz; ++iz) {
             heights.emplace_back();
             for (std::int64_t ix = 0; ix <= nx; ++ix) {
                 const Real x = size[0] * (static_cast<Real>(ix) / static_cast<Real>(nx) - 0.5);
                 const Real z = size[1] * (static_cast<Real>(iz) / static_cast<Real>(nz) - 0.5);
-                heights.back().push_back(amplitude * std::sin(2 * kPi * x / wavelength) *
-                                         std::sin(2 * kPi * z / wavelength));
+                heights.back().push_back(amplitude * std::sin(2 * kPi * x / wavelength[0]) *
+                                         std::sin(2 * kPi * z / wavelength[1]));
             }
         }
     }

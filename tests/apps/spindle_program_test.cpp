@@ -222,26 +222,107 @@ TEST(SpindleProgram, RunASceneFile) {
 TEST(SpindleProgram, BenchPyramid_PrintsOneLine) {
     const Result r = spindle("bench pyramid --steps 5", true);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    // scene=pyramid bodies=1240 threads=1 steps=5 steps_per_s=X top_y=Y hash=0x<16 hex digits>\n
+    // scene=pyramid bodies=1240 threads=1 steps=5 steps_per_s=X ms_per_step=X first_step_ms=X top_y=Y
+    //   hash=0x<16 hex digits>\n
     ASSERT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     ASSERT_EQ(r.output.back(), '\n');
     const std::vector<std::string> w = words(r.output);
-    ASSERT_EQ(w.size(), 7u) << r.output;
+    ASSERT_EQ(w.size(), 9u) << r.output;
     EXPECT_EQ(w[0], "scene=pyramid");
     EXPECT_EQ(w[1], "bodies=1240");
     EXPECT_EQ(w[2], "threads=1");
     EXPECT_EQ(w[3], "steps=5");
     EXPECT_EQ(w[4].rfind("steps_per_s=", 0), 0u);
     EXPECT_TRUE(all_of_chars(w[4].substr(12), "0123456789.")) << w[4];
-    EXPECT_EQ(w[5].rfind("top_y=", 0), 0u);
-    EXPECT_TRUE(all_of_chars(w[5].substr(6), "-0123456789.")) << w[5];
-    EXPECT_EQ(w[6].rfind("hash=0x", 0), 0u);
-    EXPECT_EQ(w[6].size(), 7u + 16u) << w[6];
-    EXPECT_TRUE(all_of_chars(w[6].substr(7), "0123456789abcdef")) << w[6];
+    EXPECT_EQ(w[5].rfind("ms_per_step=", 0), 0u) << w[5];
+    EXPECT_EQ(w[6].rfind("first_step_ms=", 0), 0u) << w[6];
+    EXPECT_EQ(w[7].rfind("top_y=", 0), 0u);
+    EXPECT_TRUE(all_of_chars(w[7].substr(6), "-0123456789.")) << w[7];
+    EXPECT_EQ(w[8].rfind("hash=0x", 0), 0u);
+    EXPECT_EQ(w[8].size(), 7u + 16u) << w[8];
+    EXPECT_TRUE(all_of_chars(w[8].substr(7), "0123456789abcdef")) << w[8];
 
     const Result substeps = spindle("bench stack --steps 3 --substeps 2 --threads 1", true);
     ASSERT_EQ(substeps.exit_code, 0) << substeps.output;
     expect_contains(substeps.output, "scene=stack bodies=20 threads=1 steps=3 ");
+}
+
+// The value of `key=` in a line of words, as a number.
+double field(const std::vector<std::string>& w, const std::string& key) {
+    for (const std::string& word : w) {
+        if (word.rfind(key + "=", 0) == 0) return std::stod(word.substr(key.size() + 1));
+    }
+    ADD_FAILURE() << "no " << key << "= in the line";
+    return -1;
+}
+
+// The first step (it makes every contact) is timed apart from the mean of the others, and
+// together they are the run's time.
+TEST(SpindleProgram, BenchLine_HasTheStepTimeAndTheFirstStepApart) {
+    const Result r = spindle("bench pyramid --steps 20", true);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::vector<std::string> w = words(r.output);
+    const double steps_per_s = field(w, "steps_per_s");
+    const double ms_per_step = field(w, "ms_per_step");
+    const double first_step_ms = field(w, "first_step_ms");
+    EXPECT_GT(ms_per_step, 0.0) << r.output;
+    EXPECT_GT(first_step_ms, 0.0) << r.output;
+    const double run_seconds = (first_step_ms + 19 * ms_per_step) * 1e-3;
+    EXPECT_NEAR(20 / run_seconds, steps_per_s, 0.01 * steps_per_s) << r.output;
+
+    const Result one = spindle("bench stack --steps 1", true);
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    EXPECT_EQ(field(words(one.output), "ms_per_step"), 0.0) << one.output;  // no step after the first
+    EXPECT_GT(field(words(one.output), "first_step_ms"), 0.0) << one.output;
+}
+
+// --serial: the share of the quieter half of the traced steps with at most one worker
+// working, Amdahl's bounds from it, and the serial parts over 2 % of a step, longest first.
+TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
+    const Result r = spindle("bench pyramid --threads 2 --steps 20 --serial", true);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::vector<std::vector<std::string>> lines;
+    std::istringstream in(r.output);
+    for (std::string line; std::getline(in, line);) lines.push_back(words(line));
+    ASSERT_GE(lines.size(), 2u) << r.output;
+    const std::vector<std::string>& summary = lines[1];
+    ASSERT_EQ(summary.size(), 8u) << r.output;
+    const double serial = field(summary, "serial_fraction");
+    const double serial_work = field(summary, "serial_work_fraction");
+    EXPECT_GT(serial, 0.0);  // at least the stages' own code between jobs
+    EXPECT_LE(serial, 1.0);
+    EXPECT_LE(serial_work, serial);  // one worker's work counts the parallel time twice
+    const double a4 = field(summary, "amdahl_4"), a8 = field(summary, "amdahl_8"), a16 = field(summary, "amdahl_16");
+    EXPECT_GE(a4, 1.0);
+    EXPECT_LE(a4, 4.0);
+    EXPECT_GE(a8, a4);
+    EXPECT_GE(a16, a8);
+    EXPECT_LE(a16, 1 / serial_work + 1e-9);
+    EXPECT_EQ(field(summary, "traced_steps"), 19.0);
+    EXPECT_GE(field(summary, "all_steps_serial_fraction"), serial - 1e-4);  // the quieter half's is the least
+    const double code = field(summary, "serial_code_fraction");
+    EXPECT_GT(code, 0.0);  // the stages' own code between jobs
+    EXPECT_LE(code, field(summary, "all_steps_serial_fraction"));
+    double previous = 1, sum = 0;
+    for (std::size_t i = 2; i < lines.size(); ++i) {
+        const std::vector<std::string>& part = lines[i];
+        ASSERT_GE(part.size(), 4u) << r.output;
+        EXPECT_EQ(part[0], "serial_part");
+        const double share = field(part, "share");
+        EXPECT_GE(share, 0.02) << r.output;
+        EXPECT_LE(share, previous) << r.output;
+        previous = share;
+        sum += share;
+        EXPECT_EQ(part[3].rfind("name=\"", 0), 0u) << r.output;
+    }
+    EXPECT_LE(sum, serial + 1e-3) << r.output;
+
+    const Result one = spindle("bench pyramid --threads 1 --serial");
+    EXPECT_EQ(one.exit_code, 2) << one.output;
+    expect_contains(one.output, "--serial needs --threads 2 or more");
+    const Result untraced = spindle("bench pyramid --threads 2 --steps 1 --serial");  // the first step is not traced
+    EXPECT_EQ(untraced.exit_code, 2) << untraced.output;
+    expect_contains(untraced.output, "--steps 2 or more");
 }
 
 TEST(SpindleProgram, BenchStages_PrintsMillisecondsPerStage) {
@@ -308,12 +389,21 @@ TEST(SpindleProgram, Scenes_ListsEveryBuiltInSceneWithItsBodyCount) {
         if (entry.path().extension() == ".toml") expect_contains(r.output, entry.path().stem().string() + " ");
     }
     // name, dynamic bodies, other bodies, description
-    for (const auto& [scene, dynamic] : std::vector<std::pair<std::string, std::string>>{
-             {"pyramid", "1240"}, {"many_pyramids", "10780"}, {"stack", "20"}, {"convex_pile", "5120"}}) {
-        const std::vector<std::string> w = line_starting_with(r.output, scene);
-        ASSERT_GE(w.size(), 3u) << scene << " not listed in\n" << r.output;
-        EXPECT_EQ(w[1], dynamic) << scene;
-        EXPECT_EQ(w[2], "1") << scene;
+    struct Listed {
+        std::string scene, dynamic, other;
+    };
+    for (const Listed& l : std::vector<Listed>{{"pyramid", "1240", "1"},
+                                               {"many_pyramids", "10780", "1"},
+                                               {"stack", "20", "1"},
+                                               {"convex_pile", "5120", "1"},
+                                               {"rain", "3600", "200"},
+                                               {"trees", "50", "1"},
+                                               {"large_world", "100", "1000000"},
+                                               {"convex_vs_mesh", "1764", "1"}}) {
+        const std::vector<std::string> w = line_starting_with(r.output, l.scene);
+        ASSERT_GE(w.size(), 3u) << l.scene << " not listed in\n" << r.output;
+        EXPECT_EQ(w[1], l.dynamic) << l.scene;
+        EXPECT_EQ(w[2], l.other) << l.scene;
     }
 }
 

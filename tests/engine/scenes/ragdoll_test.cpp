@@ -220,7 +220,7 @@ TEST(SceneRagdoll, BrokenRagdolls_AreRejectedAtTheLine) {
     EXPECT_REJECTED("[[ragdoll]]\nmass = nan\n", "2:8", "ragdoll.mass");
     EXPECT_REJECTED("[[ragdoll]]\ncopies = { count = [2, 0, 1], step = [1, 0, 0] }\n", "2:24", "ragdoll.copies.count");
     EXPECT_REJECTED("[[ragdoll]]\ncopies = { count = [1000, 1000, 1], step = [1, 0, 0] }\n", "1:1",
-                    "ragdoll: makes 1.2e+07 bodies; a scene may have at most 1000000");
+                    "ragdoll: makes 1.2e+07 bodies; a scene may have at most 2000000");
     EXPECT_REJECTED("[[ragdoll]]\nlinks = 3\n", "2:1", "unknown key 'links' in [[ragdoll]]");
 }
 

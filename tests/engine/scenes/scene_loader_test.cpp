@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -176,6 +177,59 @@ TEST(SceneFiles, Box3DBenchmarkScenes_HaveBox3DsDynamicBodies) {
     const SceneDesc joint_grid = load("joint_grid");
     EXPECT_EQ(joint_grid.dynamic_body_count(), 9900u);
     EXPECT_EQ(joint_grid.joints.size(), 9900u);  // the columns' joints; Box3D's net has 19,800
+
+    // rain: the full grid of Box3D's Release build, 10 x 10 cells of 3 humans, all at once.
+    const SceneDesc rain = load("rain");
+    EXPECT_EQ(rain.dynamic_body_count(), 300u * 12u);
+    EXPECT_EQ(rain.joints.size(), 300u * 11u);
+    EXPECT_EQ(rain.bodies.size() - rain.dynamic_body_count(), 200u);  // a grid mesh and a torus per cell
+    for (const SceneBody& b : rain.bodies) {
+        if (b.desc.type == MotionType::Static) {
+            ASSERT_EQ(rain.shapes[b.shape].type, ShapeType::TriangleMesh);
+        }
+    }
+
+    const SceneDesc trees = load("trees");
+    EXPECT_EQ(trees.dynamic_body_count(), 50u);
+    for (const SceneBody& b : trees.bodies) {
+        if (b.desc.type != MotionType::Dynamic) continue;
+        ASSERT_EQ(trees.shapes[b.shape].type, ShapeType::Compound);
+        ASSERT_EQ(trees.shapes[b.shape].parts.size(), 22u);
+        ASSERT_EQ(b.desc.density, 1.0);
+        ASSERT_EQ(b.desc.friction, 0.9);
+    }
+
+    const SceneDesc large_world = load("large_world");
+    EXPECT_EQ(large_world.dynamic_body_count(), 100u);
+    EXPECT_EQ(large_world.bodies.size(), 1'000'100u);
+}
+
+// Jolt's PerformanceTest "ConvexVsMesh": 21 x 21 of each of four shapes over a 100 x 100 cell
+// terrain whose vertex (ix, iz) is at (3 ix - 150, 5 + 5 sin(ix / 2) cos(iz / 2), 3 iz - 150).
+TEST(SceneFiles, ConvexVsMesh_IsJoltsScene) {
+    const SceneDesc scene = load("convex_vs_mesh");
+    EXPECT_EQ(scene.dynamic_body_count(), 1764u);
+    std::array<int, static_cast<int>(ShapeType::Count)> per_type{};
+    for (const SceneBody& b : scene.bodies) {
+        ASSERT_EQ(b.desc.friction, 0.5);
+        ASSERT_EQ(b.desc.restitution, 0.6);
+        if (b.desc.type == MotionType::Dynamic) per_type[static_cast<int>(scene.shapes[b.shape].type)] += 1;
+    }
+    for (ShapeType t : {ShapeType::Box, ShapeType::Sphere, ShapeType::Capsule, ShapeType::ConvexHull}) {
+        EXPECT_EQ(per_type[static_cast<int>(t)], 441) << to_string(t);
+    }
+    const SceneBody& terrain = scene.bodies[0];
+    ASSERT_EQ(terrain.desc.type, MotionType::Static);
+    EXPECT_EQ(terrain.desc.position, Vec3(0, 5, 0));
+    const ShapeSpec& mesh = scene.shapes[terrain.shape];
+    ASSERT_EQ(mesh.points.size(), 101u * 101u);
+    EXPECT_EQ(mesh.indices.size(), 3u * 2u * 100u * 100u);
+    for (const auto& [ix, iz] : {std::pair{0, 0}, {1, 0}, {7, 3}, {100, 100}}) {
+        const Vec3& p = mesh.points[static_cast<std::size_t>(iz * 101 + ix)];
+        EXPECT_NEAR(p.x(), 3.0 * ix - 150, 1e-9);
+        EXPECT_NEAR(p.z(), 3.0 * iz - 150, 1e-9);
+        EXPECT_NEAR(p.y(), 5 * std::sin(0.5 * ix) * std::cos(0.5 * iz), 1e-5) << ix << ", " << iz;
+    }
 }
 
 TEST(SceneParse, EveryShape_IsRead) {
@@ -223,6 +277,30 @@ shape = { heightfield = { size = [2, 2], heights = [[0, 1], [2, 3]] } }
     const ShapeSpec& listed = scene.shapes[5];
     ASSERT_EQ(listed.points.size(), 4u);
     EXPECT_EQ(listed.points[3], Vec3(1, 3, 1));  // row 1 (z = +1), column 1 (x = +1)
+}
+
+// Box3D's wave mesh (the trees scene) waves at one wavelength along x and another along z.
+TEST(SceneParse, HeightfieldWithTwoWavelengths_WavesAtEachAlongItsAxis) {
+    const SceneDesc scene = parse_scene(R"(
+[[body]]
+type = "static"
+shape = { heightfield = { size = [20, 40], cells = [8, 16], amplitude = -0.5, wavelength = [10, 20] } }
+)",
+                                        "waves.toml");
+    const ShapeSpec& field = scene.shapes.at(0);
+    ASSERT_EQ(field.points.size(), 9u * 17u);
+    for (const Vec3& p : field.points) {
+        ASSERT_NEAR(p.y(), -0.5 * std::sin(2 * kPi * p.x() / 10) * std::sin(2 * kPi * p.z() / 20), 1e-12)
+            << p.transpose();
+    }
+    // x = -2.5, z = -5: a quarter wavelength from the centre on both axes, the lowest point.
+    EXPECT_NEAR(field.points[6 * 9 + 3].y(), -0.5, 1e-12);
+    EXPECT_REJECTED("[[body]]\ntype = \"static\"\nshape = { heightfield = { size = [1, 1], cells = [1, 1], "
+                    "wavelength = [10, 0] } }\n",
+                    "3:76", "body.shape.heightfield.wavelength: expected numbers > 0 [wx, wz in m], got 0");
+    EXPECT_REJECTED("[[body]]\ntype = \"static\"\nshape = { heightfield = { size = [1, 1], cells = [1, 1], "
+                    "wavelength = [10] } }\n",
+                    "3:71", "body.shape.heightfield.wavelength: expected an array of 2 numbers");
 }
 
 TEST(SceneParse, Compound_IsReadAndBuilt) {
@@ -469,7 +547,7 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncopies = { count = [2, 0, 1], step = [1, 1, 1] }\n", "3:24",
                     "body.copies.count: expected an integer in [1, 1000000], got 0");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ncopies = { count = [1000, 1000, 10], step = [1, 1, 1] }\n",
-                    "1:1", "a scene may have at most 1000000");
+                    "1:1", "a scene may have at most 2000000");
     EXPECT_REJECTED("[[pyramid]]\nshape = { box = [1, 1, 1] }\n", "1:1", "pyramid: missing key 'layers'");
     EXPECT_REJECTED("[[stack]]\nshape = { sphere = 1 }\ncount = 2\ngap = 0.1\nspacing = 3\n", "5:11",
                     "stack.spacing: not allowed together with gap");
