@@ -15,6 +15,7 @@
 #include <algorithm>
 
 #include "solver/constraints.hpp"
+#include "stages/capacity.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -326,8 +327,14 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
 void pack_contacts(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
-    scratch.wide.resize(count);                // kept from step to step: prepare_wide writes every field
-    scratch.push_rows.resize(count * kLanes);  // a row is written by push_out before it is read
+    // Kept from step to step (prepare_wide writes every field, push_out a row before it
+    // is read), at about the size of the step's.
+    reserve_for(scratch.wide, count);
+    scratch.wide.resize(count);
+    if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
+    reserve_for(scratch.push_rows, count * kLanes);
+    scratch.push_rows.resize(count * kLanes);
+    if (far_above_use(scratch.push_rows.capacity(), count * kLanes)) fit_capacity(scratch.push_rows);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     std::size_t next = 0;
     auto add = [&](const std::uint32_t* refs, int lanes) {

@@ -4,6 +4,7 @@
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/capacity.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
@@ -11,18 +12,20 @@ namespace spindle {
 
 void reserve_contacts(World& world, std::size_t more) {
     const std::size_t needed = world.contacts.size() + more;
-    if (world.contacts.capacity() < needed) {
-        // Geometric, as push_back would grow: room for exactly `needed` would make the
-        // next step's few new contacts reallocate (and move every contact) again.
-        const std::size_t capacity = std::max(needed, 2 * world.contacts.capacity());
-        world.contacts.reserve(capacity);
-        world.contact_keys.reserve(capacity);
-        world.contact_summaries.reserve(capacity);
-    }
+    reserve_for(world.contacts, needed);
+    reserve_for(world.contact_keys, needed);
+    reserve_for(world.contact_summaries, needed);
     if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
         static_cast<float>(needed)) {
         world.contact_index.reserve(std::max(needed, 2 * world.contact_index.size()));
     }
+}
+
+void fit_contacts(World& world) {
+    if (!far_above_use(world.contacts.capacity(), world.contacts.size())) return;
+    fit_capacity(world.contacts);
+    fit_capacity(world.contact_keys);
+    fit_capacity(world.contact_summaries);
 }
 
 void create_contact(World& world, std::uint64_t key) {
