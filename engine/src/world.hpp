@@ -99,12 +99,7 @@ struct Bodies {
 // One touching manifold with what the solver keeps between steps (impulses, for
 // warm starting, matched by feature id).
 struct ContactPoint {
-    ManifoldPoint geometry;  // as collided; a recycled manifold updates the separation only
-    // Anchors (Box3D's): the point from each body's centre of mass, world axes, as it was
-    // when collided. They stay attached to their bodies while the manifold is recycled
-    // (narrowphase.cpp), and the solver pushes each body at its own anchor.
-    Vec3 anchor_a = Vec3::Zero();
-    Vec3 anchor_b = Vec3::Zero();
+    ManifoldPoint geometry;    // as collided; a recycled manifold updates the separation only
     Real base_separation = 0;  // the separation when collided
     Real normal_impulse = 0;
     Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
@@ -148,6 +143,14 @@ struct Contact {
     bool cached = false;
     Vec3 cached_position = Vec3::Zero();
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
+    // The bodies' centres of mass then. A point's anchors (Box3D's) are its offsets from
+    // them, world axes: they stay attached to their bodies while the manifolds are
+    // recycled, and the solver pushes each body at its own anchor. Kept once per contact
+    // rather than twice per point: the record is most of the memory a pile holds.
+    Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
+
+    Vec3 anchor_a(const ContactPoint& p) const { return p.geometry.point - cached_xa; }
+    Vec3 anchor_b(const ContactPoint& p) const { return p.geometry.point - cached_xb; }
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
     const ContactManifold& manifold_at(int i) const {

@@ -160,16 +160,16 @@ WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wid
 // weighted down for points farther apart than friction_distance (up to twice that they
 // fade out, so the centre moves smoothly as points come and go); the two tangent rows at
 // the centre with their coupled 2x2 effective mass; the twist row about the normal.
-void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactManifold& m, const Vec3 (&tangent)[2],
-                      Real friction_distance, WideContact& wc, int l) {
+void prepare_friction(const SolverBody& A, const SolverBody& B, const Contact& contact, const ContactManifold& m,
+                      const Vec3 (&tangent)[2], Real friction_distance, WideContact& wc, int l) {
     constexpr Real kMinWeight = 1e-3;
     Vec3 center_a = Vec3::Zero(), center_b = Vec3::Zero();
     Real total = 0;
     for (int j = 0; j < m.point_count; ++j) {
         const ContactPoint& p = m.points[j];
         const Real weight = std::clamp(2 - p.geometry.separation / friction_distance, kMinWeight, Real(1));
-        center_a += weight * p.anchor_a;
-        center_b += weight * p.anchor_b;
+        center_a += weight * contact.anchor_a(p);
+        center_b += weight * contact.anchor_b(p);
         total += weight;
     }
     if (total > 0) {
@@ -177,7 +177,7 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
         center_b /= total;
     }
     for (int j = 0; j < m.point_count; ++j) {
-        wc.points[j].lever_arm[l] = static_cast<float>((m.points[j].anchor_a - center_a).norm());
+        wc.points[j].lever_arm[l] = static_cast<float>((contact.anchor_a(m.points[j]) - center_a).norm());
     }
     wc.center_a.set_lane(l, center_a);
     wc.center_b.set_lane(l, center_b);
@@ -288,13 +288,13 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
                          project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
-            ra[j].set_lane(l, src.anchor_a);
-            rb[j].set_lane(l, src.anchor_b);
+            ra[j].set_lane(l, contact.anchor_a(src));
+            rb[j].set_lane(l, contact.anchor_b(src));
             separation[j][l] = src.geometry.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
-        prepare_friction(A, B, m, tangent, friction_distance, wc, l);
+        prepare_friction(A, B, contact, m, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     // How deep a point's last impulse holds its soft row at rest, per lane (stiffer
