@@ -102,14 +102,18 @@ struct ContactPoint {
     ManifoldPoint geometry;    // as collided; a recycled manifold updates the separation only
     Real base_separation = 0;  // the separation when collided
     Real normal_impulse = 0;
-    Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
-    Real relative_velocity = 0;   // normal approach speed before solving (restitution)
 };
 
 struct ContactManifold {
     Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
     int point_count = 0;
     std::uint32_t part_a = 0, part_b = 0;  // the compound parts that touch (Manifold::part_a, part_b)
+    // The last solved step's push, for hit events (contact_events.cpp): of the points whose
+    // normal impulse pushed, the one that approached fastest (-1: none pushed), and its
+    // approach speed before solving. Per manifold, not per point: a pile's contacts are
+    // most of the memory it holds, and only reporting contacts read it.
+    std::int8_t pushed_point = -1;
+    Real pushed_speed = 0;
     // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
     // when collided, so that recycling and the solver stay off the cold descriptions.
     Real radius_a = 0, radius_b = 0;

@@ -612,12 +612,16 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.friction_impulse = wc.friction_impulse[0][l] * wc.tangent[0].lane(l) +
                                  wc.friction_impulse[1][l] * wc.tangent[1].lane(l);
             m.twist_impulse = wc.twist_impulse[l];
+            m.pushed_point = -1;
+            m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {
                 const WidePoint& p = wc.points[j];
-                ContactPoint& dst = m.points[j];
-                dst.normal_impulse = p.normal_impulse[l];
-                dst.max_normal_impulse = p.max_normal_impulse[l];
-                dst.relative_velocity = p.relative_velocity[l];
+                m.points[j].normal_impulse = p.normal_impulse[l];
+                const Real approach = -p.relative_velocity[l];
+                if (p.max_normal_impulse[l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {
+                    m.pushed_point = static_cast<std::int8_t>(j);
+                    m.pushed_speed = approach;
+                }
             }
         }
     }

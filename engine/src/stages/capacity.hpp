@@ -17,11 +17,11 @@ void reserve_for(std::vector<T>& v, std::size_t needed) {
     if (v.capacity() < needed) v.reserve(std::max(needed, v.capacity() + v.capacity() / 4));
 }
 
-// Whether a capacity is far enough above its use to give back: half as much again, and
-// more than a few elements (small arrays are not worth the move).
+// Whether a capacity is far enough above its use to give back: a quarter more, and more
+// than a few elements (small arrays are not worth the move).
 inline bool far_above_use(std::size_t capacity, std::size_t size) {
     constexpr std::size_t kMinExcess = 64;
-    return capacity > size + size / 2 + kMinExcess;
+    return capacity > size + size / 4 + kMinExcess;
 }
 
 // Moves the elements into an array with an eighth to spare.

@@ -105,14 +105,12 @@ void note_hits(World& world) {
         contact.pushed = false;
         for (int m = 0; m < contact.manifold_count; ++m) {
             const ContactManifold& manifold = contact.manifold_at(m);
-            for (int j = 0; j < manifold.point_count; ++j) {
-                const ContactPoint& p = manifold.points[j];
-                contact.pushed = contact.pushed || p.max_normal_impulse > 0;
-                if (!pushed_before && p.max_normal_impulse > 0 && -p.relative_velocity > fastest) {
-                    fastest = -p.relative_velocity;
-                    hit_manifold = &manifold;
-                    hit_point = &p;
-                }
+            if (manifold.pushed_point < 0) continue;
+            contact.pushed = true;
+            if (!pushed_before && manifold.pushed_speed > fastest) {
+                fastest = manifold.pushed_speed;
+                hit_manifold = &manifold;
+                hit_point = &manifold.points[manifold.pushed_point];
             }
         }
         if (!hit_point) continue;
