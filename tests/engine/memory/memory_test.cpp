@@ -30,15 +30,15 @@ struct Pyramid {
     }
 };
 
-constexpr int kLanded = 120;  // the top layer lands after about 60 steps
+constexpr int kLanded = 300;  // landed after about 60 steps; bench_engine times 300 from the drop
 
 }  // namespace
 
-TEST(Memory, PyramidAfterItsDropHoldsUnderThirteenKilobytesPerBody) {
+TEST(Memory, PyramidAfterItsDropHoldsUnderFifteenKilobytesPerBody) {
     const Pyramid pyramid(kLanded);
-    // 20.6 KB per body before issue 19: the contact array doubled for a few new contacts,
-    // and each point kept two anchors.
-    EXPECT_LT(pyramid.bytes_per_body(), 13'000);
+    // 21.1 KB per body before issue 19: the contact array doubled for a few new contacts,
+    // and each point kept its anchors and its step's push.
+    EXPECT_LT(pyramid.bytes_per_body(), 15'000);
     const World& world = SpaceInternals::world(pyramid.space);
     EXPECT_LE(world.contacts.capacity(), world.contacts.size() + world.contacts.size() / 2 + 64);
 }
