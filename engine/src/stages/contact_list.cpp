@@ -29,20 +29,19 @@ void fit_contacts(World& world) {
 }
 
 void create_contact(World& world, std::uint64_t key) {
-    if (world.contact_index.count(key)) return;
+    // One lookup: a first step makes tens of thousands of contacts.
+    if (!world.contact_index.try_emplace(key, static_cast<std::uint32_t>(world.contacts.size())).second) return;
     const auto a = static_cast<std::uint32_t>(key >> 32);
     const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
     const Bodies& bodies = world.bodies;
-    Contact contact;
+    Contact& contact = world.contacts.emplace_back();  // in place: the record is large
     contact.body_a = a;
     contact.body_b = b;
     // Mixing rules as most engines: geometric mean friction, largest restitution.
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     note_contact_created(world, contact);  // before the summary: a sensor's has no points
-    world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contact_summaries.push_back(contact_summary(contact));
-    world.contacts.push_back(std::move(contact));
     world.contact_keys.push_back(key);
     world.awake_contacts_dirty = true;
 }
