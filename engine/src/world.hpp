@@ -25,6 +25,7 @@
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
 #include "solver/motion_locks.hpp"
+#include "stages/contact_index.hpp"
 
 namespace spindle {
 
@@ -237,7 +238,7 @@ struct World {
     // pair lists; removal keeps the order of the rest).
     std::unique_ptr<BroadphaseState> broadphase;
     std::vector<Contact> contacts;
-    std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
+    ContactIndex contact_index;  // key -> position in contacts
     std::vector<std::uint64_t>
         contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
     // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of

@@ -39,10 +39,7 @@ MemoryReport memory_report(const Space& space) {
     report.bodies = body_bytes(world.bodies) + held(world.awake) + held(world.awake_pending);
     report.contacts = held(world.contacts);
     for (const Contact& contact : world.contacts) report.contact_extras += held(contact.extra);
-    // An unordered_map node holds the next pointer and the pair.
-    constexpr std::size_t kIndexNode = sizeof(void*) + sizeof(std::pair<const std::uint64_t, std::uint32_t>);
-    report.contact_lookup = world.contact_index.bucket_count() * sizeof(void*) +
-                            world.contact_index.size() * kIndexNode + held(world.contact_keys) +
+    report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +
                             held(world.contact_summaries) + held(world.awake_contact_list);
     const SolverScratch& solver = *world.solver;
     report.wide_contacts = held(solver.wide);

@@ -15,10 +15,7 @@ void reserve_contacts(World& world, std::size_t more) {
     reserve_for(world.contacts, needed);
     reserve_for(world.contact_keys, needed);
     reserve_for(world.contact_summaries, needed);
-    if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
-        static_cast<float>(needed)) {
-        world.contact_index.reserve(std::max(needed, 2 * world.contact_index.size()));
-    }
+    world.contact_index.reserve(needed);
 }
 
 void fit_contacts(World& world) {
@@ -30,7 +27,7 @@ void fit_contacts(World& world) {
 
 void create_contact(World& world, std::uint64_t key) {
     // One lookup: a first step makes tens of thousands of contacts.
-    if (!world.contact_index.try_emplace(key, static_cast<std::uint32_t>(world.contacts.size())).second) return;
+    if (!world.contact_index.insert(key, static_cast<std::uint32_t>(world.contacts.size()))) return;
     const auto a = static_cast<std::uint32_t>(key >> 32);
     const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
     const Bodies& bodies = world.bodies;
@@ -74,7 +71,7 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
             world.contact_keys[write] = world.contact_keys[read];
             world.contact_summaries[write] = world.contact_summaries[read];
         }
-        world.contact_index[world.contact_keys[write]] = static_cast<std::uint32_t>(write);
+        *world.contact_index.find(world.contact_keys[write]) = static_cast<std::uint32_t>(write);
         ++write;
     }
     world.contacts.resize(write);
