@@ -43,7 +43,7 @@ MemoryReport memory_report(const Space& space) {
                             held(world.contact_summaries) + held(world.awake_contact_list);
     const SolverScratch& solver = *world.solver;
     report.wide_contacts = held(solver.wide);
-    report.push_rows = held(solver.push_rows);
+    report.push_rows = held(solver.push_anchors);
     report.solver_other = solver_other_bytes(solver);
     const BroadphaseState& bp = *world.broadphase;
     report.broadphase = bp.tree.heap_bytes() + held(bp.proxy) + held(bp.pairs) + held(bp.refit) + held(bp.refit_slots) +

@@ -332,9 +332,9 @@ void pack_contacts(SolverScratch& scratch) {
     reserve_for(scratch.wide, count);
     scratch.wide.resize(count);
     if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
-    reserve_for(scratch.push_rows, count * kLanes);
-    scratch.push_rows.resize(count * kLanes);
-    if (far_above_use(scratch.push_rows.capacity(), count * kLanes)) fit_capacity(scratch.push_rows);
+    reserve_for(scratch.push_anchors, count * kLanes);
+    scratch.push_anchors.resize(count * kLanes);
+    if (far_above_use(scratch.push_anchors.capacity(), count * kLanes)) fit_capacity(scratch.push_anchors);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     std::size_t next = 0;
     auto add = [&](const std::uint32_t* refs, int lanes) {
@@ -370,7 +370,7 @@ const SolverBody& lane_body(const WideContact& wc, int lane, int side, const Sol
 // impulse), never by real speed, so a chain of deep overlaps separates without
 // launching anything. One row per manifold, through the overlap's depth-weighted centre,
 // so a face pushes straight and a tilted corner turns back.
-void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
+void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
               const Vec3& rb, const ContactSolveParams& params) {
     SolverBody& A = bodies[wc.a[lane]];
     SolverBody& B = bodies[wc.b[lane]];
@@ -379,7 +379,9 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
     SolverBody copy_a, copy_b;
     const SolverBody& Am = lane_body(wc, lane, 0, A, copy_a);
     const SolverBody& Bm = lane_body(wc, lane, 1, B, copy_b);
+    ContactRow row;
     const Real mass = make_row(Am, Bm, ra, rb, normal, row);
+    anchors = {ra, rb};
     Velocities push = load_push(A, B);
     const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
     const Real speed = row_speed(push, normal, row);
@@ -391,7 +393,7 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
 }
 
 template <bool kBias, bool kLocked>
-void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
                 EffectCounts& counts) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
@@ -511,13 +513,14 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         for (int l = 0; l < kLanes; ++l) {
             if (deep_weight[l] <= 0) continue;
             const Real w = deep_weight[l];
-            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w, params);
+            push_out(wc, push_anchors[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
+                     params);
         }
     }
 }
 
 template <bool kLocked>
-void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
@@ -533,9 +536,13 @@ void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* b
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
         SolverBody copy_a, copy_b;
+        const SolverBody& Am = lane_body(wc, l, 0, A, copy_a);
+        const SolverBody& Bm = lane_body(wc, l, 1, B, copy_b);
+        const Vec3 normal = wc.normal.lane(l);
+        ContactRow row;
+        make_row(Am, Bm, push_anchors[l].ra, push_anchors[l].rb, normal, row);
         Velocities push = load_push(A, B);
-        apply_row(lane_body(wc, l, 0, A, copy_a), lane_body(wc, l, 1, B, copy_b), push, wc.normal.lane(l), push_rows[l],
-                  wc.push_impulse[l]);
+        apply_row(Am, Bm, push, normal, row, wc.push_impulse[l]);
         store_push(A, B, push);
     }
 }
@@ -576,22 +583,22 @@ void prepare_contacts(const World& world, SolverScratch& scratch, const ContactS
 
 // Each pass in two builds: with per-axis inverse masses where a lane's body has a
 // translation lock, with the scalar ones (no extra work) everywhere else.
-void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
     if (wc.locked) {
-        warm_start_wide<true>(wc, push_rows, bodies);
+        warm_start_wide<true>(wc, push_anchors, bodies);
     } else {
-        warm_start_wide<false>(wc, push_rows, bodies);
+        warm_start_wide<false>(wc, push_anchors, bodies);
     }
 }
 
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
                    EffectCounts& counts) {
     if (wc.locked) {
-        params.use_bias ? solve_wide<true, true>(wc, push_rows, bodies, params, counts)
-                        : solve_wide<false, true>(wc, push_rows, bodies, params, counts);
+        params.use_bias ? solve_wide<true, true>(wc, push_anchors, bodies, params, counts)
+                        : solve_wide<false, true>(wc, push_anchors, bodies, params, counts);
     } else {
-        params.use_bias ? solve_wide<true, false>(wc, push_rows, bodies, params, counts)
-                        : solve_wide<false, false>(wc, push_rows, bodies, params, counts);
+        params.use_bias ? solve_wide<true, false>(wc, push_anchors, bodies, params, counts)
+                        : solve_wide<false, false>(wc, push_anchors, bodies, params, counts);
     }
 }
 
