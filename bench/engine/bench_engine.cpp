@@ -8,6 +8,7 @@
 //
 // Own flags (taken out before Google Benchmark sees the rest):
 //   --quick   a tenth of each scene's steps (at least 5)
+//   --memory  a line per run: the bytes per body of each structure (api/memory_report.hpp)
 #include "common/jobs.hpp"
 
 #include <spindle/scene/scene.hpp>
@@ -21,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "api/memory_report.hpp"
 #include "common/run.hpp"
 #include "common/scenes.hpp"
 #include "common/timing.hpp"
@@ -79,6 +81,7 @@ constexpr int kGridSettleSteps = 30;  // awake grid: contacts made and warm befo
 constexpr int kMaxStepsToSleep = 600;
 
 bool g_quick = false;
+bool g_memory = false;
 
 struct Built {
     std::unique_ptr<JobSystem> jobs;
@@ -168,6 +171,21 @@ WorstJointError worst_joint_error(const Space& space, const std::vector<JointHan
     return worst;
 }
 
+// Where bytes_per_body goes: each structure's share, and the rest the heap counter sees
+// (published buffers, write buffer, events, joints, shapes' shared data, job arenas).
+void print_memory(const char* name, unsigned threads, const Built& built) {
+    const MemoryReport report = memory_report(*built.space);
+    const double per_body = 1.0 / static_cast<double>(built.bodies.size());
+    const auto at = [&](std::size_t bytes) { return static_cast<double>(bytes) * per_body; };
+    std::printf("memory %s/threads:%u bytes_per_body=%.0f bodies=%.0f contacts=%.0f extras=%.0f lookup=%.0f wide=%.0f "
+                "push_rows=%.0f solver_other=%.0f broadphase=%.0f query_scenes=%.0f rest=%.0f\n",
+                name, threads, built.bytes_per_body(), at(report.bodies), at(report.contacts),
+                at(report.contact_extras), at(report.contact_lookup), at(report.wide_contacts), at(report.push_rows),
+                at(report.solver_other), at(report.broadphase), at(report.query_scenes),
+                built.bytes_per_body() - at(report.total()));
+    std::fflush(stdout);
+}
+
 void bm_scene(benchmark::State& state, EngineScene scene) {
     const auto threads = static_cast<unsigned>(state.range(0));
     Built built = build(scene, threads);
@@ -189,6 +207,7 @@ void bm_scene(benchmark::State& state, EngineScene scene) {
     state.counters["awake"] = space.last_update().awake_bodies;
     state.counters["contacts"] = space.last_update().contacts;
     if (scene.kind == SceneKind::Pyramid) state.counters["top_y"] = height_of(space, built.bodies.back());
+    if (g_memory) print_memory(scene.name, threads, built);
     if (!built.joints.empty()) {
         const WorstJointError worst = worst_joint_error(space, built.joints);
         state.counters["joint_error_m"] = worst.linear;
@@ -211,9 +230,9 @@ void print_notes() {
 int main(int argc, char** argv) {
     using namespace spindle::bench;
     std::vector<char*> rest = take_own_flags(argc, argv, [](const char* arg) {
-        if (std::strcmp(arg, "--quick") != 0) return false;
-        g_quick = true;
-        return true;
+        if (std::strcmp(arg, "--quick") == 0) return g_quick = true;
+        if (std::strcmp(arg, "--memory") == 0) return g_memory = true;
+        return false;
     });
     for (const EngineScene& scene : kScenes) {
         const int steps = g_quick ? std::max(5, scene.steps / 10) : scene.steps;

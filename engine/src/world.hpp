@@ -25,6 +25,7 @@
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
 #include "solver/motion_locks.hpp"
+#include "stages/contact_index.hpp"
 
 namespace spindle {
 
@@ -99,22 +100,21 @@ struct Bodies {
 // One touching manifold with what the solver keeps between steps (impulses, for
 // warm starting, matched by feature id).
 struct ContactPoint {
-    ManifoldPoint geometry;  // as collided; a recycled manifold updates the separation only
-    // Anchors (Box3D's): the point from each body's centre of mass, world axes, as it was
-    // when collided. They stay attached to their bodies while the manifold is recycled
-    // (narrowphase.cpp), and the solver pushes each body at its own anchor.
-    Vec3 anchor_a = Vec3::Zero();
-    Vec3 anchor_b = Vec3::Zero();
+    ManifoldPoint geometry;    // as collided; a recycled manifold updates the separation only
     Real base_separation = 0;  // the separation when collided
     Real normal_impulse = 0;
-    Real max_normal_impulse = 0;  // largest normal impulse of the step (restitution, reporting)
-    Real relative_velocity = 0;   // normal approach speed before solving (restitution)
 };
 
 struct ContactManifold {
     Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
     int point_count = 0;
     std::uint32_t part_a = 0, part_b = 0;  // the compound parts that touch (Manifold::part_a, part_b)
+    // The last solved step's push, for hit events (contact_events.cpp): of the points whose
+    // normal impulse pushed, the one that approached fastest (-1: none pushed), and its
+    // approach speed before solving. Per manifold, not per point: a pile's contacts are
+    // most of the memory it holds, and only reporting contacts read it.
+    std::int8_t pushed_point = -1;
+    Real pushed_speed = 0;
     // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
     // when collided, so that recycling and the solver stay off the cold descriptions.
     Real radius_a = 0, radius_b = 0;
@@ -148,6 +148,14 @@ struct Contact {
     bool cached = false;
     Vec3 cached_position = Vec3::Zero();
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
+    // The bodies' centres of mass then. A point's anchors (Box3D's) are its offsets from
+    // them, world axes: they stay attached to their bodies while the manifolds are
+    // recycled, and the solver pushes each body at its own anchor. Kept once per contact
+    // rather than twice per point: the record is most of the memory a pile holds.
+    Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
+
+    Vec3 anchor_a(const ContactPoint& p) const { return p.geometry.point - cached_xa; }
+    Vec3 anchor_b(const ContactPoint& p) const { return p.geometry.point - cached_xb; }
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
     const ContactManifold& manifold_at(int i) const {
@@ -230,7 +238,7 @@ struct World {
     // pair lists; removal keeps the order of the rest).
     std::unique_ptr<BroadphaseState> broadphase;
     std::vector<Contact> contacts;
-    std::unordered_map<std::uint64_t, std::uint32_t> contact_index;  // key -> position in contacts
+    ContactIndex contact_index;  // key -> position in contacts
     std::vector<std::uint64_t>
         contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
     // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of

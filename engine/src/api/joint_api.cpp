@@ -281,8 +281,7 @@ void block_pair(World& world, const Joint& j, int delta) {
     if (delta > 0) {
         pairs[key] += 1;
         // A contact made before the joint would otherwise live until the bounds separate.
-        auto it = world.contact_index.find(key);
-        if (it != world.contact_index.end()) remove_contacts(world, {it->second});
+        if (const std::uint32_t* position = world.contact_index.find(key)) remove_contacts(world, {*position});
     } else if (auto it = pairs.find(key); it != pairs.end() && --it->second == 0) {
         pairs.erase(it);
     }

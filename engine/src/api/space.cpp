@@ -16,6 +16,7 @@
 #include "solver/speed_limit.hpp"
 #include "stages/body_changes.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/capacity.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
@@ -30,8 +31,11 @@ World::~World() = default;
 
 namespace {
 
+// By a quarter at a time (stages/capacity.hpp), not doubled: a scene built body by body
+// keeps its per-slot arrays near its body count.
 template <typename T>
 void grow(std::vector<T>& v, std::size_t n) {
+    reserve_for(v, n);
     if (v.size() < n) v.resize(n);
 }
 
@@ -74,8 +78,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     } else {
         slot = b.capacity();
         const std::size_t n = slot + 1;
-        b.generation.push_back(0);
-        b.alive.push_back(0);
+        grow(b.generation, n), grow(b.alive, n);
         grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
         grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.locks, n),
             grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);

@@ -9,6 +9,7 @@
 
 #include "collision/cast.hpp"
 #include "query/slerp_series.hpp"
+#include "stages/capacity.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -48,6 +49,8 @@ QueryScene::QueryScene(const QueryScene& other)
 std::unique_ptr<QueryScene> QueryScene::clone() const { return std::unique_ptr<QueryScene>(new QueryScene(*this)); }
 
 void QueryScene::reserve(std::uint32_t slots) {
+    reserve_for(m_bodies, slots);  // as the bodies' own arrays grow (api/space.cpp)
+    reserve_for(m_shapes, slots);
     if (m_bodies.size() < slots) m_bodies.resize(slots);
     if (m_shapes.size() < slots) m_shapes.resize(slots);
 }

@@ -81,6 +81,10 @@ public:
     const DynamicAabbTree& tree() const noexcept { return m_tree; }
     const std::vector<QueryBody>& bodies() const noexcept { return m_bodies; }
     const Shape& shape(std::uint32_t i) const { return m_shapes[i]; }
+    // Heap bytes held: the tree and the per-slot arrays (shared shape data not counted).
+    std::size_t heap_bytes() const noexcept {
+        return m_tree.heap_bytes() + m_bodies.capacity() * sizeof(QueryBody) + m_shapes.capacity() * sizeof(Shape);
+    }
 
     // Queries walking this scene now; the physics thread copies a held scene instead of
     // writing it. Incremented under the motion-state lock, decremented with release.

@@ -29,6 +29,14 @@ struct ContactRow {
     Vec3 ib = Vec3::Zero();    // Ib^-1 (rb x dir)
 };
 
+// Where a lane's push-out row acts (contact_solver.cpp): the overlap's centre from each
+// centre of mass, as the last push of the step found it. The row itself is made again
+// from these when warm starting: the same inputs give the same bits, at half the bytes.
+struct PushAnchors {
+    Vec3 ra = Vec3::Zero();
+    Vec3 rb = Vec3::Zero();
+};
+
 // What a WideContact keeps of a row for its four lanes: the inertia-weighted angular
 // terms, in single precision (the passes are bound by the memory they stream, and these
 // only scale an impulse). The row's speed is taken from the point's relative velocity
@@ -94,7 +102,7 @@ struct WideContact {
     Wide twist_impulse{};
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The
-    // rows themselves live apart (SolverScratch::push_rows): they are rarely used, and
+    // rows' anchors live apart (SolverScratch::push_anchors): they are rarely used, and
     // every pass streams the wide contacts.
     Real push_impulse[kLanes] = {};
 };
@@ -203,8 +211,8 @@ struct SolverScratch {
     bool reuse_colors = true;                        // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
-    std::vector<WideContact> wide;      // the colours' manifolds four by four, then the overflow one by one
-    std::vector<ContactRow> push_rows;  // kLanes per wide contact: its push-out rows (written before read)
+    std::vector<WideContact> wide;          // the colours' manifolds four by four, then the overflow one by one
+    std::vector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
     std::uint32_t wide_begin[kColorCount + 1] = {};        // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;                   // awake joints, in slot order
     std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
@@ -247,10 +255,10 @@ void find_support_scales(const World& world, SolverScratch& scratch);
 void pack_contacts(SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi);  // wide [lo, hi)
-// push_rows: the wide contact's kLanes push-out rows (SolverScratch::push_rows).
-void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies);
+// push_anchors: the wide contact's kLanes push-out anchors (SolverScratch::push_anchors).
+void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies);
 // The points whose rows ran are counted into `counts` (the worker's).
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
                    EffectCounts& counts);
 void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts);
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);

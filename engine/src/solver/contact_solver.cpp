@@ -15,6 +15,7 @@
 #include <algorithm>
 
 #include "solver/constraints.hpp"
+#include "stages/capacity.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -159,16 +160,16 @@ WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wid
 // weighted down for points farther apart than friction_distance (up to twice that they
 // fade out, so the centre moves smoothly as points come and go); the two tangent rows at
 // the centre with their coupled 2x2 effective mass; the twist row about the normal.
-void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactManifold& m, const Vec3 (&tangent)[2],
-                      Real friction_distance, WideContact& wc, int l) {
+void prepare_friction(const SolverBody& A, const SolverBody& B, const Contact& contact, const ContactManifold& m,
+                      const Vec3 (&tangent)[2], Real friction_distance, WideContact& wc, int l) {
     constexpr Real kMinWeight = 1e-3;
     Vec3 center_a = Vec3::Zero(), center_b = Vec3::Zero();
     Real total = 0;
     for (int j = 0; j < m.point_count; ++j) {
         const ContactPoint& p = m.points[j];
         const Real weight = std::clamp(2 - p.geometry.separation / friction_distance, kMinWeight, Real(1));
-        center_a += weight * p.anchor_a;
-        center_b += weight * p.anchor_b;
+        center_a += weight * contact.anchor_a(p);
+        center_b += weight * contact.anchor_b(p);
         total += weight;
     }
     if (total > 0) {
@@ -176,7 +177,7 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const ContactMan
         center_b /= total;
     }
     for (int j = 0; j < m.point_count; ++j) {
-        wc.points[j].lever_arm[l] = static_cast<float>((m.points[j].anchor_a - center_a).norm());
+        wc.points[j].lever_arm[l] = static_cast<float>((contact.anchor_a(m.points[j]) - center_a).norm());
     }
     wc.center_a.set_lane(l, center_a);
     wc.center_b.set_lane(l, center_b);
@@ -287,13 +288,13 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
                          project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
-            ra[j].set_lane(l, src.anchor_a);
-            rb[j].set_lane(l, src.anchor_b);
+            ra[j].set_lane(l, contact.anchor_a(src));
+            rb[j].set_lane(l, contact.anchor_b(src));
             separation[j][l] = src.geometry.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
-        prepare_friction(A, B, m, tangent, friction_distance, wc, l);
+        prepare_friction(A, B, contact, m, tangent, friction_distance, wc, l);
     }
     const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
     // How deep a point's last impulse holds its soft row at rest, per lane (stiffer
@@ -326,8 +327,14 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
 void pack_contacts(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
-    scratch.wide.resize(count);                // kept from step to step: prepare_wide writes every field
-    scratch.push_rows.resize(count * kLanes);  // a row is written by push_out before it is read
+    // Kept from step to step (prepare_wide writes every field, push_out a row before it
+    // is read), at about the size of the step's.
+    reserve_for(scratch.wide, count);
+    scratch.wide.resize(count);
+    if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
+    reserve_for(scratch.push_anchors, count * kLanes);
+    scratch.push_anchors.resize(count * kLanes);
+    if (far_above_use(scratch.push_anchors.capacity(), count * kLanes)) fit_capacity(scratch.push_anchors);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     std::size_t next = 0;
     auto add = [&](const std::uint32_t* refs, int lanes) {
@@ -363,7 +370,7 @@ const SolverBody& lane_body(const WideContact& wc, int lane, int side, const Sol
 // impulse), never by real speed, so a chain of deep overlaps separates without
 // launching anything. One row per manifold, through the overlap's depth-weighted centre,
 // so a face pushes straight and a tilted corner turns back.
-void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
+void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
               const Vec3& rb, const ContactSolveParams& params) {
     SolverBody& A = bodies[wc.a[lane]];
     SolverBody& B = bodies[wc.b[lane]];
@@ -372,7 +379,9 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
     SolverBody copy_a, copy_b;
     const SolverBody& Am = lane_body(wc, lane, 0, A, copy_a);
     const SolverBody& Bm = lane_body(wc, lane, 1, B, copy_b);
+    ContactRow row;
     const Real mass = make_row(Am, Bm, ra, rb, normal, row);
+    anchors = {ra, rb};
     Velocities push = load_push(A, B);
     const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
     const Real speed = row_speed(push, normal, row);
@@ -384,7 +393,7 @@ void push_out(WideContact& wc, ContactRow& row, int lane, SolverBody* bodies, Re
 }
 
 template <bool kBias, bool kLocked>
-void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
                 EffectCounts& counts) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
@@ -504,13 +513,14 @@ void solve_wide(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, cons
         for (int l = 0; l < kLanes; ++l) {
             if (deep_weight[l] <= 0) continue;
             const Real w = deep_weight[l];
-            push_out(wc, push_rows[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w, params);
+            push_out(wc, push_anchors[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
+                     params);
         }
     }
 }
 
 template <bool kLocked>
-void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
@@ -526,9 +536,13 @@ void warm_start_wide(WideContact& wc, const ContactRow* push_rows, SolverBody* b
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
         SolverBody copy_a, copy_b;
+        const SolverBody& Am = lane_body(wc, l, 0, A, copy_a);
+        const SolverBody& Bm = lane_body(wc, l, 1, B, copy_b);
+        const Vec3 normal = wc.normal.lane(l);
+        ContactRow row;
+        make_row(Am, Bm, push_anchors[l].ra, push_anchors[l].rb, normal, row);
         Velocities push = load_push(A, B);
-        apply_row(lane_body(wc, l, 0, A, copy_a), lane_body(wc, l, 1, B, copy_b), push, wc.normal.lane(l), push_rows[l],
-                  wc.push_impulse[l]);
+        apply_row(Am, Bm, push, normal, row, wc.push_impulse[l]);
         store_push(A, B, push);
     }
 }
@@ -569,22 +583,22 @@ void prepare_contacts(const World& world, SolverScratch& scratch, const ContactS
 
 // Each pass in two builds: with per-axis inverse masses where a lane's body has a
 // translation lock, with the scalar ones (no extra work) everywhere else.
-void warm_start_contact(WideContact& wc, const ContactRow* push_rows, SolverBody* bodies) {
+void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
     if (wc.locked) {
-        warm_start_wide<true>(wc, push_rows, bodies);
+        warm_start_wide<true>(wc, push_anchors, bodies);
     } else {
-        warm_start_wide<false>(wc, push_rows, bodies);
+        warm_start_wide<false>(wc, push_anchors, bodies);
     }
 }
 
-void solve_contact(WideContact& wc, ContactRow* push_rows, SolverBody* bodies, const ContactSolveParams& params,
+void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
                    EffectCounts& counts) {
     if (wc.locked) {
-        params.use_bias ? solve_wide<true, true>(wc, push_rows, bodies, params, counts)
-                        : solve_wide<false, true>(wc, push_rows, bodies, params, counts);
+        params.use_bias ? solve_wide<true, true>(wc, push_anchors, bodies, params, counts)
+                        : solve_wide<false, true>(wc, push_anchors, bodies, params, counts);
     } else {
-        params.use_bias ? solve_wide<true, false>(wc, push_rows, bodies, params, counts)
-                        : solve_wide<false, false>(wc, push_rows, bodies, params, counts);
+        params.use_bias ? solve_wide<true, false>(wc, push_anchors, bodies, params, counts)
+                        : solve_wide<false, false>(wc, push_anchors, bodies, params, counts);
     }
 }
 
@@ -605,12 +619,16 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.friction_impulse = wc.friction_impulse[0][l] * wc.tangent[0].lane(l) +
                                  wc.friction_impulse[1][l] * wc.tangent[1].lane(l);
             m.twist_impulse = wc.twist_impulse[l];
+            m.pushed_point = -1;
+            m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {
                 const WidePoint& p = wc.points[j];
-                ContactPoint& dst = m.points[j];
-                dst.normal_impulse = p.normal_impulse[l];
-                dst.max_normal_impulse = p.max_normal_impulse[l];
-                dst.relative_velocity = p.relative_velocity[l];
+                m.points[j].normal_impulse = p.normal_impulse[l];
+                const Real approach = -p.relative_velocity[l];
+                if (p.max_normal_impulse[l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {
+                    m.pushed_point = static_cast<std::int8_t>(j);
+                    m.pushed_speed = approach;
+                }
             }
         }
     }

@@ -64,6 +64,11 @@ public:
         check_proxy(id);
         return m_nodes[static_cast<std::size_t>(id)].payload.user;
     }
+    // Heap bytes the tree holds (its nodes and rebuild scratch, at capacity).
+    std::size_t heap_bytes() const noexcept {
+        return m_nodes.capacity() * sizeof(Node) + m_build_leaves.capacity() * sizeof(BuildLeaf) +
+               m_build_tasks.capacity() * sizeof(BuildTask) + m_build_order.capacity() * sizeof(std::int32_t);
+    }
     bool is_proxy(std::int32_t id) const noexcept {
         return id >= 0 && static_cast<std::size_t>(id) < m_nodes.size() &&
                m_nodes[static_cast<std::size_t>(id)].height == 0;

@@ -133,6 +133,14 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
 
 void ProxyTrees::rebuild_static_tree() { m_trees[1].rebuild(); }
 
+std::size_t ProxyTrees::heap_bytes() const noexcept {
+    std::size_t bytes = m_trees[0].heap_bytes() + m_trees[1].heap_bytes() + m_enlarged.capacity() * sizeof(ProxyId) +
+                        (m_enlarged_slot[0].capacity() + m_enlarged_slot[1].capacity()) * sizeof(std::int32_t) +
+                        m_chunk_pairs.capacity() * sizeof(std::vector<Pair>);
+    for (const std::vector<Pair>& pairs : m_chunk_pairs) bytes += pairs.capacity() * sizeof(Pair);
+    return bytes;
+}
+
 void ProxyTrees::validate() const {
     m_trees[0].validate();
     m_trees[1].validate();

@@ -106,6 +106,8 @@ public:
     const DynamicAabbTree& moving_tree() const noexcept { return m_trees[0]; }
     const DynamicAabbTree& static_tree() const noexcept { return m_trees[1]; }
     const BroadphaseSettings& settings() const noexcept { return m_settings; }
+    // Heap bytes held: both trees, the enlarged list and the pair jobs' lists (at capacity).
+    std::size_t heap_bytes() const noexcept;
 
     // Validates both trees and the enlarged list (any build type; see DynamicAabbTree).
     void validate() const;

@@ -152,6 +152,7 @@ void update_broadphase(World& world, Real dt) {
         }
     }
     remove_contacts(world, lost);
+    fit_contacts(world);
     // Only the marked slots are cleared: a sleeping pile's slots are not touched.
     for (std::uint32_t slot : bp.refit_slots) bp.refit[slot] = 0;
     bp.refit_slots.clear();

@@ -52,6 +52,9 @@ void create_contact(World& world, std::uint64_t key);
 // Makes room for `more` contacts at once (a first step finds tens of thousands of pairs:
 // growing by push_back would move every contact again and again).
 void reserve_contacts(World& world, std::size_t more);
+// Gives back the contact arrays' room when it is far above their use (a pile came apart,
+// or the pairs reserved for were mostly not made into contacts).
+void fit_contacts(World& world);
 // Removes contacts by their positions in world.contacts (ascending), keeping the order of the rest.
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);
 

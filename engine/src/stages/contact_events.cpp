@@ -105,20 +105,20 @@ void note_hits(World& world) {
         contact.pushed = false;
         for (int m = 0; m < contact.manifold_count; ++m) {
             const ContactManifold& manifold = contact.manifold_at(m);
-            for (int j = 0; j < manifold.point_count; ++j) {
-                const ContactPoint& p = manifold.points[j];
-                contact.pushed = contact.pushed || p.max_normal_impulse > 0;
-                if (!pushed_before && p.max_normal_impulse > 0 && -p.relative_velocity > fastest) {
-                    fastest = -p.relative_velocity;
-                    hit_manifold = &manifold;
-                    hit_point = &p;
-                }
+            if (manifold.pushed_point < 0) continue;
+            contact.pushed = true;
+            if (!pushed_before && manifold.pushed_speed > fastest) {
+                fastest = manifold.pushed_speed;
+                hit_manifold = &manifold;
+                hit_point = &manifold.points[manifold.pushed_point];
             }
         }
         if (!hit_point) continue;
         ContactEvent event = make_event(world, ContactEventKind::Hit, contact);
         // Midway between the surfaces as the solver left them: each anchor moved with its body.
-        event.point = (b.x[contact.body_a] + hit_point->anchor_a + b.x[contact.body_b] + hit_point->anchor_b) / 2;
+        event.point =
+            (b.x[contact.body_a] + contact.anchor_a(*hit_point) + b.x[contact.body_b] + contact.anchor_b(*hit_point)) /
+            2;
         event.normal = hit_manifold->normal;
         event.speed = fastest;
         emit(world, event);
@@ -153,7 +153,8 @@ void publish_contact_points(World& world) {
                     ContactPointInfo& info = gathered.emplace_back();
                     info.body_a = body_a;
                     info.body_b = body_b;
-                    info.point = (b.x[contact.body_a] + p.anchor_a + b.x[contact.body_b] + p.anchor_b) / 2;
+                    info.point =
+                        (b.x[contact.body_a] + contact.anchor_a(p) + b.x[contact.body_b] + contact.anchor_b(p)) / 2;
                     info.normal = manifold.normal;
                     info.separation = p.geometry.separation;
                     info.normal_impulse = p.normal_impulse;

@@ -4,6 +4,7 @@
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/capacity.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
@@ -11,35 +12,33 @@ namespace spindle {
 
 void reserve_contacts(World& world, std::size_t more) {
     const std::size_t needed = world.contacts.size() + more;
-    if (world.contacts.capacity() < needed) {
-        // Geometric, as push_back would grow: room for exactly `needed` would make the
-        // next step's few new contacts reallocate (and move every contact) again.
-        const std::size_t capacity = std::max(needed, 2 * world.contacts.capacity());
-        world.contacts.reserve(capacity);
-        world.contact_keys.reserve(capacity);
-        world.contact_summaries.reserve(capacity);
-    }
-    if (static_cast<float>(world.contact_index.bucket_count()) * world.contact_index.max_load_factor() <
-        static_cast<float>(needed)) {
-        world.contact_index.reserve(std::max(needed, 2 * world.contact_index.size()));
-    }
+    reserve_for(world.contacts, needed);
+    reserve_for(world.contact_keys, needed);
+    reserve_for(world.contact_summaries, needed);
+    world.contact_index.reserve(needed);
+}
+
+void fit_contacts(World& world) {
+    if (!far_above_use(world.contacts.capacity(), world.contacts.size())) return;
+    fit_capacity(world.contacts);
+    fit_capacity(world.contact_keys);
+    fit_capacity(world.contact_summaries);
 }
 
 void create_contact(World& world, std::uint64_t key) {
-    if (world.contact_index.count(key)) return;
+    // One lookup: a first step makes tens of thousands of contacts.
+    if (!world.contact_index.insert(key, static_cast<std::uint32_t>(world.contacts.size()))) return;
     const auto a = static_cast<std::uint32_t>(key >> 32);
     const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
     const Bodies& bodies = world.bodies;
-    Contact contact;
+    Contact& contact = world.contacts.emplace_back();  // in place: the record is large
     contact.body_a = a;
     contact.body_b = b;
     // Mixing rules as most engines: geometric mean friction, largest restitution.
     contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
     contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
     note_contact_created(world, contact);  // before the summary: a sensor's has no points
-    world.contact_index.emplace(key, static_cast<std::uint32_t>(world.contacts.size()));
     world.contact_summaries.push_back(contact_summary(contact));
-    world.contacts.push_back(std::move(contact));
     world.contact_keys.push_back(key);
     world.awake_contacts_dirty = true;
 }
@@ -72,7 +71,7 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
             world.contact_keys[write] = world.contact_keys[read];
             world.contact_summaries[write] = world.contact_summaries[read];
         }
-        world.contact_index[world.contact_keys[write]] = static_cast<std::uint32_t>(write);
+        *world.contact_index.find(world.contact_keys[write]) = static_cast<std::uint32_t>(write);
         ++write;
     }
     world.contacts.resize(write);

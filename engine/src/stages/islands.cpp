@@ -95,8 +95,7 @@ void wake_body(World& world, std::uint32_t slot) {
         world.changed_now.push_back(member);
     }
     for (std::uint64_t key : sleeping.contacts) {
-        auto it = world.contact_index.find(key);
-        if (it != world.contact_index.end()) world.contacts[it->second].sleeping = false;
+        if (const std::uint32_t* position = world.contact_index.find(key)) world.contacts[*position].sleeping = false;
     }
     world.awake_contacts_dirty = true;
     for (JointHandle joint : sleeping.joints) {
@@ -117,7 +116,7 @@ void wake_touching(World& world, std::uint32_t slot) {
     if (slot < bp.proxy.size() && bp.proxy[slot].valid()) {
         bp.tree.query(bp.tree.fat_aabb(bp.proxy[slot]), [&](ProxyId id) {
             const auto other = static_cast<std::uint32_t>(bp.tree.user(id));
-            if (other != slot && world.contact_index.count(pair_key(slot, other))) wake_body(world, other);
+            if (other != slot && world.contact_index.contains(pair_key(slot, other))) wake_body(world, other);
             return true;
         });
     }

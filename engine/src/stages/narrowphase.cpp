@@ -81,7 +81,8 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
         const Real base = n.dot(moved) + manifold.radius_a * (na.dot(n) - 1) + manifold.radius_b * (nb.dot(n) - 1);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
-            p.geometry.separation = p.base_separation + base + nb.dot(p.anchor_b) - na.dot(p.anchor_a);
+            p.geometry.separation = p.base_separation + base + nb.dot(contact.anchor_b(p)) -
+                                    na.dot(contact.anchor_a(p));
         }
     }
 }
@@ -89,17 +90,16 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
 // Anchors the fresh manifolds to their bodies and keeps the poses they were collided at.
 void remember(Contact& contact, const Bodies& b, const Vec3& position) {
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
-    const Vec3 xa = b.x[a], xb = b.x[bb];
     for (int m = 0; m < contact.manifold_count; ++m) {
         ContactManifold& manifold = contact.manifold_at(m);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
-            p.anchor_a = p.geometry.point - xa;  // both anchors meet at the point now
-            p.anchor_b = p.geometry.point - xb;
             p.base_separation = p.geometry.separation;
         }
     }
     contact.cached = true;
+    contact.cached_xa = b.x[a];  // both anchors meet at the point now
+    contact.cached_xb = b.x[bb];
     contact.cached_position = position;
     contact.cached_qa = b.q[a];
     contact.cached_qb = b.q[bb];

@@ -291,8 +291,8 @@ void solve(World& world, Real dt) {
     plan_step(world, scratch, restitution);  // no pass at all over a scene without bouncy contacts
     world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
     const Real restitution_threshold = settings.restitution_threshold;
-    auto push_rows = [&](const WideContact& wc) {
-        return scratch.push_rows.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
+    auto push_anchors = [&](const WideContact& wc) {
+        return scratch.push_anchors.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
     };
     world.jobs->run_phases(
         "Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
@@ -307,19 +307,19 @@ void solve(World& world, Real dt) {
                 case Pass::WarmStart:
                     for_colored<true>(
                         scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-                        [&](WideContact& wc) { warm_start_contact(wc, push_rows(wc), bodies); });
+                        [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies); });
                     break;
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
-                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, solve_params, counts); });
+                        [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, solve_params, counts); });
                     break;
                 case Pass::Relax:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
-                        [&](WideContact& wc) { solve_contact(wc, push_rows(wc), bodies, relax_params, counts); });
+                        [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, relax_params, counts); });
                     break;
                 case Pass::Restitution:
                     for_colored<false>(

@@ -1,0 +1,57 @@
+// The heap a Space holds, by structure (memory_report.hpp).
+#include "api/memory_report.hpp"
+
+#include "api/space_internals.hpp"
+#include "query/query_scene.hpp"
+#include "solver/constraints.hpp"
+#include "stages/broadphase_state.hpp"
+
+namespace spindle {
+namespace {
+
+template <typename T>
+std::size_t held(const std::vector<T>& v) {
+    return v.capacity() * sizeof(T);
+}
+
+std::size_t body_bytes(const Bodies& b) {
+    return held(b.generation) + held(b.alive) + held(b.free_slots) + held(b.type) + held(b.x) + held(b.q) + held(b.v) +
+           held(b.w) + held(b.inv_mass) + held(b.inv_inertia_local) + held(b.inertia_local) + held(b.local_com) +
+           held(b.locks) + held(b.force) + held(b.torque) + held(b.bounds) + held(b.awake_index) + held(b.sleep_time) +
+           held(b.island) + held(b.layer) + held(b.group) + held(b.history_position[0]) + held(b.history_position[1]) +
+           held(b.history_orientation[0]) + held(b.history_orientation[1]) + held(b.interpolate) + held(b.desc);
+}
+
+std::size_t solver_other_bytes(const SolverScratch& s) {
+    std::size_t bytes = held(s.bodies) + held(s.manifolds) + held(s.colored_manifolds) + held(s.overflow) +
+                        held(s.joints) + held(s.joint_overflow) + held(s.body_colors) + held(s.support_scales) +
+                        held(s.support_edges) + held(s.support_first) + held(s.support_by_lower) +
+                        held(s.support_queue) + held(s.supported) + held(s.phases) + held(s.plan);
+    for (int c = 0; c < kColorCount; ++c) bytes += held(s.colors[c]) + held(s.joint_colors[c]);
+    return bytes;
+}
+
+}  // namespace
+
+MemoryReport memory_report(const Space& space) {
+    const World& world = SpaceInternals::world(space);
+    MemoryReport report;
+    report.bodies = body_bytes(world.bodies) + held(world.awake) + held(world.awake_pending);
+    report.contacts = held(world.contacts);
+    for (const Contact& contact : world.contacts) report.contact_extras += held(contact.extra);
+    report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +
+                            held(world.contact_summaries) + held(world.awake_contact_list);
+    const SolverScratch& solver = *world.solver;
+    report.wide_contacts = held(solver.wide);
+    report.push_rows = held(solver.push_anchors);
+    report.solver_other = solver_other_bytes(solver);
+    const BroadphaseState& bp = *world.broadphase;
+    report.broadphase = bp.tree.heap_bytes() + held(bp.proxy) + held(bp.pairs) + held(bp.refit) + held(bp.refit_slots) +
+                        held(bp.moving);
+    for (const std::shared_ptr<QueryScene>& scene : world.query_scenes) {
+        if (scene) report.query_scenes += scene->heap_bytes();
+    }
+    return report;
+}
+
+}  // namespace spindle
