@@ -86,6 +86,7 @@ void LiveView::run(std::optional<double> seconds, const std::atomic<bool>& stop_
         m_steps_this_frame = 0;
         for (const ViewCommand& command : m_server.take_commands()) apply(command);
         set_time_scale(m_mode == Mode::Paused ? 0 : m_speed);
+        m_paused = pause_taken();
         collect_created();
         pull_grabbed();
         survey_sleep(now);
@@ -136,7 +137,7 @@ void LiveView::set_time_scale(double scale) {
     if (scale == 0 && m_runner.running()) m_pause_taken = m_runner.post([](Space&) {});
 }
 
-bool LiveView::paused() const {
+bool LiveView::pause_taken() const {
     return m_mode == Mode::Paused &&
            (!m_pause_taken || m_pause_taken->wait_for(std::chrono::seconds(0)) == std::future_status::ready);
 }

@@ -66,7 +66,8 @@ private:
     void publish_frame(double now);
     void publish_stats(double now);
     void set_time_scale(double scale);
-    bool paused() const;  // asked for, and no update at the old scale left
+    bool pause_taken() const;  // asked for, and no update at the old scale left
+    bool paused() const { return m_paused; }
     const char* mode_name() const;
     std::uint32_t add_shape(const ShapeSpec& shape);
 
@@ -79,6 +80,11 @@ private:
     Mode m_mode = Mode::Running;
     double m_speed = 1;
     std::optional<std::future<void>> m_pause_taken;  // posted after the scale turned 0
+    // pause_taken() as this frame's turn found it, before it read the published step: the
+    // frame and the stats made in that turn both show it, so a page that sees "paused"
+    // sees the last step there will be (asked again for the stats, a pause taken between
+    // the frame and them would show "paused" beside a frame a step old).
+    bool m_paused = false;
     bool m_interpolate = true;
     bool m_contacts = false;                 // the page asked for the touching points
     std::vector<ContactPointInfo> m_points;  // the newest step's, when m_contacts
