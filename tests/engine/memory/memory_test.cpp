@@ -30,7 +30,7 @@ struct Pyramid {
     }
 };
 
-constexpr int kLanded = 300;  // landed after about 60 steps; bench_engine times 300 from the drop
+constexpr int kLanded = 300;   // landed after about 60 steps; bench_engine times 300 from the drop
 constexpr int kSettled = 100;  // enough to have every contact (fewer steps: the sanitizer builds are slow)
 
 }  // namespace
