@@ -85,21 +85,16 @@ double MotionStateManager::alpha_locked(BlendClock clock) const noexcept {
 
 namespace {
 
-// Slot i of a published buffer as reads return it: blended where it interpolates (the
-// caller leaves out alpha = 1, where every slot reads as its newest state).
-struct Blend {
-    explicit Blend(double alpha) : t(alpha), turn(alpha) {}
-    Real t;
-    SlerpSeries turn;
-};
-
-MotionState blended(const PublishedBuffer& front, std::uint32_t i, const Blend& blend) {
+// Slot i of a published buffer as reads return it: blended by the series' fraction where
+// it interpolates (the caller leaves out alpha = 1, where every slot reads as its newest state).
+MotionState blended(const PublishedBuffer& front, std::uint32_t i, const SlerpSeries& blend) {
     if (!front.interpolate[i]) return front.current[i];
     const PublishedHistory& before = front.previous[i];
     MotionState s = front.current[i];
-    s.position = before.position + (s.position - before.position) * blend.t;
-    s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * blend.t;
-    s.orientation = blend.turn(before.orientation, s.orientation);
+    const Real t = blend.t();
+    s.position = before.position + (s.position - before.position) * t;
+    s.center_of_mass = before.center_of_mass + (s.center_of_mass - before.center_of_mass) * t;
+    s.orientation = blend(before.orientation, s.orientation);
     return s;
 }
 
@@ -107,7 +102,7 @@ MotionState blended(const PublishedBuffer& front, std::uint32_t i, const Blend& 
 
 MotionState MotionStateManager::blend_locked(std::uint32_t i, double alpha) const {
     if (alpha >= 1) return m_front->current[i];
-    return blended(*m_front, i, Blend(alpha));
+    return blended(*m_front, i, SlerpSeries(alpha));
 }
 
 void MotionStateManager::check_locked(BodyHandle body) const {
@@ -160,7 +155,7 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
         return count;
     }
     auto copied = [&](std::uint32_t i) { return front.generation[i] != 0 && !(blending && front.interpolate[i]); };
-    const Blend blend(blending ? alpha : 0.0);
+    const SlerpSeries blend(blending ? alpha : 0.0);
     std::size_t k = 0;
     for (std::uint32_t i = 0; i < slots;) {
         if (front.generation[i] == 0) {
@@ -197,7 +192,7 @@ void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, s
         for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = m_front->current[bodies[i].index];
         return;
     }
-    const Blend blend(alpha);
+    const SlerpSeries blend(alpha);
     for (std::size_t i = 0; i < bodies.size(); ++i) out[i] = blended(*m_front, bodies[i].index, blend);
 }
 

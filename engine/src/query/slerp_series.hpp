@@ -21,6 +21,8 @@ public:
         fill(m_to_a, 1 - t);
     }
 
+    Real t() const noexcept { return m_t; }
+
     // slerp_shortest(a, b, t), equal to it within a few ulps (the series is cut where its
     // remainder is below double rounding: tests/engine/queries/slerp_series_test.cpp). Pairs
     // more than 1.44 rad apart (a body turning faster than 86 rad/s at 60 Hz) take the
