@@ -136,6 +136,7 @@ struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
     int manifold_count = 0;
+    FeatureCache feature;                // the axis that last kept a box or hull pair apart (collide_cached)
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
     bool sleeping = false;

@@ -35,6 +35,34 @@ struct Manifold {
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
             Manifold* out, int capacity);
 
+// What the last test of a box or hull pair found apart, kept with the contact: the axis
+// that separated the two (a face of either, or an edge of each). A pair that stays apart
+// is then told so by one support query on that axis instead of a whole SAT. The indices
+// are the pair function's (the lower shape type is its A), so a contact always reads its
+// own. Only an axis that still separates past the speculative distance ends the test,
+// and the whole SAT would have found it too: the result is the same bits with or without.
+class FeatureCache {
+public:
+    enum class Kind : std::uint32_t { None, FaceA, FaceB, EdgePair };
+    FeatureCache() = default;
+    FeatureCache(Kind kind, std::uint32_t index_a, std::uint32_t index_b)
+        : m_bits(static_cast<std::uint32_t>(kind) | (index_a & kIndexMask) << 2 | (index_b & kIndexMask) << 17) {}
+    Kind kind() const noexcept { return static_cast<Kind>(m_bits & 3u); }
+    std::uint32_t index_a() const noexcept { return m_bits >> 2 & kIndexMask; }
+    std::uint32_t index_b() const noexcept { return m_bits >> 17 & kIndexMask; }
+    friend bool operator==(FeatureCache, FeatureCache) = default;
+
+private:
+    // Four bytes, in a gap of the contact record: a hull has at most 762 edges.
+    static constexpr std::uint32_t kIndexMask = (1u << 15) - 1;
+    std::uint32_t m_bits = 0;
+};
+
+// collide() with the pair's cache, for the narrowphase: box-hull and hull-hull pairs
+// read and write it; any other pair clears it.
+int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
+                   Manifold* out, int capacity, FeatureCache& cache);
+
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns
 // about the core (a rolling ball's contact stays below its centre).

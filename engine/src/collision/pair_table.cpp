@@ -71,4 +71,33 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
     return fn(a, xa, b, xb, speculative_distance, out, capacity);
 }
 
+int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
+                   Manifold* out, int capacity, FeatureCache& cache) {
+    const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
+    // Box-box has its own 15-axis test.
+    if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
+        cache = FeatureCache();
+        return collide(a, xa, b, xb, speculative_distance, out, capacity);
+    }
+    // The pair functions' order: the lower type is A (box before hull), as in the table.
+    const bool swap = b.type < a.type;
+    const Shape& first = swap ? b : a;
+    const Shape& second = swap ? a : b;
+    const Transform& x_first = swap ? xb : xa;
+    const Transform& x_second = swap ? xa : xb;
+    const detail::PolyView second_view = detail::view_of(*second.hull);
+    bool touching = false;
+    if (first.type == ShapeType::Box) {
+        const detail::BoxPoly box(first.half_extents);
+        touching = detail::collide_polyhedra(box.view(), x_first, second_view, x_second, speculative_distance, out[0],
+                                             &cache);
+    } else {
+        touching = detail::collide_polyhedra(detail::view_of(*first.hull), x_first, second_view, x_second,
+                                             speculative_distance, out[0], &cache);
+    }
+    if (!touching) return 0;
+    if (swap) detail::flip_manifold(out[0]);
+    return 1;
+}
+
 }  // namespace spindle

@@ -2,6 +2,7 @@
 // face normals of both and the edge pairs whose Gauss-map arcs cross (the only edge
 // pairs that can realise the minimum), then clipping of the incident face or one point
 // between the two edges. All work happens in A's frame.
+#include <algorithm>
 #include <cmath>
 
 #include "collision/clipping.hpp"
@@ -13,24 +14,65 @@ namespace {
 
 constexpr std::size_t kInlineVertices = 64;
 
+// Four doubles worked on together (GCC's vector extensions: AVX where the build has it).
+// Each lane computes what the scalar code computes, in the same order, so the results
+// are the same bits.
+using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
+using LaneMask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+// Bit k set when lane k is set.
+inline unsigned lane_bits(LaneMask m) {
+#ifdef __AVX__
+    return static_cast<unsigned>(__builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(m)));
+#else
+    return (m[0] ? 1u : 0u) | (m[1] ? 2u : 0u) | (m[2] ? 4u : 0u) | (m[3] ? 8u : 0u);
+#endif
+}
+
+// Vertices in lanes: lane k of group i holds vertex 4i + k; lanes past the last vertex
+// repeat vertex 0, which never wins a support query over it (ties go to the lower index).
+struct VertexLanes {
+    Lanes x, y, z;
+};
+
+void fill_lanes(const Vec3* vertices, std::uint32_t count, VertexLanes* out) {
+    for (std::uint32_t i = 0; i < (count + 3) / 4 * 4; ++i) {
+        const Vec3& v = vertices[i < count ? i : 0];
+        out[i / 4].x[i % 4] = v.x(), out[i / 4].y[i % 4] = v.y(), out[i / 4].z[i % 4] = v.z();
+    }
+}
+
 // A polyhedron placed in the common frame: its vertices already there, its normals
 // rotated by r and its plane offsets shifted by t on demand.
 struct Posed {
     const PolyView& view;
     const Vec3* vertices;  // in the common frame
+    const VertexLanes* lanes;
     Mat3 r;
     Vec3 t;
 
     Vec3 normal(std::uint32_t f) const { return r * view.faces[f].normal; }
     Real offset(std::uint32_t f, const Vec3& n) const { return view.faces[f].offset + n.dot(t); }
+    // The vertex farthest along d, the first of equals: four vertices a step, each lane
+    // keeping its own best and the first index it was found at.
     std::uint32_t support(const Vec3& d) const {
-        std::uint32_t best = 0;
-        Real best_dot = vertices[0].dot(d);
-        for (std::uint32_t i = 1; i < view.vertex_count; ++i) {
-            const Real x = vertices[i].dot(d);
-            if (x > best_dot) best_dot = x, best = i;
+        const Lanes dx = Lanes{} + d.x(), dy = Lanes{} + d.y(), dz = Lanes{} + d.z();
+        using Indices = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+        Lanes best = (lanes[0].x * dx + lanes[0].y * dy) + lanes[0].z * dz;
+        Indices best_index{0, 1, 2, 3};
+        Indices index = best_index;
+        const std::uint32_t groups = (view.vertex_count + 3) / 4;
+        for (std::uint32_t g = 1; g < groups; ++g) {
+            index += 4;
+            const Lanes x = (lanes[g].x * dx + lanes[g].y * dy) + lanes[g].z * dz;
+            const LaneMask better = x > best;
+            best = better ? x : best;
+            best_index = better ? index : best_index;
         }
-        return best;
+        int lane = 0;
+        for (int k = 1; k < 4; ++k) {
+            if (best[k] > best[lane] || (best[k] == best[lane] && best_index[k] < best_index[lane])) lane = k;
+        }
+        return best_index[lane] < view.vertex_count ? static_cast<std::uint32_t>(best_index[lane]) : 0;
     }
 };
 
@@ -47,12 +89,17 @@ struct EdgeQuery {
     bool found = false;
 };
 
+// Separation of `other` from face f's plane of p.
+[[gnu::always_inline]] inline Real face_separation(const Posed& p, const Posed& other, std::uint32_t f) {
+    const Vec3 n = p.normal(f);
+    return n.dot(other.vertices[other.support(-n)]) - p.offset(f, n);
+}
+
 // Largest separation of `other` from the face planes of p. Stops early past `limit`.
 FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     FaceQuery best;
     for (std::uint32_t f = 0; f < p.view.face_count; ++f) {
-        const Vec3 n = p.normal(f);
-        const Real s = n.dot(other.vertices[other.support(-n)]) - p.offset(f, n);
+        const Real s = face_separation(p, other, f);
         if (s > best.separation) best = {s, f};
         if (s > limit) break;
     }
@@ -68,50 +115,128 @@ struct ArcEdge {
     Vec3 t0, t1;  // direction x n0, n1 x direction
 };
 
+ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
+    const HullEdge& e = p.view.edges[j];
+    ArcEdge a;
+    a.origin = p.vertices[e.v0];
+    a.direction = p.vertices[e.v1] - a.origin;
+    a.n0 = p.normal(e.f0);
+    a.n1 = p.normal(e.f1);
+    a.t0 = a.direction.cross(a.n0);
+    a.t1 = a.n1.cross(a.direction);
+    return a;
+}
+
 void prepare_edges(const Posed& p, ArcEdge* out) {
-    for (std::uint32_t j = 0; j < p.view.edge_count; ++j) {
-        const HullEdge& e = p.view.edges[j];
-        ArcEdge& a = out[j];
-        a.origin = p.vertices[e.v0];
-        a.direction = p.vertices[e.v1] - a.origin;
-        a.n0 = p.normal(e.f0);
-        a.n1 = p.normal(e.f1);
-        a.t0 = a.direction.cross(a.n0);
-        a.t1 = a.n1.cross(a.direction);
+    for (std::uint32_t j = 0; j < p.view.edge_count; ++j) out[j] = arc_edge(p, j);
+}
+
+// Whether edges ea (of A) and eb (of B) form a face of the Minkowski difference: their
+// arcs cross on the Gauss map, A's at the direction L = +-(ea x eb) and B's at -L. If so,
+// the unit axis (from A to B) and the separation of the two edges' lines along it.
+[[gnu::always_inline]] inline bool edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit, Real& separation) {
+    // Cheap rejections first: each arc must cross the other's great circle.
+    if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) return false;
+    if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) return false;
+    const Vec3 cross = ea.direction.cross(eb.direction);
+    const Real length2 = cross.squaredNorm();
+    if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) return false;
+    // L = +cross or -cross must lie on A's arc while -L lies on B's arc.
+    const Real x0 = cross.dot(ea.t0), x1 = cross.dot(ea.t1);
+    const Real y0 = cross.dot(eb.t0), y1 = cross.dot(eb.t1);
+    Real sign = 0;
+    if (x0 >= 0 && x1 >= 0 && y0 <= 0 && y1 <= 0) sign = 1;
+    else if (x0 <= 0 && x1 <= 0 && y0 >= 0 && y1 >= 0) sign = -1;
+    if (sign == 0) return false;
+    unit = cross * (sign / std::sqrt(length2));
+    separation = unit.dot(eb.origin - ea.origin);
+    return true;
+}
+
+// Four of A's edges for the edge query's cheap rejections: the components of each edge's
+// direction and two face normals, lane k holding edge 4i + k.
+struct EdgeLanes {
+    Lanes dx, dy, dz, n0x, n0y, n0z, n1x, n1y, n1z;
+};
+
+void prepare_lanes(const ArcEdge* edges, std::uint32_t count, EdgeLanes* out) {
+    for (std::uint32_t j = 0; j < count; ++j) {
+        EdgeLanes& l = out[j / 4];
+        const std::uint32_t k = j % 4;
+        const ArcEdge& e = edges[j];
+        l.dx[k] = e.direction.x(), l.dy[k] = e.direction.y(), l.dz[k] = e.direction.z();
+        l.n0x[k] = e.n0.x(), l.n0y[k] = e.n0.y(), l.n0z[k] = e.n0.z();
+        l.n1x[k] = e.n1.x(), l.n1y[k] = e.n1.y(), l.n1z[k] = e.n1.z();
+    }
+    for (std::uint32_t j = count; j % 4 != 0; ++j) {  // lanes past the last edge: never tested further
+        EdgeLanes& l = out[j / 4];
+        const std::uint32_t k = j % 4;
+        l.dx[k] = l.dy[k] = l.dz[k] = l.n0x[k] = l.n0y[k] = l.n0z[k] = l.n1x[k] = l.n1y[k] = l.n1z[k] = 0;
     }
 }
 
 // Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
-// negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb).
+// negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb). Most pairs
+// fail the first two tests of edge_pair_axis (an arc that does not cross the other's
+// great circle): those run on four of A's edges at once, each lane computing what the
+// scalar test computes in the same order, so the pairs kept are the same.
 EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_a(a.view.edge_count), edges_b(b.view.edge_count);
     prepare_edges(a, edges_a.data());
     prepare_edges(b, edges_b.data());
+    const std::uint32_t groups = (a.view.edge_count + 3) / 4;
+    ScratchBuffer<EdgeLanes, kInlineVertices> lanes(groups);
+    prepare_lanes(edges_a.data(), a.view.edge_count, lanes.data());
     EdgeQuery best;
     for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
         const ArcEdge& eb = edges_b[jb];
-        for (std::uint32_t ja = 0; ja < a.view.edge_count; ++ja) {
-            const ArcEdge& ea = edges_a[ja];
-            // Cheap rejections first: each arc must cross the other's great circle.
-            if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) continue;
-            if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) continue;
-            const Vec3 cross = ea.direction.cross(eb.direction);
-            const Real length2 = cross.squaredNorm();
-            if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) continue;
-            // L = +cross or -cross must lie on A's arc while -L lies on B's arc.
-            const Real x0 = cross.dot(ea.t0), x1 = cross.dot(ea.t1);
-            const Real y0 = cross.dot(eb.t0), y1 = cross.dot(eb.t1);
-            Real sign = 0;
-            if (x0 >= 0 && x1 >= 0 && y0 <= 0 && y1 <= 0) sign = 1;
-            else if (x0 <= 0 && x1 <= 0 && y0 >= 0 && y1 >= 0) sign = -1;
-            if (sign == 0) continue;
-            const Vec3 unit = cross * (sign / std::sqrt(length2));
-            const Real s = unit.dot(eb.origin - ea.origin);
-            if (s > best.separation) best = {s, ja, jb, unit, true};
-            if (s > limit) return best;
+        const Lanes bn0x = Lanes{} + eb.n0.x(), bn0y = Lanes{} + eb.n0.y(), bn0z = Lanes{} + eb.n0.z();
+        const Lanes bn1x = Lanes{} + eb.n1.x(), bn1y = Lanes{} + eb.n1.y(), bn1z = Lanes{} + eb.n1.z();
+        const Lanes bdx = Lanes{} + eb.direction.x(), bdy = Lanes{} + eb.direction.y(),
+                    bdz = Lanes{} + eb.direction.z();
+        for (std::uint32_t g = 0; g < groups; ++g) {
+            const EdgeLanes& l = lanes[g];
+            const Lanes b0 = (bn0x * l.dx + bn0y * l.dy) + bn0z * l.dz;
+            const Lanes b1 = (bn1x * l.dx + bn1y * l.dy) + bn1z * l.dz;
+            const Lanes a0 = (l.n0x * bdx + l.n0y * bdy) + l.n0z * bdz;
+            const Lanes a1 = (l.n1x * bdx + l.n1y * bdy) + l.n1z * bdz;
+            // Lanes past the last edge (all zero) pass; their indices are dropped below.
+            for (unsigned crossing = lane_bits((b0 * b1 <= 0) & (a0 * a1 <= 0)); crossing != 0;
+                 crossing &= crossing - 1) {
+                const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
+                if (ja >= a.view.edge_count) break;
+                Vec3 unit;
+                Real s;
+                if (!edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
+                if (s > best.separation) best = {s, ja, jb, unit, true};
+                if (s > limit) return best;
+            }
         }
     }
     return best;
+}
+
+// Whether the axis the cache holds still separates the two past `limit`. Computed as the
+// whole SAT computes it, so it says so exactly when that axis would end the whole SAT.
+bool apart_on_cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b, Real limit) {
+    switch (cache.kind()) {
+        case FeatureCache::Kind::FaceA:
+            return cache.index_a() < a.view.face_count && face_separation(a, b, cache.index_a()) > limit;
+        case FeatureCache::Kind::FaceB:
+            return cache.index_b() < b.view.face_count && face_separation(b, a, cache.index_b()) > limit;
+        case FeatureCache::Kind::EdgePair: {
+            if (cache.index_a() >= a.view.edge_count || cache.index_b() >= b.view.edge_count) return false;
+            Vec3 unit;
+            Real s;
+            return edge_pair_axis(arc_edge(a, cache.index_a()), arc_edge(b, cache.index_b()), unit, s) && s > limit;
+        }
+        case FeatureCache::Kind::None: break;
+    }
+    return false;
+}
+
+void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t index_a, std::uint32_t index_b) {
+    if (cache) *cache = FeatureCache(kind, index_a, index_b);
 }
 
 // Clips the incident face of `inc` against reference face `face` of `ref`. A vertex that
@@ -166,20 +291,36 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
 }  // namespace
 
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,
-                       Manifold& m) {
+                       Manifold& m, FeatureCache* cache) {
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
-    const Posed pa{a, a.vertices, Mat3::Identity(), Vec3::Zero()};
-    const Posed pb{b, b_vertices.data(), r, t};
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> a_lanes((a.vertex_count + 3) / 4),
+        b_lanes((b.vertex_count + 3) / 4);
+    fill_lanes(a.vertices, a.vertex_count, a_lanes.data());
+    fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
+    const Posed pa{a, a.vertices, a_lanes.data(), Mat3::Identity(), Vec3::Zero()};
+    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t};
 
+    if (cache && apart_on_cached_axis(*cache, pa, pb, speculative)) return false;
+    using Kind = FeatureCache::Kind;
     const FaceQuery face_a = query_faces(pa, pb, speculative);
-    if (face_a.separation > speculative) return false;
+    if (face_a.separation > speculative) {
+        remember_axis(cache, Kind::FaceA, face_a.face, 0);
+        return false;
+    }
     const FaceQuery face_b = query_faces(pb, pa, speculative);
-    if (face_b.separation > speculative) return false;
+    if (face_b.separation > speculative) {
+        remember_axis(cache, Kind::FaceB, 0, face_b.face);
+        return false;
+    }
     const EdgeQuery edge = query_edges(pa, pb, speculative);
-    if (edge.separation > speculative) return false;
+    if (edge.separation > speculative) {
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b);
+        return false;
+    }
+    remember_axis(cache, Kind::None, 0, 0);
 
     if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
         const HullEdge& ea = a.edges[edge.edge_a];
