@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 
+#include "collision/clipping.hpp"
 #include "collision/compound.hpp"
 #include "collision/pair_functions.hpp"
 
@@ -12,7 +13,8 @@ namespace {
 
 // Manifolds kept while walking part pairs; past this a deeper one replaces the shallowest.
 constexpr int kMaxGathered = 64;
-constexpr int kPerPair = 4;  // a mesh may give several manifolds per part
+constexpr int kPerPair = 4;               // a mesh may give several manifolds per part
+constexpr std::size_t kInlineParts = 32;  // parts posed on the stack; more go to the heap
 
 struct Gathered {
     std::array<Manifold, kMaxGathered> list;
@@ -40,15 +42,31 @@ void keep(Gathered& g, const Manifold& m) {
     g.list.back() = m;
 }
 
+// Compound b's parts posed in the world, with their world bounds: worked out once per
+// pair, not once for every part of the other shape they are tested against.
+struct PosedParts {
+    explicit PosedParts(const Compound& parts, const Transform& x)
+        : compound(parts), poses(parts.size()), bounds(parts.size()) {
+        for (std::uint32_t i = 0; i < parts.size(); ++i) {
+            poses[i] = x * parts.pose(i);
+            bounds[i] = parts.shape(i).bounds(poses[i]);
+            all = all.merged(bounds[i]);
+        }
+    }
+    const Compound& compound;
+    ScratchBuffer<Transform, kInlineParts> poses;
+    ScratchBuffer<Aabb, kInlineParts> bounds;
+    Aabb all;
+};
+
 // Shape a (part `part_a` of its body, 0 if it is whole) against every part of compound b
 // near it.
-void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, const Compound& b,
-                   const Transform& xb, Real speculative, Gathered& g) {
+void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
+                   Real speculative, Gathered& g) {
     Manifold found[kPerPair];
-    for (std::uint32_t i = 0; i < b.size(); ++i) {
-        const Transform x = xb * b.pose(i);
-        if (!a_box.overlaps(b.shape(i).bounds(x))) continue;
-        const int n = collide(a, xa, b.shape(i), x, speculative, found, kPerPair);
+    for (std::uint32_t i = 0; i < b.compound.size(); ++i) {
+        if (!a_box.overlaps(b.bounds[i])) continue;
+        const int n = collide(a, xa, b.compound.shape(i), b.poses[i], speculative, found, kPerPair);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -82,7 +100,8 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
                            Manifold* out, int capacity) {
     Gathered g;
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
-    collide_parts(a, xa, 0, a_box, *b.parts, xb, speculative, g);
+    PosedParts parts(*b.parts, xb);
+    collide_parts(a, xa, 0, a_box, parts, speculative, g);
     return emit(g, out, capacity);
 }
 
@@ -90,12 +109,12 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
                               Real speculative, Manifold* out, int capacity) {
     Gathered g;
     const Compound& parts = *a.parts;
-    const Aabb b_box = b.bounds(xb);
+    PosedParts b_parts(*b.parts, xb);
     for (std::uint32_t j = 0; j < parts.size(); ++j) {
         const Transform x = xa * parts.pose(j);
         const Aabb part_box = parts.shape(j).bounds(x).fattened(std::max(speculative, Real(0)));
-        if (!part_box.overlaps(b_box)) continue;
-        collide_parts(parts.shape(j), x, j, part_box, *b.parts, xb, speculative, g);
+        if (!part_box.overlaps(b_parts.all)) continue;
+        collide_parts(parts.shape(j), x, j, part_box, b_parts, speculative, g);
     }
     return emit(g, out, capacity);
 }
