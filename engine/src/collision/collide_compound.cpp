@@ -6,6 +6,7 @@
 
 #include "collision/clipping.hpp"
 #include "collision/compound.hpp"
+#include "collision/manifold_slots.hpp"
 #include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
@@ -15,9 +16,11 @@ namespace {
 constexpr int kMaxGathered = 64;
 constexpr int kPerPair = 4;               // a mesh may give several manifolds per part
 constexpr std::size_t kInlineParts = 32;  // parts posed on the stack; more go to the heap
+// Far above the relative rounding of a part's bounds computed two ways (about 1e-15).
+constexpr Real kLooseRelative = 1e-9;
 
 struct Gathered {
-    std::array<Manifold, kMaxGathered> list;
+    ManifoldSlots<kMaxGathered> list;
     int count = 0;
 };
 
@@ -29,44 +32,83 @@ Real deepest(const Manifold& m) {
 
 void keep(Gathered& g, const Manifold& m) {
     if (g.count < kMaxGathered) {
-        g.list[static_cast<std::size_t>(g.count++)] = m;
+        g.list.fill(static_cast<std::size_t>(g.count++), m);
         return;
     }
-    auto shallowest = g.list.begin();
-    for (auto it = g.list.begin(); it != g.list.end(); ++it) {
+    Manifold* const begin = g.list.data();
+    Manifold* const end = begin + kMaxGathered;
+    Manifold* shallowest = begin;
+    for (Manifold* it = begin; it != end; ++it) {
         if (deepest(*it) > deepest(*shallowest)) shallowest = it;
     }
     if (deepest(m) >= deepest(*shallowest)) return;
     // Out of its place, and m at the end: the list stays in the order of the walk.
-    std::move(shallowest + 1, g.list.end(), shallowest);
-    g.list.back() = m;
+    std::move(shallowest + 1, end, shallowest);
+    end[-1] = m;
 }
 
-// Compound b's parts posed in the world, with their world bounds: worked out once per
-// pair, not once for every part of the other shape they are tested against.
-struct PosedParts {
-    explicit PosedParts(const Compound& parts, const Transform& x)
-        : compound(parts), poses(parts.size()), bounds(parts.size()) {
-        for (std::uint32_t i = 0; i < parts.size(); ++i) {
-            poses[i] = x * parts.pose(i);
-            bounds[i] = parts.shape(i).bounds(poses[i]);
-            all = all.merged(bounds[i]);
-        }
+// Compound b's parts posed in the world, and their bounds: worked out once per pair, not
+// once for every part of the other shape they are tested against. A part's exact bounds
+// (its hull's vertices moved into the world) are what decide whether it meets the other
+// shape, as they did when each pair was tested alone; its compound-frame box turned with
+// the compound is a cheap superset that rules most parts out first.
+class PosedParts {
+public:
+    PosedParts(const Compound& parts, const Transform& x)
+        : m_compound(parts),
+          m_x(x),
+          m_rotation(x.q.toRotationMatrix()),
+          m_poses(parts.size()),
+          m_exact(parts.size()),
+          m_has_exact(parts.size()) {
+        for (std::uint32_t i = 0; i < parts.size(); ++i) m_has_exact[i] = false;
     }
-    const Compound& compound;
-    ScratchBuffer<Transform, kInlineParts> poses;
-    ScratchBuffer<Aabb, kInlineParts> bounds;
-    Aabb all;
+
+    std::uint32_t size() const { return m_compound.size(); }
+    const Shape& shape(std::uint32_t i) const { return m_compound.shape(i); }
+
+    // Part i's world pose and exact bounds, made the first time they are asked for.
+    const Transform& pose(std::uint32_t i) {
+        exact(i);
+        return m_poses[i];
+    }
+    const Aabb& exact(std::uint32_t i) {
+        if (!m_has_exact[i]) {
+            m_poses[i] = m_x * m_compound.pose(i);
+            m_exact[i] = m_compound.shape(i).bounds(m_poses[i]);
+            m_has_exact[i] = true;
+        }
+        return m_exact[i];
+    }
+    // A box holding part i's exact bounds: its compound-frame bounds turned into the world,
+    // widened by far more than the two computations' rounding can differ.
+    Aabb loose(std::uint32_t i) const { return turned(m_compound.part_bounds(i)); }
+    Aabb loose_all() const { return turned(m_compound.local_bounds()); }
+
+private:
+    Aabb turned(const Aabb& local) const {
+        const Vec3 c = m_x.p + m_rotation * local.center();
+        const Vec3 e = m_rotation.cwiseAbs() * local.extents();
+        const Real pad = kLooseRelative * (c.cwiseAbs().maxCoeff() + e.maxCoeff());
+        return Aabb::from_center_extents(c, e.array() + pad);
+    }
+
+    const Compound& m_compound;
+    Transform m_x;
+    Mat3 m_rotation;
+    ScratchBuffer<Transform, kInlineParts> m_poses;
+    ScratchBuffer<Aabb, kInlineParts> m_exact;
+    ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
 };
 
 // Shape a (part `part_a` of its body, 0 if it is whole) against every part of compound b
-// near it.
+// near it; a_box is a's exact bounds fattened by the speculative distance.
 void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
                    Real speculative, Gathered& g) {
     Manifold found[kPerPair];
-    for (std::uint32_t i = 0; i < b.compound.size(); ++i) {
-        if (!a_box.overlaps(b.bounds[i])) continue;
-        const int n = collide(a, xa, b.compound.shape(i), b.poses[i], speculative, found, kPerPair);
+    for (std::uint32_t i = 0; i < b.size(); ++i) {
+        if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
+        const int n = collide(a, xa, b.shape(i), b.pose(i), speculative, found, kPerPair);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -78,7 +120,7 @@ void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, co
 // The deepest `capacity` manifolds, in part-pair order (the order of the walk), so the
 // order does not depend on which were kept.
 int emit(Gathered& g, Manifold* out, int capacity) {
-    const auto end = g.list.begin() + g.count;
+    const Manifold* begin = g.list.data();
     if (g.count > capacity) {
         std::array<int, kMaxGathered> order;
         for (int i = 0; i < g.count; ++i) order[static_cast<std::size_t>(i)] = i;
@@ -90,7 +132,7 @@ int emit(Gathered& g, Manifold* out, int capacity) {
             out[i] = g.list[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
         return capacity;
     }
-    std::copy(g.list.begin(), end, out);
+    std::copy(begin, begin + g.count, out);
     return g.count;
 }
 
@@ -109,12 +151,13 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
                               Real speculative, Manifold* out, int capacity) {
     Gathered g;
     const Compound& parts = *a.parts;
-    PosedParts b_parts(*b.parts, xb);
+    const Real margin = std::max(speculative, Real(0));
+    PosedParts a_parts(parts, xa), b_parts(*b.parts, xb);
+    const Aabb b_box = b_parts.loose_all();
     for (std::uint32_t j = 0; j < parts.size(); ++j) {
-        const Transform x = xa * parts.pose(j);
-        const Aabb part_box = parts.shape(j).bounds(x).fattened(std::max(speculative, Real(0)));
-        if (!part_box.overlaps(b_parts.all)) continue;
-        collide_parts(parts.shape(j), x, j, part_box, b_parts, speculative, g);
+        if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
+        const Aabb part_box = a_parts.exact(j).fattened(margin);
+        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, speculative, g);
     }
     return emit(g, out, capacity);
 }
