@@ -60,8 +60,12 @@ public:
           m_rotation(x.q.toRotationMatrix()),
           m_poses(parts.size()),
           m_exact(parts.size()),
+          m_loose(parts.size()),
           m_has_exact(parts.size()) {
-        for (std::uint32_t i = 0; i < parts.size(); ++i) m_has_exact[i] = false;
+        for (std::uint32_t i = 0; i < parts.size(); ++i) {
+            m_loose[i] = turned(parts.part_bounds(i));
+            m_has_exact[i] = false;
+        }
     }
 
     std::uint32_t size() const { return m_compound.size(); }
@@ -82,7 +86,7 @@ public:
     }
     // A box holding part i's exact bounds: its compound-frame bounds turned into the world,
     // widened by far more than the two computations' rounding can differ.
-    Aabb loose(std::uint32_t i) const { return turned(m_compound.part_bounds(i)); }
+    const Aabb& loose(std::uint32_t i) { return m_loose[i]; }
     Aabb loose_all() const { return turned(m_compound.local_bounds()); }
 
 private:
@@ -98,6 +102,7 @@ private:
     Mat3 m_rotation;
     ScratchBuffer<Transform, kInlineParts> m_poses;
     ScratchBuffer<Aabb, kInlineParts> m_exact;
+    ScratchBuffer<Aabb, kInlineParts> m_loose;
     ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
 };
 
