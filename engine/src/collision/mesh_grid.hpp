@@ -36,14 +36,18 @@ private:
     struct Range {
         int lo, hi;  // buckets lo..hi along one axis
     };
-    Range cells(Real lo, Real hi, int axis) const;
+    Real in_cells(Real x, int axis) const;
+    int clamped(Real c, int axis) const;
+    Range triangle_cells(Real lo, Real hi, int axis) const;
+    Range query_cells(Real lo, Real hi, int axis) const;
 
     int m_axis[2] = {0, 2};  // the grid's two axes, the mesh's widest
     Vec3 m_origin = Vec3::Zero();
     Real m_inverse_cell = 1;
     int m_count[2] = {1, 1};
     // Bucket (i, j) lists m_entries[m_first[b]..m_first[b + 1]), b = j * m_count[0] + i,
-    // triangles in increasing order.
+    // triangles in increasing order, each with flags saying whether the bucket is its first
+    // along either axis.
     std::vector<std::uint32_t> m_first;
     std::vector<std::uint32_t> m_entries;
 };
