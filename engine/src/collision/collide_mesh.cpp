@@ -1,7 +1,7 @@
-// Convex shape against a triangle mesh: the shape meets each triangle the mesh tree
-// finds under its bounds and whose plane it comes near (shape_span.hpp); contacts on inactive (flat interior) edges
-// take the triangle's face normal so shapes slide over seams without catching; manifolds whose normals agree are
-// merged, and the deepest come first.
+// Convex shape against a triangle mesh: the shape meets each triangle the mesh finds
+// under its bounds and whose plane it comes near (shape_span.hpp); contacts on inactive
+// (flat interior) edges take the triangle's face normal so shapes slide over seams
+// without catching; manifolds whose normals agree are merged, and the deepest come first.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,6 +20,7 @@ constexpr int kMaxMeshOutput = 4;       // the deepest of them a shape keeps aga
 constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
 constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
+
 // Triangle t in the mesh frame against convex a posed there by xa.
 bool collide_triangle(const Shape& a, const Transform& xa, const BoxPoly* box, const TrianglePoly& tri,
                       Real speculative, Manifold& m) {
