@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <array>
 
+#include "collision/clipping.hpp"
 #include "collision/compound.hpp"
+#include "collision/manifold_slots.hpp"
 #include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
@@ -12,10 +14,13 @@ namespace {
 
 // Manifolds kept while walking part pairs; past this a deeper one replaces the shallowest.
 constexpr int kMaxGathered = 64;
-constexpr int kPerPair = 4;  // a mesh may give several manifolds per part
+constexpr int kPerPair = 4;               // a mesh may give several manifolds per part
+constexpr std::size_t kInlineParts = 32;  // parts posed on the stack; more go to the heap
+// Far above the relative rounding of a part's bounds computed two ways (about 1e-15).
+constexpr Real kLooseRelative = 1e-9;
 
 struct Gathered {
-    std::array<Manifold, kMaxGathered> list;
+    ManifoldSlots<kMaxGathered> list;
     int count = 0;
 };
 
@@ -27,28 +32,88 @@ Real deepest(const Manifold& m) {
 
 void keep(Gathered& g, const Manifold& m) {
     if (g.count < kMaxGathered) {
-        g.list[static_cast<std::size_t>(g.count++)] = m;
+        g.list.fill(static_cast<std::size_t>(g.count++), m);
         return;
     }
-    auto shallowest = g.list.begin();
-    for (auto it = g.list.begin(); it != g.list.end(); ++it) {
+    Manifold* const begin = g.list.data();
+    Manifold* const end = begin + kMaxGathered;
+    Manifold* shallowest = begin;
+    for (Manifold* it = begin; it != end; ++it) {
         if (deepest(*it) > deepest(*shallowest)) shallowest = it;
     }
     if (deepest(m) >= deepest(*shallowest)) return;
     // Out of its place, and m at the end: the list stays in the order of the walk.
-    std::move(shallowest + 1, g.list.end(), shallowest);
-    g.list.back() = m;
+    std::move(shallowest + 1, end, shallowest);
+    end[-1] = m;
 }
 
+// Compound b's parts posed in the world, and their bounds: worked out once per pair, not
+// once for every part of the other shape they are tested against. A part's exact bounds
+// (its hull's vertices moved into the world) are what decide whether it meets the other
+// shape, as they did when each pair was tested alone; its compound-frame box turned with
+// the compound is a cheap superset that rules most parts out first.
+class PosedParts {
+public:
+    PosedParts(const Compound& parts, const Transform& x)
+        : m_compound(parts),
+          m_x(x),
+          m_rotation(x.q.toRotationMatrix()),
+          m_poses(parts.size()),
+          m_exact(parts.size()),
+          m_loose(parts.size()),
+          m_has_exact(parts.size()) {
+        for (std::uint32_t i = 0; i < parts.size(); ++i) {
+            m_loose[i] = turned(parts.part_bounds(i));
+            m_has_exact[i] = false;
+        }
+    }
+
+    std::uint32_t size() const { return m_compound.size(); }
+    const Shape& shape(std::uint32_t i) const { return m_compound.shape(i); }
+
+    // Part i's world pose and exact bounds, made the first time they are asked for.
+    const Transform& pose(std::uint32_t i) {
+        exact(i);
+        return m_poses[i];
+    }
+    const Aabb& exact(std::uint32_t i) {
+        if (!m_has_exact[i]) {
+            m_poses[i] = m_x * m_compound.pose(i);
+            m_exact[i] = m_compound.shape(i).bounds(m_poses[i]);
+            m_has_exact[i] = true;
+        }
+        return m_exact[i];
+    }
+    // A box holding part i's exact bounds: its compound-frame bounds turned into the world,
+    // widened by far more than the two computations' rounding can differ.
+    const Aabb& loose(std::uint32_t i) { return m_loose[i]; }
+    Aabb loose_all() const { return turned(m_compound.local_bounds()); }
+
+private:
+    Aabb turned(const Aabb& local) const {
+        const Vec3 c = m_x.p + m_rotation * local.center();
+        const Vec3 e = m_rotation.cwiseAbs() * local.extents();
+        const Real pad = kLooseRelative * (c.cwiseAbs().maxCoeff() + e.maxCoeff());
+        return Aabb::from_center_extents(c, e.array() + pad);
+    }
+
+    const Compound& m_compound;
+    Transform m_x;
+    Mat3 m_rotation;
+    ScratchBuffer<Transform, kInlineParts> m_poses;
+    ScratchBuffer<Aabb, kInlineParts> m_exact;
+    ScratchBuffer<Aabb, kInlineParts> m_loose;
+    ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
+};
+
 // Shape a (part `part_a` of its body, 0 if it is whole) against every part of compound b
-// near it.
-void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, const Compound& b,
-                   const Transform& xb, Real speculative, Gathered& g) {
+// near it; a_box is a's exact bounds fattened by the speculative distance.
+void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
+                   Real speculative, Gathered& g) {
     Manifold found[kPerPair];
     for (std::uint32_t i = 0; i < b.size(); ++i) {
-        const Transform x = xb * b.pose(i);
-        if (!a_box.overlaps(b.shape(i).bounds(x))) continue;
-        const int n = collide(a, xa, b.shape(i), x, speculative, found, kPerPair);
+        if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
+        const int n = collide(a, xa, b.shape(i), b.pose(i), speculative, found, kPerPair);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -60,7 +125,7 @@ void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, co
 // The deepest `capacity` manifolds, in part-pair order (the order of the walk), so the
 // order does not depend on which were kept.
 int emit(Gathered& g, Manifold* out, int capacity) {
-    const auto end = g.list.begin() + g.count;
+    const Manifold* begin = g.list.data();
     if (g.count > capacity) {
         std::array<int, kMaxGathered> order;
         for (int i = 0; i < g.count; ++i) order[static_cast<std::size_t>(i)] = i;
@@ -72,7 +137,7 @@ int emit(Gathered& g, Manifold* out, int capacity) {
             out[i] = g.list[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
         return capacity;
     }
-    std::copy(g.list.begin(), end, out);
+    std::copy(begin, begin + g.count, out);
     return g.count;
 }
 
@@ -82,7 +147,8 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
                            Manifold* out, int capacity) {
     Gathered g;
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
-    collide_parts(a, xa, 0, a_box, *b.parts, xb, speculative, g);
+    PosedParts parts(*b.parts, xb);
+    collide_parts(a, xa, 0, a_box, parts, speculative, g);
     return emit(g, out, capacity);
 }
 
@@ -90,12 +156,13 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
                               Real speculative, Manifold* out, int capacity) {
     Gathered g;
     const Compound& parts = *a.parts;
-    const Aabb b_box = b.bounds(xb);
+    const Real margin = std::max(speculative, Real(0));
+    PosedParts a_parts(parts, xa), b_parts(*b.parts, xb);
+    const Aabb b_box = b_parts.loose_all();
     for (std::uint32_t j = 0; j < parts.size(); ++j) {
-        const Transform x = xa * parts.pose(j);
-        const Aabb part_box = parts.shape(j).bounds(x).fattened(std::max(speculative, Real(0)));
-        if (!part_box.overlaps(b_box)) continue;
-        collide_parts(parts.shape(j), x, j, part_box, *b.parts, xb, speculative, g);
+        if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
+        const Aabb part_box = a_parts.exact(j).fattened(margin);
+        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, speculative, g);
     }
     return emit(g, out, capacity);
 }

@@ -1,13 +1,15 @@
-// Convex shape against a triangle mesh: the shape meets each triangle the mesh tree
-// finds under its bounds; contacts on inactive (flat interior) edges take the triangle's
-// face normal so shapes slide over seams without catching; manifolds whose normals
-// agree are merged, and the deepest come first.
+// Convex shape against a triangle mesh: the shape meets each triangle the mesh finds
+// under its bounds and whose plane it comes near (shape_span.hpp); contacts on inactive
+// (flat interior) edges take the triangle's face normal so shapes slide over seams
+// without catching; manifolds whose normals agree are merged, and the deepest come first.
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "collision/clipping.hpp"
+#include "collision/manifold_slots.hpp"
 #include "collision/pair_functions.hpp"
+#include "collision/shape_span.hpp"
 #include "collision/triangle_mesh.hpp"
 
 namespace spindle::detail {
@@ -93,7 +95,7 @@ Real deepest(const Manifold& m) {
 
 // Adds m to the list, merging it into a manifold with nearly the same normal; when the
 // list is full a deeper manifold replaces the shallowest.
-void gather(Manifold* list, int& count, const Manifold& m) {
+void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& m) {
     for (int i = 0; i < count; ++i) {
         if (list[i].normal.dot(m.normal) < kSameNormal) continue;
         ContactCandidate c[2 * kMaxManifoldPoints];
@@ -107,7 +109,7 @@ void gather(Manifold* list, int& count, const Manifold& m) {
         return;
     }
     if (count < kMaxMeshManifolds) {
-        list[count++] = m;
+        list.fill(static_cast<std::size_t>(count++), m);
         return;
     }
     int shallowest = 0;
@@ -127,11 +129,14 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
     BoxPoly box_storage(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
     const BoxPoly* box = a.type == ShapeType::Box ? &box_storage : nullptr;
 
-    std::array<Manifold, kMaxMeshManifolds> found;
+    const ShapeSpan span(a, a_in_mesh);
+
+    ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
     mesh.query(query, [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
+        if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
         Manifold m;
         if (!collide_triangle(a, a_in_mesh, box, poly, speculative, m)) return;
@@ -141,10 +146,10 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         }
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
-        gather(found.data(), found_count, m);
+        gather(found, found_count, m);
     });
 
-    std::sort(found.begin(), found.begin() + found_count,
+    std::sort(found.data(), found.data() + found_count,
               [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
     const int count = std::min({found_count, capacity, kMaxMeshOutput});
     for (int i = 0; i < count; ++i) {

@@ -23,12 +23,6 @@ constexpr int kQueryStack = 128;
 // Neighbouring triangles closer than ~5 degrees to flat share an inactive edge.
 constexpr Real kFlatCosine = 0.9962;
 
-Aabb triangle_box(const std::vector<Vec3>& v, const MeshTriangle& t) {
-    Aabb box;
-    for (const std::uint32_t i : t.v) box.include(v[i]);
-    return box;
-}
-
 }  // namespace
 
 TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const std::uint32_t> indices) {
@@ -63,6 +57,7 @@ TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const std::
     if (m_triangles.empty()) throw Error("triangle mesh: has no triangle of non-zero area");
     mark_active_edges();
     build_tree();
+    m_grid = MeshGrid::build(m_vertices, m_triangles, local_bounds());
 }
 
 Vec3 TriangleMesh::normal(std::uint32_t t) const {
@@ -119,7 +114,7 @@ void TriangleMesh::build_tree() {
     std::vector<Item> items;
     items.reserve(m_triangles.size());
     for (const MeshTriangle& t : m_triangles) {
-        const Aabb box = triangle_box(m_vertices, t);
+        const Aabb box = triangle_bounds(m_vertices, t);
         items.push_back({box, box.center(), t});
     }
     struct Task {
@@ -204,6 +199,12 @@ void TriangleMesh::build_tree() {
 }
 
 void TriangleMesh::query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const {
+    if (!local_bounds().overlaps(box)) return;
+    if (m_grid && m_grid->query(box, m_vertices, m_triangles, visit)) return;
+    query_tree(box, visit);
+}
+
+void TriangleMesh::query_tree(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const {
     std::uint32_t stack[kQueryStack];
     int top = 0;
     stack[top++] = 0;
@@ -212,7 +213,7 @@ void TriangleMesh::query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit
         if (!node.box.overlaps(box)) continue;
         if (node.count > 0) {
             for (std::uint32_t t = node.first; t < node.first + node.count; ++t) {
-                if (triangle_box(m_vertices, m_triangles[t]).overlaps(box)) visit(t);
+                if (triangle_bounds(m_vertices, m_triangles[t]).overlaps(box)) visit(t);
             }
             continue;
         }

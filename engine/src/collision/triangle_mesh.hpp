@@ -4,11 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <spindle/engine/math.hpp>
 #include <spindle/scheduler/function_ref.hpp>
+
+#include "collision/mesh_grid.hpp"
 
 namespace spindle {
 
@@ -18,6 +21,13 @@ struct MeshTriangle {
     // contact may take the edge's own normal). Flat or concave shared edges are inactive.
     std::uint8_t active_edges = 0x7;
 };
+
+// Triangle t's bounds: what the tree and the grid test a query box against.
+inline Aabb triangle_bounds(std::span<const Vec3> vertices, const MeshTriangle& t) {
+    Aabb box;
+    for (const std::uint32_t i : t.v) box.include(vertices[i]);
+    return box;
+}
 
 // A node of the tree: a leaf holds triangles [first, first+count) of triangles(); an
 // internal node (count == 0) has children `first` and `first + 1`.
@@ -41,8 +51,12 @@ public:
 
     // Unit normal of triangle t (counter-clockwise winding).
     Vec3 normal(std::uint32_t t) const;
-    // Calls visit(t) for every triangle whose bounds overlap `box` (mesh frame), in tree order.
+    // Calls visit(t) for every triangle whose bounds overlap `box` (mesh frame), in tree
+    // order (increasing t); through the grid when the mesh is flat enough to have one.
     void query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const;
+    bool has_grid() const noexcept { return m_grid.has_value(); }
+    // The same, through the tree alone.
+    void query_tree(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const;
 
 private:
     void build_tree();
@@ -51,6 +65,7 @@ private:
     std::vector<Vec3> m_vertices;
     std::vector<MeshTriangle> m_triangles;
     std::vector<MeshNode> m_nodes;
+    std::optional<MeshGrid> m_grid;
 };
 
 }  // namespace spindle
