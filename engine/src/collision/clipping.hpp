@@ -87,6 +87,7 @@ public:
     ScratchBuffer(const ScratchBuffer&) = delete;
     ScratchBuffer& operator=(const ScratchBuffer&) = delete;
     T* data() { return m_data; }
+    const T* data() const { return m_data; }
     T& operator[](std::size_t i) { return m_data[i]; }
 
 private:

@@ -45,6 +45,11 @@ int collide_compound_compound(const Shape&, const Transform&, const Shape&, cons
 // one found is kept there.
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,
                        Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
+// The same with A prepared once for many tests (sat_prepared.hpp): a hull against each
+// triangle a mesh query finds.
+class PreparedPolyhedron;
+bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                       Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
 
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
 // radius) against polyhedron b: GJK distance between the cores while they are apart, SAT

@@ -8,31 +8,10 @@
 #include "collision/clipping.hpp"
 #include "collision/convex_hull.hpp"
 #include "collision/pair_functions.hpp"
+#include "collision/sat_prepared.hpp"
 
 namespace spindle::detail {
 namespace {
-
-constexpr std::size_t kInlineVertices = 64;
-
-// Four doubles worked on together (GCC's vector extensions: AVX where the build has it).
-// Each lane computes what the scalar code computes, in the same order, so the results
-// are the same bits.
-using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
-using LaneMask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
-// Bit k set when lane k is set.
-inline unsigned lane_bits(LaneMask m) {
-#ifdef __AVX__
-    return static_cast<unsigned>(__builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(m)));
-#else
-    return (m[0] ? 1u : 0u) | (m[1] ? 2u : 0u) | (m[2] ? 4u : 0u) | (m[3] ? 8u : 0u);
-#endif
-}
-
-// Vertices in lanes: lane k of group i holds vertex 4i + k; lanes past the last vertex
-// repeat vertex 0, which never wins a support query over it (ties go to the lower index).
-struct VertexLanes {
-    Lanes x, y, z;
-};
 
 void fill_lanes(const Vec3* vertices, std::uint32_t count, VertexLanes* out) {
     for (std::uint32_t i = 0; i < (count + 3) / 4 * 4; ++i) {
@@ -106,15 +85,6 @@ FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     return best;
 }
 
-// An edge in the common frame with what the Gauss-map test needs: the edge's arc
-// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
-struct ArcEdge {
-    Vec3 origin;
-    Vec3 direction;
-    Vec3 n0, n1;  // normals of the two faces
-    Vec3 t0, t1;  // direction x n0, n1 x direction
-};
-
 ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
     const HullEdge& e = p.view.edges[j];
     ArcEdge a;
@@ -153,12 +123,6 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
     return true;
 }
 
-// Four of A's edges for the edge query's cheap rejections: the components of each edge's
-// direction and two face normals, lane k holding edge 4i + k.
-struct EdgeLanes {
-    Lanes dx, dy, dz, n0x, n0y, n0z, n1x, n1y, n1z;
-};
-
 void prepare_lanes(const ArcEdge* edges, std::uint32_t count, EdgeLanes* out) {
     for (std::uint32_t j = 0; j < count; ++j) {
         EdgeLanes& l = out[j / 4];
@@ -180,13 +144,12 @@ void prepare_lanes(const ArcEdge* edges, std::uint32_t count, EdgeLanes* out) {
 // fail the first two tests of edge_pair_axis (an arc that does not cross the other's
 // great circle): those run on four of A's edges at once, each lane computing what the
 // scalar test computes in the same order, so the pairs kept are the same.
-EdgeQuery query_edges(const Posed& a, const Posed& b, Real limit) {
-    ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_a(a.view.edge_count), edges_b(b.view.edge_count);
-    prepare_edges(a, edges_a.data());
+EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, const Posed& b, Real limit) {
+    const ArcEdge* edges_a = prepared_a.edges();
+    const EdgeLanes* lanes = prepared_a.edge_lanes();
+    ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
     prepare_edges(b, edges_b.data());
     const std::uint32_t groups = (a.view.edge_count + 3) / 4;
-    ScratchBuffer<EdgeLanes, kInlineVertices> lanes(groups);
-    prepare_lanes(edges_a.data(), a.view.edge_count, lanes.data());
     EdgeQuery best;
     for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
         const ArcEdge& eb = edges_b[jb];
@@ -290,17 +253,38 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
 
 }  // namespace
 
+PreparedPolyhedron::PreparedPolyhedron(const PolyView& view)
+    : m_view(view),
+      m_vertex_lanes((view.vertex_count + 3) / 4),
+      m_edges(view.edge_count),
+      m_edge_lanes((view.edge_count + 3) / 4) {
+    fill_lanes(view.vertices, view.vertex_count, m_vertex_lanes.data());
+}
+
+void PreparedPolyhedron::prepare_edges() const {
+    if (m_edges_ready) return;
+    m_edges_ready = true;
+    const Posed own{m_view, m_view.vertices, m_vertex_lanes.data(), Mat3::Identity(), Vec3::Zero()};
+    detail::prepare_edges(own, m_edges.data());
+    prepare_lanes(m_edges.data(), m_view.edge_count, m_edge_lanes.data());
+}
+
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,
                        Manifold& m, FeatureCache* cache) {
+    const PreparedPolyhedron prepared(a);
+    return collide_polyhedra(prepared, xa, b, xb, speculative, m, cache);
+}
+
+bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
+                       Real speculative, Manifold& m, FeatureCache* cache) {
+    const PolyView& a = prepared.view();
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
-    ScratchBuffer<VertexLanes, kInlineVertices / 4> a_lanes((a.vertex_count + 3) / 4),
-        b_lanes((b.vertex_count + 3) / 4);
-    fill_lanes(a.vertices, a.vertex_count, a_lanes.data());
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
     fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
-    const Posed pa{a, a.vertices, a_lanes.data(), Mat3::Identity(), Vec3::Zero()};
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero()};
     const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t};
 
     if (cache && apart_on_cached_axis(*cache, pa, pb, speculative)) return false;
@@ -315,7 +299,7 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
         remember_axis(cache, Kind::FaceB, 0, face_b.face);
         return false;
     }
-    const EdgeQuery edge = query_edges(pa, pb, speculative);
+    const EdgeQuery edge = query_edges(prepared, pa, pb, speculative);
     if (edge.separation > speculative) {
         remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b);
         return false;

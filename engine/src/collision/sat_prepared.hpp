@@ -1,0 +1,81 @@
+// A polyhedron's SAT data laid out for the lanes sat.cpp works on, and PreparedPolyhedron,
+// that data for a polyhedron in its own frame, made once for many tests of it (a hull
+// against each triangle a mesh query finds).
+#pragma once
+
+#include <cstdint>
+
+#include "collision/clipping.hpp"
+#include "collision/polyhedron.hpp"
+
+namespace spindle::detail {
+
+// Four doubles worked on together (GCC's vector extensions: AVX where the build has it).
+// Each lane computes what the scalar code computes, in the same order, so the results
+// are the same bits.
+using Lanes = double __attribute__((vector_size(4 * sizeof(double))));
+using LaneMask = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+// Bit k set when lane k is set.
+inline unsigned lane_bits(LaneMask m) {
+#ifdef __AVX__
+    return static_cast<unsigned>(__builtin_ia32_movmskpd256(reinterpret_cast<Lanes>(m)));
+#else
+    return (m[0] ? 1u : 0u) | (m[1] ? 2u : 0u) | (m[2] ? 4u : 0u) | (m[3] ? 8u : 0u);
+#endif
+}
+
+// Vertices in lanes: lane k of group i holds vertex 4i + k; lanes past the last vertex
+// repeat vertex 0, which never wins a support query over it (ties go to the lower index).
+struct VertexLanes {
+    Lanes x, y, z;
+};
+
+// An edge in the common frame with what the Gauss-map test needs: the edge's arc
+// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
+struct ArcEdge {
+    Vec3 origin;
+    Vec3 direction;
+    Vec3 n0, n1;  // normals of the two faces
+    Vec3 t0, t1;  // direction x n0, n1 x direction
+};
+
+// Four of A's edges for the edge query's cheap rejections: the components of each edge's
+// direction and two face normals, lane k holding edge 4i + k.
+struct EdgeLanes {
+    Lanes dx, dy, dz, n0x, n0y, n0z, n1x, n1y, n1z;
+};
+
+inline constexpr std::size_t kInlineVertices = 64;
+
+// A polyhedron in its own frame (the frame sat.cpp works in, the first polyhedron's),
+// with its vertices in lanes, and its edges prepared on first use: most tests of a pair
+// that stays apart end on a face before any edge is looked at.
+class PreparedPolyhedron {
+public:
+    explicit PreparedPolyhedron(const PolyView& view);
+    PreparedPolyhedron(const PreparedPolyhedron&) = delete;
+    PreparedPolyhedron& operator=(const PreparedPolyhedron&) = delete;
+
+    const PolyView& view() const noexcept { return m_view; }
+    const VertexLanes* vertex_lanes() const noexcept { return m_vertex_lanes.data(); }
+    // The edges with their face normals, and the same in lanes of four.
+    const ArcEdge* edges() const {
+        prepare_edges();
+        return m_edges.data();
+    }
+    const EdgeLanes* edge_lanes() const {
+        prepare_edges();
+        return m_edge_lanes.data();
+    }
+
+private:
+    void prepare_edges() const;
+
+    PolyView m_view;
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> m_vertex_lanes;
+    mutable bool m_edges_ready = false;
+    mutable ScratchBuffer<ArcEdge, 2 * kInlineVertices> m_edges;
+    mutable ScratchBuffer<EdgeLanes, kInlineVertices> m_edge_lanes;
+};
+
+}  // namespace spindle::detail
