@@ -9,6 +9,7 @@
 #include "collision/clipping.hpp"
 #include "collision/manifold_slots.hpp"
 #include "collision/pair_functions.hpp"
+#include "collision/sat_prepared.hpp"
 #include "collision/shape_span.hpp"
 #include "collision/triangle_mesh.hpp"
 
@@ -21,9 +22,10 @@ constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
 constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
 
-// Triangle t in the mesh frame against convex a posed there by xa.
-bool collide_triangle(const Shape& a, const Transform& xa, const BoxPoly* box, const TrianglePoly& tri,
-                      Real speculative, Manifold& m) {
+// Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
+// prepared once for all the triangles of the query.
+bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
+                      const TrianglePoly& tri, Real speculative, Manifold& m) {
     const Transform identity;
     switch (a.type) {
         case ShapeType::Sphere:
@@ -32,9 +34,8 @@ bool collide_triangle(const Shape& a, const Transform& xa, const BoxPoly* box, c
             rounded_core(a, p0, p1);
             return collide_rounded_polyhedron(p0, p1, a.radius, xa, tri.view(), identity, speculative, m);
         }
-        case ShapeType::Box: return collide_polyhedra(box->view(), xa, tri.view(), identity, speculative, m);
-        case ShapeType::ConvexHull:
-            return collide_polyhedra(view_of(*a.hull), xa, tri.view(), identity, speculative, m);
+        case ShapeType::Box:
+        case ShapeType::ConvexHull: return collide_polyhedra(*polyhedron, xa, tri.view(), identity, speculative, m);
         default: return false;
     }
 }
@@ -126,8 +127,9 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
     const TriangleMesh& mesh = *b.mesh;
     const Transform a_in_mesh = xb.inverse() * xa;
     const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
-    BoxPoly box_storage(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
-    const BoxPoly* box = a.type == ShapeType::Box ? &box_storage : nullptr;
+    const BoxPoly box(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
+    const bool polyhedral = a.type == ShapeType::Box || a.type == ShapeType::ConvexHull;
+    const PreparedPolyhedron prepared(a.type == ShapeType::ConvexHull ? view_of(*a.hull) : box.view());
 
     const ShapeSpan span(a, a_in_mesh);
 
@@ -139,7 +141,7 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
         Manifold m;
-        if (!collide_triangle(a, a_in_mesh, box, poly, speculative, m)) return;
+        if (!collide_triangle(a, a_in_mesh, polyhedral ? &prepared : nullptr, poly, speculative, m)) return;
         if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
             use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
             if (m.point_count == 0) return;
