@@ -20,19 +20,27 @@ SwingTwistAngles angles_now(const JointConstraint& jc, const SolverBody& A, cons
     return swing_twist_angles(A.dq * jc.axis_a, B.dq * jc.axis_b, A.dq * jc.ref_a, B.dq * jc.ref_b);
 }
 
+// The swing's sine and axis and the twist axis: all a warm start needs (no angle, so no
+// arctangent and no reference turned).
+void swing_twist_axes(const Vec3& axis_a, const Vec3& axis_b, SwingTwistAngles& r, Real& sine, Vec3& cross) {
+    cross = axis_a.cross(axis_b);
+    sine = cross.norm();
+    if (sine > kMinSwingSine) r.swing_axis = cross / sine;
+    const Vec3 halfway = axis_a + axis_b;
+    r.twist_axis = halfway.norm() > 1e-6 ? Vec3(halfway.normalized()) : axis_a;
+}
+
 }  // namespace
 
 SwingTwistAngles swing_twist_angles(const Vec3& axis_a, const Vec3& axis_b, const Vec3& ref_a, const Vec3& ref_b) {
     SwingTwistAngles r;
-    const Vec3 cross = axis_a.cross(axis_b);
-    const Real sine = cross.norm();
+    Real sine;
+    Vec3 cross;
+    swing_twist_axes(axis_a, axis_b, r, sine, cross);
     r.swing = std::atan2(sine, axis_a.dot(axis_b));
-    if (sine > kMinSwingSine) r.swing_axis = cross / sine;
     // Undo the swing on B's reference: what is left is a turn about A's axis, the twist.
     const Vec3 unswung = Quat::FromTwoVectors(axis_b, axis_a) * ref_b;
     r.twist = std::atan2(axis_a.dot(ref_a.cross(unswung)), ref_a.dot(unswung));
-    const Vec3 halfway = axis_a + axis_b;
-    r.twist_axis = halfway.norm() > 1e-6 ? Vec3(halfway.normalized()) : axis_a;
     return r;
 }
 
@@ -62,7 +70,10 @@ void prepare_swing_twist(const Joint& j, const SolverBody& A, const SolverBody& 
 }
 
 void warm_start_swing_twist(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s) {
-    const SwingTwistAngles angles = angles_now(jc, A, B);
+    SwingTwistAngles angles;
+    Real sine;
+    Vec3 cross;
+    swing_twist_axes(A.dq * jc.axis_a, B.dq * jc.axis_b, angles, sine, cross);
     apply_angular(A, B, s,
                   jc.angular_impulse - jc.swing_impulse * angles.swing_axis +
                       (jc.lower_impulse - jc.upper_impulse) * angles.twist_axis);
