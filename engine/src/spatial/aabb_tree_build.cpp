@@ -1,5 +1,6 @@
-// DynamicAabbTree::rebuild: top-down binned SAH build over the existing leaves, for trees
-// filled in bulk (the static tree). Leaves stay where they are, so proxy ids survive.
+// DynamicAabbTree::rebuild and rebuild_enlarged: top-down binned SAH builds over the
+// existing leaves (all of them, for trees filled in bulk), or over the subtrees that hang
+// off the paths moves flagged. Leaves stay where they are, so proxy ids survive.
 #include "spatial/aabb_tree.hpp"
 
 #include <algorithm>
@@ -26,11 +27,37 @@ void DynamicAabbTree::rebuild() {
         }
     }
     m_root = kNull;
-    if (m_build_leaves.empty()) {
-        validate_if_enabled();
-        return;
-    }
+    build_from_leaves();
+    validate_if_enabled();
+}
 
+void DynamicAabbTree::rebuild_enlarged() {
+    if (m_enlarged_nodes == 0) return;
+    // Flagged nodes form a tree from the root down (a flagged node's parent is flagged):
+    // free them, and keep what hangs off them (a leaf or an unflagged subtree) whole.
+    m_build_leaves.clear();
+    TraversalStack stack;
+    stack.push(m_root);
+    while (!stack.empty()) {
+        const std::int32_t id = stack.pop();
+        const Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (m_enlarged[static_cast<std::size_t>(id)] == 0) {
+            m_build_leaves.push_back({id, node.box.center()});
+            continue;
+        }
+        stack.push(node.payload.children.second);
+        stack.push(node.payload.children.first);
+        free_node(id);  // the node's children stay readable until it is allocated again below
+    }
+    m_root = kNull;
+    build_from_leaves();
+    validate_if_enabled();
+}
+
+// Builds internal nodes over m_build_leaves (proxies or whole subtrees) and makes the
+// result the tree's root. Allocates exactly the nodes the callers freed before.
+void DynamicAabbTree::build_from_leaves() {
+    if (m_build_leaves.empty()) return;
     // Iterative, so a degenerate split sequence cannot overflow the C++ stack. Parents are
     // created before their children; fitting in reverse creation order is bottom up.
     m_build_tasks.clear();
@@ -58,7 +85,6 @@ void DynamicAabbTree::rebuild() {
         }
     }
     for (auto it = m_build_order.rbegin(); it != m_build_order.rend(); ++it) refit(*it);
-    validate_if_enabled();
 }
 
 // Splits m_build_leaves[begin, end) in two along the longest axis of the leaf centres,
