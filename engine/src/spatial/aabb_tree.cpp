@@ -340,6 +340,16 @@ bool DynamicAabbTree::rotate(std::int32_t a) {
     return true;
 }
 
+std::size_t DynamicAabbTree::heap_bytes() const noexcept {
+    std::size_t bytes = m_nodes.capacity() * sizeof(Node) + m_enlarged.capacity() * sizeof(std::uint8_t) +
+                        m_build_leaves.capacity() * sizeof(BuildLeaf) +
+                        (m_build_tasks.capacity() + m_build_subtrees.capacity()) * sizeof(BuildTask) +
+                        (m_build_order.capacity() + m_build_pool.capacity()) * sizeof(std::int32_t) +
+                        m_build_stacks.capacity() * sizeof(std::vector<BuildTask>);
+    for (const std::vector<BuildTask>& stack : m_build_stacks) bytes += stack.capacity() * sizeof(BuildTask);
+    return bytes;
+}
+
 Real DynamicAabbTree::area_cost() const {
     Real sum = 0;
     for (const Node& node : m_nodes) {

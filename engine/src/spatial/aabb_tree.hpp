@@ -9,6 +9,7 @@
 
 #include <spindle/engine/math.hpp>
 #include <spindle/platform/assert.hpp>
+#include <spindle/scheduler/job_system.hpp>
 
 namespace spindle {
 
@@ -62,8 +63,10 @@ public:
     // Rebuilds, with the same heuristic, only the internal nodes move_proxy flagged (the
     // paths from moved leaves to the root); the subtrees hanging off those paths are kept
     // whole and placed as if they were leaves. Proxy ids, fat boxes and user values are
-    // unchanged. Costs nothing when no proxy moved since the last rebuild.
-    void rebuild_enlarged();
+    // unchanged. Costs nothing when no proxy moved since the last rebuild. With `jobs`,
+    // the lower parts are built in parallel (the same tree for any worker count); the
+    // caller waits for them, and nothing else may touch the tree meanwhile.
+    void rebuild_enlarged(JobSystem* jobs = nullptr);
     // Internal nodes flagged by moves and not rebuilt yet.
     std::int32_t enlarged_node_count() const noexcept { return m_enlarged_nodes; }
 
@@ -76,11 +79,7 @@ public:
         return m_nodes[static_cast<std::size_t>(id)].payload.user;
     }
     // Heap bytes the tree holds (its nodes and rebuild scratch, at capacity).
-    std::size_t heap_bytes() const noexcept {
-        return m_nodes.capacity() * sizeof(Node) + m_enlarged.capacity() * sizeof(std::uint8_t) +
-               m_build_leaves.capacity() * sizeof(BuildLeaf) + m_build_tasks.capacity() * sizeof(BuildTask) +
-               m_build_order.capacity() * sizeof(std::int32_t);
-    }
+    std::size_t heap_bytes() const noexcept;
     bool is_proxy(std::int32_t id) const noexcept {
         return id >= 0 && static_cast<std::size_t>(id) < m_nodes.size() &&
                m_nodes[static_cast<std::size_t>(id)].height == 0;
@@ -144,7 +143,9 @@ private:
         if (m_settings.validate_each_operation) validate();
     }
     // rebuild() helpers (aabb_tree_build.cpp).
-    void build_from_leaves();
+    struct BuildTask;
+    void build_from_leaves(JobSystem* jobs);
+    std::int32_t place(const BuildTask& task, std::vector<BuildTask>& tasks);
     std::uint32_t partition_sah(std::uint32_t begin, std::uint32_t end);
 
     AabbTreeSettings m_settings;
@@ -165,14 +166,23 @@ private:
         std::int32_t id;
         Vec3 center;
     };
+    // A range of build leaves to place under `parent` (child `slot`), with the pool nodes
+    // from `pool` on.
     struct BuildTask {
         std::int32_t parent;
         int slot;
         std::uint32_t begin;
         std::uint32_t end;
+        std::uint32_t pool;
     };
+    // Ranges this small are built as one job each (a few per worker on a washer-sized
+    // tree; far more than its leaves would not pay for the job).
+    static constexpr std::uint32_t kSubtreeLeaves = 256;
     std::vector<BuildLeaf> m_build_leaves;
+    std::vector<std::int32_t> m_build_pool;  // the internal nodes a build fills, in creation order
     std::vector<BuildTask> m_build_tasks;
+    std::vector<BuildTask> m_build_subtrees;             // ranges left to the jobs
+    std::vector<std::vector<BuildTask>> m_build_stacks;  // per worker: a job's own ranges
     std::vector<std::int32_t> m_build_order;
 
     // A traversal stack that lives on the C++ stack and spills to the heap only for

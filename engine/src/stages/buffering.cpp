@@ -280,7 +280,7 @@ void flip_read_buffers(World& world) {
         world.published_version[k] = world.awake_version;
         world.published_interpolating[k] = interpolating;
     }
-    queries.rebuild_moved();
+    queries.rebuild_moved(*world.jobs);
     std::swap(world.changed_last, world.changed_now);
     world.changed_now.clear();
     // Bodies awake last update but asleep now were recorded in changed_now by the

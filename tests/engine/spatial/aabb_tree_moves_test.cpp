@@ -16,6 +16,7 @@
 #include "query/query_scene.hpp"
 #include "spatial/proxy_trees.hpp"
 #include "stages/broadphase_state.hpp"
+#include "test_job_systems.hpp"
 #include "tree_test_support.hpp"
 #include "world.hpp"
 
@@ -211,6 +212,52 @@ TEST(AabbTreeMoves, Churn_FlagsStayConsistentThroughInsertsRemovalsAndRotations)
         if (op % 100 == 0) {
             const Aabb box = rng.box(20, 5);
             ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box)) << "after " << op << " operations";
+        }
+    }
+}
+
+std::vector<std::int32_t> walk_order(const DynamicAabbTree& tree) {
+    std::vector<std::int32_t> order;
+    tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(1e9)), [&](std::int32_t id) {
+        order.push_back(id);
+        return true;
+    });
+    return order;
+}
+
+// The lower parts of a big rebuild are built as jobs: on three threads, in reverse chunk
+// order, the tree comes out the same as on the calling thread alone (the same walk order,
+// the same cost to the bit), and valid.
+TEST(AabbTreeMoves, RebuildEnlargedInJobs_SameTreeAsOnOneThread) {
+    Rng rng(18);
+    DynamicAabbTree serial;
+    std::vector<std::int32_t> live;
+    for (int i = 0; i < 400 * kScale; ++i) {
+        live.push_back(serial.create_proxy(Aabb::from_center_extents(rng.vec(-50, 50), Vec3::Constant(0.5)), i));
+    }
+    DynamicAabbTree parallel = serial;
+    test::ReverseThreadedJobSystem jobs(3);
+    for (int round = 0; round < 5; ++round) {
+        std::vector<Vec3> steps;
+        for (std::size_t k = 0; k < live.size(); ++k) steps.push_back(rng.vec(-1.5, 1.5));
+        for (DynamicAabbTree* tree : {&serial, &parallel}) {
+            for (std::size_t k = 0; k < live.size(); ++k) {
+                const Aabb tight = Aabb::from_center_extents(tree->fat_aabb(live[k]).center() + steps[k],
+                                                             Vec3::Constant(0.5));
+                tree->move_proxy(live[k], tight, steps[k]);
+            }
+        }
+        ASSERT_GT(parallel.enlarged_node_count(), 1000);  // enough to be split into jobs
+        serial.rebuild_enlarged();
+        parallel.rebuild_enlarged(&jobs);
+        parallel.validate();
+        EXPECT_EQ(parallel.enlarged_node_count(), 0);
+        ASSERT_EQ(walk_order(parallel), walk_order(serial)) << "round " << round;
+        ASSERT_EQ(parallel.area_cost(), serial.area_cost());
+        ASSERT_EQ(parallel.height(), serial.height());
+        for (int q = 0; q < 20; ++q) {
+            const Aabb box = rng.box(50, 6);
+            ASSERT_EQ(query_sorted(parallel, box), brute_sorted(parallel, live, box));
         }
     }
 }
