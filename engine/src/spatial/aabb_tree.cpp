@@ -342,7 +342,7 @@ bool DynamicAabbTree::rotate(std::int32_t a) {
 
 std::size_t DynamicAabbTree::heap_bytes() const noexcept {
     std::size_t bytes = m_nodes.capacity() * sizeof(Node) + m_enlarged.capacity() * sizeof(std::uint8_t) +
-                        m_build_leaves.capacity() * sizeof(BuildLeaf) +
+                        m_build_leaves.capacity() * sizeof(std::int32_t) +
                         (m_build_tasks.capacity() + m_build_subtrees.capacity()) * sizeof(BuildTask) +
                         (m_build_order.capacity() + m_build_pool.capacity()) * sizeof(std::int32_t) +
                         m_build_stacks.capacity() * sizeof(std::vector<BuildTask>);

@@ -160,12 +160,7 @@ private:
     std::vector<std::uint8_t> m_enlarged;
     std::int32_t m_enlarged_nodes = 0;
 
-    // Scratch for rebuild(), kept so that a rebuild in steady state does not allocate. A
-    // build leaf is a proxy, or a kept subtree in rebuild_enlarged().
-    struct BuildLeaf {
-        std::int32_t id;
-        Vec3 center;
-    };
+    // Scratch for the rebuilds, kept so that a rebuild in steady state does not allocate.
     // A range of build leaves to place under `parent` (child `slot`), with the pool nodes
     // from `pool` on.
     struct BuildTask {
@@ -178,8 +173,8 @@ private:
     // Ranges this small are built as one job each (a few per worker on a washer-sized
     // tree; far more than its leaves would not pay for the job).
     static constexpr std::uint32_t kSubtreeLeaves = 256;
-    std::vector<BuildLeaf> m_build_leaves;
-    std::vector<std::int32_t> m_build_pool;  // the internal nodes a build fills, in creation order
+    std::vector<std::int32_t> m_build_leaves;  // proxies, or kept subtrees in rebuild_enlarged()
+    std::vector<std::int32_t> m_build_pool;    // the internal nodes a build fills, in creation order
     std::vector<BuildTask> m_build_tasks;
     std::vector<BuildTask> m_build_subtrees;             // ranges left to the jobs
     std::vector<std::vector<BuildTask>> m_build_stacks;  // per worker: a job's own ranges

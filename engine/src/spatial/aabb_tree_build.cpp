@@ -22,7 +22,7 @@ void DynamicAabbTree::rebuild() {
     for (std::size_t i = 0; i < m_nodes.size(); ++i) {
         const Node& node = m_nodes[i];
         if (node.height == 0) {
-            m_build_leaves.push_back({static_cast<std::int32_t>(i), node.box.center()});
+            m_build_leaves.push_back(static_cast<std::int32_t>(i));
         } else if (node.height > 0) {
             m_build_pool.push_back(static_cast<std::int32_t>(i));
         }
@@ -46,7 +46,7 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
         const std::int32_t id = stack.pop();
         const Node& node = m_nodes[static_cast<std::size_t>(id)];
         if (m_enlarged[static_cast<std::size_t>(id)] == 0) {
-            m_build_leaves.push_back({id, node.box.center()});
+            m_build_leaves.push_back(id);
             continue;
         }
         stack.push(node.payload.children.second);
@@ -66,7 +66,7 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
 std::int32_t DynamicAabbTree::place(const BuildTask& task, std::vector<BuildTask>& tasks) {
     std::int32_t id;
     if (task.end - task.begin == 1) {
-        id = m_build_leaves[task.begin].id;
+        id = m_build_leaves[task.begin];
     } else {
         id = m_build_pool[task.pool];
         const std::uint32_t mid = partition_sah(task.begin, task.end);
@@ -142,8 +142,11 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
     const std::uint32_t half = begin + count / 2;
     if (count == 2) return half;
 
+    // Centres are read from the nodes, not kept beside the ids: the scratch of every tree
+    // that moves is held at its high-water mark, a quarter of the tree's own bytes.
+    auto center = [&](std::int32_t id) { return m_nodes[static_cast<std::size_t>(id)].box.center(); };
     Aabb centers;
-    for (std::uint32_t i = begin; i < end; ++i) centers.include(m_build_leaves[i].center);
+    for (std::uint32_t i = begin; i < end; ++i) centers.include(center(m_build_leaves[i]));
     int axis;
     const Real extent = (centers.max - centers.min).maxCoeff(&axis);
     if (!(extent > 0)) return half;  // all centres equal: any split is as good, keep it balanced
@@ -158,8 +161,9 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
     };
     std::array<Bin, kBinCount> bins{};
     for (std::uint32_t i = begin; i < end; ++i) {
-        Bin& bin = bins[static_cast<std::size_t>(bin_of(m_build_leaves[i].center))];
-        bin.box = bin.box.merged(m_nodes[static_cast<std::size_t>(m_build_leaves[i].id)].box);
+        const Aabb& leaf = m_nodes[static_cast<std::size_t>(m_build_leaves[i])].box;
+        Bin& bin = bins[static_cast<std::size_t>(bin_of(leaf.center()))];
+        bin.box = bin.box.merged(leaf);
         ++bin.count;
     }
 
@@ -190,7 +194,7 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
 
     const auto first = m_build_leaves.begin() + static_cast<std::ptrdiff_t>(begin);
     const auto last = m_build_leaves.begin() + static_cast<std::ptrdiff_t>(end);
-    const auto mid = std::partition(first, last, [&](const BuildLeaf& l) { return bin_of(l.center) < best_split; });
+    const auto mid = std::partition(first, last, [&](std::int32_t id) { return bin_of(center(id)) < best_split; });
     const auto split = static_cast<std::uint32_t>(mid - m_build_leaves.begin());
     return split == begin || split == end ? half : split;
 }
