@@ -61,6 +61,9 @@ public:
     // along `displacement` (the body's travel in a step, as the broadphase does: a falling
     // body is not re-inserted every step). One thread.
     void move(std::uint32_t i, const Aabb& tight, const Vec3& displacement);
+    // Rebuilds the parts of the tree that move() and refresh() left loose (they move
+    // proxies in place): once after a batch of them, before the scene is published.
+    void rebuild_moved(JobSystem& jobs) { m_tree.rebuild_enlarged(&jobs); }
     // The capacity of the body slots, at least.
     void reserve(std::uint32_t slots);
 

@@ -1,5 +1,6 @@
 // DynamicAabbTree incremental updates: node pool, SAH sibling search, insert/remove with
-// rotations on the way up, and the validation walk. rebuild() is in aabb_tree_build.cpp.
+// rotations on the way up, moves in place, and the validation walk. rebuild() and
+// rebuild_enlarged() are in aabb_tree_build.cpp.
 #include "spatial/aabb_tree.hpp"
 
 #include <algorithm>
@@ -38,6 +39,7 @@ std::int32_t DynamicAabbTree::allocate_node() {
     } else {
         id = static_cast<std::int32_t>(m_nodes.size());
         m_nodes.emplace_back();
+        m_enlarged.push_back(0);
     }
     Node& node = m_nodes[static_cast<std::size_t>(id)];
     node.parent_or_next = kNull;
@@ -50,6 +52,10 @@ void DynamicAabbTree::free_node(std::int32_t id) {
     Node& node = m_nodes[static_cast<std::size_t>(id)];
     node.height = kFreeHeight;
     node.parent_or_next = m_free_list;
+    if (m_enlarged[static_cast<std::size_t>(id)] != 0) {
+        m_enlarged[static_cast<std::size_t>(id)] = 0;
+        --m_enlarged_nodes;
+    }
     m_free_list = id;
     ++m_free_count;
 }
@@ -104,11 +110,38 @@ bool DynamicAabbTree::move_proxy(std::int32_t id, const Aabb& tight, const Vec3&
     SPINDLE_ASSERT(is_finite_box(tight) && is_finite(displacement),
                    "DynamicAabbTree::move_proxy: box and displacement must be finite");
     if (!needs_move(id, tight, displacement)) return false;
-    remove_leaf(id);
     m_nodes[static_cast<std::size_t>(id)].box = fatten(tight, displacement);
-    insert_leaf(id);
+    enlarge_ancestors(id);
     validate_if_enabled();
     return true;
+}
+
+// Box2D v3's answer to many moving proxies (b2DynamicTree_EnlargeProxy): a remove and an
+// SAH re-insert per proxy costs a sibling search and rotations each, while growing the
+// ancestors costs a few box merges, and one rebuild of the flagged part per step sorts
+// them all out together. Ancestors are flagged even when they already hold the box (a
+// fat box that shrank): the rebuild refits them.
+void DynamicAabbTree::enlarge_ancestors(std::int32_t leaf) {
+    const Aabb box = m_nodes[static_cast<std::size_t>(leaf)].box;
+    bool growing = true;
+    for (std::int32_t id = m_nodes[static_cast<std::size_t>(leaf)].parent_or_next; id != kNull;
+         id = m_nodes[static_cast<std::size_t>(id)].parent_or_next) {
+        Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (growing) {
+            if (node.box.contains(box)) {
+                growing = false;
+            } else {
+                node.box = node.box.merged(box);
+            }
+        }
+        std::uint8_t& flag = m_enlarged[static_cast<std::size_t>(id)];
+        if (flag != 0) {
+            if (!growing) return;  // the ancestors above are flagged and hold this node's box
+            continue;
+        }
+        flag = 1;
+        ++m_enlarged_nodes;
+    }
 }
 
 // Greedy branch and bound for the sibling that adds the least area to the tree. Making
@@ -168,6 +201,12 @@ void DynamicAabbTree::insert_leaf(std::int32_t leaf) {
     p.payload.children = {sibling, leaf};
     p.box = s.box.merged(l.box);
     p.height = s.height + 1;
+    // A flagged node's parent is flagged: the new parent takes the sibling's flag (the
+    // grandparent has it already if the sibling had).
+    if (m_enlarged[static_cast<std::size_t>(sibling)] != 0) {
+        m_enlarged[static_cast<std::size_t>(parent)] = 1;
+        ++m_enlarged_nodes;
+    }
     s.parent_or_next = parent;
     l.parent_or_next = parent;
     if (grand == kNull) {
@@ -292,8 +331,23 @@ bool DynamicAabbTree::rotate(std::int32_t a) {
     (oc.first == best.y ? oc.first : oc.second) = best.x;
     m_nodes[static_cast<std::size_t>(best.x)].parent_or_next = best.o;
     m_nodes[static_cast<std::size_t>(best.y)].parent_or_next = a;
+    // X now hangs under O: a flagged X needs a flagged O (A, X's old parent, is flagged).
+    if (m_enlarged[static_cast<std::size_t>(best.x)] != 0 && m_enlarged[static_cast<std::size_t>(best.o)] == 0) {
+        m_enlarged[static_cast<std::size_t>(best.o)] = 1;
+        ++m_enlarged_nodes;
+    }
     refit(best.o);
     return true;
+}
+
+std::size_t DynamicAabbTree::heap_bytes() const noexcept {
+    std::size_t bytes = m_nodes.capacity() * sizeof(Node) + m_enlarged.capacity() * sizeof(std::uint8_t) +
+                        m_build_leaves.capacity() * sizeof(std::int32_t) +
+                        (m_build_tasks.capacity() + m_build_subtrees.capacity()) * sizeof(BuildTask) +
+                        (m_build_order.capacity() + m_build_pool.capacity()) * sizeof(std::int32_t) +
+                        m_build_stacks.capacity() * sizeof(std::vector<BuildTask>);
+    for (const std::vector<BuildTask>& stack : m_build_stacks) bytes += stack.capacity() * sizeof(BuildTask);
+    return bytes;
 }
 
 Real DynamicAabbTree::area_cost() const {
@@ -308,6 +362,8 @@ void DynamicAabbTree::validate() const {
     const auto node_count = static_cast<std::int32_t>(m_nodes.size());
     std::int32_t reached = 0;
     std::int32_t leaves = 0;
+    std::int32_t flagged = 0;
+    SPINDLE_TREE_CHECK(m_enlarged.size() == m_nodes.size(), "tree: flags and nodes differ in number");
     if (m_root != kNull) {
         SPINDLE_TREE_CHECK(m_root >= 0 && m_root < node_count, "tree: root out of range");
         SPINDLE_TREE_CHECK(m_nodes[static_cast<std::size_t>(m_root)].parent_or_next == kNull,
@@ -321,6 +377,13 @@ void DynamicAabbTree::validate() const {
             SPINDLE_TREE_CHECK(reached <= node_count, "tree: cycle (more nodes reached than exist)");
             SPINDLE_TREE_CHECK(node.height >= 0, "tree: a node on the free list is reachable from the root");
             SPINDLE_TREE_CHECK(node.box.valid(), "tree: node box has min > max");
+            if (m_enlarged[static_cast<std::size_t>(id)] != 0) {
+                ++flagged;
+                SPINDLE_TREE_CHECK(node.height > 0, "tree: a leaf is flagged enlarged");
+                SPINDLE_TREE_CHECK(node.parent_or_next == kNull ||
+                                       m_enlarged[static_cast<std::size_t>(node.parent_or_next)] != 0,
+                                   "tree: a flagged node's parent is not flagged");
+            }
             if (node.height == 0) {
                 ++leaves;
                 continue;
@@ -340,6 +403,7 @@ void DynamicAabbTree::validate() const {
         }
     }
     SPINDLE_TREE_CHECK(leaves == m_proxy_count, "tree: leaf count differs from proxy count");
+    SPINDLE_TREE_CHECK(flagged == m_enlarged_nodes, "tree: flagged node count differs from the nodes flagged");
 
     std::int32_t free_nodes = 0;
     for (std::int32_t id = m_free_list; id != kNull; id = m_nodes[static_cast<std::size_t>(id)].parent_or_next) {

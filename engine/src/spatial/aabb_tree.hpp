@@ -1,5 +1,6 @@
 // DynamicAabbTree: a bounding volume hierarchy over fattened AABBs, updated incrementally
-// (insert by cheapest SAH sibling, rebalance by tree rotations) or rebuilt in bulk.
+// (insert by cheapest SAH sibling, rebalance by tree rotations), moved in place and
+// rebuilt where moves enlarged it, or rebuilt in bulk.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,7 @@
 
 #include <spindle/engine/math.hpp>
 #include <spindle/platform/assert.hpp>
+#include <spindle/scheduler/job_system.hpp>
 
 namespace spindle {
 
@@ -34,9 +36,12 @@ public:
     // Adds a proxy whose fat box is `tight` grown by the margin. Returns its id.
     std::int32_t create_proxy(const Aabb& tight, std::uint64_t user);
     void destroy_proxy(std::int32_t id);
-    // Returns true when the proxy was re-inserted with a new fat box: when `tight` left
-    // the fat box, or when the fat box is far bigger than needed (a fast body stopped).
-    // The new fat box is `tight` grown by the margin and stretched along the displacement.
+    // Returns true when the proxy got a new fat box: when `tight` left the fat box, or
+    // when the fat box is far bigger than needed (a fast body stopped). The new fat box
+    // is `tight` grown by the margin and stretched along the displacement. The leaf stays
+    // where it is: its ancestors grow to hold the new box and are flagged for
+    // rebuild_enlarged(), which a caller moving a batch of proxies calls once after them
+    // (queries stay exact before it, only slower).
     bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement);
     // Whether move_proxy(id, tight, displacement) would re-insert the proxy. Const: may
     // run on many threads at once while nothing writes.
@@ -55,6 +60,15 @@ public:
     // Rebuilds every internal node top down with a binned surface area heuristic. Proxy
     // ids, fat boxes and user values are unchanged. For trees built in bulk (static).
     void rebuild();
+    // Rebuilds, with the same heuristic, only the internal nodes move_proxy flagged (the
+    // paths from moved leaves to the root); the subtrees hanging off those paths are kept
+    // whole and placed as if they were leaves. Proxy ids, fat boxes and user values are
+    // unchanged. Costs nothing when no proxy moved since the last rebuild. With `jobs`,
+    // the lower parts are built in parallel (the same tree for any worker count); the
+    // caller waits for them, and nothing else may touch the tree meanwhile.
+    void rebuild_enlarged(JobSystem* jobs = nullptr);
+    // Internal nodes flagged by moves and not rebuilt yet.
+    std::int32_t enlarged_node_count() const noexcept { return m_enlarged_nodes; }
 
     const Aabb& fat_aabb(std::int32_t id) const {
         check_proxy(id);
@@ -65,10 +79,7 @@ public:
         return m_nodes[static_cast<std::size_t>(id)].payload.user;
     }
     // Heap bytes the tree holds (its nodes and rebuild scratch, at capacity).
-    std::size_t heap_bytes() const noexcept {
-        return m_nodes.capacity() * sizeof(Node) + m_build_leaves.capacity() * sizeof(BuildLeaf) +
-               m_build_tasks.capacity() * sizeof(BuildTask) + m_build_order.capacity() * sizeof(std::int32_t);
-    }
+    std::size_t heap_bytes() const noexcept;
     bool is_proxy(std::int32_t id) const noexcept {
         return id >= 0 && static_cast<std::size_t>(id) < m_nodes.size() &&
                m_nodes[static_cast<std::size_t>(id)].height == 0;
@@ -127,10 +138,14 @@ private:
     void refit_upwards(std::int32_t id);
     void refit(std::int32_t id);
     bool rotate(std::int32_t id);  // true when it swapped
+    void enlarge_ancestors(std::int32_t leaf);
     void validate_if_enabled() const {
         if (m_settings.validate_each_operation) validate();
     }
     // rebuild() helpers (aabb_tree_build.cpp).
+    struct BuildTask;
+    void build_from_leaves(JobSystem* jobs);
+    std::int32_t place(const BuildTask& task, std::vector<BuildTask>& tasks);
     std::uint32_t partition_sah(std::uint32_t begin, std::uint32_t end);
 
     AabbTreeSettings m_settings;
@@ -139,20 +154,30 @@ private:
     std::int32_t m_free_list = kNull;
     std::int32_t m_proxy_count = 0;
     std::int32_t m_free_count = 0;
+    // Per node: 1 when a move grew it (or moved a leaf below it) since the last rebuild.
+    // Apart from the nodes, which fill their cache line; queries never read it. A flagged
+    // node's parent is flagged too, so a walk from the root finds every flagged node.
+    std::vector<std::uint8_t> m_enlarged;
+    std::int32_t m_enlarged_nodes = 0;
 
-    // Scratch for rebuild(), kept so that a rebuild in steady state does not allocate.
-    struct BuildLeaf {
-        std::int32_t id;
-        Vec3 center;
-    };
+    // Scratch for the rebuilds, kept so that a rebuild in steady state does not allocate.
+    // A range of build leaves to place under `parent` (child `slot`), with the pool nodes
+    // from `pool` on.
     struct BuildTask {
         std::int32_t parent;
         int slot;
         std::uint32_t begin;
         std::uint32_t end;
+        std::uint32_t pool;
     };
-    std::vector<BuildLeaf> m_build_leaves;
+    // Ranges this small are built as one job each (a few per worker on a washer-sized
+    // tree; far more than its leaves would not pay for the job).
+    static constexpr std::uint32_t kSubtreeLeaves = 256;
+    std::vector<std::int32_t> m_build_leaves;  // proxies, or kept subtrees in rebuild_enlarged()
+    std::vector<std::int32_t> m_build_pool;    // the internal nodes a build fills, in creation order
     std::vector<BuildTask> m_build_tasks;
+    std::vector<BuildTask> m_build_subtrees;             // ranges left to the jobs
+    std::vector<std::vector<BuildTask>> m_build_stacks;  // per worker: a job's own ranges
     std::vector<std::int32_t> m_build_order;
 
     // A traversal stack that lives on the C++ stack and spills to the heap only for

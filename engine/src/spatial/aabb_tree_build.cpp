@@ -1,5 +1,6 @@
-// DynamicAabbTree::rebuild: top-down binned SAH build over the existing leaves, for trees
-// filled in bulk (the static tree). Leaves stay where they are, so proxy ids survive.
+// DynamicAabbTree::rebuild and rebuild_enlarged: top-down binned SAH builds over the
+// existing leaves (all of them, for trees filled in bulk), or over the subtrees that hang
+// off the paths moves flagged. Leaves stay where they are, so proxy ids survive.
 #include "spatial/aabb_tree.hpp"
 
 #include <algorithm>
@@ -15,50 +16,122 @@ constexpr int kBinCount = 16;
 }  // namespace
 
 void DynamicAabbTree::rebuild() {
-    // Free every internal node; they are allocated again below, so the pool does not grow.
+    // Every internal node is built again, from the same nodes: the pool does not grow.
     m_build_leaves.clear();
+    m_build_pool.clear();
     for (std::size_t i = 0; i < m_nodes.size(); ++i) {
         const Node& node = m_nodes[i];
         if (node.height == 0) {
-            m_build_leaves.push_back({static_cast<std::int32_t>(i), node.box.center()});
+            m_build_leaves.push_back(static_cast<std::int32_t>(i));
         } else if (node.height > 0) {
-            free_node(static_cast<std::int32_t>(i));
+            m_build_pool.push_back(static_cast<std::int32_t>(i));
         }
+        m_enlarged[i] = 0;
     }
-    m_root = kNull;
-    if (m_build_leaves.empty()) {
-        validate_if_enabled();
-        return;
-    }
+    m_enlarged_nodes = 0;
+    build_from_leaves(nullptr);
+    validate_if_enabled();
+}
 
-    // Iterative, so a degenerate split sequence cannot overflow the C++ stack. Parents are
-    // created before their children; fitting in reverse creation order is bottom up.
+void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
+    if (m_enlarged_nodes == 0) return;
+    // Flagged nodes form a tree from the root down (a flagged node's parent is flagged):
+    // they are built again, and what hangs off them (a leaf or an unflagged subtree) is
+    // kept whole.
+    m_build_leaves.clear();
+    m_build_pool.clear();
+    TraversalStack stack;
+    stack.push(m_root);
+    while (!stack.empty()) {
+        const std::int32_t id = stack.pop();
+        const Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (m_enlarged[static_cast<std::size_t>(id)] == 0) {
+            m_build_leaves.push_back(id);
+            continue;
+        }
+        stack.push(node.payload.children.second);
+        stack.push(node.payload.children.first);
+        m_enlarged[static_cast<std::size_t>(id)] = 0;
+        m_build_pool.push_back(id);
+    }
+    m_enlarged_nodes = 0;
+    build_from_leaves(jobs);
+    validate_if_enabled();
+}
+
+// Places one range of build leaves: a leaf or kept subtree for one, else the pool node
+// task.pool with the range split in two (pushed on `tasks`). In pre-order, a range of n
+// leaves takes the n - 1 pool nodes from task.pool on, its own first: the result does not
+// depend on which thread builds which range, and pool order is creation order.
+std::int32_t DynamicAabbTree::place(const BuildTask& task, std::vector<BuildTask>& tasks) {
+    std::int32_t id;
+    if (task.end - task.begin == 1) {
+        id = m_build_leaves[task.begin];
+    } else {
+        id = m_build_pool[task.pool];
+        const std::uint32_t mid = partition_sah(task.begin, task.end);
+        Node& node = m_nodes[static_cast<std::size_t>(id)];
+        node.height = 1;  // internal; refit sets the height
+        tasks.push_back({id, 1, mid, task.end, task.pool + (mid - task.begin)});
+        tasks.push_back({id, 0, task.begin, mid, task.pool + 1});
+    }
+    m_nodes[static_cast<std::size_t>(id)].parent_or_next = task.parent;
+    if (task.parent == kNull) {
+        m_root = id;
+    } else {
+        Children& pc = m_nodes[static_cast<std::size_t>(task.parent)].payload.children;
+        (task.slot == 0 ? pc.first : pc.second) = id;
+    }
+    return id;
+}
+
+// Builds internal nodes from m_build_pool over m_build_leaves (proxies or whole
+// subtrees) and makes the result the tree's root. Iterative, so a degenerate split
+// sequence cannot overflow the C++ stack. With jobs, the ranges of at most
+// kSubtreeLeaves below the top are built as jobs, each fitting its own nodes.
+void DynamicAabbTree::build_from_leaves(JobSystem* jobs) {
+    m_root = kNull;
+    const auto count = static_cast<std::uint32_t>(m_build_leaves.size());
+    if (count == 0) return;
+    SPINDLE_ASSERT(m_build_pool.size() + 1 == count, "DynamicAabbTree: a build needs one node fewer than leaves");
+    const bool split = jobs != nullptr && jobs->worker_count() > 1 && count > 2 * kSubtreeLeaves;
     m_build_tasks.clear();
+    m_build_subtrees.clear();
     m_build_order.clear();
-    m_build_tasks.push_back({kNull, 0, 0, static_cast<std::uint32_t>(m_build_leaves.size())});
+    m_build_tasks.push_back({kNull, 0, 0, count, 0});
     while (!m_build_tasks.empty()) {
         const BuildTask task = m_build_tasks.back();
         m_build_tasks.pop_back();
-        std::int32_t id;
-        if (task.end - task.begin == 1) {
-            id = m_build_leaves[task.begin].id;
-        } else {
-            id = allocate_node();
-            const std::uint32_t mid = partition_sah(task.begin, task.end);
-            m_build_order.push_back(id);
-            m_build_tasks.push_back({id, 0, task.begin, mid});
-            m_build_tasks.push_back({id, 1, mid, task.end});
+        if (split && task.end - task.begin <= kSubtreeLeaves) {
+            m_build_subtrees.push_back(task);
+            continue;
         }
-        m_nodes[static_cast<std::size_t>(id)].parent_or_next = task.parent;
-        if (task.parent == kNull) {
-            m_root = id;
-        } else {
-            Children& pc = m_nodes[static_cast<std::size_t>(task.parent)].payload.children;
-            (task.slot == 0 ? pc.first : pc.second) = id;
-        }
+        const std::int32_t id = place(task, m_build_tasks);
+        if (task.end - task.begin > 1) m_build_order.push_back(id);
+    }
+    if (!m_build_subtrees.empty()) {
+        if (m_build_stacks.size() < jobs->worker_count()) m_build_stacks.resize(jobs->worker_count());
+        // Each job writes only its range's leaves and pool nodes, and one child slot of a
+        // top node; the top is fitted after them.
+        jobs->parallel_for("TreeRebuild", 0, static_cast<std::uint32_t>(m_build_subtrees.size()), 1,
+                           [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+                               std::vector<BuildTask>& tasks = m_build_stacks[worker];
+                               for (std::uint32_t k = lo; k < hi; ++k) {
+                                   const BuildTask& subtree = m_build_subtrees[k];
+                                   tasks.clear();
+                                   tasks.push_back(subtree);
+                                   while (!tasks.empty()) {
+                                       const BuildTask task = tasks.back();
+                                       tasks.pop_back();
+                                       place(task, tasks);
+                                   }
+                                   // Pre-order: walking the range's pool nodes backwards fits children first.
+                                   const std::uint32_t nodes = subtree.end - subtree.begin - 1;
+                                   for (std::uint32_t i = nodes; i-- > 0;) refit(m_build_pool[subtree.pool + i]);
+                               }
+                           });
     }
     for (auto it = m_build_order.rbegin(); it != m_build_order.rend(); ++it) refit(*it);
-    validate_if_enabled();
 }
 
 // Splits m_build_leaves[begin, end) in two along the longest axis of the leaf centres,
@@ -69,8 +142,11 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
     const std::uint32_t half = begin + count / 2;
     if (count == 2) return half;
 
+    // Centres are read from the nodes, not kept beside the ids: the scratch of every tree
+    // that moves is held at its high-water mark, a quarter of the tree's own bytes.
+    auto center = [&](std::int32_t id) { return m_nodes[static_cast<std::size_t>(id)].box.center(); };
     Aabb centers;
-    for (std::uint32_t i = begin; i < end; ++i) centers.include(m_build_leaves[i].center);
+    for (std::uint32_t i = begin; i < end; ++i) centers.include(center(m_build_leaves[i]));
     int axis;
     const Real extent = (centers.max - centers.min).maxCoeff(&axis);
     if (!(extent > 0)) return half;  // all centres equal: any split is as good, keep it balanced
@@ -85,8 +161,9 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
     };
     std::array<Bin, kBinCount> bins{};
     for (std::uint32_t i = begin; i < end; ++i) {
-        Bin& bin = bins[static_cast<std::size_t>(bin_of(m_build_leaves[i].center))];
-        bin.box = bin.box.merged(m_nodes[static_cast<std::size_t>(m_build_leaves[i].id)].box);
+        const Aabb& leaf = m_nodes[static_cast<std::size_t>(m_build_leaves[i])].box;
+        Bin& bin = bins[static_cast<std::size_t>(bin_of(leaf.center()))];
+        bin.box = bin.box.merged(leaf);
         ++bin.count;
     }
 
@@ -117,7 +194,7 @@ std::uint32_t DynamicAabbTree::partition_sah(std::uint32_t begin, std::uint32_t 
 
     const auto first = m_build_leaves.begin() + static_cast<std::ptrdiff_t>(begin);
     const auto last = m_build_leaves.begin() + static_cast<std::ptrdiff_t>(end);
-    const auto mid = std::partition(first, last, [&](const BuildLeaf& l) { return bin_of(l.center) < best_split; });
+    const auto mid = std::partition(first, last, [&](std::int32_t id) { return bin_of(center(id)) < best_split; });
     const auto split = static_cast<std::uint32_t>(mid - m_build_leaves.begin());
     return split == begin || split == end ? half : split;
 }

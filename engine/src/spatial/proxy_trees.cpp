@@ -103,6 +103,10 @@ void ProxyTrees::find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const {
 
 void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
     new_pairs.clear();
+    // The moves since the last call left the trees valid but loose where proxies went:
+    // one rebuild of those parts, before the searches walk them.
+    m_trees[0].rebuild_enlarged(&jobs);
+    m_trees[1].rebuild_enlarged(&jobs);
     const auto count = static_cast<std::uint32_t>(m_enlarged.size());
     if (count == 0) return;
 

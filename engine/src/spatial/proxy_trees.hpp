@@ -82,7 +82,8 @@ public:
     // static, each pair once, sorted by (user_a, user_b, proxy_a.key, proxy_b.key), so
     // the result does not depend on the worker count or on which job ran first. Pairs
     // found before are found again if one of them grew: the caller skips pairs it has.
-    // Clears the enlarged marks. Who may call: the thread that owns the broadphase; it
+    // Clears the enlarged marks, and first rebuilds the parts of the trees that moves
+    // enlarged (DynamicAabbTree::rebuild_enlarged). Who may call: the thread that owns the broadphase; it
     // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
     // meanwhile). Safe from inside a job: parallel_for may nest.
     void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs);

@@ -268,7 +268,8 @@ void flip_read_buffers(World& world) {
             }
             interpolated[worker].value += count;
         });
-        // The tree by one thread: most proxies are still inside their fat boxes.
+        // The tree by one thread: most proxies are still inside their fat boxes, and those
+        // that left are moved in place (their ancestors rebuilt once, below).
         const Real step = world.settings.time_step.duration;
         for (std::uint32_t a = 0; a < n; ++a) {
             const std::uint32_t i = world.awake[a];
@@ -279,6 +280,7 @@ void flip_read_buffers(World& world) {
         world.published_version[k] = world.awake_version;
         world.published_interpolating[k] = interpolating;
     }
+    queries.rebuild_moved(*world.jobs);
     std::swap(world.changed_last, world.changed_now);
     world.changed_now.clear();
     // Bodies awake last update but asleep now were recorded in changed_now by the
