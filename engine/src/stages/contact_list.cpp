@@ -60,17 +60,16 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
         note_contact_removed(world, world.contacts[p]);  // a touching one ends its touch
         world.contact_index.erase(world.contact_keys[p]);
     }
-    std::size_t next = 0, write = 0;
-    for (std::size_t read = 0; read < world.contacts.size(); ++read) {
+    // The contacts before the first removed one keep their places (and their index entries).
+    std::size_t next = 0, write = positions[0];
+    for (std::size_t read = positions[0]; read < world.contacts.size(); ++read) {
         if (next < positions.size() && positions[next] == read) {
             ++next;
             continue;
         }
-        if (write != read) {
-            world.contacts[write] = std::move(world.contacts[read]);
-            world.contact_keys[write] = world.contact_keys[read];
-            world.contact_summaries[write] = world.contact_summaries[read];
-        }
+        world.contacts[write] = std::move(world.contacts[read]);
+        world.contact_keys[write] = world.contact_keys[read];
+        world.contact_summaries[write] = world.contact_summaries[read];
         *world.contact_index.find(world.contact_keys[write]) = static_cast<std::uint32_t>(write);
         ++write;
     }
