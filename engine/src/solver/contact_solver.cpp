@@ -13,6 +13,8 @@
 // holds it) is pushed out by a split impulse on separate push-out velocities, per lane
 // (rare: bodies created or teleported inside each other).
 #include <algorithm>
+#include <cstddef>
+#include <type_traits>
 
 #include "solver/constraints.hpp"
 #include "stages/capacity.hpp"
@@ -64,33 +66,39 @@ struct WideVelocities {
     Wide3 va, wa, vb, wb;
 };
 
+// A solver body read as a row of doubles: v, w from its start, dp and dq (x, y, z, w)
+// from the sixth. Eight lanes' rows are loaded, narrowed and transposed into columns.
+static_assert(std::is_standard_layout_v<SolverBody> && offsetof(SolverBody, v) == 0 &&
+                  offsetof(SolverBody, w) == 3 * sizeof(Real) && offsetof(SolverBody, dp) == 6 * sizeof(Real) &&
+                  offsetof(SolverBody, dq) == 9 * sizeof(Real) && sizeof(SolverBody) >= 14 * sizeof(Real),
+              "the solver's gather reads a body's v, w, dp and dq as consecutive doubles");
+constexpr int kVelocityRow = 0, kMotionRow = 6;
+
+[[gnu::always_inline]] inline void gather_rows(const SolverBody* bodies, const std::uint32_t* index, int first,
+                                               Wide (&rows)[kLanes]) {
+    for (int l = 0; l < kLanes; ++l) rows[l] = load_narrow(reinterpret_cast<const Real*>(bodies + index[l]) + first);
+    transpose(rows);
+}
+
 [[gnu::always_inline]] inline WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
-    WideVelocities s;
-    for (int l = 0; l < kLanes; ++l) {
-        const SolverBody& A = bodies[wc.a[l]];
-        const SolverBody& B = bodies[wc.b[l]];
-        s.va.set_lane(l, A.v);
-        s.wa.set_lane(l, A.w);
-        s.vb.set_lane(l, B.v);
-        s.wb.set_lane(l, B.w);
-    }
-    return s;
+    Wide a[kLanes], b[kLanes];
+    gather_rows(bodies, wc.a, kVelocityRow, a);
+    gather_rows(bodies, wc.b, kVelocityRow, b);
+    return {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}, {b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
 }
 
 // Writes the dynamic bodies back: static and kinematic ones (and the empty lanes'
 // immovable body) are shared by constraints of every colour and never written.
 [[gnu::always_inline]] inline void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
+    Wide a[kLanes] = {s.va.x, s.va.y, s.va.z, s.wa.x, s.wa.y, s.wa.z};
+    Wide b[kLanes] = {s.vb.x, s.vb.y, s.vb.z, s.wb.x, s.wb.y, s.wb.z};
+    transpose(a);
+    transpose(b);
     for (int l = 0; l < kLanes; ++l) {
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
-        if (A.dynamic) {
-            A.v = s.va.lane(l);
-            A.w = s.wa.lane(l);
-        }
-        if (B.dynamic) {
-            B.v = s.vb.lane(l);
-            B.w = s.wb.lane(l);
-        }
+        if (A.dynamic) store_widened6(reinterpret_cast<Real*>(&A) + kVelocityRow, a[l]);
+        if (B.dynamic) store_widened6(reinterpret_cast<Real*>(&B) + kVelocityRow, b[l]);
     }
 }
 
@@ -411,16 +419,11 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
     // rotation is applied once per lane rather than once per point.
-    Wide3 dpa, dpb;
-    WideQuat dqa, dqb;
-    for (int l = 0; l < kLanes; ++l) {
-        const SolverBody& A = bodies[wc.a[l]];
-        const SolverBody& B = bodies[wc.b[l]];
-        dpa.set_lane(l, A.dp);
-        dpb.set_lane(l, B.dp);
-        dqa.set_lane(l, A.dq);
-        dqb.set_lane(l, B.dq);
-    }
+    Wide ma[kLanes], mb[kLanes];
+    gather_rows(bodies, wc.a, kMotionRow, ma);
+    gather_rows(bodies, wc.b, kMotionRow, mb);
+    const Wide3 dpa{ma[0], ma[1], ma[2]}, dpb{mb[0], mb[1], mb[2]};
+    const WideQuat dqa{{ma[3], ma[4], ma[5]}, ma[6]}, dqb{{mb[3], mb[4], mb[5]}, mb[6]};
     const Wide3 na = rotate_inverse(dqa, wc.normal);
     const Wide3 nb = rotate_inverse(dqb, wc.normal);
     const Wide zero = splat(0), one = splat(1);
