@@ -37,26 +37,25 @@ struct PushAnchors {
     Vec3 rb = Vec3::Zero();
 };
 
-// What a WideContact keeps of a row for its four lanes: the inertia-weighted angular
-// terms, in single precision (the passes are bound by the memory they stream, and these
-// only scale an impulse). The row's speed is taken from the point's relative velocity
-// instead, so ra x dir and rb x dir need not be stored.
+// What a WideContact keeps of a row for its lanes: the inertia-weighted angular terms.
+// The row's speed is taken from the point's relative velocity instead, so ra x dir and
+// rb x dir need not be stored: fewer bytes for every pass to stream.
 struct WideRow {
-    Wide3F ia, ib;
+    Wide3 ia, ib;
 };
 
-// One point slot of four manifolds (contact_solver.cpp). A slot a manifold does not
+// One point slot of a WideContact's manifolds (contact_solver.cpp). A slot a manifold does not
 // fill has no mass and lies far apart, so it never pushes and never rubs.
 struct WidePoint {
     Wide3 ra, rb;                // anchors from each centre of mass, world, fixed for the step
     Wide adjusted_separation{};  // separation minus n.(rb - ra): current separation = n.d + this
     WideRow normal_row;
-    WideF normal_mass{};
-    WideF lever_arm{};  // distance from the friction centre on A: the twist friction's reach
+    Wide normal_mass{};
+    Wide lever_arm{};  // distance from the friction centre on A: the twist friction's reach
     // Overlap the soft row corrects itself; deeper overlap is pushed out. The recovery
     // depth, or deeper where the point's load (its last impulse) compresses the soft
     // contact further: a heavy body rests where its spring holds it.
-    WideF recovery{};
+    Wide recovery{};
     Wide normal_impulse{};
     Wide max_normal_impulse{};
     Wide relative_velocity{};  // approach speed at impact (restitution)
@@ -69,7 +68,7 @@ struct ManifoldRef {
     std::uint32_t a = 0, b = 0;  // solver bodies
 };
 
-// Four manifolds of one colour solved together, one per lane (structure of arrays).
+// kLanes manifolds of one colour solved together, one per lane (structure of arrays).
 // They share no dynamic body, so the lanes never write the same body. Lanes past the
 // colour's end hold no manifold: both bodies are the immovable one and nothing is written.
 struct WideContact {
@@ -95,16 +94,16 @@ struct WideContact {
     // two per point, and no point's order favoured over another's.
     Wide3 center_a, center_b;  // the friction centre from each centre of mass
     WideRow friction_row[2];   // the tangents' angular terms at the centre
-    WideF friction_mass[3]{};  // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
+    Wide friction_mass[3]{};   // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
     Wide friction_impulse[2]{};
     WideRow twist_row;  // Ia^-1 n, Ib^-1 n
-    WideF twist_mass{};
+    Wide twist_mass{};
     Wide twist_impulse{};
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The
     // rows' anchors live apart (SolverScratch::push_anchors): they are rarely used, and
     // every pass streams the wide contacts.
-    Real push_impulse[kLanes] = {};
+    float push_impulse[kLanes] = {};
 };
 
 using Vec2 = Eigen::Matrix<Real, 2, 1>;
@@ -211,7 +210,7 @@ struct SolverScratch {
     bool reuse_colors = true;                        // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
     std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
-    std::vector<WideContact> wide;          // the colours' manifolds four by four, then the overflow one by one
+    std::vector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
     std::vector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
     std::uint32_t wide_begin[kColorCount + 1] = {};        // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;                   // awake joints, in slot order

@@ -1,8 +1,8 @@
-// Contact constraints of the soft-step solver, four manifolds at a time: each colour's
-// manifolds are packed four to a WideContact (structure of arrays, one manifold per
-// lane) and every pass works on the four lanes together (wide.hpp). The lanes of a
+// Contact constraints of the soft-step solver, eight manifolds at a time: each colour's
+// manifolds are packed kLanes to a WideContact (structure of arrays, one manifold per
+// lane) and every pass works on the lanes together in floats (wide.hpp). The lanes of a
 // WideContact share no dynamic body, so gathering their velocities, solving and
-// scattering them back is the same as solving the four one after another.
+// scattering them back is the same as solving them one after another.
 //
 // Per pass: each point's normal row (soft push-out of resting overlap while biased,
 // speculative for a gap); in the relax passes then the manifold's central friction
@@ -13,6 +13,8 @@
 // holds it) is pushed out by a split impulse on separate push-out velocities, per lane
 // (rare: bodies created or teleported inside each other).
 #include <algorithm>
+#include <cstddef>
+#include <type_traits>
 
 #include "solver/constraints.hpp"
 #include "stages/capacity.hpp"
@@ -57,39 +59,46 @@ inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, c
     s.wb += L * row.ib;
 }
 
-// The four lanes' body velocities while a WideContact is solved. gather and scatter
-// are forced inline: as calls they returned and copied 768 bytes per pass.
+// The lanes' body velocities while a WideContact is solved, in floats: gathered from
+// the bodies' doubles and scattered back. gather and scatter are forced inline: as calls
+// they returned and copied their result per pass.
 struct WideVelocities {
     Wide3 va, wa, vb, wb;
 };
 
+// A solver body read as a row of doubles: v, w from its start, dp and dq (x, y, z, w)
+// from the sixth. Eight lanes' rows are loaded, narrowed and transposed into columns.
+static_assert(std::is_standard_layout_v<SolverBody> && offsetof(SolverBody, v) == 0 &&
+                  offsetof(SolverBody, w) == 3 * sizeof(Real) && offsetof(SolverBody, dp) == 6 * sizeof(Real) &&
+                  offsetof(SolverBody, dq) == 9 * sizeof(Real) && sizeof(SolverBody) >= 14 * sizeof(Real),
+              "the solver's gather reads a body's v, w, dp and dq as consecutive doubles");
+constexpr int kVelocityRow = 0, kMotionRow = 6;
+
+[[gnu::always_inline]] inline void gather_rows(const SolverBody* bodies, const std::uint32_t* index, int first,
+                                               Wide (&rows)[kLanes]) {
+    for (int l = 0; l < kLanes; ++l) rows[l] = load_narrow(reinterpret_cast<const Real*>(bodies + index[l]) + first);
+    transpose(rows);
+}
+
 [[gnu::always_inline]] inline WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
-    WideVelocities s;
-    for (int l = 0; l < kLanes; ++l) {
-        const SolverBody& A = bodies[wc.a[l]];
-        const SolverBody& B = bodies[wc.b[l]];
-        s.va.set_lane(l, A.v);
-        s.wa.set_lane(l, A.w);
-        s.vb.set_lane(l, B.v);
-        s.wb.set_lane(l, B.w);
-    }
-    return s;
+    Wide a[kLanes], b[kLanes];
+    gather_rows(bodies, wc.a, kVelocityRow, a);
+    gather_rows(bodies, wc.b, kVelocityRow, b);
+    return {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}, {b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
 }
 
 // Writes the dynamic bodies back: static and kinematic ones (and the empty lanes'
 // immovable body) are shared by constraints of every colour and never written.
 [[gnu::always_inline]] inline void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
+    Wide a[kLanes] = {s.va.x, s.va.y, s.va.z, s.wa.x, s.wa.y, s.wa.z};
+    Wide b[kLanes] = {s.vb.x, s.vb.y, s.vb.z, s.wb.x, s.wb.y, s.wb.z};
+    transpose(a);
+    transpose(b);
     for (int l = 0; l < kLanes; ++l) {
         SolverBody& A = bodies[wc.a[l]];
         SolverBody& B = bodies[wc.b[l]];
-        if (A.dynamic) {
-            A.v = s.va.lane(l);
-            A.w = s.wa.lane(l);
-        }
-        if (B.dynamic) {
-            B.v = s.vb.lane(l);
-            B.w = s.wb.lane(l);
-        }
+        if (A.dynamic) store_widened6(reinterpret_cast<Real*>(&A) + kVelocityRow, a[l]);
+        if (B.dynamic) store_widened6(reinterpret_cast<Real*>(&B) + kVelocityRow, b[l]);
     }
 }
 
@@ -129,31 +138,31 @@ inline void apply_row(const WideContact& wc, const WideAxisMasses& m, WideVeloci
     } else {
         s.va -= (wc.inv_mass_a * L) * dir;
     }
-    s.wa -= L * widen(row.ia);
+    s.wa -= L * row.ia;
     if constexpr (kLocked) {
         s.vb += scaled(m.b, L, dir);
     } else {
         s.vb += (wc.inv_mass_b * L) * dir;
     }
-    s.wb += L * widen(row.ib);
+    s.wb += L * row.ib;
 }
 
 // An angular impulse L about a row's axis (the twist row): no linear part.
 inline void apply_angular_row(WideVelocities& s, const WideRow& row, Wide L) {
-    s.wa -= L * widen(row.ia);
-    s.wb += L * widen(row.ib);
+    s.wa -= L * row.ia;
+    s.wb += L * row.ib;
 }
 
-// A row's angular terms for four lanes; returns the effective masses (0 where nothing moves).
-WideF make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
-               const Wide3& rb, const Wide3& dir, WideRow& row) {
+// A row's angular terms for the lanes; returns the effective masses (0 where nothing moves).
+Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide inv_mass_sum, const Wide3& ra,
+              const Wide3& rb, const Wide3& dir, WideRow& row) {
     const Wide3 ra_x = cross(ra, dir);
     const Wide3 rb_x = cross(rb, dir);
     const Wide3 ia = inv_inertia_a * ra_x;
     const Wide3 ib = inv_inertia_b * rb_x;
-    row = {narrow(ia), narrow(ib)};
+    row = {ia, ib};
     const Wide k = inv_mass_sum + dot(ra_x, ia) + dot(rb_x, ib);
-    return narrow(select(k > splat(0), splat(1) / k, splat(0)));
+    return select(k > splat(0), splat(1) / k, splat(0));
 }
 
 // Central friction of one lane (Box3D's): the friction centre is the points' mean,
@@ -251,9 +260,9 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     wc.radius_a = wc.radius_b = Wide{};
     wc.center_a = wc.center_b = Wide3{};
     wc.friction_row[0] = wc.friction_row[1] = wc.twist_row = WideRow{};
-    wc.friction_mass[0] = wc.friction_mass[1] = wc.friction_mass[2] = wc.twist_mass = WideF{};
+    wc.friction_mass[0] = wc.friction_mass[1] = wc.friction_mass[2] = wc.twist_mass = Wide{};
     wc.friction_impulse[0] = wc.friction_impulse[1] = wc.twist_impulse = Wide{};
-    for (WidePoint& p : wc.points) p.lever_arm = WideF{};
+    for (WidePoint& p : wc.points) p.lever_arm = Wide{};
     for (std::uint8_t& points : wc.slot_points) points = 0;
     const Real friction_distance = std::max(world.settings.solver.speculative_distance, Real(1e-3));
     for (int l = 0; l < wc.lanes; ++l) {
@@ -311,18 +320,27 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum, splat(0)), ra[j], rb[j],
                                  wc.normal, p.normal_row);
         p.normal_impulse = normal_impulse[j];
-        const Wide mass = widen(p.normal_mass);
+        const Wide mass = p.normal_mass;
         const Wide held = select(mass > splat(0), held_per_impulse * normal_impulse[j] / mass, splat(0));
-        p.recovery = narrow(wide_max(splat(params.recovery_depth), held));
+        p.recovery = wide_max(splat(params.recovery_depth), held);
         p.max_normal_impulse = Wide{};
         p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
     }
-    for (Real& impulse : wc.push_impulse) impulse = 0;
+    for (float& impulse : wc.push_impulse) impulse = 0;
+}
+
+// The lanes' contact records are read at random, each a few cache lines: asked for one
+// wide contact ahead, their misses overlap the preparing of the one before.
+void prefetch_contacts(const World& world, const SolverScratch& scratch, const WideContact& wc) {
+    for (int l = 0; l < wc.lanes; ++l) {
+        const auto* record = reinterpret_cast<const char*>(&world.contacts[scratch.manifolds[wc.ref[l]].contact]);
+        for (std::size_t line = 0; line < sizeof(Contact); line += 64) __builtin_prefetch(record + line);
+    }
 }
 
 }  // namespace
 
-// Lays the colours' manifold refs out four by four, then the overflow one per
+// Lays the colours' manifold refs out kLanes at a time, then the overflow one per
 // WideContact (its manifolds may share bodies, so they are solved one at a time).
 void pack_contacts(SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
@@ -375,7 +393,7 @@ void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodie
     SolverBody& A = bodies[wc.a[lane]];
     SolverBody& B = bodies[wc.b[lane]];
     const Vec3 normal = wc.normal.lane(lane);
-    Real& impulse = wc.push_impulse[lane];
+    float& impulse = wc.push_impulse[lane];
     SolverBody copy_a, copy_b;
     const SolverBody& Am = lane_body(wc, lane, 0, A, copy_a);
     const SolverBody& Bm = lane_body(wc, lane, 1, B, copy_b);
@@ -385,9 +403,9 @@ void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodie
     Velocities push = load_push(A, B);
     const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
     const Real speed = row_speed(push, normal, row);
-    const Real total = std::max(
-        impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * impulse, Real(0));
-    apply_row(Am, Bm, push, normal, row, total - impulse);
+    const auto total = static_cast<float>(std::max(
+        impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * impulse, Real(0)));
+    apply_row(Am, Bm, push, normal, row, Real(total) - Real(impulse));
     impulse = total;
     store_push(A, B, push);
 }
@@ -401,16 +419,11 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     // Current separation from the bodies' motion since the step began:
     // n.(dpB - dpA + dqB rb - dqA ra), with n.(dq r) = (dq^-1 n).r so each body's
     // rotation is applied once per lane rather than once per point.
-    Wide3 dpa, dpb;
-    WideQuat dqa, dqb;
-    for (int l = 0; l < kLanes; ++l) {
-        const SolverBody& A = bodies[wc.a[l]];
-        const SolverBody& B = bodies[wc.b[l]];
-        dpa.set_lane(l, A.dp);
-        dpb.set_lane(l, B.dp);
-        dqa.set_lane(l, A.dq);
-        dqb.set_lane(l, B.dq);
-    }
+    Wide ma[kLanes], mb[kLanes];
+    gather_rows(bodies, wc.a, kMotionRow, ma);
+    gather_rows(bodies, wc.b, kMotionRow, mb);
+    const Wide3 dpa{ma[0], ma[1], ma[2]}, dpb{mb[0], mb[1], mb[2]};
+    const WideQuat dqa{{ma[3], ma[4], ma[5]}, ma[6]}, dqb{{mb[3], mb[4], mb[5]}, mb[6]};
     const Wide3 na = rotate_inverse(dqa, wc.normal);
     const Wide3 nb = rotate_inverse(dqb, wc.normal);
     const Wide zero = splat(0), one = splat(1);
@@ -438,7 +451,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
         if constexpr (kBias) {
-            const Wide recovery = widen(p.recovery);
+            const Wide recovery = p.recovery;
             const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
             deep_weight += depth;
             deep_excess -= depth * depth;
@@ -450,9 +463,9 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             const Wide bias = select(speculative, separation * inv_h, soft_bias);
             const Wide mass_scale = select(speculative, one, soft_mass);
             const Wide impulse_scale = select(speculative, zero, soft_impulse);
-            impulse = -widen(p.normal_mass) * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+            impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         } else {
-            impulse = -widen(p.normal_mass) * (vn + select(speculative, separation * inv_h, zero));
+            impulse = -p.normal_mass * (vn + select(speculative, separation * inv_h, zero));
         }
         const Wide total = wide_max(p.normal_impulse + impulse, zero);
         impulse = total - p.normal_impulse;
@@ -477,7 +490,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
             const Wide touching_impulse = select(gap[j] <= slop, wc.points[j].normal_impulse, zero);
             pressed += touching_impulse;
-            twist_reach += widen(wc.points[j].lever_arm) * touching_impulse;
+            twist_reach += wc.points[j].lever_arm * touching_impulse;
         }
         counts.friction += static_cast<std::uint64_t>(wc.lanes);
         // Twist about the normal, within friction x the normal impulses' moments.
@@ -485,7 +498,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             const Wide speed = dot(wc.normal, s.wb - s.wa);
             const Wide limit = wc.friction * twist_reach;
             const Wide old = wc.twist_impulse;
-            const Wide total = wide_min(wide_max(old - widen(wc.twist_mass) * speed, -limit), limit);
+            const Wide total = wide_min(wide_max(old - wc.twist_mass * speed, -limit), limit);
             wc.twist_impulse = total;
             apply_angular_row(s, wc.twist_row, total - old);
         }
@@ -494,7 +507,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
         const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
         const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
-        const Wide m00 = widen(wc.friction_mass[0]), m01 = widen(wc.friction_mass[1]), m11 = widen(wc.friction_mass[2]);
+        const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
         Wide new0 = old0 - (m00 * v0 + m01 * v1);
         Wide new1 = old1 - (m01 * v0 + m11 * v1);
         const Wide limit = wc.friction * pressed;
@@ -564,7 +577,7 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
         // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
         const Wide approach = p.relative_velocity + wc.gravity_normal * splat(h);
-        const Wide impulse = -widen(p.normal_mass) * (vn + wc.restitution * wide_min(approach, zero));
+        const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
         const Wide total = wide_max(p.normal_impulse + impulse, zero);
         const Wide applied = select(bounce, total - p.normal_impulse, zero);
         p.normal_impulse += applied;
@@ -578,7 +591,10 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
 
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi) {
-    for (std::uint32_t k = lo; k < hi; ++k) prepare_wide(world, scratch, params, scratch.wide[k]);
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        if (k + 1 < hi) prefetch_contacts(world, scratch, scratch.wide[k + 1]);
+        prepare_wide(world, scratch, params, scratch.wide[k]);
+    }
 }
 
 // Each pass in two builds: with per-axis inverse masses where a lane's body has a

@@ -1,58 +1,93 @@
-// Wide: four doubles worked on together, the engine's one SIMD header. GCC's vector
-// extensions compile it to AVX when the build enables it and to two SSE2 halves
-// otherwise, with no intrinsics to port. The contact solver puts four manifolds of one
+// Wide: eight floats worked on together, the engine's one SIMD header. GCC's vector
+// extensions compile it to one AVX instruction when the build enables AVX and to two
+// SSE halves otherwise, with no intrinsics to port; every operation is IEEE lane by
+// lane, so both give the same bits. The contact solver puts eight manifolds of one
 // colour in the lanes, so the dependent chain of one manifold's Gauss-Seidel rows
-// overlaps three others instead of stalling on its own latency.
+// overlaps seven others instead of stalling on its own latency. Floats are enough for
+// what it keeps (Box2D v3 and Box3D solve in floats): anchors and separations are
+// relative to the bodies, positions stay in double in the bodies themselves.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 #include <spindle/engine/math.hpp>
 
 namespace spindle {
 
-inline constexpr int kLanes = 4;
-using Wide = double __attribute__((vector_size(kLanes * sizeof(double))));
-using WideMask = std::int64_t __attribute__((vector_size(kLanes * sizeof(std::int64_t))));  // lanes: 0 or -1
+inline constexpr int kLanes = 8;
+using Wide = float __attribute__((vector_size(kLanes * sizeof(float))));
+using WideMask = std::int32_t __attribute__((vector_size(kLanes * sizeof(std::int32_t))));  // lanes: 0 or -1
 
-// Four floats, for data that is only read back (a contact's rows): half the memory a
-// pass streams through. Widened to doubles before any arithmetic.
-using WideF = float __attribute__((vector_size(kLanes * sizeof(float))));
-inline Wide widen(WideF f) { return __builtin_convertvector(f, Wide); }
-inline WideF narrow(Wide d) { return __builtin_convertvector(d, WideF); }
-
-inline Wide splat(Real x) { return Wide{x, x, x, x}; }
+inline Wide splat(Real x) {
+    const auto f = static_cast<float>(x);
+    return Wide{f, f, f, f, f, f, f, f};
+}
 inline Wide wide_max(Wide a, Wide b) { return a > b ? a : b; }
 inline Wide wide_min(Wide a, Wide b) { return a < b ? a : b; }
 inline Wide select(WideMask m, Wide if_set, Wide if_clear) { return m ? if_set : if_clear; }
-inline bool any(WideMask m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
-inline Wide wide_sqrt(Wide a) { return Wide{std::sqrt(a[0]), std::sqrt(a[1]), std::sqrt(a[2]), std::sqrt(a[3])}; }
+inline bool any(WideMask m) {
+    std::int32_t set = 0;
+    for (int i = 0; i < kLanes; ++i) set |= m[i];
+    return set != 0;
+}
+inline Wide wide_sqrt(Wide a) {
+    Wide r;
+    for (int i = 0; i < kLanes; ++i) r[i] = __builtin_sqrtf(a[i]);
+    return r;
+}
+
+// Eight rows of eight lanes turned into eight columns (the 8x8 transpose Box2D v3
+// gathers its bodies with): three rounds of shuffles instead of 64 lane inserts.
+inline void transpose(Wide (&r)[8]) {
+    static_assert(kLanes == 8, "an 8x8 transpose");
+    Wide t[8], u[8];
+    for (int i = 0; i < 8; i += 2) {
+        t[i] = __builtin_shufflevector(r[i], r[i + 1], 0, 8, 1, 9, 4, 12, 5, 13);
+        t[i + 1] = __builtin_shufflevector(r[i], r[i + 1], 2, 10, 3, 11, 6, 14, 7, 15);
+    }
+    for (int i = 0; i < 8; i += 4) {
+        for (int k = 0; k < 2; ++k) {
+            u[i + 2 * k] = __builtin_shufflevector(t[i + k], t[i + k + 2], 0, 1, 8, 9, 4, 5, 12, 13);
+            u[i + 2 * k + 1] = __builtin_shufflevector(t[i + k], t[i + k + 2], 2, 3, 10, 11, 6, 7, 14, 15);
+        }
+    }
+    for (int k = 0; k < 4; ++k) {
+        r[k] = __builtin_shufflevector(u[k], u[k + 4], 0, 1, 2, 3, 8, 9, 10, 11);
+        r[k + 4] = __builtin_shufflevector(u[k], u[k + 4], 4, 5, 6, 7, 12, 13, 14, 15);
+    }
+}
+
+// Eight doubles from memory as a row of floats (rounded to nearest, as a scalar cast), and
+// back: the first `count` lanes stored as doubles.
+using Double4 = double __attribute__((vector_size(4 * sizeof(double))));
+using Float4 = float __attribute__((vector_size(4 * sizeof(float))));
+inline Wide load_narrow(const Real* p) {
+    Double4 lo, hi;
+    std::memcpy(&lo, p, sizeof lo);
+    std::memcpy(&hi, p + 4, sizeof hi);
+    return __builtin_shufflevector(__builtin_convertvector(lo, Float4), __builtin_convertvector(hi, Float4), 0, 1, 2, 3,
+                                   4, 5, 6, 7);
+}
+inline void store_widened6(Real* p, Wide row) {
+    const Double4 lo = __builtin_convertvector(__builtin_shufflevector(row, row, 0, 1, 2, 3), Double4);
+    const Double4 hi = __builtin_convertvector(__builtin_shufflevector(row, row, 4, 5, 6, 7), Double4);
+    std::memcpy(p, &lo, sizeof lo);
+    std::memcpy(p + 4, &hi, 2 * sizeof(Real));
+}
 
 // A vector per lane, as three Wide components (structure of arrays).
 struct Wide3 {
     Wide x{}, y{}, z{};
 
-    Vec3 lane(int i) const { return {x[i], y[i], z[i]}; }
-    void set_lane(int i, const Vec3& v) {
-        x[i] = v.x();
-        y[i] = v.y();
-        z[i] = v.z();
-    }
-};
-
-// A Wide3 stored as floats.
-struct Wide3F {
-    WideF x{}, y{}, z{};
-
+    Vec3 lane(int i) const { return {Real(x[i]), Real(y[i]), Real(z[i])}; }
     void set_lane(int i, const Vec3& v) {
         x[i] = static_cast<float>(v.x());
         y[i] = static_cast<float>(v.y());
         z[i] = static_cast<float>(v.z());
     }
 };
-inline Wide3 widen(const Wide3F& v) { return {widen(v.x), widen(v.y), widen(v.z)}; }
-inline Wide3F narrow(const Wide3& v) { return {narrow(v.x), narrow(v.y), narrow(v.z)}; }
 
 inline Wide3 operator+(const Wide3& a, const Wide3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline Wide3 operator-(const Wide3& a, const Wide3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -70,7 +105,7 @@ struct WideMat3 {
 
     void set_lane(int i, const Mat3& a) {
         for (int r = 0; r < 3; ++r) {
-            for (int c = 0; c < 3; ++c) m[r][c][i] = a(r, c);
+            for (int c = 0; c < 3; ++c) m[r][c][i] = static_cast<float>(a(r, c));
         }
     }
 };
@@ -87,7 +122,7 @@ struct WideQuat {
 
     void set_lane(int i, const Quat& q) {
         v.set_lane(i, q.vec());
-        w[i] = q.w();
+        w[i] = static_cast<float>(q.w());
     }
 };
 

@@ -33,7 +33,7 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 namespace {
 
 constexpr std::uint32_t kBodyGrain = 128;
-// Joints or wide contacts (4 manifolds each) per chunk: small, so the end of a colour
+// Joints or wide contacts (kLanes manifolds each) per chunk: small, so the end of a colour
 // splits evenly between the workers.
 constexpr std::uint32_t kConstraintGrain = 2;
 // Wide contacts per block when preparing them and storing their impulses.
