@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "collision/clipping.hpp"
 #include "collision/manifold_slots.hpp"
@@ -127,9 +128,11 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
     const TriangleMesh& mesh = *b.mesh;
     const Transform a_in_mesh = xb.inverse() * xa;
     const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
+    // A sphere or capsule is not a polyhedron: nothing to prepare for it.
     const BoxPoly box(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
-    const bool polyhedral = a.type == ShapeType::Box || a.type == ShapeType::ConvexHull;
-    const PreparedPolyhedron prepared(a.type == ShapeType::ConvexHull ? view_of(*a.hull) : box.view());
+    std::optional<PreparedPolyhedron> prepared;
+    if (a.type == ShapeType::Box) prepared.emplace(box.view());
+    if (a.type == ShapeType::ConvexHull) prepared.emplace(view_of(*a.hull));
 
     const ShapeSpan span(a, a_in_mesh);
 
@@ -141,7 +144,7 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
         Manifold m;
-        if (!collide_triangle(a, a_in_mesh, polyhedral ? &prepared : nullptr, poly, speculative, m)) return;
+        if (!collide_triangle(a, a_in_mesh, prepared ? &*prepared : nullptr, poly, speculative, m)) return;
         if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
             use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
             if (m.point_count == 0) return;
