@@ -20,6 +20,7 @@ usage() { sed -n '7p' "$0" | sed 's/^#  */usage: /' >&2; exit 2; }
 [[ $# -ge 2 ]] || usage
 jolt=$(realpath -q "$1" || echo "$1")
 spindle=$(realpath -q "$2" || echo "$2")
+here=$(dirname "$(realpath "$0")")
 shift 2
 [[ -f $jolt && -x $jolt ]] || { echo "jolt_side_by_side: $jolt is not an executable" >&2; exit 2; }
 [[ -f $spindle && -x $spindle ]] || { echo "jolt_side_by_side: $spindle is not an executable" >&2; exit 2; }
@@ -82,19 +83,8 @@ done
 echo "medians (steps/s after the first step; ratio = Spindle / Jolt, the median of the pairs' ratios; first steps in ms):"
 for scene in "${scenes[@]}"; do
     for t in "${threads[@]}"; do
-        grep "^$scene threads=$t " "$results" | awk -v name="$scene" -v t="$t" '
-            function median(a, n,   i, j, x) {
-                for (i = 2; i <= n; i++) { x = a[i]; for (j = i - 1; j >= 1 && a[j] > x; j--) a[j + 1] = a[j]; a[j + 1] = x }
-                return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2
-            }
-            { for (f = 2; f <= NF; f++) { split($f, kv, "="); v[kv[1], NR] = kv[2] } n = NR }
-            END {
-                for (i = 1; i <= n; i++) {
-                    j[i] = v["jolt", i]; s[i] = v["spindle", i]; r[i] = v["ratio", i]
-                    jf[i] = v["jolt_first_ms", i]; sf[i] = v["spindle_first_ms", i]
-                }
-                printf "  %-13s %d thread(s): Jolt %.1f  Spindle %.1f  ratio %.2f  first step: Jolt %.2f Spindle %.2f  (%d pairs)\n",
-                    name, t, median(j, n), median(s, n), median(r, n), median(jf, n), median(sf, n), n
-            }'
+        grep "^$scene threads=$t " "$results" |
+            awk -f "$here/medians.awk" -v name="$scene" -v t="$t" -v fields="jolt spindle ratio jolt_first_ms spindle_first_ms" \
+                -v labels="Jolt,Spindle,ratio,first step: Jolt,Spindle"
     done
 done

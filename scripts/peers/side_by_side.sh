@@ -15,6 +15,7 @@ usage() { sed -n '6p' "$0" | sed 's/^#  */usage: /' >&2; exit 2; }
 [[ $# -ge 2 ]] || usage
 box3d=$(realpath "$1")
 spindle=$(realpath "$2")
+here=$(dirname "$(realpath "$0")")
 shift 2
 [[ -x $box3d ]] || { echo "side_by_side: $box3d is not an executable" >&2; exit 2; }
 [[ -x $spindle ]] || { echo "side_by_side: $spindle is not an executable" >&2; exit 2; }
@@ -54,15 +55,7 @@ done
 echo "medians (steps/s; ratio = Spindle / Box3D, the median of the pairs' ratios):"
 for scene in "${scenes[@]}"; do
     for t in "${threads[@]}"; do
-        grep "^$scene threads=$t " "$results" | awk -v name="$scene" -v t="$t" '
-            function median(a, n,   i, j, x) {
-                for (i = 2; i <= n; i++) { x = a[i]; for (j = i - 1; j >= 1 && a[j] > x; j--) a[j + 1] = a[j]; a[j + 1] = x }
-                return n % 2 ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2
-            }
-            { for (f = 1; f <= NF; f++) { split($f, kv, "="); v[kv[1], NR] = kv[2] } n = NR }
-            END {
-                for (i = 1; i <= n; i++) { b[i] = v["box3d", i]; s[i] = v["spindle", i]; r[i] = v["ratio", i] }
-                printf "  %-14s %d thread(s): Box3D %.1f  Spindle %.1f  ratio %.2f  (%d pairs)\n", name, t, median(b, n), median(s, n), median(r, n), n
-            }'
+        grep "^$scene threads=$t " "$results" |
+            awk -f "$here/medians.awk" -v name="$scene" -v t="$t" -v fields="box3d spindle ratio" -v labels="Box3D,Spindle,ratio"
     done
 done
