@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <vector>
 
@@ -23,6 +24,23 @@ constexpr double kCardDensity = 700;
 constexpr double kCardFriction = 0.5;
 constexpr double kLean = 68 * kPi / 180;  // a leaning card's angle from horizontal
 constexpr double kGap = 1e-4;             // each card is built this far above what it rests on
+
+// Uniform in [-1, 1), the same on every platform (splitmix64): the jittered houses must be
+// the same houses everywhere.
+class Jitter {
+public:
+    explicit Jitter(std::uint64_t seed) : m_state(seed) {}
+    double operator()() {
+        std::uint64_t z = (m_state += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        z ^= z >> 31;
+        return static_cast<double>(z >> 11) * 0x1.0p-52 - 1;
+    }
+
+private:
+    std::uint64_t m_state;
+};
 
 BodyHandle add_card(Space& space, const Vec3& position, double angle_about_z) {
     BodyDesc d;
@@ -51,7 +69,10 @@ struct CardHouse {
 // middles. The cards of a pair touch along their inner top edges at the apex; each
 // leaning card's top edge lies 2 b sin(lean) (1.9 mm) inside the apex, so a flat card's
 // end overhangs the edge it rests on by that much.
-CardHouse build_card_house(Space& space, int levels) {
+// off > 0: each card is built up to off along x from its place, at random (seed).
+CardHouse build_card_house(Space& space, int levels, double off = 0, std::uint64_t seed = 0) {
+    Jitter jitter(seed);
+    auto shift = [&] { return off > 0 ? Vec3(off * jitter(), 0, 0) : Vec3::Zero(); };
     add_static_box(space, Vec3(1, 0.5, 1), Vec3(0, -0.5, 0), Quat::Identity(), kCardFriction);
     const double a = kCard.x(), b = kCard.y();
     const double c = std::cos(kLean), s = std::sin(kLean);
@@ -65,8 +86,8 @@ CardHouse build_card_house(Space& space, int levels) {
         for (int j = 0; j < pairs; ++j) {
             const double apex = (j - 0.5 * (pairs - 1)) * spacing;
             const double half = a * c + b * s;  // apex to a leaning card's centre, in x
-            const BodyHandle left = add_card(space, Vec3(apex - half, centre_y, 0), kLean);
-            const BodyHandle right = add_card(space, Vec3(apex + half, centre_y, 0), -kLean);
+            const BodyHandle left = add_card(space, Vec3(apex - half, centre_y, 0) + shift(), kLean);
+            const BodyHandle right = add_card(space, Vec3(apex + half, centre_y, 0) + shift(), -kLean);
             house.cards.push_back(left);
             house.cards.push_back(right);
             house.top = {left, right};
@@ -74,7 +95,7 @@ CardHouse build_card_house(Space& space, int levels) {
         const double flat_y = floor_y + kGap + pair_height + kGap + b;
         for (int j = 0; j + 1 < pairs; ++j) {
             const double apex = (j - 0.5 * (pairs - 1)) * spacing;
-            house.cards.push_back(add_card(space, Vec3(apex + 0.5 * spacing, flat_y, 0), 0));
+            house.cards.push_back(add_card(space, Vec3(apex + 0.5 * spacing, flat_y, 0) + shift(), 0));
         }
         floor_y = flat_y + b;
     }
@@ -191,6 +212,38 @@ TEST(Delicate, CardHouseOfFiveLevelsStands) {
     EXPECT_LT(worst_racking, 20 * kPi / 180);
     EXPECT_LT(worst, 0.003);
     EXPECT_LT(speed, 0.001);
+}
+
+// The same house built with each card up to 0.5 mm off along x (at random, 19 houses):
+// a house that stands only when built exactly is marginal. Each must keep its top pair:
+// its top less than 2 cm down and the pair racked less than 20 degrees, at worst over
+// 5 s (a pair that topples turns by tens of degrees and drops its top 94 mm). Disabled:
+// main (60ba99e) fails it, 3 of these 19 houses (seeds 1, 10 and 15) lose their top pair
+// (racked 176-179 degrees, top 94-95 mm down); issue 16 measured 5 of 19 with other
+// offsets, none at 8 substeps, with 4 iterations and 4 relax iterations, or at friction
+// 0.7. A position pass after each substep (Box2D v2.4's, Jolt's) did not fix it: every
+// variant made all 19 fall (docs/accuracy.md, "Delicate structures").
+TEST(Delicate, DISABLED_CardHousesBuiltSlightlyOffKeepTheirTopPair) {
+    constexpr double kOff = 0.0005;
+    int fallen = 0;
+    for (std::uint64_t seed = 1; seed <= 19; ++seed) {
+        auto space = make_space();
+        const CardHouse house = build_card_house(*space, 5, kOff, seed);
+        const double built_top = house_top(*space, house);
+        const std::array<Quat, 2> built{space->internal_orientation(house.top[0]),
+                                        space->internal_orientation(house.top[1])};
+        double worst_drop = 0, worst_racking = 0;
+        for (int step = 0; step < 300; ++step) {
+            space->update();
+            worst_drop = std::max(worst_drop, built_top - house_top(*space, house));
+            worst_racking = std::max(worst_racking, top_racking(*space, house, built));
+        }
+        const bool stands = all_finite(*space, house.cards) && worst_drop < 0.02 && worst_racking < 20 * kPi / 180;
+        fallen += stands ? 0 : 1;
+        std::printf("[ measure  ] card house, seed %2d: top dropped %.2f mm at worst, top pair racked %.2f degrees%s\n",
+                    static_cast<int>(seed), 1000 * worst_drop, worst_racking * 180 / kPi, stands ? "" : ": fell");
+    }
+    EXPECT_EQ(fallen, 0);
 }
 
 // A semicircular arch of 11 voussoirs (inner radius 2 m, outer 2.5 m, 1 m deep; about
