@@ -56,6 +56,7 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     if (end == first) return;
     reserve_for(world.contacts, end);
     reserve_for(world.contact_summaries, end);
+    map_room(*world.jobs, world.contacts, end);
     world.contacts.resize(end);  // in place, all at once: the record is large
     world.contact_summaries.resize(end);
 
