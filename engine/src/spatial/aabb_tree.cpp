@@ -86,6 +86,54 @@ std::int32_t DynamicAabbTree::create_proxy(const Aabb& tight, std::uint64_t user
     return id;
 }
 
+void DynamicAabbTree::create_proxies(std::span<const Aabb> tight, std::span<const std::uint64_t> user,
+                                     std::span<std::int32_t> ids, JobSystem* jobs) {
+    SPINDLE_ASSERT(user.size() == tight.size() && ids.size() == tight.size(),
+                   "DynamicAabbTree::create_proxies: one user value and one id per box");
+    for (const Aabb& box : tight) {
+        SPINDLE_ASSERT(is_finite_box(box), "DynamicAabbTree::create_proxies: boxes must be finite with min <= max");
+    }
+    if (tight.empty()) return;
+    // The build's leaves and internal nodes: the tree's own (read before any node is
+    // allocated: a new one starts as a leaf), then the new ones.
+    const std::size_t leaves = static_cast<std::size_t>(m_proxy_count) + tight.size();
+    m_build_leaves.clear();
+    m_build_pool.clear();
+    m_build_leaves.reserve(leaves);
+    m_build_pool.reserve(leaves - 1);
+    for (std::size_t i = 0; i < m_nodes.size(); ++i) {
+        const std::int32_t height = m_nodes[i].height;
+        if (height == 0) m_build_leaves.push_back(static_cast<std::int32_t>(i));
+        if (height > 0) m_build_pool.push_back(static_cast<std::int32_t>(i));
+        m_enlarged[i] = 0;
+    }
+    m_enlarged_nodes = 0;
+    // One internal node per new leaf, one fewer in an empty tree.
+    const std::size_t internal = m_proxy_count == 0 ? tight.size() - 1 : tight.size();
+    m_nodes.reserve(m_nodes.size() + tight.size() + internal);
+    m_enlarged.reserve(m_nodes.capacity());
+    for (std::size_t k = 0; k < tight.size(); ++k) {
+        const std::int32_t id = allocate_node();
+        Node& node = m_nodes[static_cast<std::size_t>(id)];
+        node.box = fatten(tight[k], Vec3::Zero());
+        node.payload.user = user[k];
+        ids[k] = id;
+        m_build_leaves.push_back(id);
+    }
+    for (std::size_t k = 0; k < internal; ++k) {
+        const std::int32_t id = allocate_node();
+        m_nodes[static_cast<std::size_t>(id)].height = 1;  // internal: the build fits it
+        m_build_pool.push_back(id);
+    }
+    m_proxy_count += static_cast<std::int32_t>(tight.size());
+    build_from_leaves(jobs);
+    // Once, not every step: the scratch is not kept at the size of the whole tree.
+    m_build_leaves = {};
+    m_build_pool = {};
+    m_build_order = {};
+    validate_if_enabled();
+}
+
 void DynamicAabbTree::destroy_proxy(std::int32_t id) {
     check_proxy(id);
     remove_leaf(id);

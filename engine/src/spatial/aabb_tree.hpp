@@ -1,9 +1,10 @@
 // DynamicAabbTree: a bounding volume hierarchy over fattened AABBs, updated incrementally
 // (insert by cheapest SAH sibling, rebalance by tree rotations), moved in place and
-// rebuilt where moves enlarged it, or rebuilt in bulk.
+// rebuilt where moves enlarged it, or built in bulk.
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -35,6 +36,15 @@ public:
 
     // Adds a proxy whose fat box is `tight` grown by the margin. Returns its id.
     std::int32_t create_proxy(const Aabb& tight, std::uint64_t user);
+    // Adds many proxies at once: one for tight[k] (grown by the margin) with user[k], its
+    // id written to ids[k]. The whole tree, old proxies and new, is then built top down
+    // with rebuild()'s binned SAH, its lower parts as jobs when `jobs` is given (the same
+    // tree for any worker count; the caller waits for them). For filling a tree with a
+    // scene's bodies: one create_proxy each pays a sibling search and rotations per
+    // proxy, and this a rebuild of the whole tree, so a few proxies go one at a time.
+    // Old proxies keep their ids, fat boxes and user values.
+    void create_proxies(std::span<const Aabb> tight, std::span<const std::uint64_t> user, std::span<std::int32_t> ids,
+                        JobSystem* jobs = nullptr);
     void destroy_proxy(std::int32_t id);
     // Returns true when the proxy got a new fat box: when `tight` left the fat box, or
     // when the fat box is far bigger than needed (a fast body stopped). The new fat box

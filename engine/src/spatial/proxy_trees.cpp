@@ -115,24 +115,53 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
     if (m_chunk_pairs.size() < chunks) m_chunk_pairs.resize(chunks);
     for (std::uint32_t c = 0; c < chunks; ++c) m_chunk_pairs[c].clear();
 
-    // Jobs only read the trees and the enlarged marks and write their own chunk's list.
+    // Jobs only read the trees and the enlarged marks and write their own chunk's list,
+    // sorted there: the merge below puts the sorted runs together.
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
         for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], out);
+        std::sort(out.begin(), out.end(), canonical_less);
     });
 
-    std::size_t total = 0;
-    for (std::uint32_t c = 0; c < chunks; ++c) total += m_chunk_pairs[c].size();
-    new_pairs.reserve(total);
+    m_run_starts.assign(chunks + 1, 0);
+    for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
+    new_pairs.resize(m_run_starts[chunks]);
     for (std::uint32_t c = 0; c < chunks; ++c) {
-        new_pairs.insert(new_pairs.end(), m_chunk_pairs[c].begin(), m_chunk_pairs[c].end());
+        std::copy(m_chunk_pairs[c].begin(), m_chunk_pairs[c].end(),
+                  new_pairs.begin() + static_cast<std::ptrdiff_t>(m_run_starts[c]));
     }
     // The chunk order already fixes the result for a given enlarged list; sorting also
     // frees it from the marking order, so the engine sees pairs in a canonical order.
-    std::sort(new_pairs.begin(), new_pairs.end(), canonical_less);
+    merge_runs(jobs, new_pairs);
 
     for (const ProxyId id : m_enlarged) slots_of(id)[static_cast<std::size_t>(id.tree_id())] = -1;
     m_enlarged.clear();
+}
+
+// Merges the sorted runs [m_run_starts[r], m_run_starts[r + 1]) of `pairs` into one sorted
+// list, neighbouring runs two at a time in parallel rounds. No two pairs are equal, so the
+// sorted order is unique: the result does not depend on how the rounds ran.
+void ProxyTrees::merge_runs(JobSystem& jobs, std::vector<Pair>& pairs) {
+    std::vector<std::size_t>& starts = m_run_starts;
+    m_merged_pairs.resize(pairs.size());
+    for (auto runs = static_cast<std::uint32_t>(starts.size() - 1); runs > 1;) {
+        const std::uint32_t merges = (runs + 1) / 2;
+        jobs.parallel_for("broadphase.merge_pairs", 0, merges, 1,
+                          [&](std::uint32_t begin, std::uint32_t end, unsigned) {
+                              for (std::uint32_t m = begin; m < end; ++m) {
+                                  const auto first = static_cast<std::ptrdiff_t>(starts[2 * m]);
+                                  const auto middle = static_cast<std::ptrdiff_t>(starts[std::min(2 * m + 1, runs)]);
+                                  const auto last = static_cast<std::ptrdiff_t>(starts[std::min(2 * m + 2, runs)]);
+                                  std::merge(pairs.begin() + first, pairs.begin() + middle, pairs.begin() + middle,
+                                             pairs.begin() + last, m_merged_pairs.begin() + first, canonical_less);
+                              }
+                          });
+        for (std::uint32_t m = 0; m < merges; ++m) starts[m] = starts[2 * m];  // reads at or ahead of the write
+        starts[merges] = starts[runs];
+        starts.resize(merges + 1);
+        pairs.swap(m_merged_pairs);
+        runs = merges;
+    }
 }
 
 void ProxyTrees::rebuild_static_tree() { m_trees[1].rebuild(); }
@@ -140,7 +169,8 @@ void ProxyTrees::rebuild_static_tree() { m_trees[1].rebuild(); }
 std::size_t ProxyTrees::heap_bytes() const noexcept {
     std::size_t bytes = m_trees[0].heap_bytes() + m_trees[1].heap_bytes() + m_enlarged.capacity() * sizeof(ProxyId) +
                         (m_enlarged_slot[0].capacity() + m_enlarged_slot[1].capacity()) * sizeof(std::int32_t) +
-                        m_chunk_pairs.capacity() * sizeof(std::vector<Pair>);
+                        m_chunk_pairs.capacity() * sizeof(std::vector<Pair>) +
+                        m_run_starts.capacity() * sizeof(std::size_t) + m_merged_pairs.capacity() * sizeof(Pair);
     for (const std::vector<Pair>& pairs : m_chunk_pairs) bytes += pairs.capacity() * sizeof(Pair);
     return bytes;
 }

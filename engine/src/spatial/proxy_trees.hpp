@@ -107,7 +107,7 @@ public:
     const DynamicAabbTree& moving_tree() const noexcept { return m_trees[0]; }
     const DynamicAabbTree& static_tree() const noexcept { return m_trees[1]; }
     const BroadphaseSettings& settings() const noexcept { return m_settings; }
-    // Heap bytes held: both trees, the enlarged list and the pair jobs' lists (at capacity).
+    // Heap bytes held: both trees, the enlarged list, the pair jobs' lists and the merge's scratch (at capacity).
     std::size_t heap_bytes() const noexcept;
 
     // Validates both trees and the enlarged list (any build type; see DynamicAabbTree).
@@ -126,6 +126,7 @@ private:
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
     void find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const;
+    void merge_runs(JobSystem& jobs, std::vector<Pair>& pairs);
     void validate_enlarged() const;
     // The trees validate themselves after each change; this adds the enlarged list.
     void validate_if_enabled() const {
@@ -142,6 +143,10 @@ private:
     // One output list per job chunk, merged in chunk order; kept between calls so a
     // steady-state update does not allocate.
     std::vector<std::vector<Pair>> m_chunk_pairs;
+    // Scratch for putting the chunks' sorted lists together: where each run starts, and
+    // the merged list (swapped with the caller's at each round).
+    std::vector<std::size_t> m_run_starts;
+    std::vector<Pair> m_merged_pairs;
 };
 
 template <typename Callback>

@@ -43,7 +43,7 @@ void recombine_materials(World& world, std::span<const std::uint32_t> slots) {
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         Contact& contact = world.contacts[c];
         if (!changed(contact.body_a) && !changed(contact.body_b)) continue;
-        // The mixing rules of create_contact (contact_list.cpp).
+        // The mixing rules of create_contacts (contact_list.cpp).
         const BodyDesc& da = b.desc[contact.body_a];
         const BodyDesc& db = b.desc[contact.body_b];
         contact.friction = std::sqrt(da.friction * db.friction);

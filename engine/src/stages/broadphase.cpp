@@ -1,6 +1,7 @@
 // Broadphase stage: bounds of awake bodies, proxies moved in the AABB tree, new pairs
 // -> contacts, contacts whose fat bounds separated -> removed.
 #include <algorithm>
+#include <atomic>
 
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
@@ -101,6 +102,76 @@ void refilter_all(World& world) {
     }
 }
 
+namespace {
+
+// Pairs and contacts per job in the broadphase's passes over them.
+constexpr std::uint32_t kPairGrain = 256;
+constexpr std::uint32_t kContactGrain = 1024;
+
+// Runs keep(k, out) -> bool over [0, n) in parallel ranges of `grain`, each range writing
+// what it keeps to out from its own first index on; then closes the ranges up, in range
+// order. `out` holds the kept values in index order, the same for any number of workers.
+template <typename T, typename Keep>
+void select_in_order(JobSystem& jobs, const char* name, std::uint32_t n, std::uint32_t grain,
+                     std::vector<std::uint32_t>& counts, std::vector<T>& out, Keep&& keep) {
+    out.resize(n);
+    counts.assign((n + grain - 1) / grain, 0);
+    jobs.parallel_for(name, 0, n, grain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        std::uint32_t kept = 0;
+        for (std::uint32_t k = lo; k < hi; ++k) kept += keep(k, out[lo + kept]) ? 1u : 0u;
+        counts[lo / grain] = kept;
+    });
+    std::size_t size = 0;
+    for (std::size_t c = 0; c < counts.size(); ++c) {
+        const auto from = out.begin() + static_cast<std::ptrdiff_t>(c * grain);
+        std::copy(from, from + counts[c],
+                  out.begin() + static_cast<std::ptrdiff_t>(size));  // down: never overlaps ahead
+        size += counts[c];
+    }
+    out.resize(size);
+}
+
+// New pairs -> contacts, in pair order. The checks read the bodies' descriptions (cold),
+// so they run in parallel ranges; the contacts are made from the keys kept.
+void make_contacts(World& world, BroadphaseState& bp) {
+    const Bodies& b = world.bodies;
+    std::atomic<std::uint64_t> filtered{0};
+    select_in_order(*world.jobs, "NewPairs", static_cast<std::uint32_t>(bp.pairs.size()), kPairGrain, bp.range_counts,
+                    bp.new_keys, [&](std::uint32_t k, std::uint64_t& key) {
+                        const auto i = static_cast<std::uint32_t>(bp.pairs[k].user_a);
+                        const auto j = static_cast<std::uint32_t>(bp.pairs[k].user_b);
+                        if (!can_collide(b, i, j)) return false;
+                        if (filter_blocks_pair(world, i, j)) {
+                            // No contact: the narrowphase never sees the pair.
+                            filtered.fetch_add(1, std::memory_order_relaxed);
+                            return false;
+                        }
+                        if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
+                        key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
+                        return true;
+                    });
+    world.counters.pairs_filtered += filtered.load(std::memory_order_relaxed);
+    create_contacts(world, bp.new_keys);
+}
+
+// The awake contacts (positions ascending) whose fat boxes stopped overlapping; only a
+// refitted box can have.
+void find_lost_contacts(World& world, BroadphaseState& bp, std::vector<std::uint32_t>& lost) {
+    const std::vector<std::uint32_t>& awake = awake_contacts(world);
+    select_in_order(*world.jobs, "LostPairs", static_cast<std::uint32_t>(awake.size()), kContactGrain, bp.range_counts,
+                    lost, [&](std::uint32_t k, std::uint32_t& position) {
+                        const std::uint64_t key = world.contact_keys[awake[k]];  // packed: no Contact is read
+                        const auto i = static_cast<std::uint32_t>(key >> 32);
+                        const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
+                        if (!bp.refit[i] && !bp.refit[j]) return false;
+                        if (bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) return false;
+                        position = awake[k];
+                        return true;
+                    });
+}
+
+}  // namespace
+
 void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
@@ -125,32 +196,13 @@ void update_broadphase(World& world, Real dt) {
 
     bp.pairs.clear();
     bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count
-    reserve_contacts(world, bp.pairs.size());
-    for (const Pair& pair : bp.pairs) {
-        const auto i = static_cast<std::uint32_t>(pair.user_a);
-        const auto j = static_cast<std::uint32_t>(pair.user_b);
-        if (!can_collide(b, i, j)) continue;
-        if (filter_blocks_pair(world, i, j)) {
-            world.counters.pairs_filtered += 1;  // no contact: the narrowphase never sees the pair
-            continue;
-        }
-        if (joint_blocks_pair(world, i, j)) continue;  // jointed bodies do not collide unless asked
-        create_contact(world, (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j));
-    }
+    make_contacts(world, bp);
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
     // can have stopped overlapping.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
-    if (!bp.refit_slots.empty()) {
-        for (std::uint32_t c : awake_contacts(world)) {
-            const std::uint64_t key = world.contact_keys[c];  // packed: no Contact is read
-            const auto i = static_cast<std::uint32_t>(key >> 32);
-            const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
-            if (!bp.refit[i] && !bp.refit[j]) continue;
-            if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) lost.push_back(c);
-        }
-    }
+    if (!bp.refit_slots.empty()) find_lost_contacts(world, bp, lost);
     remove_contacts(world, lost);
     fit_contacts(world);
     // Only the marked slots are cleared: a sleeping pile's slots are not touched.

@@ -17,8 +17,10 @@ struct BroadphaseState {
     // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;
-    std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
-    std::vector<std::uint8_t> moving;        // scratch, per awake body: its proxy must move this step
+    std::vector<std::uint32_t> refit_slots;   // the slots marked in refit, to clear just them
+    std::vector<std::uint8_t> moving;         // scratch, per awake body: its proxy must move this step
+    std::vector<std::uint64_t> new_keys;      // scratch: keys of the new pairs that may make contacts
+    std::vector<std::uint32_t> range_counts;  // scratch: values kept per job range (broadphase.cpp)
 };
 
 // Whether bodies on layers a and b collide, per the space's layer table.
@@ -47,13 +49,12 @@ void remove_proxy(World& world, std::uint32_t slot);
 void refresh_proxy(World& world, std::uint32_t slot);
 // Removes every contact of a body (destroy_body).
 void remove_contacts_of(World& world, std::uint32_t slot);
-// Creates a contact for a pair key (min slot << 32 | max slot) if there is none.
-void create_contact(World& world, std::uint64_t key);
-// Makes room for `more` contacts at once (a first step finds tens of thousands of pairs:
-// growing by push_back would move every contact again and again).
-void reserve_contacts(World& world, std::size_t more);
-// Gives back the contact arrays' room when it is far above their use (a pile came apart,
-// or the pairs reserved for were mostly not made into contacts).
+// Creates a contact for each pair key (min slot << 32 | max slot) that has none, at the
+// end of World::contacts in the keys' order, the records filled in parallel jobs. Room is
+// made once for all of them: a first step makes tens of thousands, and growing by
+// push_back would move every contact again and again.
+void create_contacts(World& world, std::span<const std::uint64_t> keys);
+// Gives back the contact arrays' room when it is far above their use (a pile came apart).
 void fit_contacts(World& world);
 // Removes contacts by their positions in world.contacts (ascending), keeping the order of the rest.
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);

@@ -6,8 +6,15 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <iterator>
 #include <vector>
+
+#include <spindle/scheduler/job_system.hpp>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace spindle {
 
@@ -33,6 +40,33 @@ void fit_capacity(std::vector<T>& v) {
     fitted.reserve(v.size() + v.size() / 4);
     std::move(v.begin(), v.end(), std::back_inserter(fitted));
     v.swap(fitted);
+}
+
+// Has the OS map the pages of v's room for elements [v.size(), end) (end <= capacity) now,
+// split over jobs, before one thread constructs them there. A first step fills tens of
+// megabytes of new arrays, and a page's first touch (a fault, the kernel zeroing it) costs
+// more than writing it: in jobs, the workers share that cost. A hint: nothing for room of
+// less than a megabyte (not worth the jobs), or where the OS has no such call.
+template <typename T>
+void map_room(JobSystem& jobs, std::vector<T>& v, std::size_t end) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+    constexpr std::uintptr_t kPage = 4096;
+    constexpr std::uintptr_t kPagesPerJob = 64;
+    constexpr std::size_t kMinBytes = std::size_t{1} << 20;
+    if (end <= v.size() || (end - v.size()) * sizeof(T) < kMinBytes) return;
+    // Whole pages inside the room only: the pages it shares with live elements are mapped.
+    const auto first = (reinterpret_cast<std::uintptr_t>(v.data() + v.size()) + kPage - 1) / kPage;
+    const auto last = reinterpret_cast<std::uintptr_t>(v.data() + end) / kPage;
+    if (last <= first) return;
+    jobs.parallel_for("MapPages", 0, static_cast<std::uint32_t>(last - first), kPagesPerJob,
+                      [first](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                          // Errors (an old kernel without the call) leave the pages to fault as before.
+                          madvise(reinterpret_cast<void*>((first + lo) * kPage), (hi - lo) * kPage,
+                                  MADV_POPULATE_WRITE);
+                      });
+#else
+    (void)jobs, (void)v, (void)end;
+#endif
 }
 
 }  // namespace spindle

@@ -53,13 +53,12 @@ bool contact_touches(const Contact& contact) {
     return false;
 }
 
-void note_contact_created(World& world, Contact& contact) {
-    const BodyDesc& a = world.bodies.desc[contact.body_a];
-    const BodyDesc& b = world.bodies.desc[contact.body_b];
-    const bool sensor = a.sensor || b.sensor;
-    contact.events = static_cast<std::uint8_t>((a.contact_events || b.contact_events || sensor ? kContactReports : 0) |
-                                               (sensor ? kContactSensor : 0));
-    if (contact.events != 0) world.events->reporting += 1;
+std::uint8_t contact_event_flags(const World& world, std::uint32_t a, std::uint32_t b) {
+    const BodyDesc& da = world.bodies.desc[a];
+    const BodyDesc& db = world.bodies.desc[b];
+    const bool sensor = da.sensor || db.sensor;
+    return static_cast<std::uint8_t>((da.contact_events || db.contact_events || sensor ? kContactReports : 0) |
+                                     (sensor ? kContactSensor : 0));
 }
 
 void note_contact_removed(World& world, Contact& contact) {

@@ -46,9 +46,11 @@ inline bool contact_event_candidate(const Contact& contact) {
            (contact.manifold_count > 0 && (contact.events & kContactSensor) == 0);
 }
 
-// create_contact and remove_contacts (contact_list.cpp): the pair's flags, and the End of a
-// touching contact removed in any way (lost, filtered, its body destroyed).
-void note_contact_created(World& world, Contact& contact);
+// create_contacts and remove_contacts (contact_list.cpp): a new pair's flags (Contact::events,
+// which ContactEvents::reporting counts; reads the descriptions only, so any number of jobs
+// may call it at once), and the End of a touching contact removed in any way (lost,
+// filtered, its body destroyed).
+std::uint8_t contact_event_flags(const World& world, std::uint32_t a, std::uint32_t b);
 void note_contact_removed(World& world, Contact& contact);
 // After the narrowphase: Begin and End for the candidates found, in contact order.
 void note_touch_changes(World& world);

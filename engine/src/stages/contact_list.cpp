@@ -1,6 +1,8 @@
 // Contact bookkeeping: creation from pair keys, removal that keeps the order of the
 // remaining contacts (so the solver's order, and so its result, is deterministic).
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
@@ -9,14 +11,27 @@
 #include "stages/stages.hpp"
 
 namespace spindle {
+namespace {
 
-void reserve_contacts(World& world, std::size_t more) {
-    const std::size_t needed = world.contacts.size() + more;
-    reserve_for(world.contacts, needed);
-    reserve_for(world.contact_keys, needed);
-    reserve_for(world.contact_summaries, needed);
-    world.contact_index.reserve(needed);
+// New contacts per job: each reads two bodies' descriptions and writes one record.
+constexpr std::uint32_t kNewContactGrain = 256;
+// Moved contacts per job when their index entries are updated (one lookup each).
+constexpr std::uint32_t kMovedContactGrain = 1024;
+
+// A new contact's record, from its bodies' descriptions (reads only: many jobs at once).
+void init_contact(const World& world, std::uint64_t key, Contact& contact) {
+    const auto a = static_cast<std::uint32_t>(key >> 32);
+    const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const Bodies& bodies = world.bodies;
+    contact.body_a = a;
+    contact.body_b = b;
+    // Mixing rules as most engines: geometric mean friction, largest restitution.
+    contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
+    contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
+    contact.events = contact_event_flags(world, a, b);
 }
+
+}  // namespace
 
 void fit_contacts(World& world) {
     if (!far_above_use(world.contacts.capacity(), world.contacts.size())) return;
@@ -25,21 +40,41 @@ void fit_contacts(World& world) {
     fit_capacity(world.contact_summaries);
 }
 
-void create_contact(World& world, std::uint64_t key) {
-    // One lookup: a first step makes tens of thousands of contacts.
-    if (!world.contact_index.insert(key, static_cast<std::uint32_t>(world.contacts.size()))) return;
-    const auto a = static_cast<std::uint32_t>(key >> 32);
-    const auto b = static_cast<std::uint32_t>(key & 0xffffffffu);
-    const Bodies& bodies = world.bodies;
-    Contact& contact = world.contacts.emplace_back();  // in place: the record is large
-    contact.body_a = a;
-    contact.body_b = b;
-    // Mixing rules as most engines: geometric mean friction, largest restitution.
-    contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
-    contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
-    note_contact_created(world, contact);  // before the summary: a sensor's has no points
-    world.contact_summaries.push_back(contact_summary(contact));
-    world.contact_keys.push_back(key);
+void create_contacts(World& world, std::span<const std::uint64_t> keys) {
+    if (keys.empty()) return;
+    // Positions in list order, one index lookup per key; a key the index holds already is
+    // a pair found again (one of its proxies grew). Room is made for the new ones only: a
+    // step that finds many pairs again must not grow the arrays only to give them back.
+    const std::size_t first = world.contacts.size();
+    world.contact_index.reserve(first + keys.size());
+    std::vector<std::uint64_t>& made = world.contact_keys;
+    reserve_for(made, first + keys.size());  // 8 bytes a key: the pairs found again are not worth a second pass
+    for (const std::uint64_t key : keys) {
+        if (world.contact_index.insert(key, static_cast<std::uint32_t>(made.size()))) made.push_back(key);
+    }
+    const auto end = static_cast<std::uint32_t>(made.size());
+    if (end == first) return;
+    reserve_for(world.contacts, end);
+    reserve_for(world.contact_summaries, end);
+    map_room(*world.jobs, world.contacts, end);
+    world.contacts.resize(end);  // in place, all at once: the record is large
+    world.contact_summaries.resize(end);
+
+    // The records read the bodies' descriptions (cold: a first step reads tens of
+    // thousands) in parallel; each job writes only its own contacts.
+    std::atomic<std::uint32_t> reporting{0};
+    world.jobs->parallel_for("NewContacts", static_cast<std::uint32_t>(first), end, kNewContactGrain,
+                             [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                                 std::uint32_t reports = 0;
+                                 for (std::uint32_t c = lo; c < hi; ++c) {
+                                     Contact& contact = world.contacts[c];
+                                     init_contact(world, made[c], contact);
+                                     reports += contact.events != 0 ? 1u : 0u;
+                                     world.contact_summaries[c] = contact_summary(contact);  // a sensor's has no points
+                                 }
+                                 reporting.fetch_add(reports, std::memory_order_relaxed);
+                             });
+    world.events->reporting += reporting.load(std::memory_order_relaxed);
     world.awake_contacts_dirty = true;
 }
 
@@ -70,9 +105,15 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
         world.contacts[write] = std::move(world.contacts[read]);
         world.contact_keys[write] = world.contact_keys[read];
         world.contact_summaries[write] = world.contact_summaries[read];
-        *world.contact_index.find(world.contact_keys[write]) = static_cast<std::uint32_t>(write);
         ++write;
     }
+    // The index learns the moved contacts' positions: one lookup each, in parallel (each
+    // writes only its own key's entry; no key is added or removed meanwhile).
+    world.jobs->parallel_for("MovedContacts", positions[0], static_cast<std::uint32_t>(write), kMovedContactGrain,
+                             [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+                                 for (std::uint32_t c = lo; c < hi; ++c)
+                                     *world.contact_index.find(world.contact_keys[c]) = c;
+                             });
     world.contacts.resize(write);
     world.contact_keys.resize(write);
     world.contact_summaries.resize(write);

@@ -1,0 +1,185 @@
+// The broadphase stage's contact list (stages/broadphase.cpp, contact_list.cpp): the new
+// pairs' contacts are decided and filled in parallel ranges, and the lost ones found so,
+// yet the list is the one a single thread makes (the pairs' order), whatever job system
+// and however its ranges ran; every contact is a pair whose fat boxes overlap and that
+// may collide, and the pair index knows every contact's position.
+#include <spindle/engine/space.hpp>
+#include <spindle/scheduler/single_threaded.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <vector>
+
+#include "api/space_internals.hpp"
+#include "stages/broadphase_state.hpp"
+#include "stages/contact_events.hpp"
+#include "test_job_systems.hpp"
+#include "world.hpp"
+
+namespace spindle {
+namespace {
+
+// What a step left in the contact list, field by field.
+struct ContactList {
+    std::vector<std::uint64_t> keys;
+    std::vector<std::uint32_t> summaries;
+    std::vector<Real> friction, restitution;
+    std::vector<std::uint8_t> events;
+    std::uint32_t reporting = 0;
+    std::uint64_t filtered = 0;
+    bool operator==(const ContactList&) const = default;
+};
+
+ContactList contact_list(const World& world) {
+    ContactList list;
+    list.keys = world.contact_keys;
+    list.summaries = world.contact_summaries;
+    for (const Contact& c : world.contacts) {
+        list.friction.push_back(c.friction);
+        list.restitution.push_back(c.restitution);
+        list.events.push_back(c.events);
+    }
+    list.reporting = world.events->reporting;
+    list.filtered = world.counters.pairs_filtered;
+    return list;
+}
+
+// A 24 x 24 x 2 block of touching boxes on a static floor (two thousand new pairs in the
+// first step, far more than one job's range), with every kind of pair the broadphase
+// turns down or marks: shared groups, layers that do not collide, joints, sensors, a
+// kinematic pair; and mixed materials and event flags on the contacts it makes.
+struct Block {
+    explicit Block(JobSystem& jobs) : space(settings(), &jobs) {
+        space.set_layers_collide(1, 2, false);
+        BodyDesc floor;
+        floor.type = MotionType::Static;
+        floor.shape = Shape::box(Vec3(30, 1, 30));
+        floor.position = Vec3(0, -1, 0);
+        space.create_body(floor);
+        int n = 0;
+        for (int y = 0; y < 2; ++y) {
+            for (int i = 0; i < 24; ++i) {
+                for (int k = 0; k < 24; ++k, ++n) {
+                    BodyDesc d;
+                    d.shape = Shape::box(Vec3::Constant(0.5));
+                    d.position = Vec3(i - 12, 0.5 + y, k - 12);
+                    d.type = n % 97 == 5 || n % 97 == 6 ? MotionType::Kinematic : MotionType::Dynamic;
+                    d.group = n % 11 == 0 ? 3 : 0;
+                    d.layer = static_cast<std::uint32_t>(n % 3);
+                    d.friction = 0.2 + 0.1 * (n % 7);
+                    d.restitution = n % 5 == 0 ? 0.3 : 0;
+                    d.contact_events = n % 13 == 0;
+                    d.sensor = n % 29 == 0;
+                    bodies.push_back(space.create_body(d));
+                    dynamic.push_back(d.type == MotionType::Dynamic);
+                }
+            }
+        }
+        for (std::size_t b = 0; b + 1 < bodies.size(); b += 17) {
+            if (!dynamic[b] && !dynamic[b + 1]) continue;
+            const Vec3 anchor = space.internal_position(bodies[b]);
+            space.create_joint(JointDesc::ball_socket_at(bodies[b], bodies[b + 1], anchor));
+        }
+    }
+    static SpaceSettings settings() {
+        SpaceSettings s;
+        s.sleep.enabled = false;
+        return s;
+    }
+    Space space;
+    std::vector<BodyHandle> bodies;
+    std::vector<bool> dynamic;
+};
+
+// Every contact is a pair the broadphase may make (fat boxes overlapping, one body
+// dynamic, not both sensors, filter and joints allowing), each such pair has one, and
+// the index holds each contact's position.
+void expect_contacts_are_the_allowed_overlaps(const World& world) {
+    const Bodies& b = world.bodies;
+    const BroadphaseState& bp = *world.broadphase;
+    std::set<std::uint64_t> expected;
+    for (std::uint32_t i = 0; i < b.capacity(); ++i) {
+        for (std::uint32_t j = i + 1; j < b.capacity(); ++j) {
+            if (!b.alive[i] || !b.alive[j]) continue;
+            if (b.type[i] != MotionType::Dynamic && b.type[j] != MotionType::Dynamic) continue;
+            if (b.desc[i].sensor && b.desc[j].sensor) continue;
+            if (filter_blocks_pair(world, i, j) || joint_blocks_pair(world, i, j)) continue;
+            if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) continue;
+            expected.insert(std::uint64_t{i} << 32 | j);
+        }
+    }
+    const std::set<std::uint64_t> made(world.contact_keys.begin(), world.contact_keys.end());
+    ASSERT_EQ(made.size(), world.contact_keys.size()) << "a pair has two contacts";
+    EXPECT_EQ(made, expected);
+    ContactIndex index = world.contact_index;
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const std::uint32_t* position = index.find(world.contact_keys[c]);
+        ASSERT_NE(position, nullptr);
+        ASSERT_EQ(*position, c);
+        ASSERT_EQ(world.contacts[c].body_a, world.contact_keys[c] >> 32);
+        ASSERT_EQ(world.contacts[c].body_b, world.contact_keys[c] & 0xffffffffu);
+    }
+}
+
+// The block's first step, then its top layer teleported away (their contacts lost, from
+// positions all through the list) and a step more; the lists after each.
+std::vector<ContactList> run_block(JobSystem& jobs) {
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    std::vector<ContactList> lists;
+    block.space.update();
+    expect_contacts_are_the_allowed_overlaps(world);
+    lists.push_back(contact_list(world));
+    for (std::size_t k = block.bodies.size() / 2; k < block.bodies.size(); k += 2) {
+        if (block.dynamic[k]) block.space.set_position(block.bodies[k], Vec3(0, 40 + Real(k), 0));
+    }
+    block.space.update();
+    expect_contacts_are_the_allowed_overlaps(world);
+    lists.push_back(contact_list(world));
+    return lists;
+}
+
+TEST(BroadphaseContacts, FirstStep_ContactsInPairOrderWithTheirMaterialsAndFlags) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    block.space.update();
+    const World& world = SpaceInternals::world(block.space);
+    expect_contacts_are_the_allowed_overlaps(world);
+    ASSERT_GT(world.contacts.size(), 2000u);
+    EXPECT_TRUE(std::is_sorted(world.contact_keys.begin(), world.contact_keys.end()));
+    EXPECT_GT(world.counters.pairs_filtered, 0u);
+    std::uint32_t reporting = 0;
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const Contact& contact = world.contacts[c];
+        const BodyDesc& a = world.bodies.desc[contact.body_a];
+        const BodyDesc& b = world.bodies.desc[contact.body_b];
+        ASSERT_EQ(contact.friction, std::sqrt(a.friction * b.friction));
+        ASSERT_EQ(contact.restitution, std::max(a.restitution, b.restitution));
+        ASSERT_EQ(contact.events, contact_event_flags(world, contact.body_a, contact.body_b));
+        ASSERT_EQ(world.contact_summaries[c], contact_summary(contact));
+        reporting += contact.events != 0 ? 1u : 0u;
+    }
+    EXPECT_GT(reporting, 0u);
+    EXPECT_EQ(world.events->reporting, reporting);
+}
+
+// Three threads taking the ranges from the last to the first: the same lists, field for
+// field, as one thread in order.
+TEST(BroadphaseContacts, SameListsOnThreadsRunningRangesInReverse) {
+    SingleThreadedJobSystem single;
+    const std::vector<ContactList> reference = run_block(single);
+    test::ReverseThreadedJobSystem reverse(3);
+    const std::vector<ContactList> lists = run_block(reverse);
+    ASSERT_EQ(lists.size(), reference.size());
+    for (std::size_t k = 0; k < lists.size(); ++k) {
+        EXPECT_TRUE(lists[k] == reference[k]) << "after step " << k + 1;
+        EXPECT_EQ(lists[k].keys, reference[k].keys) << "after step " << k + 1;
+    }
+    EXPECT_LT(reference[1].keys.size(), reference[0].keys.size());  // the teleported layer lost contacts
+}
+
+}  // namespace
+}  // namespace spindle
