@@ -125,7 +125,7 @@ void update_broadphase(World& world, Real dt) {
 
     bp.pairs.clear();
     bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count
-    reserve_contacts(world, bp.pairs.size());
+    reserve_contacts(world, bp.pairs);
     for (const Pair& pair : bp.pairs) {
         const auto i = static_cast<std::uint32_t>(pair.user_a);
         const auto j = static_cast<std::uint32_t>(pair.user_b);

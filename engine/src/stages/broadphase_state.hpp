@@ -49,9 +49,9 @@ void refresh_proxy(World& world, std::uint32_t slot);
 void remove_contacts_of(World& world, std::uint32_t slot);
 // Creates a contact for a pair key (min slot << 32 | max slot) if there is none.
 void create_contact(World& world, std::uint64_t key);
-// Makes room for `more` contacts at once (a first step finds tens of thousands of pairs:
-// growing by push_back would move every contact again and again).
-void reserve_contacts(World& world, std::size_t more);
+// Makes room at once for the contacts the pairs would make (a first step finds tens of
+// thousands of pairs: growing by push_back would move every contact again and again).
+void reserve_contacts(World& world, const std::vector<Pair>& pairs);
 // Gives back the contact arrays' room when it is far above their use (a pile came apart,
 // or the pairs reserved for were mostly not made into contacts).
 void fit_contacts(World& world);

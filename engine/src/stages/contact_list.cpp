@@ -10,8 +10,18 @@
 
 namespace spindle {
 
-void reserve_contacts(World& world, std::size_t more) {
-    const std::size_t needed = world.contacts.size() + more;
+void reserve_contacts(World& world, const std::vector<Pair>& pairs) {
+    std::size_t needed = world.contacts.size() + pairs.size();
+    // A proxy that moved finds its pairs again, contacts already: room for all of them
+    // would hold the arrays at the pairs' high-water mark, not the contacts'. Counted only
+    // when they could not all fit, so a step that makes few contacts looks up none.
+    if (needed > world.contacts.capacity()) {
+        needed = world.contacts.size();
+        for (const Pair& pair : pairs) {
+            const auto i = static_cast<std::uint32_t>(pair.user_a), j = static_cast<std::uint32_t>(pair.user_b);
+            if (!world.contact_index.find((std::uint64_t{std::min(i, j)} << 32) | std::max(i, j))) ++needed;
+        }
+    }
     reserve_for(world.contacts, needed);
     reserve_for(world.contact_keys, needed);
     reserve_for(world.contact_summaries, needed);
