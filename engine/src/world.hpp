@@ -98,32 +98,37 @@ struct Bodies {
 };
 
 // One touching manifold with what the solver keeps between steps (impulses, for
-// warm starting, matched by feature id).
+// warm starting, matched by feature id). The solver computes impulses and approach speeds
+// in float lanes (solver/wide.hpp), so they are kept as floats here: the same values, in
+// half the bytes. What the narrowphase computes in double (points, separations, the
+// normal, the friction impulse it carries over to a new normal) stays double.
 struct ContactPoint {
-    ManifoldPoint geometry;    // as collided; a recycled manifold updates the separation only
-    Real base_separation = 0;  // the separation when collided
-    Real normal_impulse = 0;
+    Vec3 point = Vec3::Zero();  // world, midway between the surfaces when collided (ManifoldPoint::point)
+    Real separation = 0;        // as collided, or as a recycled manifold has moved it
+    Real base_separation = 0;   // the separation when collided
+    float normal_impulse = 0;
+    std::uint32_t id = 0;  // feature id (ManifoldPoint::id)
 };
 
 struct ContactManifold {
-    Vec3 normal = Vec3::UnitY();  // world; fixed while the manifold is recycled
-    int point_count = 0;
+    Vec3 normal = Vec3::UnitY();           // world; fixed while the manifold is recycled
     std::uint32_t part_a = 0, part_b = 0;  // the compound parts that touch (Manifold::part_a, part_b)
+    std::uint8_t point_count = 0;
     // The last solved step's push, for hit events (contact_events.cpp): of the points whose
     // normal impulse pushed, the one that approached fastest (-1: none pushed), and its
     // approach speed before solving. Per manifold, not per point: a pile's contacts are
     // most of the memory it holds, and only reporting contacts read it.
     std::int8_t pushed_point = -1;
-    Real pushed_speed = 0;
+    float pushed_speed = 0;
+    // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
+    // central friction): the twist impulse about the normal, and (below) the tangential
+    // impulse there (world, in the contact plane), kept for warm starting.
+    float twist_impulse = 0;
     // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
     // when collided, so that recycling and the solver stay off the cold descriptions.
     Real radius_a = 0, radius_b = 0;
     ContactPoint points[kMaxManifoldPoints];
-    // Friction acts on the manifold as a whole, at the centre of its points (Box3D's
-    // central friction): the tangential impulse there (world, in the contact plane) and
-    // the twist impulse about the normal, kept for warm starting.
     Vec3 friction_impulse = Vec3::Zero();
-    Real twist_impulse = 0;
 };
 
 // Contact::events: the pair reports events (a body asked, or is a sensor); a body is a
@@ -131,32 +136,35 @@ struct ContactManifold {
 inline constexpr std::uint8_t kContactReports = 1u << 0;
 inline constexpr std::uint8_t kContactSensor = 1u << 1;
 
-// A pair of bodies whose fat bounds overlap.
+// A pair of bodies whose fat bounds overlap. Most of the memory a pile holds: the fields
+// are ordered so that the record has no padding, the flags are bits, and nothing is kept
+// that the rest gives exactly (B's centre in A's frame when collided: cached_position()).
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
-    int manifold_count = 0;
-    FeatureCache feature;                // the axis that last kept a box or hull pair apart (collide_cached)
+    FeatureCache feature;  // the axis that last kept a box or hull pair apart (collide_cached)
+    std::uint8_t manifold_count = 0;
+    std::uint8_t events = 0;          // kContactReports, kContactSensor (set at creation)
+    bool sleeping : 1 = false;        // written by one thread at a time, as every field of a contact
+    bool touch_reported : 1 = false;  // touching as last reported by a Begin (an End clears it)
+    bool pushed : 1 = false;          // a reporting contact pushed in its last solved step (a Hit starts a push)
+    // Whether the poses below are those the manifolds were last collided at (both
+    // rotations and centres of mass): while the bodies stay close to them the manifolds
+    // are recycled, not collided again (narrowphase.cpp).
+    bool cached : 1 = false;
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
-    bool sleeping = false;
-    std::uint8_t events = 0;      // kContactReports, kContactSensor (set at creation)
-    bool touch_reported = false;  // touching as last reported by a Begin (an End clears it)
-    bool pushed = false;          // a reporting contact pushed in its last solved step (a Hit starts a push)
-    // The poses the manifolds were last collided at (B's centre of mass in A's frame and
-    // both rotations): while the bodies stay close to them the manifolds are recycled,
-    // not collided again (narrowphase.cpp).
-    bool cached = false;
-    Vec3 cached_position = Vec3::Zero();
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
-    // The bodies' centres of mass then. A point's anchors (Box3D's) are its offsets from
-    // them, world axes: they stay attached to their bodies while the manifolds are
-    // recycled, and the solver pushes each body at its own anchor. Kept once per contact
-    // rather than twice per point: the record is most of the memory a pile holds.
+    // A point's anchors (Box3D's) are its offsets from the centres of mass, world axes: they
+    // stay attached to their bodies while the manifolds are recycled, and the solver pushes
+    // each body at its own anchor. Kept once per contact rather than twice per point.
     Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
 
-    Vec3 anchor_a(const ContactPoint& p) const { return p.geometry.point - cached_xa; }
-    Vec3 anchor_b(const ContactPoint& p) const { return p.geometry.point - cached_xb; }
+    Vec3 anchor_a(const ContactPoint& p) const { return p.point - cached_xa; }
+    Vec3 anchor_b(const ContactPoint& p) const { return p.point - cached_xb; }
+    // The same expression the narrowphase measures the pair's pose with, on the same
+    // values: the same bits it had when collided.
+    Vec3 cached_position() const { return cached_qa.conjugate() * (cached_xb - cached_xa); }
 
     ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
     const ContactManifold& manifold_at(int i) const {

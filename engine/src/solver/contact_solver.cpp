@@ -176,7 +176,7 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const Contact& c
     Real total = 0;
     for (int j = 0; j < m.point_count; ++j) {
         const ContactPoint& p = m.points[j];
-        const Real weight = std::clamp(2 - p.geometry.separation / friction_distance, kMinWeight, Real(1));
+        const Real weight = std::clamp(2 - p.separation / friction_distance, kMinWeight, Real(1));
         center_a += weight * contact.anchor_a(p);
         center_b += weight * contact.anchor_b(p);
         total += weight;
@@ -299,7 +299,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             const ContactPoint& src = m.points[j];
             ra[j].set_lane(l, contact.anchor_a(src));
             rb[j].set_lane(l, contact.anchor_b(src));
-            separation[j][l] = src.geometry.separation;
+            separation[j][l] = src.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
@@ -640,7 +640,7 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             for (int j = 0; j < m.point_count; ++j) {
                 const WidePoint& p = wc.points[j];
                 m.points[j].normal_impulse = p.normal_impulse[l];
-                const Real approach = -p.relative_velocity[l];
+                const float approach = -p.relative_velocity[l];
                 if (p.max_normal_impulse[l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {
                     m.pushed_point = static_cast<std::int8_t>(j);
                     m.pushed_speed = approach;

@@ -47,7 +47,7 @@ bool contact_touches(const Contact& contact) {
     for (int m = 0; m < contact.manifold_count; ++m) {
         const ContactManifold& manifold = contact.manifold_at(m);
         for (int j = 0; j < manifold.point_count; ++j) {
-            if (manifold.points[j].geometry.separation <= 0) return true;
+            if (manifold.points[j].separation <= 0) return true;
         }
     }
     return false;
@@ -144,7 +144,7 @@ void publish_contact_points(World& world) {
                 for (int j = 0; j < manifold.point_count; ++j) {
                     const ContactPoint& p = manifold.points[j];
                     // Speculative points that pushed nothing are not touching.
-                    if (p.geometry.separation > 0 && p.normal_impulse <= 0) continue;
+                    if (p.separation > 0 && p.normal_impulse <= 0) continue;
                     if (gathered.size() >= settings.max_contact_points) {
                         left_out += 1;
                         continue;
@@ -155,7 +155,7 @@ void publish_contact_points(World& world) {
                     info.point =
                         (b.x[contact.body_a] + contact.anchor_a(p) + b.x[contact.body_b] + contact.anchor_b(p)) / 2;
                     info.normal = manifold.normal;
-                    info.separation = p.geometry.separation;
+                    info.separation = p.separation;
                     info.normal_impulse = p.normal_impulse;
                 }
             }

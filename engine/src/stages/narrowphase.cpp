@@ -50,12 +50,13 @@ struct Turns {
 
 // Whether the contact's manifolds can be recycled; its bodies' turns in `turns` if so.
 // The cheap checks first: the reach of both bodies only for a pair that passes them.
-bool recycles(const Contact& contact, const Bodies& b, const Vec3& position, Real tolerance, Turns& turns) {
+bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& turns) {
     if (!contact.cached) return false;
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
     const Real turn_a = b.q[a].dot(contact.cached_qa), turn_b = b.q[bb].dot(contact.cached_qb);
     if (std::min(turn_a * turn_a, turn_b * turn_b) <= kRecycleCosHalfAngleSq) return false;
-    const Real distance = (position - contact.cached_position).norm();
+    const Vec3 position = b.q[a].conjugate() * (b.x[bb] - b.x[a]);  // B's centre in A's frame
+    const Real distance = (position - contact.cached_position()).norm();
     if (distance >= tolerance) return false;
     turns.dqa = b.q[a] * contact.cached_qa.conjugate();
     turns.dqb = b.q[bb] * contact.cached_qb.conjugate();
@@ -81,26 +82,24 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
         const Real base = n.dot(moved) + manifold.radius_a * (na.dot(n) - 1) + manifold.radius_b * (nb.dot(n) - 1);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
-            p.geometry.separation = p.base_separation + base + nb.dot(contact.anchor_b(p)) -
-                                    na.dot(contact.anchor_a(p));
+            p.separation = p.base_separation + base + nb.dot(contact.anchor_b(p)) - na.dot(contact.anchor_a(p));
         }
     }
 }
 
 // Anchors the fresh manifolds to their bodies and keeps the poses they were collided at.
-void remember(Contact& contact, const Bodies& b, const Vec3& position) {
+void remember(Contact& contact, const Bodies& b) {
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
     for (int m = 0; m < contact.manifold_count; ++m) {
         ContactManifold& manifold = contact.manifold_at(m);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
-            p.base_separation = p.geometry.separation;
+            p.base_separation = p.separation;
         }
     }
     contact.cached = true;
     contact.cached_xa = b.x[a];  // both anchors meet at the point now
     contact.cached_xb = b.x[bb];
-    contact.cached_position = position;
     contact.cached_qa = b.q[a];
     contact.cached_qb = b.q[bb];
 }
@@ -132,16 +131,16 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
         ContactPoint& p = fresh.points[j];
         const ContactPoint* match = nullptr;
         Real nearest = kCarryDistance * kCarryDistance;
-        for (int m = 0; m < old_contact.manifold_count && !(match && match->geometry.id == p.geometry.id); ++m) {
+        for (int m = 0; m < old_contact.manifold_count && !(match && match->id == p.id); ++m) {
             const ContactManifold& old = old_contact.manifold_at(m);
             if (!same_parts(old, fresh) || old.normal.dot(fresh.normal) < kSameFace) continue;
             for (int k = 0; k < old.point_count; ++k) {
                 const ContactPoint& o = old.points[k];
-                if (o.geometry.id == p.geometry.id) {
+                if (o.id == p.id) {
                     match = &o;
                     break;
                 }
-                const Real d2 = (o.geometry.point - p.geometry.point).squaredNorm();
+                const Real d2 = (o.point - p.point).squaredNorm();
                 if (d2 < nearest) {
                     nearest = d2;
                     match = &o;
@@ -186,11 +185,10 @@ void update_narrowphase(World& world) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             Contact& contact = world.contacts[awake[k]];
             const std::uint32_t a = contact.body_a, bb = contact.body_b;
-            const Vec3 position = b.q[a].conjugate() * (b.x[bb] - b.x[a]);  // B's centre in A's frame
             // Not for a swept body: its contacts must see where it went.
             const bool recyclable = !b.is_fast(a) && !b.is_fast(bb);
             Turns turns;
-            if (recyclable && recycles(contact, b, position, recycle_distance, turns)) {
+            if (recyclable && recycles(contact, b, recycle_distance, turns)) {
                 recycle(contact, b, turns);
                 counts.reused += 1;
                 counts.touching += contact.manifold_count > 0 ? 1u : 0u;
@@ -207,18 +205,23 @@ void update_narrowphase(World& world) {
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;
-                fresh[m].point_count = found[m].point_count;
+                fresh[m].point_count = static_cast<std::uint8_t>(found[m].point_count);
                 fresh[m].part_a = found[m].part_a;
                 fresh[m].part_b = found[m].part_b;
                 fresh[m].radius_a = round_radius(part_shape(shape_a, found[m].part_a));
                 fresh[m].radius_b = round_radius(part_shape(shape_b, found[m].part_b));
-                for (int j = 0; j < found[m].point_count; ++j) fresh[m].points[j].geometry = found[m].points[j];
+                for (int j = 0; j < found[m].point_count; ++j) {
+                    ContactPoint& p = fresh[m].points[j];
+                    p.point = found[m].points[j].point;
+                    p.separation = found[m].points[j].separation;
+                    p.id = found[m].points[j].id;
+                }
                 carry_impulses(contact, fresh[m]);
             }
-            contact.manifold_count = n;
+            contact.manifold_count = static_cast<std::uint8_t>(n);
             if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
-            remember(contact, b, position);
+            remember(contact, b);
             // New manifolds, new summary (a cached pair, above, keeps both).
             world.contact_summaries[awake[k]] = contact_summary(contact);
             counts.touching += n > 0 ? 1u : 0u;

@@ -35,16 +35,19 @@ constexpr int kSettled = 100;  // enough to have every contact (fewer steps: the
 
 }  // namespace
 
-TEST(Memory, PyramidAfterItsDropHoldsUnderFifteenKilobytesPerBody) {
+TEST(Memory, PyramidAfterItsDropHoldsUnderElevenKilobytesPerBody) {
     const Pyramid pyramid(kLanded);
     // 21.1 KB per body before issue 19: the contact array doubled for a few new contacts,
-    // and each point kept its anchors and its step's push.
-    EXPECT_LT(pyramid.bytes_per_body(), 15'000);
+    // and each point kept its anchors and its step's push. 13.6 KB before the contact
+    // records lost their padding and their double copies of float impulses, and before
+    // the pairs a moved proxy finds again stopped reserving room for new contacts.
+    EXPECT_LT(pyramid.bytes_per_body(), 11'100);
     // The solver's wide contacts keep floats: in doubles they took half as much again.
     const auto body_count = static_cast<double>(pyramid.scene.dynamic_body_count());
     EXPECT_LT(static_cast<double>(memory_report(pyramid.space).wide_contacts) / body_count, 4'200);
+    // Room for a quarter more at most: the pile's contacts came in a few at a time.
     const World& world = SpaceInternals::world(pyramid.space);
-    EXPECT_LE(world.contacts.capacity(), world.contacts.size() + world.contacts.size() / 2 + 64);
+    EXPECT_LE(world.contacts.capacity(), world.contacts.size() + world.contacts.size() / 4 + 64);
 }
 
 TEST(Memory, ContactArraysAreGivenBackWhenThePileComesApart) {
