@@ -285,8 +285,12 @@ struct World {
     std::vector<std::uint32_t> changed_now;   // slots whose published state changed outside a step
     std::vector<std::uint32_t> changed_last;  // the same, one flip ago (the back buffer is two flips old)
     // The query scene that goes with published buffer k, updated with it (buffering.cpp);
-    // null until the first body is published. Replaced by a copy while a query holds it.
+    // null until the space's first query (query/query_lease.cpp): a space that never
+    // queries keeps none. Replaced by a copy while a query holds it.
     std::shared_ptr<QueryScene> query_scenes[2];
+    // Set by the first query that found no published scene: from then on each flip builds
+    // the scene it publishes if it has none. Any thread.
+    std::atomic<bool> queries_wanted{false};
     std::vector<Aabb> scratch_query_bounds;  // per awake body, the flip's tight query boxes
 
     // Time stepping.

@@ -12,10 +12,12 @@
 #include <cmath>
 #include <future>
 #include <mutex>
+#include <random>
 #include <thread>
 #include <vector>
 
 #include "async_util.hpp"
+#include "collision/cast.hpp"
 
 namespace spindle {
 namespace {
@@ -156,6 +158,139 @@ TEST(AsyncQueries, BodiesMadeWhileAQueryHoldsTheSceneReachQueriesAtTheNextUpdate
         ASSERT_TRUE(hit) << i;
         EXPECT_EQ(hit->body, made[static_cast<std::size_t>(i - 1)]);
     }
+}
+
+// Bodies of three shapes on a grid, drifting and turning, for the first-query tests; their
+// shapes by handle for a brute-force pass.
+struct Drifters {
+    std::vector<BodyHandle> handles;
+    std::vector<Shape> shapes;
+};
+
+Drifters make_drifters(Space& space) {
+    std::mt19937 random(5);
+    std::uniform_real_distribution<Real> drift(-0.3, 0.3), spin(-2, 2);
+    const Shape kinds[] = {Shape::sphere(0.4), Shape::box({0.4, 0.3, 0.35}), Shape::capsule(0.3, 0.2)};
+    Drifters d;
+    for (int i = 0; i < 40; ++i) {
+        BodyDesc desc = test::ball({2.5 * (i % 8), 0.5 * drift(random), 2.5 * (i / 8)});
+        desc.shape = kinds[i % 3];
+        desc.linear_velocity = {drift(random), drift(random), drift(random)};
+        desc.angular_velocity = {spin(random), spin(random), spin(random)};
+        d.handles.push_back(space.create_body(desc));
+        d.shapes.push_back(desc.shape);
+    }
+    return d;
+}
+
+// Rays down through the grid, each answered by the space and by a brute-force pass over
+// the bodies at the poses get_motion_states reads: the same body at the same fraction,
+// bit for bit. The caller makes sure both see one step (a held lock, a posted function,
+// or a runner taking no step). Returns the rays that met a body.
+int compare_with_brute_force(const Space& space, const Drifters& d, std::mt19937& random, int rays) {
+    std::uniform_int_distribution<int> column(0, 7), row(0, 4);
+    std::uniform_real_distribution<Real> jitter(-0.3, 0.3);
+    std::vector<MotionState> states(d.handles.size());
+    space.motion_states().get_motion_states(d.handles, states);
+    int hits = 0;
+    for (int r = 0; r < rays; ++r) {
+        // Near a body's starting column, slanted a little: most meet it, some miss.
+        const Vec3 top(2.5 * column(random), 5, 2.5 * row(random));
+        const Vec3 from = top + Vec3(jitter(random), 0, jitter(random));
+        const Vec3 to = top + Vec3(jitter(random), -10, jitter(random));
+        Real best = 2;
+        BodyHandle nearest{};
+        for (std::size_t k = 0; k < d.handles.size(); ++k) {
+            CastHit h;
+            if (ray_cast(d.shapes[k], {states[k].position, states[k].orientation}, from, to, h) && h.fraction < best) {
+                best = h.fraction;
+                nearest = d.handles[k];
+            }
+        }
+        const std::optional<QueryHit> hit = space.cast_ray(from, to);
+        EXPECT_EQ(hit.has_value(), best <= 1) << "ray " << r;
+        if (!hit) continue;
+        EXPECT_EQ(hit->body, nearest) << "ray " << r;
+        EXPECT_EQ(hit->fraction, best) << "ray " << r;
+        ++hits;
+    }
+    return hits;
+}
+
+// Polls until pred() holds; false after a few seconds.
+template <typename Pred>
+bool eventually(Pred pred) {
+    for (int i = 0; i < 5000 && !pred(); ++i) std::this_thread::sleep_for(1ms);
+    return pred();
+}
+
+// The first query of a space whose runner updates: the game thread may not build the
+// scenes (the loop owns the space), so it waits for the next flip to build the one it
+// publishes. The runner takes no step meanwhile (time scale 0, still publishing), so
+// the query and the reads show one instant whenever each is made.
+TEST(AsyncQueries, FirstQueryFromTheGameThreadWhileTheRunnerUpdatesMatchesABruteForcePass) {
+    Space space(test::async_settings());
+    const Drifters d = make_drifters(space);
+    AsyncRunner runner(space);
+    runner.start();
+    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    runner.set_time_scale(0);
+    std::uint64_t steps = 0;
+    ASSERT_TRUE(eventually([&] {
+        const std::uint64_t before = space.motion_states().published_steps();
+        std::this_thread::sleep_for(50ms);
+        steps = space.motion_states().published_steps();
+        return steps == before;
+    }));
+    std::mt19937 random(3);
+    test::finishes_in_time([&] { EXPECT_GT(compare_with_brute_force(space, d, random, 60), 10); });
+    EXPECT_EQ(space.motion_states().published_steps(), steps);  // still the same instant
+    // Stepping again, the flips keep the scenes: queries under one hold, exact.
+    runner.set_time_scale(1);
+    for (int round = 0; round < 20; ++round) {
+        std::this_thread::sleep_for(10ms);
+        std::scoped_lock hold(space.motion_states().lock());
+        compare_with_brute_force(space, d, random, 10);
+    }
+    EXPECT_GT(space.motion_states().published_steps(), steps);
+    runner.stop();
+}
+
+// The first query made while holding the motion-state lock as the runner steps: it cannot
+// wait for a flip (the flip waits for its lock), so it builds the scenes while the physics
+// thread waits at the flip; the answer is exact for the step the hold shows.
+TEST(AsyncQueries, FirstQueryUnderTheLockWhileTheRunnerStepsMatchesABruteForcePass) {
+    Space space(test::async_settings());
+    const Drifters d = make_drifters(space);
+    AsyncRunner runner(space);
+    runner.start();
+    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    std::mt19937 random(4);
+    test::finishes_in_time([&] {
+        std::scoped_lock hold(space.motion_states().lock());
+        EXPECT_GT(compare_with_brute_force(space, d, random, 60), 10);
+    });
+    const std::uint64_t steps = space.motion_states().published_steps();
+    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
+    std::scoped_lock hold(space.motion_states().lock());
+    compare_with_brute_force(space, d, random, 20);
+}
+
+// The first query from a posted function: on the loop thread between updates the space
+// may be read, so it builds the scenes itself, at once, while the runner steps.
+TEST(AsyncQueries, FirstQueryInAPostedFunctionWhileTheRunnerStepsMatchesABruteForcePass) {
+    Space space(test::async_settings());
+    const Drifters d = make_drifters(space);
+    AsyncRunner runner(space);
+    runner.start();
+    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    std::mt19937 random(6);
+    std::future<int> hits = runner.post([&](Space& s) { return compare_with_brute_force(s, d, random, 60); });
+    test::finishes_in_time([&] { EXPECT_GT(hits.get(), 10); });
+    const std::uint64_t steps = space.motion_states().published_steps();
+    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
+    std::scoped_lock hold(space.motion_states().lock());
+    compare_with_brute_force(space, d, random, 20);
 }
 
 }  // namespace

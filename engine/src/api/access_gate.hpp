@@ -22,13 +22,19 @@ public:
     class Structure {
     public:
         Structure(AccessGate& gate, const char* what);
+        // The same without waiting or throwing, for a caller that has something else to
+        // do when the space is busy (a first scene query): owns() says whether it may go on.
+        Structure(AccessGate& gate, std::try_to_lock_t);
         ~Structure();
         Structure(const Structure&) = delete;
         Structure& operator=(const Structure&) = delete;
 
+        bool owns() const noexcept { return m_owns; }
+
     private:
         AccessGate& m_gate;
         bool m_took = false;
+        bool m_owns = true;
     };
 
     // An update (or flush), for its scope: waits for a structural call in progress on
@@ -51,6 +57,7 @@ public:
 private:
     enum State : int { kFree = 0, kStructure = 1, kUpdate = 2 };
     void check_claim(const char* what) const;
+    bool claimed_by_other() const noexcept;
 
     std::mutex m_structure;  // structural calls from several threads take turns
     std::atomic<int> m_state{kFree};
@@ -58,9 +65,13 @@ private:
     std::atomic<std::thread::id> m_claimed_by{};
 };
 
-inline void AccessGate::check_claim(const char* what) const {
+inline bool AccessGate::claimed_by_other() const noexcept {
     const std::thread::id claimed = m_claimed_by.load(std::memory_order_acquire);
-    if (claimed != std::thread::id{} && claimed != std::this_thread::get_id()) {
+    return claimed != std::thread::id{} && claimed != std::this_thread::get_id();
+}
+
+inline void AccessGate::check_claim(const char* what) const {
+    if (claimed_by_other()) {
         throw Error(std::string(what) + ": an AsyncRunner is running this space on its loop thread; "
                                         "call it there (AsyncRunner::post) or after stop()");
     }
@@ -79,6 +90,22 @@ inline AccessGate::Structure::Structure(AccessGate& gate, const char* what) : m_
     gate.m_holder.store(self, std::memory_order_release);
     turn.release();  // held until the destructor
     m_took = true;
+}
+
+inline AccessGate::Structure::Structure(AccessGate& gate, std::try_to_lock_t) : m_gate(gate) {
+    const std::thread::id self = std::this_thread::get_id();
+    if (gate.m_holder.load(std::memory_order_acquire) == self) return;  // nested on this thread
+    m_owns = false;
+    if (gate.claimed_by_other()) return;
+    std::unique_lock turn(gate.m_structure, std::try_to_lock);
+    int expected = kFree;
+    if (!turn.owns_lock() || !gate.m_state.compare_exchange_strong(expected, kStructure, std::memory_order_acquire)) {
+        return;
+    }
+    gate.m_holder.store(self, std::memory_order_release);
+    turn.release();  // held until the destructor
+    m_took = true;
+    m_owns = true;
 }
 
 inline AccessGate::Structure::~Structure() {

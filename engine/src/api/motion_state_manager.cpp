@@ -218,12 +218,26 @@ PublishedTime MotionStateManager::published_time() const {
     return m_time;
 }
 
-double MotionStateManager::flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries) {
-    std::scoped_lock guard(m_lock);
+// The flag is cleared under the lock, so a holder that reads it set knows the physics
+// side is between setting it and taking the lock: it writes nothing there.
+void MotionStateManager::lock_for_publishing() {
+    m_publisher_waiting.store(true, std::memory_order_release);
+    try {
+        m_lock.lock();
+    } catch (...) {
+        m_publisher_waiting.store(false, std::memory_order_relaxed);  // this thread held it: nobody waited
+        throw;
+    }
+    m_publisher_waiting.store(false, std::memory_order_relaxed);
+}
+
+double MotionStateManager::flip(const PublishedTime& time, const std::shared_ptr<QueryScene>& queries) {
+    lock_for_publishing();
+    const std::unique_lock guard(m_lock, std::adopt_lock);
     const std::int64_t acquired = m_lock.taken_at_ns();
     std::swap(m_front, m_back);
     m_time = time;
-    m_query_scene = std::move(queries);
+    m_query_scene = queries;
     return static_cast<double>(now_nanoseconds() - acquired) * 1e-9;  // hold time, not wait time
 }
 

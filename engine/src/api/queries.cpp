@@ -5,6 +5,7 @@
 
 #include "api/describe.hpp"
 #include "api/validation.hpp"
+#include "query/query_lease.hpp"
 #include "query/query_scene.hpp"
 #include "world.hpp"
 
@@ -35,24 +36,24 @@ Transform normalized(const Transform& pose) { return {pose.p, pose.q.normalized(
 
 std::optional<QueryHit> Space::cast_ray(const Vec3& from, const Vec3& to, const QueryFilter& filter) const {
     check_segment(from, to, "cast_ray");
-    const QueryLease lease(m_world->motion_states);
+    const QueryLease lease(*m_world);
     QueryHit hit;
-    if (!lease.scene() || !lease.scene()->cast_ray(from, to, filter, lease.alpha(), hit)) return std::nullopt;
+    if (!lease.scene().cast_ray(from, to, filter, lease.alpha(), hit)) return std::nullopt;
     return hit;
 }
 
 bool Space::ray_hits_any(const Vec3& from, const Vec3& to, const QueryFilter& filter) const {
     check_segment(from, to, "ray_hits_any");
-    const QueryLease lease(m_world->motion_states);
-    return lease.scene() && lease.scene()->ray_hits_any(from, to, filter, lease.alpha());
+    const QueryLease lease(*m_world);
+    return lease.scene().ray_hits_any(from, to, filter, lease.alpha());
 }
 
 std::size_t Space::cast_ray_all(const Vec3& from, const Vec3& to, std::vector<QueryHit>& hits,
                                 const QueryFilter& filter) const {
     check_segment(from, to, "cast_ray_all");
     hits.clear();
-    const QueryLease lease(m_world->motion_states);
-    if (lease.scene()) lease.scene()->cast_ray_all(from, to, filter, lease.alpha(), hits);
+    const QueryLease lease(*m_world);
+    lease.scene().cast_ray_all(from, to, filter, lease.alpha(), hits);
     return hits.size();
 }
 
@@ -60,10 +61,9 @@ std::optional<QueryHit> Space::cast_shape(const Shape& shape, const Transform& s
                                           const QueryFilter& filter) const {
     check_query_shape(shape, start, "cast_shape");
     check_position(translation, "cast_shape", "translation");
-    const QueryLease lease(m_world->motion_states);
+    const QueryLease lease(*m_world);
     QueryHit hit;
-    if (!lease.scene() ||
-        !lease.scene()->cast_shape(shape, normalized(start), translation, filter, lease.alpha(), hit)) {
+    if (!lease.scene().cast_shape(shape, normalized(start), translation, filter, lease.alpha(), hit)) {
         return std::nullopt;
     }
     return hit;
@@ -73,8 +73,8 @@ std::size_t Space::overlap_shape(const Shape& shape, const Transform& pose, std:
                                  const QueryFilter& filter) const {
     check_query_shape(shape, pose, "overlap_shape");
     bodies.clear();
-    const QueryLease lease(m_world->motion_states);
-    if (lease.scene()) lease.scene()->overlap_shape(shape, normalized(pose), filter, lease.alpha(), bodies);
+    const QueryLease lease(*m_world);
+    lease.scene().overlap_shape(shape, normalized(pose), filter, lease.alpha(), bodies);
     return bodies.size();
 }
 
@@ -85,8 +85,8 @@ std::size_t Space::overlap_box(const Aabb& box, std::vector<BodyHandle>& bodies,
         throw Error("overlap_box: box.min must not exceed box.max, got min " + vec(box.min) + " max " + vec(box.max));
     }
     bodies.clear();
-    const QueryLease lease(m_world->motion_states);
-    if (lease.scene()) lease.scene()->overlap_box(box, filter, lease.alpha(), bodies);
+    const QueryLease lease(*m_world);
+    lease.scene().overlap_box(box, filter, lease.alpha(), bodies);
     return bodies.size();
 }
 

@@ -1,5 +1,6 @@
-// The published query structure: keeping it in step with the live bodies (the physics
-// thread, at publication) and walking it (any thread, under a QueryLease).
+// The published query structure: building it from a published buffer, keeping it in step
+// with the live bodies (the physics thread, at publication) and walking it (any thread,
+// under a QueryLease).
 #include "query/query_scene.hpp"
 
 #include <spindle/engine/motion_state_manager.hpp>
@@ -103,6 +104,17 @@ void QueryScene::move(std::uint32_t i, const Aabb& tight, const Vec3& displaceme
     }
 }
 
+void QueryScene::set_shape(const World& world, std::uint32_t i) {
+    QueryBody& body = m_bodies[i];
+    const Shape& shape = world.bodies.desc[i].shape;
+    m_shapes[i] = shape;
+    body.exact_bounds = shape.static_only();
+    body.sensor = world.bodies.desc[i].sensor;  // set at creation only
+    const Aabb local = shape.bounds({});
+    body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
+    body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
+}
+
 void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating) {
     reserve(world.bodies.capacity());
     QueryBody& body = m_bodies[i];
@@ -113,20 +125,41 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
         return;
     }
     // Shapes change only with the body (creation, a new shape): compared, not copied.
-    const Shape& shape = world.bodies.desc[i].shape;
-    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], shape)) {
-        m_shapes[i] = shape;
-        body.exact_bounds = shape.static_only();
-        body.sensor = world.bodies.desc[i].sensor;  // set at creation only
-        const Aabb local = shape.bounds({});
-        body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
-        body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
+    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], world.bodies.desc[i].shape)) {
+        set_shape(world, i);
     }
     body.generation = world.bodies.generation[i];
     Aabb tight;
     refresh_pose(world, i, interpolating, tight);
     const Bodies& b = world.bodies;
     move(i, tight, b.type[i] == MotionType::Static ? Vec3::Zero() : Vec3(b.v[i] * world.settings.time_step.duration));
+}
+
+// Poses from the buffer, not the live state: between flips the live state may be ahead of
+// what reads return (set_internal_motion_state), and the back buffer is behind it until
+// the flip refills it (then exactly the bodies refreshed there differ). Every proxy goes
+// in, then the tree is built once over all of them.
+std::shared_ptr<QueryScene> QueryScene::build(const World& world, const PublishedBuffer& buffer) {
+    auto scene = std::make_shared<QueryScene>();
+    const Bodies& b = world.bodies;
+    scene->reserve(b.capacity());
+    const auto slots = static_cast<std::uint32_t>(std::min<std::size_t>(buffer.size(), b.capacity()));
+    for (std::uint32_t i = 0; i < slots; ++i) {
+        // A body made or destroyed but not published yet (a creation waiting for the lock
+        // this build runs under) joins the scene at the next flip, which refreshes it.
+        if (buffer.generation[i] == 0 || !b.alive[i] || b.generation[i] != buffer.generation[i]) continue;
+        QueryBody& body = scene->m_bodies[i];
+        body.generation = buffer.generation[i];
+        scene->set_shape(world, i);
+        body.layer = b.layer[i];
+        body.group = b.group[i];
+        body.current = {buffer.current[i].position, buffer.current[i].orientation};
+        body.interpolate = buffer.interpolate[i] != 0;
+        if (body.interpolate) body.previous = {buffer.previous[i].position, buffer.previous[i].orientation};
+        body.proxy = scene->m_tree.create_proxy(scene->tight_bounds(i), i);
+    }
+    scene->m_tree.rebuild();
+    return scene;
 }
 
 bool QueryScene::passes(const QueryBody& body, BodyHandle handle, const QueryFilter& filter) {
@@ -242,30 +275,12 @@ void QueryScene::overlap_box(const Aabb& box, const QueryFilter& filter, double 
     overlap_shape(shape, {box.center(), Quat::Identity()}, filter, alpha, bodies);
 }
 
-// ---- holding and updating ----
-
-QueryLease::QueryLease(const MotionStateManager& manager) {
-    const MotionStateLock::Hold guard(manager.m_lock);
-    m_scene = manager.m_query_scene;
-    m_alpha = manager.alpha_locked();
-    if (m_scene) m_scene->holders.fetch_add(1, std::memory_order_relaxed);  // under the lock
-}
-
-QueryLease::~QueryLease() {
-    // Release: this query's reads happen before the physics thread's next writes.
-    if (m_scene) m_scene->holders.fetch_sub(1, std::memory_order_release);
-}
+// ---- updating ----
 
 QueryScene& writable_query_scene(World& world, int k) {
     std::shared_ptr<QueryScene>& scene = world.query_scenes[k];
-    if (!scene) {
-        // The first publication: every body there is (creation publishes each at once).
-        scene = std::make_shared<QueryScene>();
-        const bool interpolating = world.settings.time_step.use_internal_time_stepping;
-        for (std::uint32_t i = 0; i < world.bodies.capacity(); ++i) {
-            if (world.bodies.alive[i]) scene->refresh(world, i, interpolating);
-        }
-    } else if (scene->holders.load(std::memory_order_acquire) != 0) {
+    SPINDLE_ASSERT(scene != nullptr, "writable_query_scene: no query scene for this buffer");
+    if (scene->holders.load(std::memory_order_acquire) != 0) {
         // A query walks it still: it keeps the old one, which goes when it lets go.
         scene = std::shared_ptr<QueryScene>(scene->clone());
         world.counters.query_scene_copies += 1;

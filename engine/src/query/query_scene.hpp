@@ -2,9 +2,10 @@
 // scenes go with the two published motion-state buffers; FlipReadBuffers brings the
 // back one up to date and publishes it with the buffer, under the motion-state lock, so
 // a query sees exactly the step buffered reads see. A query takes the published scene
-// (a shared pointer and a holder count) under the lock and walks it without the lock; a
-// scene the physics thread wants to update while a query still holds it is copied
-// first, so a query never waits for a step and a step never waits for a query.
+// (a shared pointer and a holder count, query/query_lease.hpp) under the lock and walks
+// it without the lock; a scene the physics thread wants to update while a query still
+// holds it is copied first, so a query never waits for a step and a step never waits
+// for a query. None exists until the space's first query (query_lease.cpp).
 #pragma once
 
 #include <atomic>
@@ -20,7 +21,7 @@
 
 namespace spindle {
 
-class MotionStateManager;
+struct PublishedBuffer;
 struct World;
 
 // One body as queries see it: its published pose (and the one before, for blending),
@@ -49,6 +50,11 @@ public:
     QueryScene();
     // A copy for the physics thread to update while a query holds this one.
     std::unique_ptr<QueryScene> clone() const;
+    // The scene that goes with a published buffer: every body in it at its pose there
+    // (so a query meets it where reads of that buffer put it), with its shape and filter
+    // from the live state. The caller may read the live state (it holds the AccessGate,
+    // or the thread that does waits for the motion-state lock) and nothing writes `buffer`.
+    static std::shared_ptr<QueryScene> build(const World& world, const PublishedBuffer& buffer);
 
     // Slot i from the live state, shape included (or empty if no body lives there); its
     // proxy moved. For bodies created, destroyed or changed by a write.
@@ -100,33 +106,16 @@ private:
                  QueryHit& hit) const;
     // The box a proxy must cover: the shape at both poses (and the swing between them).
     Aabb tight_bounds(std::uint32_t i) const;
-    void set_proxy(std::uint32_t i, const Aabb& tight);
+    // Slot i's shape, its box and the flags that come with it, from the live state.
+    void set_shape(const World& world, std::uint32_t i);
 
     DynamicAabbTree m_tree;
     std::vector<QueryBody> m_bodies;  // per body slot; the flip's hot data
     std::vector<Shape> m_shapes;      // per body slot; changed only with the body's shape
 };
 
-// A query's hold on the published scene: taken under the motion-state lock (briefly:
-// two loads and an increment), released on destruction. Any thread.
-class QueryLease {
-public:
-    explicit QueryLease(const MotionStateManager& manager);
-    ~QueryLease();
-    QueryLease(const QueryLease&) = delete;
-    QueryLease& operator=(const QueryLease&) = delete;
-
-    // Null before the space publishes its first body.
-    const QueryScene* scene() const noexcept { return m_scene.get(); }
-    double alpha() const noexcept { return m_alpha; }
-
-private:
-    std::shared_ptr<const QueryScene> m_scene;
-    double m_alpha = 1;
-};
-
-// The physics side: the scene that goes with published buffer k, ready to be written
-// (copied first if a query holds it).
+// The physics side: the scene that goes with published buffer k (there must be one),
+// ready to be written (copied first if a query holds it).
 QueryScene& writable_query_scene(World& world, int k);
 
 }  // namespace spindle

@@ -19,14 +19,15 @@ public:
     int back_index() const noexcept { return m_manager.back_index(); }
     PublishedBuffer& buffer_locked(int k) noexcept { return m_manager.buffer_locked(k); }
     MotionStateLock& lock() const noexcept { return m_manager.lock(); }
+    void lock_for_publishing() { m_manager.lock_for_publishing(); }
     void set_published_generation(std::uint32_t slot, std::uint32_t generation) {
         m_manager.set_published_generation(slot, generation);
     }
     void set_published_kind(std::uint32_t slot, MotionType type, bool static_only_shape) {
         m_manager.set_published_kind(slot, type, static_only_shape);
     }
-    double flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries) {
-        return m_manager.flip(time, std::move(queries));
+    double flip(const PublishedTime& time, const std::shared_ptr<QueryScene>& queries) {
+        return m_manager.flip(time, queries);
     }
     void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) {
         m_manager.set_query_scene_locked(std::move(queries));
@@ -37,6 +38,26 @@ private:
 };
 
 namespace {
+
+// MotionStateLock::Hold for the physics side: while it waits, it says so, so that a first
+// query holding the lock builds the query scenes meanwhile instead of waiting for it
+// (query/query_lease.cpp).
+class PublishingHold {
+public:
+    explicit PublishingHold(MotionStatePublisher& manager)
+        : m_lock(manager.lock()), m_took(!m_lock.held_by_this_thread()) {
+        if (m_took) manager.lock_for_publishing();
+    }
+    ~PublishingHold() {
+        if (m_took) m_lock.unlock();
+    }
+    PublishingHold(const PublishingHold&) = delete;
+    PublishingHold& operator=(const PublishingHold&) = delete;
+
+private:
+    MotionStateLock& m_lock;
+    bool m_took;
+};
 
 // A teleport: the body jumps, so both history entries take the new pose and the
 // interpolation does not slide it there.
@@ -176,11 +197,12 @@ void publish_now(World& world, std::uint32_t slot) {
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
     // The back query scene first, outside the lock: no query can take it (it is not
     // published), so a copy of one an old query still holds costs the lock nothing.
+    // Before the space's first query there is none (query/query_lease.cpp).
     const int back = manager.back_index();
-    writable_query_scene(world, back).refresh(world, slot, interpolating);
+    if (world.query_scenes[back]) writable_query_scene(world, back).refresh(world, slot, interpolating);
     // The update thread may hold the lock itself (a posted function reading one step
     // while it creates bodies); then publishing goes ahead under its hold.
-    const MotionStateLock::Hold guard(manager.lock());
+    const PublishingHold guard(manager);
     for (int k = 0; k < 2; ++k) {
         PublishedBuffer& buffer = manager.buffer_locked(k);
         if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
@@ -195,13 +217,13 @@ void publish_now(World& world, std::uint32_t slot) {
     // published scene now: copying a whole scene under the lock for each body made would
     // stall every reader, so then the next flip brings the body to queries (the front
     // scene is refreshed there for it, as a changed body; WorkCounters::query_publishes_deferred).
+    // Read under the lock: a first query holding it may have built the scenes while this
+    // thread waited for it (and holds the front one: then the body is deferred).
     QueryScene* front = world.query_scenes[1 - back].get();
     if (front && front->holders.load(std::memory_order_acquire) == 0) {
         front->refresh(world, slot, interpolating);
     } else if (front) {
         world.counters.query_publishes_deferred += 1;
-    } else {
-        writable_query_scene(world, 1 - back).refresh(world, slot, interpolating);
     }
     manager.set_query_scene_locked(world.query_scenes[1 - back]);
 }
@@ -235,9 +257,10 @@ void flip_read_buffers(World& world) {
         world.awake_version += 1;
     }
     const int k = manager.back_index();
-    // The query scene that goes with the back buffer gets the same bodies refreshed.
-    QueryScene& queries = writable_query_scene(world, k);
-    queries.reserve(b.capacity());
+    // The query scene that goes with the back buffer gets the same bodies refreshed; before
+    // the space's first query there is none, and no query work is done.
+    QueryScene* queries = world.query_scenes[k] ? &writable_query_scene(world, k) : nullptr;
+    if (queries) queries->reserve(b.capacity());
     // Bodies changed by writes, creation, destruction or sleep first, awake or not: a
     // shape or filter changes here, and the awake poses below use the new shape's box.
     // User data too: it changes only by creation or a write, both noted in changed_now (it
@@ -245,7 +268,7 @@ void flip_read_buffers(World& world) {
     // awake ones' states are refilled below with the rest of the awake bodies.
     for (const std::vector<std::uint32_t>* changed : {&world.changed_now, &world.changed_last}) {
         for (std::uint32_t i : *changed) {
-            queries.refresh(world, i, interpolating);
+            if (queries) queries->refresh(world, i, interpolating);
             publish_user_data(world, i, back);
             if (!b.alive[i] || b.awake_index[i] < 0) publish(i);
         }
@@ -257,30 +280,37 @@ void flip_read_buffers(World& world) {
         interpolated.assign(world.jobs->worker_count(), {});
         const auto n = static_cast<std::uint32_t>(world.awake.size());
         std::vector<Aabb>& query_bounds = world.scratch_query_bounds;
-        query_bounds.resize(n);
+        if (queries) query_bounds.resize(n);
         world.jobs->parallel_for("Publish", 0, n, 256, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
             std::uint64_t count = 0;
             for (std::uint32_t a = lo; a < hi; ++a) {
                 const std::uint32_t i = world.awake[a];
                 fill(world, i, back, interpolating);
                 count += back.interpolate[i];
-                queries.refresh_pose(world, i, interpolating, query_bounds[a]);
+                if (queries) queries->refresh_pose(world, i, interpolating, query_bounds[a]);
             }
             interpolated[worker].value += count;
         });
-        // The tree by one thread: most proxies are still inside their fat boxes, and those
-        // that left are moved in place (their ancestors rebuilt once, below).
-        const Real step = world.settings.time_step.duration;
-        for (std::uint32_t a = 0; a < n; ++a) {
-            const std::uint32_t i = world.awake[a];
-            queries.move(i, query_bounds[a], b.v[i] * step);
+        if (queries) {
+            // The tree by one thread: most proxies are still inside their fat boxes, and
+            // those that left are moved in place (their ancestors rebuilt once, below).
+            const Real step = world.settings.time_step.duration;
+            for (std::uint32_t a = 0; a < n; ++a) {
+                const std::uint32_t i = world.awake[a];
+                queries->move(i, query_bounds[a], b.v[i] * step);
+            }
         }
         for (const CacheLinePadded<std::uint64_t>& c : interpolated) world.counters.interpolated_publishes += c.value;
         world.counters.awake_publishes += n;
         world.published_version[k] = world.awake_version;
         world.published_interpolating[k] = interpolating;
     }
-    queries.rebuild_moved(*world.jobs);
+    if (queries) {
+        queries->rebuild_moved(*world.jobs);
+    } else if (world.queries_wanted.load(std::memory_order_relaxed)) {
+        // A query is waiting for a scene (query/query_lease.cpp): the buffer is complete now.
+        world.query_scenes[k] = QueryScene::build(world, back);
+    }
     std::swap(world.changed_last, world.changed_now);
     world.changed_now.clear();
     // Bodies awake last update but asleep now were recorded in changed_now by the

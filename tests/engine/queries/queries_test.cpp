@@ -8,10 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
 
+#include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
 #include "collision/cast.hpp"
 #include "query/query_scene.hpp"
@@ -298,14 +300,61 @@ TEST(SceneQueries, BadArgumentsAreNamed) {
               std::string::npos);
 }
 
-// A falling, tumbling pile of mixed shapes read between steps: every query the tree
-// answers equals a brute-force pass over every body at its published pose.
-TEST(SceneQueries, TreeAnswersAsABruteForcePassOverEveryBody) {
-    SpaceSettings settings;
-    settings.time_step.use_internal_time_stepping = true;
-    Space space(settings);
+// What compare_with_brute_force saw: rays that met a body other than the first (the
+// ground in the piles below), and bodies the overlaps found.
+struct Compared {
+    int rays = 0, hits = 0, overlapped = 0;
+};
+
+// Rays from above and an overlap through the published step, each answered by the space
+// and by a brute-force pass over every body at the pose reads give it, exactly the same.
+Compared compare_with_brute_force(const Space& space, std::mt19937& random, int rays) {
+    std::uniform_real_distribution<Real> spread(-4, 4);
+    std::vector<BodyHandle> handles;
+    std::vector<MotionState> states;
+    space.motion_states().get_all_motion_states(handles, states);
+    std::vector<Shape> shapes;
+    for (BodyHandle h : handles) shapes.push_back(space.internal_desc(h).shape);
+    Compared seen;
+    for (int r = 0; r < rays; ++r) {
+        const Vec3 from(spread(random), 20 + spread(random), spread(random));
+        const Vec3 to(spread(random), -1, spread(random));
+        Real best = 2;
+        BodyHandle nearest{};
+        for (std::size_t k = 0; k < handles.size(); ++k) {
+            CastHit h;
+            if (ray_cast(shapes[k], {states[k].position, states[k].orientation}, from, to, h) && h.fraction < best) {
+                best = h.fraction;
+                nearest = handles[k];
+            }
+        }
+        const std::optional<QueryHit> hit = space.cast_ray(from, to);
+        EXPECT_EQ(hit.has_value(), best <= 1)
+            << "nearest " << to_string(nearest) << " from " << from.transpose() << " to " << to.transpose();
+        if (hit) {
+            EXPECT_EQ(hit->body, nearest);
+            EXPECT_EQ(hit->fraction, best);
+            seen.hits += hit->body != handles[0];
+        }
+        ++seen.rays;
+    }
+    const Transform probe{{spread(random), 0.5 + std::abs(spread(random)), spread(random)}, Quat::Identity()};
+    std::vector<BodyHandle> expected, found;
+    for (std::size_t k = 0; k < handles.size(); ++k) {
+        if (overlaps(Shape::sphere(1), probe, shapes[k], {states[k].position, states[k].orientation})) {
+            expected.push_back(handles[k]);
+        }
+    }
+    space.overlap_shape(Shape::sphere(1), probe, found);
+    EXPECT_EQ(found, expected);
+    seen.overlapped += static_cast<int>(found.size());
+    return seen;
+}
+
+// A falling, tumbling pile of mixed shapes, stepped with internal time stepping so that
+// reads blend between steps.
+void make_tumbling_pile(Space& space, std::mt19937& random) {
     space.create_body(body(Shape::plane({0, 1, 0}, 0), {0, 0, 0}, MotionType::Static));
-    std::mt19937 random(7);
     std::uniform_real_distribution<Real> spread(-4, 4), spin(-6, 6);
     const Shape shapes[] = {Shape::sphere(0.3), Shape::box({0.4, 0.2, 0.3}), Shape::capsule(0.3, 0.15)};
     for (int i = 0; i < 120; ++i) {
@@ -314,53 +363,85 @@ TEST(SceneQueries, TreeAnswersAsABruteForcePassOverEveryBody) {
         d.linear_velocity = {spin(random), 0, spin(random)};
         space.create_body(d);
     }
-    std::vector<BodyHandle> handles;
-    std::vector<MotionState> states;
-    int checked = 0, hits_seen = 0, overlaps_seen = 0;
+}
+
+SpaceSettings blending() {
+    SpaceSettings settings;
+    settings.time_step.use_internal_time_stepping = true;
+    return settings;
+}
+
+// The pile read between steps: every query the tree answers equals a brute-force pass
+// over every body at its published pose.
+TEST(SceneQueries, TreeAnswersAsABruteForcePassOverEveryBody) {
+    Space space(blending());
+    std::mt19937 random(7);
+    make_tumbling_pile(space, random);
+    Compared seen;
     for (int frame = 0; frame < 60; ++frame) {
         space.update(1.0 / 47);  // a frame rate that leaves a different alpha each time
-        space.motion_states().get_all_motion_states(handles, states);
-        for (int r = 0; r < 20; ++r) {
-            const Vec3 from(spread(random), 20 + spread(random), spread(random));
-            const Vec3 to(spread(random), -1, spread(random));
-            // Brute force: every body at its read pose.
-            Real best = 2;
-            BodyHandle nearest{};
-            for (std::size_t k = 0; k < handles.size(); ++k) {
-                CastHit h;
-                const Shape shape = space.internal_desc(handles[k]).shape;
-                if (ray_cast(shape, {states[k].position, states[k].orientation}, from, to, h) && h.fraction < best) {
-                    best = h.fraction;
-                    nearest = handles[k];
-                }
-            }
-            const std::optional<QueryHit> hit = space.cast_ray(from, to);
-            ASSERT_EQ(hit.has_value(), best <= 1) << "frame " << frame << " nearest " << to_string(nearest) << " from "
-                                                  << from.transpose() << " to " << to.transpose();
-            if (hit) {
-                EXPECT_EQ(hit->body, nearest) << "frame " << frame;
-                EXPECT_EQ(hit->fraction, best) << "frame " << frame;
-                hits_seen += hit->body != handles[0];
-            }
-            ++checked;
+        const Compared now = compare_with_brute_force(space, random, 20);
+        seen.rays += now.rays;
+        seen.hits += now.hits;
+        seen.overlapped += now.overlapped;
+        for (const auto& scene : SpaceInternals::world(space).query_scenes) {
+            if (scene) scene->tree().validate();  // one of them may wait for the next flip (query_lease.cpp)
         }
-        // Overlaps, the same way.
-        const Transform probe{{spread(random), 0.5 + std::abs(spread(random)), spread(random)}, Quat::Identity()};
-        std::vector<BodyHandle> expected, found;
-        for (std::size_t k = 0; k < handles.size(); ++k) {
-            const Shape shape = space.internal_desc(handles[k]).shape;
-            if (overlaps(Shape::sphere(1), probe, shape, {states[k].position, states[k].orientation})) {
-                expected.push_back(handles[k]);
-            }
-        }
-        space.overlap_shape(Shape::sphere(1), probe, found);
-        EXPECT_EQ(found, expected) << "frame " << frame;
-        overlaps_seen += static_cast<int>(found.size());
-        for (const auto& scene : SpaceInternals::world(space).query_scenes) scene->tree().validate();
     }
-    EXPECT_EQ(checked, 1200);
-    EXPECT_GT(overlaps_seen, 20);  // 36 when written: the probes meet bodies, not only nothing
-    EXPECT_GT(hits_seen, 100);     // the rays meet the moving bodies, not only the ground
+    EXPECT_EQ(seen.rays, 1200);
+    EXPECT_GT(seen.overlapped, 20);  // 36 when written: the probes meet bodies, not only nothing
+    EXPECT_GT(seen.hits, 100);       // the rays meet the moving bodies, not only the ground
+}
+
+// Until its first query a space keeps no query scene and its flips do no query work; the
+// physics is the same either way (the state hash of a space queried every frame).
+TEST(SceneQueries, ASpaceThatNeverQueriesKeepsNoQueryScene) {
+    Space quiet(blending()), queried(blending());
+    std::mt19937 random_quiet(7), random_queried(7);
+    make_tumbling_pile(quiet, random_quiet);
+    make_tumbling_pile(queried, random_queried);
+    for (int frame = 0; frame < 40; ++frame) {
+        quiet.update(1.0 / 47);
+        queried.update(1.0 / 47);
+        queried.ray_hits_any({0, 20, 0}, {0, -1, 0});
+    }
+    const World& world = SpaceInternals::world(quiet);
+    EXPECT_EQ(world.query_scenes[0], nullptr);
+    EXPECT_EQ(world.query_scenes[1], nullptr);
+    EXPECT_EQ(memory_report(quiet).query_scenes, 0u);
+    EXPECT_GT(memory_report(queried).query_scenes, 0u);
+    EXPECT_EQ(quiet.state_hash(), queried.state_hash());
+}
+
+// The first query of a space that stepped without any: the scenes are built from what
+// reads return, not from the live state (a direct change is not published before the
+// update), and from then on the flips keep them.
+TEST(SceneQueries, FirstQueryAfterStepsMeetsBodiesAsABruteForcePass) {
+    Space space(blending());
+    std::mt19937 random(11);
+    make_tumbling_pile(space, random);
+    for (int frame = 0; frame < 30; ++frame) space.update(1.0 / 47);
+    std::vector<BodyHandle> handles;
+    std::vector<MotionState> states;
+    space.motion_states().get_all_motion_states(handles, states);
+    MotionState moved = space.internal_motion_state(handles[5]);
+    moved.position += Vec3(0, 50, 0);
+    space.set_internal_motion_state(handles[5], moved);  // live now, published at the next flip
+    ASSERT_EQ(SpaceInternals::world(space).query_scenes[0], nullptr);
+    const Compared first = compare_with_brute_force(space, random, 40);
+    EXPECT_GT(first.hits, 5);
+    // Where the read puts the moved body (its centre is inside it), not where it lives now.
+    std::vector<BodyHandle> at_read;
+    space.overlap_shape(Shape::sphere(0.01), {space.motion_state(handles[5]).position, Quat::Identity()}, at_read);
+    EXPECT_NE(std::find(at_read.begin(), at_read.end(), handles[5]), at_read.end());
+    EXPECT_FALSE(space.ray_hits_any(moved.position + Vec3(0, 0, 5), moved.position + Vec3(0, 0, -5)));
+    for (int frame = 0; frame < 20; ++frame) {
+        space.update(1.0 / 47);
+        compare_with_brute_force(space, random, 10);
+        for (const auto& scene : SpaceInternals::world(space).query_scenes) {
+            if (scene) scene->tree().validate();  // one of them may wait for the next flip (query_lease.cpp)
+        }
+    }
 }
 
 }  // namespace

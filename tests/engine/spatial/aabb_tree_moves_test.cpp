@@ -304,10 +304,12 @@ TEST(AabbTreeMoves, Space_BroadphaseAndQueryTreesAreRebuiltEachStep) {
         space.create_body(d);
     }
     const World& world = SpaceInternals::world(space);
+    space.ray_hits_any({0, 0, 0}, {0, 1, 0});  // the query scenes exist from the first query on
     for (int step = 0; step < 30; ++step) {
         space.update(Real(1) / 60);
         EXPECT_EQ(world.broadphase->tree.moving_tree().enlarged_node_count(), 0) << "step " << step;
         for (const auto& scene : world.query_scenes) {
+            EXPECT_NE(scene, nullptr) << "step " << step;
             if (!scene) continue;
             scene->tree().validate();
             EXPECT_EQ(scene->tree().enlarged_node_count(), 0) << "step " << step;

@@ -193,8 +193,15 @@ private:
     // Both buffers, for a caller that holds lock() (publishing a created body at once).
     PublishedBuffer& buffer_locked(int k) noexcept { return m_buffers[k]; }
     // Swaps back and front under the lock and publishes the query scene that goes with
-    // the new front; returns seconds the lock was held.
-    double flip(const PublishedTime& time, std::shared_ptr<const QueryScene> queries);
+    // the new front (read under the lock: a first query that holds the lock may build it
+    // while the flip waits); returns seconds the lock was held.
+    double flip(const PublishedTime& time, const std::shared_ptr<QueryScene>& queries);
+    // Takes lock() for the physics side (the thread that may change the space), saying so
+    // while it waits: a thread holding the lock then knows the physics side touches
+    // nothing until it lets go (publisher_waiting()).
+    void lock_for_publishing();
+    // Whether the physics side waits for lock(); exact for a caller holding it.
+    bool publisher_waiting() const noexcept { return m_publisher_waiting.load(std::memory_order_acquire); }
     // Replaces the published query scene, for a caller that holds lock().
     void set_query_scene_locked(std::shared_ptr<const QueryScene> queries) noexcept {
         m_query_scene = std::move(queries);
@@ -235,7 +242,8 @@ private:
     PublishedBuffer* m_front = &m_buffers[0];
     PublishedBuffer* m_back = &m_buffers[1];
     PublishedTime m_time;
-    std::shared_ptr<const QueryScene> m_query_scene;  // null until a body is published
+    std::shared_ptr<const QueryScene> m_query_scene;  // null until the space's first query
+    std::atomic<bool> m_publisher_waiting{false};     // set before lock_for_publishing() blocks, cleared under the lock
 };
 
 }  // namespace spindle

@@ -176,6 +176,12 @@ public:
     // scene a query still holds, WorkCounters::query_scene_copies). It may deadlock only
     // through filter.accept (which must not wait for an update). Non-finite arguments, or
     // a plane or mesh as the query's own shape, throw spindle::Error naming the argument.
+    // A space keeps no query structure until its first query (one that never queries pays
+    // nothing for them). That query builds it where the space may be read (no update runs,
+    // or a posted function); else it waits for the next update's flip, or, made while
+    // holding the motion-state lock, for the physics thread to wait for that lock, and it
+    // throws spindle::Error after 10 s of that (the physics thread waits for something
+    // the holder holds: make the first query without the lock).
     //
     // The nearest body the segment from -> to enters (a segment starting inside a solid
     // does not hit it); none for a zero-length segment.
