@@ -202,6 +202,14 @@ void solve_distance(JointConstraint& jc, const SolverBody& A, const SolverBody& 
     }
 }
 
+// A ball-socket's constraint is made by setting what its rows read (type, anchors, centres,
+// point impulse; prepare_joint) and zeroing the impulses it keeps none of: the rest of the
+// record, hundreds of bytes, is never read for it, and a chain or a net is all ball-sockets.
+void clear_unused_impulses(JointConstraint& jc) {
+    jc.angular_impulse = Vec3::Zero();
+    jc.axial_impulse = jc.motor_impulse = jc.lower_impulse = jc.upper_impulse = jc.swing_impulse = 0;
+}
+
 void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint& jc, Real h) {
     const Bodies& b = world.bodies;
     const Joint& j = world.joints.joint[jc.joint];
@@ -303,7 +311,11 @@ void prepare_joints(World& world, SolverScratch& scratch, Real h) {
                                  for (std::uint32_t k = lo; k < hi; ++k) {
                                      const JointRef& ref = scratch.joint_refs[k];
                                      JointConstraint& jc = scratch.joints[k];
-                                     jc = JointConstraint{};
+                                     if (ref.type == static_cast<std::uint32_t>(JointType::BallSocket)) {
+                                         clear_unused_impulses(jc);
+                                     } else {
+                                         jc = JointConstraint{};
+                                     }
                                      jc.joint = ref.joint;
                                      jc.a = ref.a;
                                      jc.b = ref.b;
