@@ -231,18 +231,19 @@ struct SolverScratch {
     std::vector<ManifoldRef> colored_manifolds;
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
-    std::vector<JointRef> colored_joints;
-    bool reuse_colors = true;                        // false colours every step (tests compare the two)
-    std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
-    std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
+    std::vector<JointRef> colored_joints;                // the joint list then
+    bool reuse_colors = true;                            // false colours every step (tests compare the two)
+    std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
+    std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
     std::vector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
     std::vector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
-    std::uint32_t wide_begin[kColorCount + 1] = {};        // colour c holds wide[wide_begin[c], wide_begin[c + 1])
-    std::vector<JointConstraint> joints;                   // awake joints, in slot order
-    std::vector<JointRef> joint_refs;                      // the same, as listed
-    std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first), but
-    // the ball-socket joints, which are packed kLanes at a time (in colour c:
-    // wide_joints[wide_joint_begin[c], wide_joint_begin[c + 1]))
+    std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
+    std::vector<JointConstraint> joints;             // awake joints, in slot order
+    std::vector<JointRef> joint_refs;                // the same, as listed
+    // Joint indices per colour (joints are coloured first), but for the ball-socket joints
+    // of bodies without motion locks: those are packed kLanes at a time, colour c's in
+    // wide_joints[wide_joint_begin[c], wide_joint_begin[c + 1]).
+    std::vector<std::uint32_t> joint_colors[kColorCount];
     std::vector<WideBallSocket> wide_joints;
     std::uint32_t wide_joint_begin[kColorCount + 1] = {};
     std::vector<std::uint32_t> joint_overflow;
