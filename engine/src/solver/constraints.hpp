@@ -61,6 +61,13 @@ struct WidePoint {
     Wide relative_velocity{};  // approach speed at impact (restitution)
 };
 
+// An awake joint as listed for the step: what its colour and packing depend on.
+struct JointRef {
+    std::uint32_t joint = 0;     // slot in world.joints
+    std::uint32_t a = 0, b = 0;  // solver bodies
+    std::uint32_t type = 0;      // JointType: ball-socket joints are packed kLanes at a time
+};
+
 // A touching manifold of an awake contact, as listed and coloured for the step.
 struct ManifoldRef {
     std::uint32_t contact = 0;
@@ -159,6 +166,21 @@ struct JointConstraint {
     Real swing_impulse = 0;
 };
 
+// kLanes ball-socket joints of one colour solved together, one per lane
+// (joint_ball_socket.cpp), as a WideContact solves manifolds: a chain or a net of them is
+// most of its step. Lanes past `lanes` hold no joint: both bodies are the immovable one.
+// Made from the joints' JointConstraints each step, and their impulses handed back.
+struct WideBallSocket {
+    std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
+    std::uint32_t joint[kLanes] = {};              // index in SolverScratch::joints
+    int lanes = 0;
+    Wide3 ra, rb;        // anchors from each centre of mass at the step's start, world
+    Wide3 delta_center;  // B's centre of mass minus A's at the step's start
+    Wide inv_mass_a{}, inv_mass_b{};
+    WideSym3 inv_inertia_a, inv_inertia_b;  // world, fixed for the step
+    Wide3 impulse;                          // accumulated (JointConstraint::linear_impulse)
+};
+
 // How joints are solved in one pass: soft position correction with use_bias, none
 // (relax) without.
 struct JointSolveParams {
@@ -173,6 +195,7 @@ inline constexpr int kColorCount = 24;
 // or over one colour's constraints (color == kColorCount: the overflow, one block).
 enum class Pass : std::uint8_t {
     PrepareContacts,
+    PrepareJoints,
     IntegrateVelocities,
     WarmStart,
     Solve,
@@ -180,6 +203,8 @@ enum class Pass : std::uint8_t {
     Relax,
     Restitution,
     StoreImpulses,
+    StoreJointLanes,
+    StoreJoints,
     FinalizeBodies
 };
 struct SolverPhase {
@@ -206,15 +231,21 @@ struct SolverScratch {
     std::vector<ManifoldRef> colored_manifolds;
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
-    bool colored_joints = false;
-    bool reuse_colors = true;                        // false colours every step (tests compare the two)
-    std::vector<std::uint32_t> colors[kColorCount];  // manifold refs per colour
-    std::vector<std::uint32_t> overflow;             // refs that fit no colour, solved serially
+    std::vector<JointRef> colored_joints;                // the joint list then
+    bool reuse_colors = true;                            // false colours every step (tests compare the two)
+    std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
+    std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
     std::vector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
     std::vector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
-    std::uint32_t wide_begin[kColorCount + 1] = {};        // colour c holds wide[wide_begin[c], wide_begin[c + 1])
-    std::vector<JointConstraint> joints;                   // awake joints, in slot order
-    std::vector<std::uint32_t> joint_colors[kColorCount];  // joint indices per colour (coloured first)
+    std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
+    std::vector<JointConstraint> joints;             // awake joints, in slot order
+    std::vector<JointRef> joint_refs;                // the same, as listed
+    // Joint indices per colour (joints are coloured first), but for the ball-socket joints
+    // of bodies without motion locks: those are packed kLanes at a time, colour c's in
+    // wide_joints[wide_joint_begin[c], wide_joint_begin[c + 1]).
+    std::vector<std::uint32_t> joint_colors[kColorCount];
+    std::vector<WideBallSocket> wide_joints;
+    std::uint32_t wide_joint_begin[kColorCount + 1] = {};
     std::vector<std::uint32_t> joint_overflow;
     std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
     // Per manifold ref, or empty when every scale is 1 (most steps of most scenes).
@@ -269,6 +300,18 @@ Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz
 void prepare_joints(World& world, SolverScratch& scratch, Real h);
 void warm_start_joint(JointConstraint& jc, SolverBody* bodies);
 void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts);
-void store_joint_impulses(World& world, SolverScratch& scratch);
+void store_joint_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo,
+                          std::uint32_t hi);  // joints [lo, hi)
+
+// joint_ball_socket.cpp. pack_ball_sockets takes the ball-socket joints out of the
+// colours' joint lists (after colouring) and lays them out kLanes at a time;
+// prepare_ball_sockets fills wide_joints [lo, hi) from their prepared JointConstraints;
+// store_ball_socket_impulses hands the impulses of wide_joints [lo, hi) back to them
+// (before store_joint_impulses).
+void pack_ball_sockets(SolverScratch& scratch);
+void prepare_ball_sockets(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
+void warm_start_ball_sockets(WideBallSocket& wj, SolverBody* bodies);
+void solve_ball_sockets(WideBallSocket& wj, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts);
+void store_ball_socket_impulses(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 }  // namespace spindle

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <type_traits>
 
+#include "solver/body_lanes.hpp"
 #include "solver/constraints.hpp"
 #include "stages/capacity.hpp"
 #include "stages/stages.hpp"
@@ -57,54 +58,6 @@ inline void apply_row(const SolverBody& A, const SolverBody& B, Velocities& s, c
     s.wa -= L * row.ia;
     s.vb += project_linear((B.inv_mass * L) * dir, B.locks);
     s.wb += L * row.ib;
-}
-
-// The lanes' body velocities while a WideContact is solved, in floats: gathered from
-// the bodies' doubles and scattered back. gather and scatter are forced inline: as calls
-// they returned and copied their result per pass.
-struct WideVelocities {
-    Wide3 va, wa, vb, wb;
-};
-
-// A solver body read as a row of doubles: v, w from its start, dp and dq (x, y, z, w)
-// from the sixth. Eight lanes' rows are loaded, narrowed and transposed into columns.
-static_assert(std::is_standard_layout_v<SolverBody> && offsetof(SolverBody, v) == 0 &&
-                  offsetof(SolverBody, w) == 3 * sizeof(Real) && offsetof(SolverBody, dp) == 6 * sizeof(Real) &&
-                  offsetof(SolverBody, dq) == 9 * sizeof(Real) && sizeof(SolverBody) >= 14 * sizeof(Real),
-              "the solver's gather reads a body's v, w, dp and dq as consecutive doubles");
-constexpr int kVelocityRow = 0, kMotionRow = 6;
-
-[[gnu::always_inline]] inline void gather_rows(const SolverBody* bodies, const std::uint32_t* index, int first,
-                                               Wide (&rows)[kLanes]) {
-    for (int l = 0; l < kLanes; ++l) rows[l] = load_narrow(reinterpret_cast<const Real*>(bodies + index[l]) + first);
-    transpose(rows);
-}
-
-[[gnu::always_inline]] inline WideVelocities gather(const WideContact& wc, const SolverBody* bodies) {
-    Wide a[kLanes], b[kLanes];
-    gather_rows(bodies, wc.a, kVelocityRow, a);
-    gather_rows(bodies, wc.b, kVelocityRow, b);
-    return {{a[0], a[1], a[2]}, {a[3], a[4], a[5]}, {b[0], b[1], b[2]}, {b[3], b[4], b[5]}};
-}
-
-// Writes the dynamic bodies back: static and kinematic ones (and the empty lanes'
-// immovable body) are shared by constraints of every colour and never written.
-[[gnu::always_inline]] inline void scatter(const WideContact& wc, SolverBody* bodies, const WideVelocities& s) {
-    Wide a[kLanes] = {s.va.x, s.va.y, s.va.z, s.wa.x, s.wa.y, s.wa.z};
-    Wide b[kLanes] = {s.vb.x, s.vb.y, s.vb.z, s.wb.x, s.wb.y, s.wb.z};
-    transpose(a);
-    transpose(b);
-    for (int l = 0; l < kLanes; ++l) {
-        SolverBody& A = bodies[wc.a[l]];
-        SolverBody& B = bodies[wc.b[l]];
-        if (A.dynamic) store_widened6(reinterpret_cast<Real*>(&A) + kVelocityRow, a[l]);
-        if (B.dynamic) store_widened6(reinterpret_cast<Real*>(&B) + kVelocityRow, b[l]);
-    }
-}
-
-// Velocity of B's anchor relative to A's, per lane.
-inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide3& rb) {
-    return s.vb + cross(s.wb, rb) - s.va - cross(s.wa, ra);
 }
 
 // The lanes' inverse masses per world axis (zero along a locked one), for a wide

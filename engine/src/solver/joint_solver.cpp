@@ -202,6 +202,14 @@ void solve_distance(JointConstraint& jc, const SolverBody& A, const SolverBody& 
     }
 }
 
+// A ball-socket's constraint is made by setting what its rows read (type, anchors, centres,
+// point impulse; prepare_joint) and zeroing the impulses it keeps none of: the rest of the
+// record, hundreds of bytes, is never read for it, and a chain or a net is all ball-sockets.
+void clear_unused_impulses(JointConstraint& jc) {
+    jc.angular_impulse = Vec3::Zero();
+    jc.axial_impulse = jc.motor_impulse = jc.lower_impulse = jc.upper_impulse = jc.swing_impulse = 0;
+}
+
 void prepare_joint(const World& world, const SolverBody* bodies, JointConstraint& jc, Real h) {
     const Bodies& b = world.bodies;
     const Joint& j = world.joints.joint[jc.joint];
@@ -275,9 +283,12 @@ Softness joint_softness(const SolverSettings& settings, Real h) {
 }
 
 void prepare_joints(World& world, SolverScratch& scratch, Real h) {
-    scratch.joints.clear();
+    scratch.joint_refs.clear();
     const Joints& js = world.joints;
-    if (js.live == 0) return;
+    if (js.live == 0) {
+        scratch.joints.clear();
+        return;
+    }
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     auto solver_index = [&](std::uint32_t slot) {
@@ -286,18 +297,30 @@ void prepare_joints(World& world, SolverScratch& scratch, Real h) {
     };
     // Slot order: the same list, so the same colours, for any worker count.
     for (std::uint32_t slot : awake_joints(world)) {
-        const std::uint32_t a = solver_index(js.joint[slot].body_a), bb = solver_index(js.joint[slot].body_b);
+        const Joint& j = js.joint[slot];
+        const std::uint32_t a = solver_index(j.body_a), bb = solver_index(j.body_b);
         if (!scratch.bodies[a].dynamic && !scratch.bodies[bb].dynamic) continue;  // nothing it could move
-        JointConstraint& jc = scratch.joints.emplace_back();
-        jc.joint = slot;
-        jc.a = a;
-        jc.b = bb;
+        scratch.joint_refs.push_back({slot, a, bb, static_cast<std::uint32_t>(j.type)});
     }
+    // The constraints are made afresh in the jobs: a joint's is hundreds of bytes, too
+    // many to write on one thread.
+    scratch.joints.resize(scratch.joint_refs.size());
     const SolverBody* bodies = scratch.bodies.data();
     world.jobs->parallel_for("PrepareJoints", 0, static_cast<std::uint32_t>(scratch.joints.size()), kJointGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-                                 for (std::uint32_t k = lo; k < hi; ++k)
-                                     prepare_joint(world, bodies, scratch.joints[k], h);
+                                 for (std::uint32_t k = lo; k < hi; ++k) {
+                                     const JointRef& ref = scratch.joint_refs[k];
+                                     JointConstraint& jc = scratch.joints[k];
+                                     if (ref.type == static_cast<std::uint32_t>(JointType::BallSocket)) {
+                                         clear_unused_impulses(jc);
+                                     } else {
+                                         jc = JointConstraint{};
+                                     }
+                                     jc.joint = ref.joint;
+                                     jc.a = ref.a;
+                                     jc.b = ref.b;
+                                     prepare_joint(world, bodies, jc, h);
+                                 }
                              });
 }
 
@@ -353,10 +376,11 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
     store(A, B, s);
 }
 
-void store_joint_impulses(World& world, SolverScratch& scratch) {
+void store_joint_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
     const SolverBody* bodies = scratch.bodies.data();
-    // Each constraint writes its own joint: any order gives the same result.
-    for (const JointConstraint& jc : scratch.joints) {
+    // Each constraint writes its own joint: any order, any split gives the same result.
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const JointConstraint& jc = scratch.joints[k];
         Joint& j = world.joints.joint[jc.joint];
         j.linear_impulse = jc.linear_impulse;
         j.angular_impulse = jc.angular_impulse;

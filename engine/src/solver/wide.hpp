@@ -115,6 +115,25 @@ inline Wide3 operator*(const WideMat3& a, const Wide3& v) {
             a.m[2][0] * v.x + a.m[2][1] * v.y + a.m[2][2] * v.z};
 }
 
+// A symmetric 3x3 matrix per lane (an inverse inertia, an effective mass): six entries.
+struct WideSym3 {
+    Wide xx{}, xy{}, xz{}, yy{}, yz{}, zz{};
+
+    void set_lane(int i, const Mat3& a) {
+        xx[i] = static_cast<float>(a(0, 0));
+        xy[i] = static_cast<float>(a(0, 1));
+        xz[i] = static_cast<float>(a(0, 2));
+        yy[i] = static_cast<float>(a(1, 1));
+        yz[i] = static_cast<float>(a(1, 2));
+        zz[i] = static_cast<float>(a(2, 2));
+    }
+};
+
+inline Wide3 operator*(const WideSym3& a, const Wide3& v) {
+    return {a.xx * v.x + a.xy * v.y + a.xz * v.z, a.xy * v.x + a.yy * v.y + a.yz * v.z,
+            a.xz * v.x + a.yz * v.y + a.zz * v.z};
+}
+
 // A unit quaternion per lane.
 struct WideQuat {
     Wide3 v;  // x, y, z
@@ -125,6 +144,13 @@ struct WideQuat {
         w[i] = static_cast<float>(q.w());
     }
 };
+
+// q applied to a: a + 2w (v x a) + 2 v x (v x a).
+inline Wide3 rotate(const WideQuat& q, const Wide3& a) {
+    const Wide3 t = cross(q.v, a);
+    const Wide two = splat(2);
+    return a + (two * q.w) * t + two * cross(q.v, t);
+}
 
 // q^-1 applied to a: a - 2w (v x a) + 2 v x (v x a).
 inline Wide3 rotate_inverse(const WideQuat& q, const Wide3& a) {

@@ -38,6 +38,8 @@ constexpr std::uint32_t kBodyGrain = 128;
 constexpr std::uint32_t kConstraintGrain = 2;
 // Wide contacts per block when preparing them and storing their impulses.
 constexpr std::uint32_t kWideGrain = 8;
+// Joints per block when storing their impulses.
+constexpr std::uint32_t kJointGrain = 32;
 
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
@@ -129,36 +131,40 @@ void color(SolverScratch& scratch) {
     }
 }
 
+template <typename T>
+bool same_bytes(const std::vector<T>& x, const std::vector<T>& y) {
+    return x.size() == y.size() && (x.empty() ||  // memcmp may not see the null data of an empty vector
+                                    std::memcmp(x.data(), y.data(), x.size() * sizeof(T)) == 0);
+}
+
 // Whether the colours and packing of the last colouring hold for this step's
 // constraints: the same manifolds of the same bodies, no body made or destroyed (a
 // reused slot could change from kinematic to dynamic, which the colours depend on),
-// the same awake count (the immovable body is the last) and no joints then or now. A
-// resting pile keeps its manifold list from step to step, and comparing it is far
-// cheaper than colouring.
+// the same awake count (the immovable body is the last) and the same joints of the same
+// bodies. A resting pile keeps its manifold list from step to step, a jointed scene its
+// joint list, and comparing them is far cheaper than colouring.
 bool same_constraints(const World& world, SolverScratch& scratch) {
     static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
-    const bool same = scratch.reuse_colors && scratch.joints.empty() && !scratch.colored_joints &&
+    static_assert(std::has_unique_object_representations_v<JointRef>, "compared as bytes");
+    const bool same = scratch.reuse_colors && same_bytes(scratch.colored_joints, scratch.joint_refs) &&
                       scratch.colored_body_set == world.body_set_version &&
                       scratch.colored_bodies == scratch.bodies.size() &&
-                      scratch.colored_manifolds.size() == scratch.manifolds.size() &&
-                      (scratch.manifolds.empty() ||  // memcmp may not see the null data of an empty vector
-                       std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
-                                   scratch.manifolds.size() * sizeof(ManifoldRef)) == 0);
+                      same_bytes(scratch.colored_manifolds, scratch.manifolds);
     if (!same) {
         scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
         scratch.colored_bodies = scratch.bodies.size();
         scratch.colored_body_set = world.body_set_version;
-        scratch.colored_joints = !scratch.joints.empty();
+        scratch.colored_joints = scratch.joint_refs;
     }
     return same;
 }
 
-// Runs joint_fn and contact_fn over constraints [lo, hi) of colour `color`: its joints
-// (if kJoints), then its wide contacts. The overflow (color == kColorCount) is one
-// block, run serially, joints first.
-template <bool kJoints, typename JointFn, typename ContactFn>
-void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, JointFn&& joint_fn,
-                 ContactFn&& contact_fn) {
+// Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
+// `color`: its wide ball-socket joints and other joints (if kJoints), then its wide
+// contacts. The overflow (color == kColorCount) is one block, run serially, joints first.
+template <bool kJoints, typename BallSocketFn, typename JointFn, typename ContactFn>
+void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, BallSocketFn&& ball_socket_fn,
+                 JointFn&& joint_fn, ContactFn&& contact_fn) {
     if (color == kColorCount) {
         if (kJoints) {
             for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
@@ -167,11 +173,16 @@ void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint3
         return;
     }
     const std::vector<std::uint32_t>& joints = scratch.joint_colors[color];
-    const auto joint_count = kJoints ? static_cast<std::uint32_t>(joints.size()) : 0u;
+    const std::uint32_t ball_sockets = kJoints ? scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color]
+                                               : 0u;
+    const auto joint_count = kJoints ? ball_sockets + static_cast<std::uint32_t>(joints.size()) : 0u;
+    WideBallSocket* wide_joints = scratch.wide_joints.data() + scratch.wide_joint_begin[color];
     WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
     for (std::uint32_t k = lo; k < hi; ++k) {
-        if (k < joint_count) {
-            joint_fn(scratch.joints[joints[k]]);
+        if (k < ball_sockets) {
+            ball_socket_fn(wide_joints[k]);
+        } else if (k < joint_count) {
+            joint_fn(scratch.joints[joints[k - ball_sockets]]);
         } else {
             contact_fn(contacts[k - joint_count]);
         }
@@ -182,7 +193,9 @@ void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint3
 // joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
 void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints) {
     for (int c = 0; c < kColorCount; ++c) {
-        const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) : 0u;
+        const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) +
+                                              (scratch.wide_joint_begin[c + 1] - scratch.wide_joint_begin[c])
+                                        : 0u;
         const std::uint32_t count = joints + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
         if (count == 0) continue;
         scratch.phases.push_back(Phase{name, count, kConstraintGrain});
@@ -214,6 +227,11 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     scratch.phases.clear();
     scratch.plan.clear();
     plan_wide_pass(scratch, Pass::PrepareContacts, "PrepareContacts");
+    if (!scratch.wide_joints.empty()) {
+        scratch.phases.push_back(
+            Phase{"PrepareJoints", static_cast<std::uint32_t>(scratch.wide_joints.size()), kWideGrain});
+        scratch.plan.push_back(SolverPhase{Pass::PrepareJoints, 0});
+    }
     for (int sub = 0; sub < settings.substeps; ++sub) {
         plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
         plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
@@ -224,6 +242,16 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     }
     if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
     plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
+    if (!scratch.joints.empty()) {
+        // The lanes' impulses go back to their constraints before the joints keep them.
+        if (!scratch.wide_joints.empty()) {
+            scratch.phases.push_back(
+                Phase{"StoreJointLanes", static_cast<std::uint32_t>(scratch.wide_joints.size()), kWideGrain});
+            scratch.plan.push_back(SolverPhase{Pass::StoreJointLanes, 0});
+        }
+        scratch.phases.push_back(Phase{"StoreJoints", static_cast<std::uint32_t>(scratch.joints.size()), kJointGrain});
+        scratch.plan.push_back(SolverPhase{Pass::StoreJoints, 0});
+    }
     plan_body_pass(scratch, Pass::FinalizeBodies, "FinalizeBodies", n);
 }
 
@@ -260,6 +288,7 @@ void solve(World& world, Real dt) {
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
+        pack_ball_sockets(scratch);  // nothing to do in a scene without joints
         pack_contacts(scratch);
         world.counters.constraint_colorings += 1;
     }
@@ -300,30 +329,36 @@ void solve(World& world, Real dt) {
             EffectCounts& counts = world.scratch_counts[worker];
             switch (phase.pass) {
                 case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
+                case Pass::PrepareJoints: prepare_ball_sockets(scratch, lo, hi); break;
                 case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
+                case Pass::StoreJointLanes: store_ball_socket_impulses(scratch, lo, hi); break;
+                case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
                 case Pass::IntegrateVelocities: integrate_velocities(world, bodies, h, lo, hi, counts); break;
                 case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi, counts); break;
                 case Pass::WarmStart:
                     for_colored<true>(
-                        scratch, phase.color, lo, hi, [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+                        scratch, phase.color, lo, hi, [&](WideBallSocket& wj) { warm_start_ball_sockets(wj, bodies); },
+                        [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
                         [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies); });
                     break;
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
+                        [&](WideBallSocket& wj) { solve_ball_sockets(wj, bodies, joint_solve, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
                         [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, solve_params, counts); });
                     break;
                 case Pass::Relax:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
+                        [&](WideBallSocket& wj) { solve_ball_sockets(wj, bodies, joint_relax, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
                         [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, relax_params, counts); });
                     break;
                 case Pass::Restitution:
                     for_colored<false>(
-                        scratch, phase.color, lo, hi, [](JointConstraint&) {},
+                        scratch, phase.color, lo, hi, [](WideBallSocket&) {}, [](JointConstraint&) {},
                         [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
                     break;
             }
@@ -337,7 +372,6 @@ void solve(World& world, Real dt) {
         world.counters.restitution_applied += c.restitution;
         world.counters.joints_solved += c.joints;
     }
-    if (!scratch.joints.empty()) store_joint_impulses(world, scratch);
     world.counters.bodies_integrated += world.awake.size();
 }
 

@@ -324,3 +324,23 @@ TEST(Sleeping, CreatingAJointWakesBothBodies) {
     space.create_joint(JointDesc::distance_between(a, ball, Vec3(0, 5, 0), Vec3(0, 0.5, 0)));
     EXPECT_TRUE(space.internal_is_awake(ball));
 }
+
+// The solver keeps a step's colours while its constraints stay the same (here: no
+// manifolds, the same joints); a joint made or destroyed between steps must still be
+// solved from the next step on, or no longer.
+TEST(JointColours, AJointMadeOrDestroyedBetweenStepsActsFromTheNextStep) {
+    Space space;
+    space.set_sleep(SleepSettings{.enabled = false});
+    const BodyHandle anchor = add_static(space, Vec3::Zero());
+    const BodyHandle hanging = add_sphere(space, Vec3(0, -1, 0), 0.2, 1);
+    const JointHandle held = space.create_joint(JointDesc::ball_socket_at(anchor, hanging, Vec3::Zero()));
+    const BodyHandle falling = add_sphere(space, Vec3(3, -1, 0), 0.2, 1);
+    for (int i = 0; i < 10; ++i) space.update();
+    const Vec3 caught_at = space.internal_position(falling);
+    space.create_joint(JointDesc::ball_socket_at(anchor, falling, caught_at));  // a rod to the first anchor
+    space.destroy_joint(held);
+    for (int i = 0; i < 60; ++i) space.update();
+    // The caught sphere stays at the rod's end (it swings about the anchor, never away).
+    EXPECT_NEAR((space.internal_position(falling) - Vec3::Zero()).norm(), caught_at.norm(), 0.02);
+    EXPECT_LT(space.internal_position(hanging).y(), -4.0) << "the released sphere falls";
+}
