@@ -142,7 +142,7 @@ inline constexpr std::uint8_t kContactSensor = 1u << 1;
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;
-    FeatureCache feature;  // the axis that last kept a box or hull pair apart (collide_cached)
+    FeatureCache feature;  // the feature that last kept a box or hull pair apart or made its manifold (collide_cached)
     std::uint8_t manifold_count = 0;
     std::uint8_t events = 0;          // kContactReports, kContactSensor (set at creation)
     bool sleeping : 1 = false;        // written by one thread at a time, as every field of a contact

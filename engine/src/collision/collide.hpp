@@ -35,33 +35,46 @@ struct Manifold {
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
             Manifold* out, int capacity);
 
-// What the last test of a box or hull pair found apart, kept with the contact: the axis
-// that separated the two (a face of either, or an edge of each). A pair that stays apart
-// is then told so by one support query on that axis instead of a whole SAT. The indices
-// are the pair function's (the lower shape type is its A), so a contact always reads its
-// own. Only an axis that still separates past the speculative distance ends the test,
-// and the whole SAT would have found it too: the result is the same bits with or without.
+// What the last whole test of a box or hull pair decided on, kept with the contact (the
+// idea of Box3D's b3SATCache): the feature whose axis separated the two or made their
+// manifold (a face of either, or an edge of each) and the separation along that axis then.
+// The indices are the pair function's (the lower shape type is its A), so a contact always
+// reads its own. Next time one query on that axis comes first:
+// - still apart past the speculative distance: apart, as the whole SAT would find too (the
+//   same bits with or without the cache);
+// - else, while the separation along the axis is within `feature_slop` of the one kept and
+//   the feature still makes a contact (the face's clipped points within reach, the two
+//   edges still crossing), the manifold is built from that feature alone. It may then not
+//   be the SAT's best axis any more: the pair has moved less than a slop along it, which
+//   the solver allows as penetration anyway, and the whole SAT runs once it has moved more.
 class FeatureCache {
 public:
     enum class Kind : std::uint32_t { None, FaceA, FaceB, EdgePair };
     FeatureCache() = default;
-    FeatureCache(Kind kind, std::uint32_t index_a, std::uint32_t index_b)
-        : m_bits(static_cast<std::uint32_t>(kind) | (index_a & kIndexMask) << 2 | (index_b & kIndexMask) << 17) {}
+    FeatureCache(Kind kind, std::uint32_t index_a, std::uint32_t index_b, float separation = 0)
+        : m_bits(static_cast<std::uint32_t>(kind) | (index_a & kIndexMask) << 2 | (index_b & kIndexMask) << 17),
+          m_separation(separation) {}
     Kind kind() const noexcept { return static_cast<Kind>(m_bits & 3u); }
     std::uint32_t index_a() const noexcept { return m_bits >> 2 & kIndexMask; }
     std::uint32_t index_b() const noexcept { return m_bits >> 17 & kIndexMask; }
+    // Along the feature's axis when the whole SAT chose it (negative: overlapping).
+    float separation() const noexcept { return m_separation; }
     friend bool operator==(FeatureCache, FeatureCache) = default;
 
 private:
-    // Four bytes, in a gap of the contact record: a hull has at most 762 edges.
+    // Eight bytes, in every contact record: a hull has at most 762 edges, and a float
+    // tells a slop (millimetres) apart from metres.
     static constexpr std::uint32_t kIndexMask = (1u << 15) - 1;
     std::uint32_t m_bits = 0;
+    float m_separation = 0;
 };
 
 // collide() with the pair's cache, for the narrowphase: box-hull and hull-hull pairs
-// read and write it; any other pair clears it.
+// read and write it; any other pair clears it. `feature_slop`: how far the separation
+// along a cached touching feature may drift before the whole SAT runs again (the
+// solver's linear slop; 0 never reuses a touching feature).
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-                   Manifold* out, int capacity, FeatureCache& cache);
+                   Manifold* out, int capacity, FeatureCache& cache, Real feature_slop);
 
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns

@@ -41,15 +41,15 @@ int collide_compound_compound(const Shape&, const Transform&, const Shape&, cons
 // ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and
 // Gauss-map-pruned edge pairs, then face clipping or a single edge-edge point.
-// With a cache (see FeatureCache), the separating axis it holds is tried first and the
-// one found is kept there.
+// With a cache (see FeatureCache), the feature it holds is tried first (a touching one
+// while its separation stays within `feature_slop`) and the one found is kept there.
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb,
-                       Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
+                       Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr, Real feature_slop = 0);
 // The same with A prepared once for many tests (sat_prepared.hpp): a hull against each
 // triangle a mesh query finds.
 class PreparedPolyhedron;
 bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
-                       Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
+                       Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr, Real feature_slop = 0);
 
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
 // radius) against polyhedron b: GJK distance between the cores while they are apart, SAT

@@ -72,7 +72,7 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
 }
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-                   Manifold* out, int capacity, FeatureCache& cache) {
+                   Manifold* out, int capacity, FeatureCache& cache, Real feature_slop) {
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
     // Box-box has its own 15-axis test.
     if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
@@ -90,10 +90,10 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
     if (first.type == ShapeType::Box) {
         const detail::BoxPoly box(first.half_extents);
         touching = detail::collide_polyhedra(box.view(), x_first, second_view, x_second, speculative_distance, out[0],
-                                             &cache);
+                                             &cache, feature_slop);
     } else {
         touching = detail::collide_polyhedra(detail::view_of(*first.hull), x_first, second_view, x_second,
-                                             speculative_distance, out[0], &cache);
+                                             speculative_distance, out[0], &cache, feature_slop);
     }
     if (!touching) return 0;
     if (swap) detail::flip_manifold(out[0]);

@@ -179,32 +179,44 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     return best;
 }
 
-// Whether the axis the cache holds still separates the two past `limit`. Computed as the
-// whole SAT computes it, so it says so exactly when that axis would end the whole SAT.
-bool apart_on_cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b, Real limit) {
+// The axis of the feature the cache holds, with the separation along it computed as the
+// whole SAT computes it: past the speculative distance it ends the test exactly when that
+// axis would end the whole SAT. Not valid when the feature no longer stands (an index past
+// the shape's, edges that no longer form a face of the Minkowski difference).
+struct CachedAxis {
+    bool valid = false;
+    Real separation = 0;
+    Vec3 unit = Vec3::UnitY();  // edge pairs only: from A to B
+};
+
+CachedAxis cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b) {
+    CachedAxis axis;
     switch (cache.kind()) {
         case FeatureCache::Kind::FaceA:
-            return cache.index_a() < a.view.face_count && face_separation(a, b, cache.index_a()) > limit;
+            if (cache.index_a() < a.view.face_count) axis = {true, face_separation(a, b, cache.index_a())};
+            break;
         case FeatureCache::Kind::FaceB:
-            return cache.index_b() < b.view.face_count && face_separation(b, a, cache.index_b()) > limit;
-        case FeatureCache::Kind::EdgePair: {
-            if (cache.index_a() >= a.view.edge_count || cache.index_b() >= b.view.edge_count) return false;
-            Vec3 unit;
-            Real s;
-            return edge_pair_axis(arc_edge(a, cache.index_a()), arc_edge(b, cache.index_b()), unit, s) && s > limit;
-        }
+            if (cache.index_b() < b.view.face_count) axis = {true, face_separation(b, a, cache.index_b())};
+            break;
+        case FeatureCache::Kind::EdgePair:
+            if (cache.index_a() < a.view.edge_count && cache.index_b() < b.view.edge_count) {
+                axis.valid = edge_pair_axis(arc_edge(a, cache.index_a()), arc_edge(b, cache.index_b()), axis.unit,
+                                            axis.separation);
+            }
+            break;
         case FeatureCache::Kind::None: break;
     }
-    return false;
+    return axis;
 }
 
-void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t index_a, std::uint32_t index_b) {
-    if (cache) *cache = FeatureCache(kind, index_a, index_b);
+void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t index_a, std::uint32_t index_b,
+                   Real separation) {
+    if (cache) *cache = FeatureCache(kind, index_a, index_b, static_cast<float>(separation));
 }
 
-// Clips the incident face of `inc` against reference face `face` of `ref`. A vertex that
-// clipping drops lies beside the reference face, outside `ref`, and is not kept, unless
-// no point survives at all.
+// Clips the incident face of `inc` against reference face `face` of `ref` and returns the
+// points within reach. A vertex that clipping drops lies beside the reference face,
+// outside `ref`, and is not kept.
 int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative, Vec3& n,
                  ContactCandidate* out) {
     n = ref.normal(face);
@@ -239,16 +251,82 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
         if (s > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
     }
-    if (n_out > 0) return n_out;
-    // Nothing over the reference face is within reach, yet the face axis says the shapes
-    // touch (it won over an edge pair by the bias towards faces): the incident vertex
-    // deepest along the normal stands for the contact, so the pair is never left without one.
+    return n_out;
+}
+
+// When nothing over the reference face is within reach, yet the face axis says the shapes
+// touch (it won over an edge pair by the bias towards faces): the incident vertex deepest
+// along the normal stands for the contact, so the pair is never left without one.
+int deepest_vertex_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b,
+                           Real speculative, ContactCandidate* out) {
+    const Vec3 n = ref.normal(face);
+    const Real d = ref.offset(face, n);
+    std::uint32_t incident = 0;
+    Real most_against = kHuge;
+    for (std::uint32_t f = 0; f < inc.view.face_count; ++f) {
+        const Real x = inc.normal(f).dot(n);
+        if (x < most_against) most_against = x, incident = f;
+    }
     const std::uint32_t v = inc.support(-n);
     const Real s = n.dot(inc.vertices[v]) - d;
     if (s > speculative) return 0;
     out[0] = {inc.vertices[v] - n * (Real(0.5) * s), s,
               face_contact_id(reference_is_b, face, incident, clip_key(3, v, v >> 6))};
     return 1;
+}
+
+// The manifold (in A's frame) of reference face `face`, of B when `reference_is_b`, with
+// the deepest incident vertex standing in when no clipped point is within reach (unless
+// `clipped_only`). False when there is no point.
+bool face_manifold(const Posed& pa, const Posed& pb, std::uint32_t face, bool reference_is_b, Real speculative,
+                   bool clipped_only, Manifold& m) {
+    const Posed& ref = reference_is_b ? pb : pa;
+    const Posed& inc = reference_is_b ? pa : pb;
+    // Clipping leaves at most (incident face + reference face) vertices.
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
+    Vec3 n;
+    int count = face_contact(ref, face, inc, reference_is_b, speculative, n, candidates.data());
+    if (count == 0 && !clipped_only)
+        count = deepest_vertex_contact(ref, face, inc, reference_is_b, speculative, candidates.data());
+    if (count == 0) return false;
+    m.normal = reference_is_b ? Vec3(-n) : n;
+    reduce_to_manifold(candidates.data(), count, m);
+    return true;
+}
+
+// The one point (in A's frame) between edge edge_a of A and edge_b of B, along `axis`.
+// With `crossing_only`, false when the closest points of the two lines lie beyond the ends
+// of either edge: the edges no longer cross, and something else touches.
+bool edge_manifold(const Posed& pa, const Posed& pb, std::uint32_t edge_a, std::uint32_t edge_b, const Vec3& axis,
+                   bool crossing_only, Manifold& m) {
+    const HullEdge& ea = pa.view.edges[edge_a];
+    const HullEdge& eb = pb.view.edges[edge_b];
+    const Vec3& a0 = pa.vertices[ea.v0];
+    const Vec3& b0 = pb.vertices[eb.v0];
+    const Vec3 da = pa.vertices[ea.v1] - a0, db = pb.vertices[eb.v1] - b0;
+    Real s = 0, u = 0;
+    closest_segment_parameters(a0, da, b0, db, s, u);
+    if (crossing_only && (s <= 0 || s >= 1 || u <= 0 || u >= 1)) return false;
+    const Vec3 on_a = a0 + s * da, on_b = b0 + u * db;
+    m.normal = axis;
+    m.points[0] = {Real(0.5) * (on_a + on_b), axis.dot(on_b - on_a), edge_contact_id(edge_a, edge_b)};
+    m.point_count = 1;
+    return true;
+}
+
+// The manifold from the cached touching feature alone (in A's frame), when the feature
+// still makes one within reach.
+bool cached_manifold(const FeatureCache& cache, const CachedAxis& axis, const Posed& pa, const Posed& pb,
+                     Real speculative, Manifold& m) {
+    switch (cache.kind()) {
+        case FeatureCache::Kind::FaceA: return face_manifold(pa, pb, cache.index_a(), false, speculative, true, m);
+        case FeatureCache::Kind::FaceB: return face_manifold(pa, pb, cache.index_b(), true, speculative, true, m);
+        case FeatureCache::Kind::EdgePair:
+            return edge_manifold(pa, pb, cache.index_a(), cache.index_b(), axis.unit, true, m) &&
+                   m.points[0].separation <= speculative;
+        case FeatureCache::Kind::None: break;
+    }
+    return false;
 }
 
 }  // namespace
@@ -270,13 +348,13 @@ void PreparedPolyhedron::prepare_edges() const {
 }
 
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,
-                       Manifold& m, FeatureCache* cache) {
+                       Manifold& m, FeatureCache* cache, Real feature_slop) {
     const PreparedPolyhedron prepared(a);
-    return collide_polyhedra(prepared, xa, b, xb, speculative, m, cache);
+    return collide_polyhedra(prepared, xa, b, xb, speculative, m, cache, feature_slop);
 }
 
 bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
-                       Real speculative, Manifold& m, FeatureCache* cache) {
+                       Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop) {
     const PolyView& a = prepared.view();
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
@@ -287,51 +365,47 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero()};
     const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t};
 
-    if (cache && apart_on_cached_axis(*cache, pa, pb, speculative)) return false;
     using Kind = FeatureCache::Kind;
+    if (cache && cache->kind() != Kind::None) {
+        const CachedAxis axis = cached_axis(*cache, pa, pb);
+        if (axis.valid && axis.separation > speculative) return false;
+        if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
+            cached_manifold(*cache, axis, pa, pb, speculative, m)) {
+            manifold_to_world(m, xa);
+            return true;
+        }
+    }
     const FaceQuery face_a = query_faces(pa, pb, speculative);
     if (face_a.separation > speculative) {
-        remember_axis(cache, Kind::FaceA, face_a.face, 0);
+        remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
         return false;
     }
     const FaceQuery face_b = query_faces(pb, pa, speculative);
     if (face_b.separation > speculative) {
-        remember_axis(cache, Kind::FaceB, 0, face_b.face);
+        remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
         return false;
     }
     const EdgeQuery edge = query_edges(prepared, pa, pb, speculative);
     if (edge.separation > speculative) {
-        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b);
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
         return false;
     }
-    remember_axis(cache, Kind::None, 0, 0);
 
     if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
-        const HullEdge& ea = a.edges[edge.edge_a];
-        const HullEdge& eb = b.edges[edge.edge_b];
-        const Vec3& a0 = a.vertices[ea.v0];
-        const Vec3& b0 = b_vertices[eb.v0];
-        const Vec3 da = a.vertices[ea.v1] - a0, db = b_vertices[eb.v1] - b0;
-        Real s = 0, u = 0;
-        closest_segment_parameters(a0, da, b0, db, s, u);
-        const Vec3 on_a = a0 + s * da, on_b = b0 + u * db;
-        m.normal = edge.axis;
-        m.points[0] = {Real(0.5) * (on_a + on_b), edge.axis.dot(on_b - on_a),
-                       edge_contact_id(edge.edge_a, edge.edge_b)};
-        m.point_count = 1;
+        edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
         manifold_to_world(m, xa);
         return true;
     }
 
     const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-    // Clipping leaves at most (incident face + reference face) vertices.
-    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(a.vertex_count + b.vertex_count);
-    Vec3 n;
-    const int count = reference_is_b ? face_contact(pb, face_b.face, pa, true, speculative, n, candidates.data())
-                                     : face_contact(pa, face_a.face, pb, false, speculative, n, candidates.data());
-    if (count == 0) return false;
-    m.normal = reference_is_b ? Vec3(-n) : n;
-    reduce_to_manifold(candidates.data(), count, m);
+    const FaceQuery& reference = reference_is_b ? face_b : face_a;
+    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
+        remember_axis(cache, Kind::None, 0, 0, 0);
+        return false;
+    }
+    if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
+    else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
     manifold_to_world(m, xa);
     return true;
 }

@@ -201,7 +201,8 @@ void update_narrowphase(World& world) {
             const Real speculative = settings.speculative_distance + closing;
             const Shape& shape_a = b.desc[a].shape;
             const Shape& shape_b = b.desc[bb].shape;
-            const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature);
+            const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
+                                         settings.linear_slop);
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;
