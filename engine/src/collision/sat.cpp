@@ -214,6 +214,17 @@ void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t i
     if (cache) *cache = FeatureCache(kind, index_a, index_b, static_cast<float>(separation));
 }
 
+// The face of `inc` that faces most against the reference normal n.
+std::uint32_t incident_face(const Posed& inc, const Vec3& n) {
+    std::uint32_t incident = 0;
+    Real most_against = kHuge;
+    for (std::uint32_t f = 0; f < inc.view.face_count; ++f) {
+        const Real x = inc.normal(f).dot(n);
+        if (x < most_against) most_against = x, incident = f;
+    }
+    return incident;
+}
+
 // Clips the incident face of `inc` against reference face `face` of `ref` and returns the
 // points within reach. A vertex that clipping drops lies beside the reference face,
 // outside `ref`, and is not kept.
@@ -221,12 +232,7 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
                  ContactCandidate* out) {
     n = ref.normal(face);
     const Real d = ref.offset(face, n);
-    std::uint32_t incident = 0;
-    Real most_against = kHuge;
-    for (std::uint32_t f = 0; f < inc.view.face_count; ++f) {
-        const Real x = inc.normal(f).dot(n);
-        if (x < most_against) most_against = x, incident = f;
-    }
+    const std::uint32_t incident = incident_face(inc, n);
     const HullFace& ref_face = ref.view.faces[face];
     const HullFace& inc_face = inc.view.faces[incident];
     const std::size_t capacity = inc_face.count + ref_face.count + 1;
@@ -261,12 +267,7 @@ int deepest_vertex_contact(const Posed& ref, std::uint32_t face, const Posed& in
                            Real speculative, ContactCandidate* out) {
     const Vec3 n = ref.normal(face);
     const Real d = ref.offset(face, n);
-    std::uint32_t incident = 0;
-    Real most_against = kHuge;
-    for (std::uint32_t f = 0; f < inc.view.face_count; ++f) {
-        const Real x = inc.normal(f).dot(n);
-        if (x < most_against) most_against = x, incident = f;
-    }
+    const std::uint32_t incident = incident_face(inc, n);
     const std::uint32_t v = inc.support(-n);
     const Real s = n.dot(inc.vertices[v]) - d;
     if (s > speculative) return 0;
