@@ -3,7 +3,8 @@
 // every body moves the query tree's way each flip) while an AsyncRunner steps it on the
 // other core, a frame at most every 1/60 s. Reported: time per query on the game thread,
 // hits, and the loop's steps per second beside the same loop with the game thread idle
-// (queries 0).
+// (queries 0). FirstQuery: the first ray cast into a space that has never been queried, which
+// builds its query scenes from the published states (a field of static boxes, stepped once).
 #include <spindle/engine/async_runner.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/clock.hpp>
@@ -11,6 +12,8 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cmath>
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -73,8 +76,47 @@ void QueriesWhilePhysicsRuns(benchmark::State& state) {
     state.counters["query_scene_copies"] = static_cast<double>(space.counters().query_scene_copies);
 }
 
+// A square field of state.range(0) static unit boxes, 2 m apart, and one falling box,
+// stepped once; timed: the first ray cast, straight down onto the field's middle.
+void FirstQuery(benchmark::State& state) {
+    const auto bodies = static_cast<int>(state.range(0));
+    const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(bodies))));
+    double build_seconds = 0;
+    for (auto _ : state) {
+        state.PauseTiming();
+        auto space = std::make_unique<Space>();
+        BodyDesc field;
+        field.type = MotionType::Static;
+        field.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        for (int k = 0; k < bodies; ++k) {
+            field.position = Vec3(2.0 * (k % side), 0, 2.0 * (k / side));
+            space->create_body(field);
+        }
+        BodyDesc falling;
+        falling.position = Vec3(0, 5, 0);
+        space->create_body(falling);
+        space->update();
+        const Vec3 middle(2.0 * (side / 2), 10, 2.0 * (side / 2));
+        state.ResumeTiming();
+        const std::int64_t t0 = now_nanoseconds();
+        const bool hit = space->cast_ray(middle, middle - Vec3(0, 20, 0)).has_value();
+        build_seconds += static_cast<double>(now_nanoseconds() - t0) * 1e-9;
+        if (!hit) state.SkipWithError("the first ray missed the field");
+        state.PauseTiming();
+        space.reset();
+        state.ResumeTiming();
+    }
+    state.counters["ms_first_query"] = build_seconds / static_cast<double>(state.iterations()) * 1e3;
+}
+
 }  // namespace
 
+BENCHMARK(FirstQuery)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->ArgName("static_bodies")
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(QueriesWhilePhysicsRuns)
     ->Arg(kIdle)
     ->Arg(kRays)

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <numbers>
+#include <vector>
 
 #include "collision/cast.hpp"
 #include "query/slerp_series.hpp"
@@ -137,13 +138,16 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
 
 // Poses from the buffer, not the live state: between flips the live state may be ahead of
 // what reads return (set_internal_motion_state), and the back buffer is behind it until
-// the flip refills it (then exactly the bodies refreshed there differ). Every proxy goes
-// in, then the tree is built once over all of them.
+// the flip refills it (then exactly the bodies refreshed there differ). The tree is built
+// once over all the boxes (create_proxies), not grown a proxy at a time: a first query in a
+// world of a million bodies pays one top-down build instead of a million sibling searches.
 std::shared_ptr<QueryScene> QueryScene::build(const World& world, const PublishedBuffer& buffer) {
     auto scene = std::make_shared<QueryScene>();
     const Bodies& b = world.bodies;
     scene->reserve(b.capacity());
     const auto slots = static_cast<std::uint32_t>(std::min<std::size_t>(buffer.size(), b.capacity()));
+    std::vector<Aabb> tight;
+    std::vector<std::uint64_t> user;
     for (std::uint32_t i = 0; i < slots; ++i) {
         // A body made or destroyed but not published yet (a creation waiting for the lock
         // this build runs under) joins the scene at the next flip, which refreshes it.
@@ -156,9 +160,12 @@ std::shared_ptr<QueryScene> QueryScene::build(const World& world, const Publishe
         body.current = {buffer.current[i].position, buffer.current[i].orientation};
         body.interpolate = buffer.interpolate[i] != 0;
         if (body.interpolate) body.previous = {buffer.previous[i].position, buffer.previous[i].orientation};
-        body.proxy = scene->m_tree.create_proxy(scene->tight_bounds(i), i);
+        tight.push_back(scene->tight_bounds(i));
+        user.push_back(i);
     }
-    scene->m_tree.rebuild();
+    std::vector<std::int32_t> ids(tight.size());
+    scene->m_tree.create_proxies(tight, user, ids);
+    for (std::size_t k = 0; k < ids.size(); ++k) scene->m_bodies[user[k]].proxy = ids[k];
     return scene;
 }
 
