@@ -7,7 +7,7 @@
 // library (jrouwe/JoltPhysics, cmake -S Build -B build -DCMAKE_BUILD_TYPE=Release, target Jolt),
 // then
 //   scripts/peers/build_jolt_delicate.sh JOLT_BUILD_DIR [OUT]   (JOLT_BUILD_DIR holds libJolt.a)
-//   OUT [velocity_steps [position_steps]]
+//   OUT [velocity_steps [position_steps [penetration_slop_m]]]   (Jolt's defaults: 10, 2, 0.02)
 #include <Jolt/Jolt.h>
 
 #include <Jolt/Core/Factory.h>
@@ -35,6 +35,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kGap = 1e-4;  // each body is built this far above what it rests on
 constexpr float kStep = 1.0f / 60;
 int g_velocity_steps = -1, g_position_steps = -1;  // -1: Jolt's default
+float g_penetration_slop = -1;                      // m; -1: Jolt's default
 
 constexpr ObjectLayer kStatic = 0, kMoving = 1;
 
@@ -70,6 +71,7 @@ public:
         settings.mAllowSleeping = false;
         if (g_velocity_steps > 0) settings.mNumVelocitySteps = static_cast<uint>(g_velocity_steps);
         if (g_position_steps >= 0) settings.mNumPositionSteps = static_cast<uint>(g_position_steps);
+        if (g_penetration_slop >= 0) settings.mPenetrationSlop = g_penetration_slop;
         m_system.SetPhysicsSettings(settings);
     }
 
@@ -236,6 +238,7 @@ void arch(int stones, double inner, double outer) {
 int main(int argc, char** argv) {
     if (argc > 1) g_velocity_steps = std::atoi(argv[1]);
     if (argc > 2) g_position_steps = std::atoi(argv[2]);
+    if (argc > 3) g_penetration_slop = static_cast<float>(std::atof(argv[3]));
     RegisterDefaultAllocator();
     Factory::sInstance = new Factory();
     RegisterTypes();
