@@ -138,5 +138,28 @@ TEST(BoxBox, MatchesHullHullOnRandomPoses) {
     EXPECT_GT(compared, 30);
 }
 
+// Two cards leaning at 68 degrees, their inner top edges meeting as at a card house's
+// apex: a sharp edge has no one normal, and either card's face normal would tilt the push
+// 22 degrees off the symmetric one. Meeting exactly, the normal is the faces' bisector
+// (horizontal); with one edge 1 mm down the other card's face, well past the edges'
+// rounding, that face carries the edge and its normal is kept.
+TEST(BoxBox, CardsMeetingAtAnApexPushAlongTheBisector) {
+    const Vec3 half(0.044, 0.001, 0.0315);
+    const Shape card = Shape::box(half);
+    const Real lean = 68 * kPi / 180, c = std::cos(lean), s = std::sin(lean);
+    const Real x = half.x() * c + half.y() * s;  // apex to a card's centre
+    const Transform left = at(Vec3(-x, 0, 0), about(Vec3::UnitZ(), lean));
+    const Transform right = at(Vec3(x, 0, 0), about(Vec3::UnitZ(), -lean));
+    const auto apex = run(card, left, card, right, 0.01);
+    ASSERT_EQ(apex.size(), 1u);
+    EXPECT_NEAR(apex[0].normal.x(), 1, 1e-9);
+    EXPECT_NEAR(test::min_separation(apex[0]), 0, 1e-9);
+
+    const Vec3 down_the_face = -Vec3(c, s, 0) * 0.001;
+    const auto lower = run(card, left, card, at(right.p + down_the_face, right.q), 0.01);
+    ASSERT_EQ(lower.size(), 1u);
+    SPINDLE_EXPECT_VEC_NEAR(lower[0].normal, Vec3(s, -c, 0), 1e-9);  // the left card's inner face
+}
+
 }  // namespace
 }  // namespace spindle
