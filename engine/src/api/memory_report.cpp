@@ -25,9 +25,10 @@ std::size_t body_bytes(const Bodies& b) {
 std::size_t solver_other_bytes(const SolverScratch& s) {
     std::size_t bytes = held(s.bodies) + held(s.manifolds) + held(s.colored_manifolds) + held(s.overflow) +
                         held(s.joints) + held(s.joint_refs) + held(s.colored_joints) + held(s.wide_joints) +
-                        held(s.joint_overflow) + held(s.body_colors) + held(s.support_scales) + held(s.support_edges) +
-                        held(s.support_first) + held(s.support_by_lower) + held(s.support_queue) + held(s.supported) +
-                        held(s.phases) + held(s.plan);
+                        held(s.wide_swing_twists) + held(s.wide_hinges) + held(s.joint_overflow) + held(s.body_colors) +
+                        held(s.support_scales) + held(s.support_edges) + held(s.support_first) +
+                        held(s.support_by_lower) + held(s.support_queue) + held(s.supported) + held(s.phases) +
+                        held(s.plan);
     for (int c = 0; c < kColorCount; ++c) bytes += held(s.colors[c]) + held(s.joint_colors[c]);
     return bytes;
 }

@@ -1,6 +1,6 @@
 // The bodies of kLanes constraints of one colour in floats, a lane each: gathered from
 // the solver bodies' doubles before a pass over the constraints and scattered back after
-// it. Shared by the solvers that work on lanes (contact_solver.cpp, joint_ball_socket.cpp).
+// it. Shared by the solvers that work on lanes (contact_solver.cpp, joint_lanes.cpp).
 #pragma once
 
 #include <cstddef>

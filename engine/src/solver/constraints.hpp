@@ -166,19 +166,47 @@ struct JointConstraint {
     Real swing_impulse = 0;
 };
 
-// kLanes ball-socket joints of one colour solved together, one per lane
-// (joint_ball_socket.cpp), as a WideContact solves manifolds: a chain or a net of them is
-// most of its step. Lanes past `lanes` hold no joint: both bodies are the immovable one.
-// Made from the joints' JointConstraints each step, and their impulses handed back.
-struct WideBallSocket {
+// kLanes joints of one colour and one type solved together, one per lane (joint_lanes.cpp),
+// as a WideContact solves manifolds: a chain or a net of ball-sockets, or ragdolls of
+// swing-twist joints and hinges, is most of its step. Every lane joint has the point row
+// (a ball-socket's only row, the point part of the others), kept here; a swing-twist or
+// hinge block's angular rows are kept apart (`angular` indexes SolverScratch's
+// wide_swing_twists or wide_hinges), so a ball-socket pass streams only what it reads.
+// Lanes past `lanes` hold no joint: both bodies are the immovable one. Made from the
+// joints' JointConstraints each step, and their impulses handed back.
+struct WideJoint {
     std::uint32_t a[kLanes] = {}, b[kLanes] = {};  // solver bodies per lane
     std::uint32_t joint[kLanes] = {};              // index in SolverScratch::joints
     int lanes = 0;
+    JointType type = JointType::BallSocket;
+    std::uint32_t angular = 0;
     Wide3 ra, rb;        // anchors from each centre of mass at the step's start, world
     Wide3 delta_center;  // B's centre of mass minus A's at the step's start
     Wide inv_mass_a{}, inv_mass_b{};
     WideSym3 inv_inertia_a, inv_inertia_b;  // world, fixed for the step
     Wide3 impulse;                          // accumulated (JointConstraint::linear_impulse)
+};
+
+// A swing-twist block's angular rows (joint_swing_twist.cpp): JointConstraint's, per lane.
+struct WideSwingTwist {
+    Wide3 axis_a, axis_b, ref_a, ref_b;  // twist axes and references, world at the step's start
+    Wide cone{}, lower{}, upper{};
+    WideMask limits_cone{}, limits_twist{};  // lanes whose cone or twist range limits anything
+    Wide max_friction_impulse{};             // 0 where there is no friction
+    WideSym3 rotation_mass;                  // (Ia^-1 + Ib^-1)^-1, the friction's
+    Wide3 friction_impulse;                  // JointConstraint::angular_impulse
+    Wide swing_impulse{}, lower_impulse{}, upper_impulse{};
+};
+
+// A hinge block's angular rows (joint_hinge.cpp): JointConstraint's, per lane.
+struct WideHinge {
+    Wide3 axis_a, perp_b[2], ref_a, ref_b;  // world at the step's start
+    Wide lower{}, upper{};
+    WideMask limited{}, soft_limit{};
+    Wide spring_bias_rate{}, spring_mass_scale{}, spring_impulse_scale{};  // a soft limit's
+    Wide motor_speed{}, max_motor_impulse{};                               // 0 without a motor
+    Wide align_impulse[2]{};
+    Wide motor_impulse{}, lower_impulse{}, upper_impulse{};
 };
 
 // How joints are solved in one pass: soft position correction with use_bias, none
@@ -240,11 +268,13 @@ struct SolverScratch {
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed
-    // Joint indices per colour (joints are coloured first), but for the ball-socket joints
-    // of bodies without motion locks: those are packed kLanes at a time, colour c's in
-    // wide_joints[wide_joint_begin[c], wide_joint_begin[c + 1]).
+    // Joint indices per colour (joints are coloured first), but for the ball-socket,
+    // swing-twist and hinge joints of bodies without motion locks: those are packed kLanes
+    // at a time, colour c's in wide_joints[wide_joint_begin[c], wide_joint_begin[c + 1]).
     std::vector<std::uint32_t> joint_colors[kColorCount];
-    std::vector<WideBallSocket> wide_joints;
+    std::vector<WideJoint> wide_joints;
+    std::vector<WideSwingTwist> wide_swing_twists;  // the angular rows of wide_joints' swing-twist blocks
+    std::vector<WideHinge> wide_hinges;             // and of their hinge blocks
     std::uint32_t wide_joint_begin[kColorCount + 1] = {};
     std::vector<std::uint32_t> joint_overflow;
     std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
@@ -303,15 +333,16 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
 void store_joint_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo,
                           std::uint32_t hi);  // joints [lo, hi)
 
-// joint_ball_socket.cpp. pack_ball_sockets takes the ball-socket joints out of the
-// colours' joint lists (after colouring) and lays them out kLanes at a time;
-// prepare_ball_sockets fills wide_joints [lo, hi) from their prepared JointConstraints;
-// store_ball_socket_impulses hands the impulses of wide_joints [lo, hi) back to them
-// (before store_joint_impulses).
-void pack_ball_sockets(SolverScratch& scratch);
-void prepare_ball_sockets(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
-void warm_start_ball_sockets(WideBallSocket& wj, SolverBody* bodies);
-void solve_ball_sockets(WideBallSocket& wj, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts);
-void store_ball_socket_impulses(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
+// joint_lanes.cpp. pack_joint_lanes takes the ball-socket, swing-twist and hinge joints
+// out of the colours' joint lists (after colouring) and lays them out kLanes at a time,
+// one type to a block; prepare_joint_lanes fills wide_joints [lo, hi) from their prepared
+// JointConstraints; store_joint_lane_impulses hands the impulses of wide_joints [lo, hi)
+// back to them (before store_joint_impulses).
+void pack_joint_lanes(SolverScratch& scratch);
+void prepare_joint_lanes(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
+void warm_start_joint_lanes(const SolverScratch& scratch, const WideJoint& wj, SolverBody* bodies);
+void solve_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, const JointSolveParams& params,
+                       EffectCounts& counts);
+void store_joint_lane_impulses(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 }  // namespace spindle

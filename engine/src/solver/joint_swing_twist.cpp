@@ -1,11 +1,13 @@
 // The swing-twist joint (ragdoll shoulders, hips, necks): the point constraint, a cone
 // limit on the swing of B's twist axis away from A's, a range on the twist about it, and
 // friction against both. One row along the swing axis for the cone, one per twist side.
+// Solved one at a time in doubles for a body with motion locks, kLanes at a time in
+// floats otherwise (the lanes below; joint_lanes.cpp runs them).
 #include <algorithm>
 #include <cmath>
 
 #include "api/joint_store.hpp"
-#include "solver/joint_rows.hpp"
+#include "solver/joint_lanes.hpp"
 
 namespace spindle {
 namespace {
@@ -108,6 +110,116 @@ void solve_swing_twist(JointConstraint& jc, const SolverBody& A, const SolverBod
         apply_angular(A, B, s, -impulse * axis);
     }
     solve_point(jc, A, B, s, p);
+}
+
+// The lanes: the rows above, per lane. A lane without a twist range or a cone has no mass
+// along its row, so it pushes nothing there.
+namespace {
+
+struct WideAxes {
+    Wide3 a, b;         // the twist axes now
+    Wide3 cross;        // a x b
+    Wide sine{};        // |a x b|
+    Wide3 swing_axis;   // unit; zero where there is no swing to speak of
+    Wide3 twist_axis;   // halfway between the two twist axes
+    WideMask swings{};  // lanes with a swing axis
+};
+
+WideAxes wide_axes(const WideSwingTwist& w, const WideMotion& m) {
+    WideAxes r;
+    r.a = rotate(m.dqa, w.axis_a);
+    r.b = rotate(m.dqb, w.axis_b);
+    r.cross = spindle::cross(r.a, r.b);
+    r.sine = length(r.cross);
+    r.swings = r.sine > splat(kMinSwingSine);
+    r.swing_axis = select(r.swings, splat(1) / r.sine, splat(0)) * r.cross;
+    const Wide3 halfway = r.a + r.b;
+    const Wide norm = length(halfway);
+    const WideMask apart = norm > splat(1e-6);
+    const Wide inv = select(apart, splat(1) / norm, splat(0));
+    r.twist_axis = {select(apart, inv * halfway.x, r.a.x), select(apart, inv * halfway.y, r.a.y),
+                    select(apart, inv * halfway.z, r.a.z)};
+    return r;
+}
+
+}  // namespace
+
+void prepare_swing_twist_lane(WideSwingTwist& w, int lane, const JointConstraint& jc) {
+    w.axis_a.set_lane(lane, jc.axis_a);
+    w.axis_b.set_lane(lane, jc.axis_b);
+    w.ref_a.set_lane(lane, jc.ref_a);
+    w.ref_b.set_lane(lane, jc.ref_b);
+    w.cone[lane] = static_cast<float>(jc.cone);
+    w.lower[lane] = static_cast<float>(jc.lower);
+    w.upper[lane] = static_cast<float>(jc.upper);
+    w.limits_cone[lane] = jc.cone < kPi ? -1 : 0;
+    w.limits_twist[lane] = limits_twist(jc) ? -1 : 0;
+    w.max_friction_impulse[lane] = static_cast<float>(jc.max_friction_impulse);
+    w.rotation_mass.set_lane(lane, jc.max_friction_impulse > 0 ? jc.rotation_mass : Mat3::Zero());
+    w.friction_impulse.set_lane(lane, jc.angular_impulse);
+    w.swing_impulse[lane] = static_cast<float>(jc.swing_impulse);
+    w.lower_impulse[lane] = static_cast<float>(jc.lower_impulse);
+    w.upper_impulse[lane] = static_cast<float>(jc.upper_impulse);
+}
+
+void warm_start_swing_twist_lanes(const WideJoint& wj, const WideSwingTwist& w, const WideMotion& m,
+                                  WideVelocities& s) {
+    const WideAxes axes = wide_axes(w, m);
+    apply_angular(wj, s,
+                  w.friction_impulse - w.swing_impulse * axes.swing_axis +
+                      (w.lower_impulse - w.upper_impulse) * axes.twist_axis);
+}
+
+void solve_swing_twist_lanes(const WideJoint& wj, WideSwingTwist& w, const WideMotion& m, WideVelocities& s,
+                             const JointSolveParams& p) {
+    {
+        const Wide3 old = w.friction_impulse;
+        Wide3 total = old - w.rotation_mass * (s.wb - s.wa);
+        const Wide norm = length(total);
+        total = select(norm > w.max_friction_impulse, w.max_friction_impulse / norm, splat(1)) * total;
+        w.friction_impulse = total;
+        apply_angular(wj, s, total - old);
+    }
+    const WideAxes axes = wide_axes(w, m);
+    const Wide cosine = dot(axes.a, axes.b);
+    const Wide swing = wide_atan2(axes.sine, cosine);
+    // Undo the swing on B's reference (the shortest arc from b to a by Rodrigues' formula,
+    // its axis k = b x a): what is left is a turn about A's axis, the twist. Where b is
+    // opposite a the arc has no axis, and the lanes take no twist.
+    const Wide3 ref_a = rotate(m.dqa, w.ref_a), ref_b = rotate(m.dqb, w.ref_b);
+    const Wide3 k = {-axes.cross.x, -axes.cross.y, -axes.cross.z};
+    const Wide one_plus = splat(1) + cosine;
+    const WideMask turns = one_plus > splat(1e-6);
+    const Wide3 unswung = cosine * ref_b + spindle::cross(k, ref_b) +
+                          select(turns, dot(k, ref_b) / one_plus, splat(0)) * k;
+    const Wide twist = select(turns, wide_atan2(dot(axes.a, spindle::cross(ref_a, unswung)), dot(ref_a, unswung)),
+                              splat(0));
+    const WideSoftness violated = violated_softness(p);
+    if (any(w.limits_twist)) {
+        const WideAngularRow row = angular_row(wj, axes.twist_axis);
+        const Wide mass = select(w.limits_twist, row.mass, splat(0));
+        const Wide lower = limit_impulse(twist - w.lower, angular_speed(s, row.axis), mass, w.lower_impulse, violated,
+                                         p);
+        apply_row(s, row, lower);
+        const Wide upper = limit_impulse(w.upper - twist, -angular_speed(s, row.axis), mass, w.upper_impulse, violated,
+                                         p);
+        apply_row(s, row, -upper);
+    }
+    const WideMask cone = w.limits_cone & axes.swings;
+    if (any(cone)) {
+        // The swing grows along a x b: the row allows swing <= cone.
+        const WideAngularRow row = angular_row(wj, axes.swing_axis);
+        const Wide impulse = limit_impulse(w.cone - swing, -angular_speed(s, row.axis),
+                                           select(cone, row.mass, splat(0)), w.swing_impulse, violated, p);
+        apply_row(s, row, -impulse);
+    }
+}
+
+void store_swing_twist_lane(const WideSwingTwist& w, int lane, JointConstraint& jc) {
+    jc.angular_impulse = w.friction_impulse.lane(lane);
+    jc.swing_impulse = w.swing_impulse[lane];
+    jc.lower_impulse = w.lower_impulse[lane];
+    jc.upper_impulse = w.upper_impulse[lane];
 }
 
 }  // namespace spindle

@@ -160,7 +160,7 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
 }
 
 // Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
-// `color`: its wide ball-socket joints and other joints (if kJoints), then its wide
+// `color`: its wide joints (joint_lanes.cpp) and other joints (if kJoints), then its wide
 // contacts. The overflow (color == kColorCount) is one block, run serially, joints first.
 template <bool kJoints, typename BallSocketFn, typename JointFn, typename ContactFn>
 void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, BallSocketFn&& ball_socket_fn,
@@ -176,7 +176,7 @@ void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint3
     const std::uint32_t ball_sockets = kJoints ? scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color]
                                                : 0u;
     const auto joint_count = kJoints ? ball_sockets + static_cast<std::uint32_t>(joints.size()) : 0u;
-    WideBallSocket* wide_joints = scratch.wide_joints.data() + scratch.wide_joint_begin[color];
+    WideJoint* wide_joints = scratch.wide_joints.data() + scratch.wide_joint_begin[color];
     WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
     for (std::uint32_t k = lo; k < hi; ++k) {
         if (k < ball_sockets) {
@@ -288,7 +288,7 @@ void solve(World& world, Real dt) {
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
-        pack_ball_sockets(scratch);  // nothing to do in a scene without joints
+        pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(scratch);
         world.counters.constraint_colorings += 1;
     }
@@ -329,36 +329,37 @@ void solve(World& world, Real dt) {
             EffectCounts& counts = world.scratch_counts[worker];
             switch (phase.pass) {
                 case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
-                case Pass::PrepareJoints: prepare_ball_sockets(scratch, lo, hi); break;
+                case Pass::PrepareJoints: prepare_joint_lanes(scratch, lo, hi); break;
                 case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
-                case Pass::StoreJointLanes: store_ball_socket_impulses(scratch, lo, hi); break;
+                case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
                 case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
                 case Pass::IntegrateVelocities: integrate_velocities(world, bodies, h, lo, hi, counts); break;
                 case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi, counts); break;
                 case Pass::WarmStart:
                     for_colored<true>(
-                        scratch, phase.color, lo, hi, [&](WideBallSocket& wj) { warm_start_ball_sockets(wj, bodies); },
+                        scratch, phase.color, lo, hi,
+                        [&](WideJoint& wj) { warm_start_joint_lanes(scratch, wj, bodies); },
                         [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
                         [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies); });
                     break;
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
-                        [&](WideBallSocket& wj) { solve_ball_sockets(wj, bodies, joint_solve, counts); },
+                        [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_solve, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
                         [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, solve_params, counts); });
                     break;
                 case Pass::Relax:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
-                        [&](WideBallSocket& wj) { solve_ball_sockets(wj, bodies, joint_relax, counts); },
+                        [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_relax, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
                         [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, relax_params, counts); });
                     break;
                 case Pass::Restitution:
                     for_colored<false>(
-                        scratch, phase.color, lo, hi, [](WideBallSocket&) {}, [](JointConstraint&) {},
+                        scratch, phase.color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
                         [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
                     break;
             }
