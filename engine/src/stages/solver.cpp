@@ -33,9 +33,9 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 namespace {
 
 constexpr std::uint32_t kBodyGrain = 128;
-// Joints or wide contacts (kLanes manifolds each) per chunk: small, so the end of a colour
-// splits evenly between the workers.
-constexpr std::uint32_t kConstraintGrain = 2;
+// Joints or wide contacts (kLanes manifolds each) per block: one, so that at a colour's
+// end the last block the others wait for is a single one.
+constexpr std::uint32_t kConstraintGrain = 1;
 // Wide contacts per block when preparing them and storing their impulses.
 constexpr std::uint32_t kWideGrain = 8;
 // Joints per block when storing their impulses.
