@@ -32,12 +32,17 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 
 namespace {
 
-constexpr std::uint32_t kBodyGrain = 128;
-// Joints or wide contacts (kLanes manifolds each) per block: one, so that at a colour's
-// end the last block the others wait for is a single one.
+// The last block of a phase is the one the other workers wait for at its barrier, and
+// block sizes halve down to the grain, so the grains of run_phases' passes are small: a
+// few claims more per phase, a shorter wait at every barrier.
+constexpr std::uint32_t kBodyGrain = 128;  // PrepareBodies, a parallel_for
+// Bodies per block of a pass over the bodies in run_phases.
+constexpr std::uint32_t kBodyPassGrain = 32;
+// Joints or wide contacts (kLanes manifolds each) per block of a colour.
 constexpr std::uint32_t kConstraintGrain = 1;
-// Wide contacts per block when preparing them and storing their impulses.
-constexpr std::uint32_t kWideGrain = 8;
+// Wide contacts per block when preparing them (the longest per item) and storing their
+// impulses.
+constexpr std::uint32_t kWideGrain = 1;
 // Joints per block when storing their impulses.
 constexpr std::uint32_t kJointGrain = 32;
 
@@ -210,7 +215,7 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
 }
 
 void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
-    scratch.phases.push_back(Phase{name, bodies, kBodyGrain});
+    scratch.phases.push_back(Phase{name, bodies, kBodyPassGrain});
     scratch.plan.push_back(SolverPhase{pass, 0});
 }
 
