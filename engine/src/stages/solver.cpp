@@ -50,7 +50,12 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     scratch.bodies.resize(n + 1);
+    // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
+    // by the grain): equal over all of them, no body is lighter than another it carries.
+    const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
+    scratch.chunk_inv_mass.assign(chunks, {kHuge, -kHuge});
     world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        auto& [least, greatest] = scratch.chunk_inv_mass[lo / kBodyGrain];
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
@@ -65,9 +70,19 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.gyroscopic = sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0;
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+            if (sb.dynamic) {
+                least = std::min(least, sb.inv_mass);
+                greatest = std::max(greatest, sb.inv_mass);
+            }
         }
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
+    Real least = kHuge, greatest = -kHuge;
+    for (const auto& [chunk_least, chunk_greatest] : scratch.chunk_inv_mass) {
+        least = std::min(least, chunk_least);
+        greatest = std::max(greatest, chunk_greatest);
+    }
+    scratch.one_dynamic_mass = !(least < greatest);
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
