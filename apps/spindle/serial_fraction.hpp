@@ -37,9 +37,10 @@ struct SerialProfile {
 };
 
 // Work is the time in leaf spans: a job span that holds other spans of its worker counts
-// only through them (a run_phases participant's chunk holds its blocks; between them it
-// waits at a barrier). Stage spans (category "stage") mark the step; time in a stage with
-// no job running is the stage's own serial code.
+// only through them (a run_phases participant's chunk holds a span per phase, from its
+// first block to its last; between them it waits at a barrier). Stage spans (category
+// "stage") mark the step; time in a stage with no job running is the stage's own serial
+// code.
 SerialProfile serial_profile(std::span<const TraceEvent> events);
 
 // The steps' profiles added up (times summed, parts merged by name, longest first).

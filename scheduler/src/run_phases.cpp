@@ -67,6 +67,7 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
         if (phase.count == 0) continue;
         const std::uint32_t grain = std::max<std::uint32_t>(phase.grain, 1);
         std::uint64_t ran = 0;
+        std::int64_t traced_from = 0;  // when this participant claimed its first block of the phase
         for (unsigned step = 0; step < n; ++step) {
             const unsigned j = (me + step) % n;
             const auto first = static_cast<std::uint32_t>(std::uint64_t{phase.count} * j / n);
@@ -80,14 +81,17 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
                 if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
                 std::uint32_t lo = 0, hi = 0;
                 share_block(items, grain, seen - taken_before[j], lo, hi);
-                const std::int64_t t0 = tracing ? now_nanoseconds() : 0;
+                if (tracing && ran == 0) traced_from = now_nanoseconds();
                 run.fn(p, first + lo, first + hi, worker);
-                if (tracing) self.record(phase.name, run.name, t0, now_nanoseconds());
                 ++ran;
                 ++seen;
             }
             taken_before[j] = share_end;
         }
+        // One span per participant and phase, from its first block to the end of its last:
+        // between its blocks it claims the next one, which is its own work, not a wait, so
+        // only the barrier below is left out of it (and a block costs no clock reads).
+        if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         // Publish this phase's blocks at once (one shared write per phase, not per block).
         if (ran > 0) run.done.value.fetch_add(ran, std::memory_order_release);
         for (int spins = 0; run.done.value.load(std::memory_order_acquire) < done_target; ++spins) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "solver/solver_body.hpp"
@@ -280,6 +281,10 @@ struct SolverScratch {
     std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
     // Per manifold ref, or empty when every scale is 1 (most steps of most scenes).
     std::vector<SupportScale> support_scales;
+    // Whether every awake dynamic body has the same inverse mass (prepare_bodies, from the
+    // least and greatest of each chunk of bodies): then no scale differs from 1.
+    bool one_dynamic_mass = false;
+    std::vector<std::pair<Real, Real>> chunk_inv_mass;
     std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity
     std::vector<std::uint32_t> support_first, support_by_lower, support_queue;
     std::vector<std::uint8_t> supported;

@@ -25,7 +25,8 @@
 // A contact supports when its normal is within 45 degrees of up (against gravity);
 // without gravity nothing is supported. Pairs of equal masses, and scenes without a
 // lighter body under a heavier one, are solved exactly as before (all scales are 1, and
-// the search stops after one scan of the manifolds). Serial, over the manifold list in
+// the search stops after one scan of the manifolds, or before it when every awake dynamic
+// body has the same mass). Serial, over the manifold list in
 // its order: the same for any number of workers.
 #include <algorithm>
 
@@ -40,6 +41,7 @@ constexpr Real kSupportCos = 0.70710678118654752;  // cos 45 degrees
 
 void find_support_scales(const World& world, SolverScratch& scratch) {
     scratch.support_scales.clear();
+    if (scratch.one_dynamic_mass) return;  // no body lighter than another: skip the scan below
     const Vec3 gravity = world.settings.gravity;
     const Real g = gravity.norm();
     if (!(g > 0)) return;

@@ -32,12 +32,17 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
 
 namespace {
 
-constexpr std::uint32_t kBodyGrain = 128;
-// Joints or wide contacts (kLanes manifolds each) per chunk: small, so the end of a colour
-// splits evenly between the workers.
-constexpr std::uint32_t kConstraintGrain = 2;
-// Wide contacts per block when preparing them and storing their impulses.
-constexpr std::uint32_t kWideGrain = 8;
+// The last block of a phase is the one the other workers wait for at its barrier, and
+// block sizes halve down to the grain, so the grains of run_phases' passes are small: a
+// few claims more per phase, a shorter wait at every barrier.
+constexpr std::uint32_t kBodyGrain = 128;  // PrepareBodies, a parallel_for
+// Bodies per block of a pass over the bodies in run_phases.
+constexpr std::uint32_t kBodyPassGrain = 32;
+// Joints or wide contacts (kLanes manifolds each) per block of a colour.
+constexpr std::uint32_t kConstraintGrain = 1;
+// Wide contacts per block when preparing them (the longest per item) and storing their
+// impulses.
+constexpr std::uint32_t kWideGrain = 1;
 // Joints per block when storing their impulses.
 constexpr std::uint32_t kJointGrain = 32;
 
@@ -45,7 +50,12 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     scratch.bodies.resize(n + 1);
+    // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
+    // by the grain): equal over all of them, no body is lighter than another it carries.
+    const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
+    scratch.chunk_inv_mass.assign(chunks, {kHuge, -kHuge});
     world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        auto& [least, greatest] = scratch.chunk_inv_mass[lo / kBodyGrain];
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
@@ -60,9 +70,19 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.gyroscopic = sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0;
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+            if (sb.dynamic) {
+                least = std::min(least, sb.inv_mass);
+                greatest = std::max(greatest, sb.inv_mass);
+            }
         }
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
+    Real least = kHuge, greatest = -kHuge;
+    for (const auto& [chunk_least, chunk_greatest] : scratch.chunk_inv_mass) {
+        least = std::min(least, chunk_least);
+        greatest = std::max(greatest, chunk_greatest);
+    }
+    scratch.one_dynamic_mass = !(least < greatest);
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
@@ -210,7 +230,7 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
 }
 
 void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
-    scratch.phases.push_back(Phase{name, bodies, kBodyGrain});
+    scratch.phases.push_back(Phase{name, bodies, kBodyPassGrain});
     scratch.plan.push_back(SolverPhase{pass, 0});
 }
 
