@@ -282,7 +282,7 @@ void find_support_scales(const World& world, SolverScratch& scratch);
 // (which manifold and bodies each lane holds); prepare_contacts fills in the rest from
 // the manifolds and bodies of the step; the others run per wide contact from the
 // colour loops.
-void pack_contacts(SolverScratch& scratch);
+void pack_contacts(JobSystem& jobs, SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi);  // wide [lo, hi)
 // push_anchors: the wide contact's kLanes push-out anchors (SolverScratch::push_anchors).

@@ -246,8 +246,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.radius_a[l] = m.radius_a;
         wc.radius_b[l] = m.radius_b;
         wc.gravity_normal[l] =
-            m.normal.dot(project_linear((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g, B.locks) -
-                         project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
+            m.normal.dot(project_linear(B.gravity_scale * g, B.locks) - project_linear(A.gravity_scale * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             ra[j].set_lane(l, contact.anchor_a(src));
@@ -295,15 +294,18 @@ void prefetch_contacts(const World& world, const SolverScratch& scratch, const W
 
 // Lays the colours' manifold refs out kLanes at a time, then the overflow one per
 // WideContact (its manifolds may share bodies, so they are solved one at a time).
-void pack_contacts(SolverScratch& scratch) {
+void pack_contacts(JobSystem& jobs, SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
     // Kept from step to step (prepare_wide writes every field, push_out a row before it
-    // is read), at about the size of the step's.
+    // is read), at about the size of the step's. A first step's are megabytes of new
+    // pages: mapped in jobs before the resize below writes them on one thread.
     reserve_for(scratch.wide, count);
+    map_room(jobs, scratch.wide, count);
     scratch.wide.resize(count);
     if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
     reserve_for(scratch.push_anchors, count * kLanes);
+    map_room(jobs, scratch.push_anchors, count * kLanes);
     scratch.push_anchors.resize(count * kLanes);
     if (far_above_use(scratch.push_anchors.capacity(), count * kLanes)) fit_capacity(scratch.push_anchors);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);

@@ -23,8 +23,13 @@ struct SolverBody {
     Vec3 push_w = Vec3::Zero();
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
     Real inv_mass = 0;                // along the free axes: zero along a locked one (locks)
-    bool dynamic = false;             // only dynamic bodies are written by constraints
-    std::uint8_t locks = 0;           // motion lock bits (motion_locks.hpp), in the padding
+    // BodyDesc::gravity_scale of a dynamic body (else 0) and whether it damps: the passes
+    // that read them once per body and substep or per contact stay off the cold
+    // descriptions, each a cache miss.
+    Real gravity_scale = 0;
+    bool damped = false;
+    bool dynamic = false;    // only dynamic bodies are written by constraints
+    std::uint8_t locks = 0;  // motion lock bits (motion_locks.hpp), in the padding
     // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
     // and no rotation lock. Kept here so integrate_positions reads no body description.
     bool gyroscopic = false;
