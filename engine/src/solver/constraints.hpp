@@ -58,8 +58,6 @@ struct WidePoint {
     // contact further: a heavy body rests where its spring holds it.
     Wide recovery{};
     Wide normal_impulse{};
-    Wide max_normal_impulse{};
-    Wide relative_velocity{};  // approach speed at impact (restitution)
 };
 
 // An awake joint as listed for the step: what its colour and packing depend on.
@@ -87,11 +85,13 @@ struct WideContact {
     // A lane's body has a translation lock: its passes take each body's inverse mass per
     // world axis (contact_solver.cpp), the others the scalar below.
     bool locked = false;
+    // A lane bounces (restitution) or reports hits (kContactReports): the passes keep
+    // the points' largest pushes and approach speeds (below). Else nothing reads them.
+    bool tracks_push = false;
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
-    Wide friction{}, restitution{};
+    Wide friction{};
     Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
-    Wide gravity_normal{};  // relative acceleration of B from A along the normal, from gravity
     // Radius of each body's round part (sphere, capsule; else 0): its surface point along
     // the normal does not turn with the body, so a rolling ball's contact stays below it.
     Wide radius_a{}, radius_b{};
@@ -112,6 +112,12 @@ struct WideContact {
     // rows' anchors live apart (SolverScratch::push_anchors): they are rarely used, and
     // every pass streams the wide contacts.
     float push_impulse[kLanes] = {};
+    // Read by restitution and hit events only, so last: a wide contact that tracks no
+    // push leaves these lines alone in every pass.
+    Wide restitution{};
+    Wide gravity_normal{};                          // relative acceleration of B from A along the normal, from gravity
+    Wide max_normal_impulse[kMaxManifoldPoints]{};  // per point slot: the largest push of the step
+    Wide relative_velocity[kMaxManifoldPoints]{};   // per point slot: approach speed at impact
 };
 
 using Vec2 = Eigen::Matrix<Real, 2, 1>;
@@ -317,7 +323,7 @@ void find_support_scales(const World& world, SolverScratch& scratch);
 // (which manifold and bodies each lane holds); prepare_contacts fills in the rest from
 // the manifolds and bodies of the step; the others run per wide contact from the
 // colour loops.
-void pack_contacts(SolverScratch& scratch);
+void pack_contacts(JobSystem& jobs, SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi);  // wide [lo, hi)
 // push_anchors: the wide contact's kLanes push-out anchors (SolverScratch::push_anchors).

@@ -208,6 +208,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     Wide linear_sum{};
     for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.locked = false;
+    wc.tracks_push = false;
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
@@ -243,11 +244,11 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.against_static[l] =
             b.type[contact.body_a] == MotionType::Static || b.type[contact.body_b] == MotionType::Static ? 1 : 0;
         wc.restitution[l] = contact.restitution;
+        wc.tracks_push = wc.tracks_push || contact.restitution > 0 || (contact.events & kContactReports) != 0;
         wc.radius_a[l] = m.radius_a;
         wc.radius_b[l] = m.radius_b;
         wc.gravity_normal[l] =
-            m.normal.dot(project_linear((B.dynamic ? b.desc[contact.body_b].gravity_scale : 0) * g, B.locks) -
-                         project_linear((A.dynamic ? b.desc[contact.body_a].gravity_scale : 0) * g, A.locks));
+            m.normal.dot(project_linear(B.gravity_scale * g, B.locks) - project_linear(A.gravity_scale * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             ra[j].set_lane(l, contact.anchor_a(src));
@@ -258,7 +259,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         }
         prepare_friction(A, B, contact, m, tangent, friction_distance, wc, l);
     }
-    const WideVelocities s = gather(wc, scratch.bodies.data());  // for the approach speeds
+    WideVelocities s{};  // for the approach speeds
+    if (wc.tracks_push) s = gather(wc, scratch.bodies.data());
     // How deep a point's last impulse holds its soft row at rest, per lane (stiffer
     // against a static body).
     const WideMask stiff = wc.against_static > splat(0);
@@ -276,8 +278,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         const Wide mass = p.normal_mass;
         const Wide held = select(mass > splat(0), held_per_impulse * normal_impulse[j] / mass, splat(0));
         p.recovery = wide_max(splat(params.recovery_depth), held);
-        p.max_normal_impulse = Wide{};
-        p.relative_velocity = dot(wc.normal, point_velocity(s, ra[j], rb[j]));
+        wc.max_normal_impulse[j] = Wide{};
+        wc.relative_velocity[j] = wc.tracks_push ? dot(wc.normal, point_velocity(s, ra[j], rb[j])) : Wide{};
     }
     for (float& impulse : wc.push_impulse) impulse = 0;
 }
@@ -295,15 +297,18 @@ void prefetch_contacts(const World& world, const SolverScratch& scratch, const W
 
 // Lays the colours' manifold refs out kLanes at a time, then the overflow one per
 // WideContact (its manifolds may share bodies, so they are solved one at a time).
-void pack_contacts(SolverScratch& scratch) {
+void pack_contacts(JobSystem& jobs, SolverScratch& scratch) {
     std::size_t count = scratch.overflow.size();
     for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
     // Kept from step to step (prepare_wide writes every field, push_out a row before it
-    // is read), at about the size of the step's.
+    // is read), at about the size of the step's. A first step's are megabytes of new
+    // pages: mapped in jobs before the resize below writes them on one thread.
     reserve_for(scratch.wide, count);
+    map_room(jobs, scratch.wide, count);
     scratch.wide.resize(count);
     if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
     reserve_for(scratch.push_anchors, count * kLanes);
+    map_room(jobs, scratch.push_anchors, count * kLanes);
     scratch.push_anchors.resize(count * kLanes);
     if (far_above_use(scratch.push_anchors.capacity(), count * kLanes)) fit_capacity(scratch.push_anchors);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
@@ -424,10 +429,14 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         impulse = total - p.normal_impulse;
         // Restitution bounces off the approach speed at impact: the speed when the
         // point first pushes in this step, gravity of the earlier substeps included.
-        const WideMask first_push = (impulse > zero) & (p.max_normal_impulse == zero);
-        p.relative_velocity = select(first_push, wide_min(p.relative_velocity, vn), p.relative_velocity);
+        if (wc.tracks_push) {
+            Wide& approach = wc.relative_velocity[j];
+            Wide& max_impulse = wc.max_normal_impulse[j];
+            const WideMask first_push = (impulse > zero) & (max_impulse == zero);
+            approach = select(first_push, wide_min(approach, vn), approach);
+            max_impulse = wide_max(max_impulse, impulse);
+        }
         p.normal_impulse = total;
-        p.max_normal_impulse = wide_max(p.max_normal_impulse, impulse);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
     // Central friction, in the relax passes only (Box3D's), when any lane has friction (a
@@ -522,19 +531,21 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
-    for (WidePoint& p : wc.points) {
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        WidePoint& p = wc.points[j];
+        Wide& max_impulse = wc.max_normal_impulse[j];
         // Only points that approached fast enough and actually pushed bounce.
-        const WideMask bounce = bouncy & (p.relative_velocity <= splat(-threshold)) & (p.max_normal_impulse > zero);
+        const WideMask bounce = bouncy & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
         if (!any(bounce)) continue;
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
-        const Wide approach = p.relative_velocity + wc.gravity_normal * splat(h);
+        const Wide approach = wc.relative_velocity[j] + wc.gravity_normal * splat(h);
         const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
         const Wide total = wide_max(p.normal_impulse + impulse, zero);
         const Wide applied = select(bounce, total - p.normal_impulse, zero);
         p.normal_impulse += applied;
-        p.max_normal_impulse = wide_max(p.max_normal_impulse, applied);
+        max_impulse = wide_max(max_impulse, applied);
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, applied);
     }
     scatter(wc, bodies, s);
@@ -591,10 +602,10 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.pushed_point = -1;
             m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {
-                const WidePoint& p = wc.points[j];
-                m.points[j].normal_impulse = p.normal_impulse[l];
-                const float approach = -p.relative_velocity[l];
-                if (p.max_normal_impulse[l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {
+                m.points[j].normal_impulse = wc.points[j].normal_impulse[l];
+                if (!wc.tracks_push) continue;  // nothing reads which point pushed
+                const float approach = -wc.relative_velocity[j][l];
+                if (wc.max_normal_impulse[j][l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {
                     m.pushed_point = static_cast<std::int8_t>(j);
                     m.pushed_speed = approach;
                 }

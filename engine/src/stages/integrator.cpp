@@ -56,9 +56,8 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
             continue;
         }
         const std::uint32_t i = world.awake[k];
-        const BodyDesc& d = b.desc[i];
-        if (d.gravity_scale != 0) {
-            sb.v += project_linear(h * d.gravity_scale * gravity, sb.locks);
+        if (sb.gravity_scale != 0) {
+            sb.v += project_linear(h * sb.gravity_scale * gravity, sb.locks);
             ++c.gravity;
         }
         // At worst infinite components, which the limit turns back.
@@ -66,8 +65,9 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
         sb.w = add_angular(sb.w, h, sb.inv_inertia, b.torque[i], max_angular);  // locked axes: zero inertia rows
         sb.v = limit_speed(sb.v, max_linear);
         sb.w = limit_speed(sb.w, max_angular);
-        if (d.linear_damping > 0 || d.angular_damping > 0) {
+        if (sb.damped) {
             // Implicit (Pade) damping: stable for any h.
+            const BodyDesc& d = b.desc[i];
             sb.v *= 1 / (1 + h * d.linear_damping);
             sb.w *= 1 / (1 + h * d.angular_damping);
             ++c.damping;

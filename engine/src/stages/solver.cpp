@@ -67,7 +67,10 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
-            sb.gyroscopic = sb.dynamic && b.desc[i].gyroscopic && (sb.locks & kLockRotation) == 0;
+            const BodyDesc& d = b.desc[i];
+            sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
+            sb.gravity_scale = sb.dynamic ? d.gravity_scale : 0;
+            sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
             if (sb.dynamic) {
@@ -309,7 +312,7 @@ void solve(World& world, Real dt) {
     if (!same_constraints(world, scratch)) {
         color(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
-        pack_contacts(scratch);
+        pack_contacts(*world.jobs, scratch);
         world.counters.constraint_colorings += 1;
     }
     SolverBody* bodies = scratch.bodies.data();
