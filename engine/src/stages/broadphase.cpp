@@ -187,11 +187,16 @@ void update_broadphase(World& world, Real dt) {
             bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
         }
     });
+    // The moved leaves' ancestors are only flagged: update_pairs rebuilds them before its
+    // searches, which are the next to read the tree.
     for (std::uint32_t k = 0; k < n; ++k) {
         if (!bp.moving[k]) continue;
         const std::uint32_t i = world.awake[k];
         const Vec3 d = b.v[i] * dt;
-        move_proxy(bp, i, swept_bounds(b, i, d), d);
+        const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept_bounds(b, i, d), d);
+        const Aabb& before = bp.tree.fat_aabb(bp.proxy[i]);
+        if (fat.min != before.min || fat.max != before.max) mark_refit(bp, i);
+        bp.tree.set_fat_box(bp.proxy[i], fat);
     }
 
     bp.pairs.clear();
