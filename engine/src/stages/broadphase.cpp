@@ -146,8 +146,11 @@ void make_contacts(World& world, BroadphaseState& bp) {
                             filtered.fetch_add(1, std::memory_order_relaxed);
                             return false;
                         }
-                        if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
                         key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
+                        // A pair found again (one of its proxies grew) has its contact: skipped here, in
+                        // parallel, not at the serial index inserts. The index is only read meanwhile.
+                        if (world.contact_index.contains(key)) return false;
+                        if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
                         return true;
                     });
     world.counters.pairs_filtered += filtered.load(std::memory_order_relaxed);
