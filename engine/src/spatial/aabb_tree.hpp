@@ -56,6 +56,14 @@ public:
     // Whether move_proxy(id, tight, displacement) would re-insert the proxy. Const: may
     // run on many threads at once while nothing writes.
     bool needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const;
+    // The fat box move_proxy gives a proxy whose tight box is `tight`. Const.
+    Aabb fat_box(const Aabb& tight, const Vec3& displacement) const { return fatten(tight, displacement); }
+    // Gives a proxy a new fat box (from fat_box()) and flags its ancestors without growing
+    // them: for a caller that moves many proxies and then calls rebuild_enlarged(), which
+    // makes every flagged node's box from its children, so growing them move by move
+    // would be wasted. Until that rebuild the ancestors' boxes are stale: query() and
+    // ray_cast() must not run (they could miss the moved proxies).
+    void set_fat_box(std::int32_t id, const Aabb& fat);
 
     // Calls callback(id) -> bool for every proxy whose fat box overlaps `box`; false stops.
     template <typename Callback>
@@ -149,6 +157,7 @@ private:
     void refit(std::int32_t id);
     bool rotate(std::int32_t id);  // true when it swapped
     void enlarge_ancestors(std::int32_t leaf);
+    void flag_ancestors(std::int32_t leaf);
     void validate_if_enabled() const {
         if (m_settings.validate_each_operation) validate();
     }
@@ -169,6 +178,9 @@ private:
     // node's parent is flagged too, so a walk from the root finds every flagged node.
     std::vector<std::uint8_t> m_enlarged;
     std::int32_t m_enlarged_nodes = 0;
+    // set_fat_box() left flagged nodes' boxes short of their children's; the next rebuild
+    // of the flagged nodes makes them whole.
+    bool m_stale_boxes = false;
 
     // Scratch for the rebuilds, kept so that a rebuild in steady state does not allocate.
     // A range of build leaves to place under `parent` (child `slot`), with the pool nodes
@@ -241,12 +253,16 @@ void DynamicAabbTree::traverse(Enter&& enter, OnLeaf&& on_leaf) const {
 
 template <typename Callback>
 void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
+    SPINDLE_ASSERT(!m_stale_boxes,
+                   "DynamicAabbTree::query: set_fat_box moved proxies and rebuild_enlarged has not run");
     traverse([&](const Aabb& node_box) { return overlaps(node_box, box); }, callback);
 }
 
 template <typename Callback>
 void DynamicAabbTree::ray_cast(const Vec3& origin, const Vec3& translation, Real max_fraction,
                                Callback&& callback) const {
+    SPINDLE_ASSERT(!m_stale_boxes,
+                   "DynamicAabbTree::ray_cast: set_fat_box moved proxies and rebuild_enlarged has not run");
     if (!(max_fraction > 0)) return;
     // Slab test of the segment [0, max_fraction]. Axis-parallel components are tested
     // apart: the division would give 0 * inf = NaN for an origin on a slab plane.

@@ -29,12 +29,16 @@ void DynamicAabbTree::rebuild() {
         m_enlarged[i] = 0;
     }
     m_enlarged_nodes = 0;
+    m_stale_boxes = false;
     build_from_leaves(nullptr);
     validate_if_enabled();
 }
 
 void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
-    if (m_enlarged_nodes == 0) return;
+    if (m_enlarged_nodes == 0) {
+        m_stale_boxes = false;  // only flagged nodes go stale
+        return;
+    }
     // Flagged nodes form a tree from the root down (a flagged node's parent is flagged):
     // they are built again, and what hangs off them (a leaf or an unflagged subtree) is
     // kept whole.
@@ -55,6 +59,7 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
         m_build_pool.push_back(id);
     }
     m_enlarged_nodes = 0;
+    m_stale_boxes = false;
     build_from_leaves(jobs);
     validate_if_enabled();
 }

@@ -59,6 +59,13 @@ bool ProxyTrees::move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& disp
     return true;
 }
 
+void ProxyTrees::set_fat_box(ProxyId id, const Aabb& fat) {
+    DynamicAabbTree& tree = tree_of(id);
+    const bool grew = !tree.fat_aabb(id.tree_id()).contains(fat);
+    tree.set_fat_box(id.tree_id(), fat);
+    if (grew) mark_enlarged(id);
+}
+
 bool ProxyTrees::is_enlarged(ProxyId id) const {
     const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
     const auto i = static_cast<std::size_t>(id.tree_id());

@@ -76,6 +76,15 @@ public:
     bool needs_move(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
         return tree_of(id).needs_move(id.tree_id(), tight_aabb, displacement);
     }
+    // The fat box move_proxy would give the proxy (when needs_move says it moves). Const.
+    Aabb fat_box(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
+        return tree_of(id).fat_box(tight_aabb, displacement);
+    }
+    // Gives the proxy a fat box from fat_box() and marks it enlarged when the box grew, as
+    // move_proxy does, but leaves the trees' inner boxes to update_pairs' rebuild: for the
+    // broadphase, which moves many proxies and then calls update_pairs. Nothing may query
+    // the trees in between (DynamicAabbTree::set_fat_box).
+    void set_fat_box(ProxyId id, const Aabb& fat);
 
     // Replaces new_pairs with every pair of proxies whose fat boxes overlap and of which at
     // least one was enlarged (created or grown) since the last call; never static with

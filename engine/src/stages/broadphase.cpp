@@ -146,8 +146,11 @@ void make_contacts(World& world, BroadphaseState& bp) {
                             filtered.fetch_add(1, std::memory_order_relaxed);
                             return false;
                         }
-                        if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
                         key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
+                        // A pair found again (one of its proxies grew) has its contact: skipped here, in
+                        // parallel, not at the serial index inserts. The index is only read meanwhile.
+                        if (world.contact_index.contains(key)) return false;
+                        if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
                         return true;
                     });
     world.counters.pairs_filtered += filtered.load(std::memory_order_relaxed);
@@ -187,11 +190,16 @@ void update_broadphase(World& world, Real dt) {
             bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
         }
     });
+    // The moved leaves' ancestors are only flagged: update_pairs rebuilds them before its
+    // searches, which are the next to read the tree.
     for (std::uint32_t k = 0; k < n; ++k) {
         if (!bp.moving[k]) continue;
         const std::uint32_t i = world.awake[k];
         const Vec3 d = b.v[i] * dt;
-        move_proxy(bp, i, swept_bounds(b, i, d), d);
+        const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept_bounds(b, i, d), d);
+        const Aabb& before = bp.tree.fat_aabb(bp.proxy[i]);
+        if (fat.min != before.min || fat.max != before.max) mark_refit(bp, i);
+        bp.tree.set_fat_box(bp.proxy[i], fat);
     }
 
     bp.pairs.clear();

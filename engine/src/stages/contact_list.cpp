@@ -31,6 +31,19 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
     contact.events = contact_event_flags(world, a, b);
 }
 
+// Takes the removed positions (ascending) out of an up-to-date awake list and moves the
+// rest down as the removal moved their contacts: the list a rebuild would give, without
+// reading the records.
+void drop_from_awake_list(std::vector<std::uint32_t>& awake, const std::vector<std::uint32_t>& removed) {
+    std::size_t write = 0, r = 0;
+    for (const std::uint32_t c : awake) {
+        while (r < removed.size() && removed[r] < c) ++r;
+        if (r < removed.size() && removed[r] == c) continue;
+        awake[write++] = c - static_cast<std::uint32_t>(r);
+    }
+    awake.resize(write);
+}
+
 }  // namespace
 
 void fit_contacts(World& world) {
@@ -75,7 +88,11 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
                                  reporting.fetch_add(reports, std::memory_order_relaxed);
                              });
     world.events->reporting += reporting.load(std::memory_order_relaxed);
-    world.awake_contacts_dirty = true;
+    // New contacts are awake, and come after every other: a list that is up to date gets
+    // their positions at its end instead of a rebuild that reads every contact's record.
+    if (!world.awake_contacts_dirty) {
+        for (std::uint32_t c = static_cast<std::uint32_t>(first); c < end; ++c) world.awake_contact_list.push_back(c);
+    }
 }
 
 const std::vector<std::uint32_t>& awake_contacts(World& world) {
@@ -117,7 +134,7 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
     world.contacts.resize(write);
     world.contact_keys.resize(write);
     world.contact_summaries.resize(write);
-    world.awake_contacts_dirty = true;
+    if (!world.awake_contacts_dirty) drop_from_awake_list(world.awake_contact_list, positions);
 }
 
 void remove_contacts_of(World& world, std::uint32_t slot) {

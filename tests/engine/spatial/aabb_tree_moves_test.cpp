@@ -264,6 +264,46 @@ TEST(AabbTreeMoves, RebuildEnlargedInJobs_SameTreeAsOnOneThread) {
     }
 }
 
+// The broadphase's moves: set_fat_box gives the leaf its box and only flags the ancestors
+// (their boxes stay short until the rebuild, which validate() allows for); the rebuild then
+// gives the very tree move_proxy's grown ancestors give (the same walk order and cost).
+TEST(AabbTreeMoves, SetFatBox_RebuildGivesTheTreeMoveProxyGives) {
+    Rng rng(19);
+    DynamicAabbTree grown;
+    std::vector<std::int32_t> live;
+    for (int i = 0; i < 300 * kScale; ++i) {
+        live.push_back(grown.create_proxy(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)), i));
+    }
+    DynamicAabbTree flagged = grown;
+    for (int round = 0; round < 10; ++round) {
+        int moved = 0;
+        for (const std::int32_t id : live) {
+            const Vec3 d = rng.vec(-0.4, 0.4);
+            const Aabb tight = Aabb::from_center_extents(grown.fat_aabb(id).center() + d, Vec3::Constant(0.5));
+            const bool moves = flagged.needs_move(id, tight, d);
+            ASSERT_EQ(grown.move_proxy(id, tight, d), moves);
+            if (!moves) continue;
+            const Aabb fat = flagged.fat_box(tight, d);
+            ASSERT_TRUE(fat.min == grown.fat_aabb(id).min && fat.max == grown.fat_aabb(id).max);
+            flagged.set_fat_box(id, fat);
+            ++moved;
+        }
+        ASSERT_GT(moved, 0);
+        EXPECT_EQ(flagged.enlarged_node_count(), grown.enlarged_node_count()) << "round " << round;
+        EXPECT_LT(flagged.area_cost(), grown.area_cost()) << "round " << round;  // no ancestor grown
+        flagged.validate();
+        grown.rebuild_enlarged();
+        flagged.rebuild_enlarged();
+        flagged.validate();
+        ASSERT_EQ(walk_order(flagged), walk_order(grown)) << "round " << round;
+        ASSERT_EQ(flagged.area_cost(), grown.area_cost());
+        for (int q = 0; q < 20; ++q) {
+            const Aabb box = rng.box(40, 6);
+            ASSERT_EQ(query_sorted(flagged, box), brute_sorted(flagged, live, box));
+        }
+    }
+}
+
 TEST(AabbTreeMoves, ProxyTrees_UpdatePairsRebuildsWhatMoved) {
     Rng rng(16);
     ProxyTrees trees;

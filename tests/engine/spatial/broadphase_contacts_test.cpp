@@ -183,3 +183,48 @@ TEST(BroadphaseContacts, SameListsOnThreadsRunningRangesInReverse) {
 
 }  // namespace
 }  // namespace spindle
+
+namespace spindle {
+namespace {
+
+// Balls thrown through each other in a space without gravity, never asleep: contacts are
+// made and lost in most steps, and the awake list the stages keep up to date (new
+// positions appended, removed ones dropped and the rest moved down) stays the list a
+// rebuild from the records gives.
+TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
+    SpaceSettings settings;
+    settings.gravity = Vec3::Zero();
+    settings.sleep.enabled = false;
+    Space space(settings);
+    for (int i = 0; i < 200; ++i) {
+        BodyDesc d;
+        d.shape = Shape::sphere(0.5);
+        const Real x = Real(i % 20) * 1.2, y = Real(i / 20) * 1.2;
+        d.position = {x, y, 0};
+        d.linear_velocity = {Real((i * 7) % 5) - 2, Real((i * 3) % 5) - 2, Real((i * 11) % 3) - 1};
+        space.create_body(d);
+    }
+    World& world = SpaceInternals::world(space);
+    int kept = 0, made = 0, lost = 0;
+    std::size_t before = 0;
+    for (int step = 0; step < 120; ++step) {
+        space.update();
+        const std::size_t now = world.contacts.size();
+        made += now > before ? 1 : 0;
+        lost += now < before ? 1 : 0;
+        before = now;
+        if (world.awake_contacts_dirty) continue;
+        ++kept;
+        std::vector<std::uint32_t> rebuilt;
+        for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+            if (!world.contacts[c].sleeping) rebuilt.push_back(c);
+        }
+        ASSERT_EQ(world.awake_contact_list, rebuilt) << "after step " << step + 1;
+    }
+    EXPECT_GT(kept, 100);  // the list was up to date after most steps
+    EXPECT_GT(made, 5);
+    EXPECT_GT(lost, 5);
+}
+
+}  // namespace
+}  // namespace spindle
