@@ -213,12 +213,15 @@ void update_narrowphase(World& world) {
         ContactManifold fresh[kMaxManifolds];
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
-            // Only a pair without points (the packed summary says so when no contact
-            // reports events: then none is a sensor, whose manifolds have no summary) is
-            // ruled out unread; it keeps its record, recycling cache included, as it was.
+            // Only a pair without points is ruled out. The packed summary says so unless
+            // some contact reports events (a sensor's manifolds have no summary): then the
+            // record says, and the pair's events are noted as for any other (ruling out must
+            // not depend on who listens).
             const bool apart = (world.contact_summaries[awake[k]] & (kSummaryRestitution - 1)) == 0;
-            if (apart && !any_reporting && out_of_reach(world, awake[k], settings.speculative_distance, dt)) {
+            if (apart && out_of_reach(world, awake[k], settings.speculative_distance, dt) &&
+                (!any_reporting || world.contacts[awake[k]].manifold_count == 0)) {
                 counts.out_of_reach += 1;
+                if (any_reporting) note_events(world.contacts[awake[k]], awake[k], worker, counts);
                 continue;
             }
             Contact& contact = world.contacts[awake[k]];
