@@ -152,13 +152,13 @@ struct Contact {
     // rotations and centres of mass): while the bodies stay close to them the manifolds
     // are recycled, not collided again (narrowphase.cpp).
     bool cached : 1 = false;
-    ContactManifold manifold;            // the first (and for convex pairs only) manifold
-    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
     // A point's anchors (Box3D's) are its offsets from the centres of mass, world axes: they
     // stay attached to their bodies while the manifolds are recycled, and the solver pushes
     // each body at its own anchor. Kept once per contact rather than twice per point.
     Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
+    ContactManifold manifold;            // the first (and for convex pairs only) manifold
+    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
 
     Vec3 anchor_a(const ContactPoint& p) const { return p.point - cached_xa; }
     Vec3 anchor_b(const ContactPoint& p) const { return p.point - cached_xb; }
@@ -205,7 +205,7 @@ struct alignas(64) EffectCounts {
 
 // Contacts of one worker in the narrowphase, summed after the stage.
 struct alignas(64) ContactCounts {
-    std::uint32_t touching = 0, reused = 0;
+    std::uint32_t touching = 0, reused = 0, out_of_reach = 0;
     std::uint32_t event_checks = 0;  // reporting contacts checked for a touch change
 };
 

@@ -43,6 +43,34 @@ Real reach(const Bodies& b, std::uint32_t i) {
     return far.norm();
 }
 
+// Tight bounds further apart than the speculative reach by more than this rule a pair out:
+// a guard against the rounding of the bounds and of the pair test's distance.
+constexpr Real kReachGuard = 1e-6;
+
+bool is_round(const Shape& s) { return s.type == ShapeType::Sphere || s.type == ShapeType::Capsule; }
+
+// Whether contact c, which has no manifold, is still out of reach: its bodies' tight
+// bounds (this step's) are further apart along an axis than the speculative reach, and
+// one of its shapes is a sphere or capsule. Such a pair's points come from the distance
+// between the cores, which is never less than the gap between the bounds, so the pair
+// test would find nothing; two polyhedra's speculative points come from their SAT
+// separation, which can be less, so they are always tested. Reads the packed key and the
+// bodies' bounds, not the contact record: a grid of spheres keeps a contact for every pair
+// whose fat boxes touch, most of them never near, and reading their records was most of
+// the narrowphase.
+bool out_of_reach(const World& world, std::uint32_t c, Real speculative_distance, Real dt) {
+    const Bodies& b = world.bodies;
+    const std::uint64_t key = world.contact_keys[c];
+    const auto a = static_cast<std::uint32_t>(key >> 32);
+    const auto bb = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const Aabb& box_a = b.bounds[a];
+    const Aabb& box_b = b.bounds[bb];
+    const Real gap = (box_b.min - box_a.max).cwiseMax(box_a.min - box_b.max).maxCoeff();
+    if (!(gap > speculative_distance + kReachGuard)) return false;  // cheap before the closing speed
+    const Real reach = speculative_distance + (b.v[bb] - b.v[a]).norm() * dt + kReachGuard;
+    return gap > reach && (is_round(b.desc[a].shape) || is_round(b.desc[bb].shape));
+}
+
 // How each body has turned since the manifolds were collided.
 struct Turns {
     Quat dqa, dqb;
@@ -158,6 +186,8 @@ void update_narrowphase(World& world) {
     const SolverSettings& settings = world.settings.solver;
     const Real dt = world.settings.time_step.duration;
     const Real recycle_distance = std::min(kRecycleSlops * settings.linear_slop, settings.speculative_distance);
+    const bool any_fast = world.fast_bodies > 0;
+    const bool any_reporting = world.events->reporting > 0;
     const std::vector<std::uint32_t>& awake = awake_contacts(world);
     const auto count = static_cast<std::uint32_t>(awake.size());
     // Counted per worker while the contacts are at hand (a sum: it does not matter who
@@ -183,10 +213,22 @@ void update_narrowphase(World& world) {
         ContactManifold fresh[kMaxManifolds];
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
+            // Only a pair without points is ruled out. The packed summary says so unless
+            // some contact reports events (a sensor's manifolds have no summary): then the
+            // record says, and the pair's events are noted as for any other (ruling out must
+            // not depend on who listens).
+            const bool apart = (world.contact_summaries[awake[k]] & (kSummaryRestitution - 1)) == 0;
+            if (apart && out_of_reach(world, awake[k], settings.speculative_distance, dt) &&
+                (!any_reporting || world.contacts[awake[k]].manifold_count == 0)) {
+                counts.out_of_reach += 1;
+                if (any_reporting) note_events(world.contacts[awake[k]], awake[k], worker, counts);
+                continue;
+            }
             Contact& contact = world.contacts[awake[k]];
             const std::uint32_t a = contact.body_a, bb = contact.body_b;
-            // Not for a swept body: its contacts must see where it went.
-            const bool recyclable = !b.is_fast(a) && !b.is_fast(bb);
+            // Not for a swept body: its contacts must see where it went. Asked only when
+            // the space has one: is_fast reads the cold description.
+            const bool recyclable = !any_fast || (!b.is_fast(a) && !b.is_fast(bb));
             Turns turns;
             if (recyclable && recycles(contact, b, recycle_distance, turns)) {
                 recycle(contact, b, turns);
@@ -229,16 +271,18 @@ void update_narrowphase(World& world) {
             note_events(contact, awake[k], worker, counts);
         }
     });
-    std::uint32_t touching = 0, reused = 0;
+    std::uint32_t touching = 0, reused = 0, ruled_out = 0;
     for (const ContactCounts& c : world.contact_counts) {
         touching += c.touching;
         reused += c.reused;
+        ruled_out += c.out_of_reach;
         world.counters.contact_event_checks += c.event_checks;
     }
     note_touch_changes(world);  // Begin and End in contact order, whichever worker found them
     world.stats.contacts = touching;
     world.counters.contacts_updated += count;
     world.counters.manifolds_reused += reused;
+    world.counters.contacts_out_of_reach += ruled_out;
 }
 
 }  // namespace spindle

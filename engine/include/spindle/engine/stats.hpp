@@ -43,6 +43,9 @@ struct WorkCounters {
     std::uint64_t gyroscopic_applied = 0;  // body-substeps with gyroscopic torque
     std::uint64_t contacts_updated = 0;    // contact-steps through the narrowphase
     std::uint64_t manifolds_reused = 0;    // of those, moved with the bodies instead of recomputed
+    // Of those, pairs without points whose bounds were too far apart for any: no collision
+    // test, and their contact records were not read.
+    std::uint64_t contacts_out_of_reach = 0;
     // Pairs the broadphase reported and the collision filter dropped (layers or group): no
     // contact, no narrowphase work. A pair is reported again when one of its fat boxes grows.
     std::uint64_t pairs_filtered = 0;
