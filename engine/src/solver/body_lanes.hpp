@@ -24,9 +24,6 @@ static_assert(std::is_standard_layout_v<SolverBody> && offsetof(SolverBody, v) =
                   offsetof(SolverBody, w) == 3 * sizeof(Real) && offsetof(SolverBody, dp) == 6 * sizeof(Real) &&
                   offsetof(SolverBody, dq) == 9 * sizeof(Real) && sizeof(SolverBody) >= 14 * sizeof(Real),
               "the solver's gather reads a body's v, w, dp and dq as consecutive doubles");
-static_assert(offsetof(SolverBody, inv_mass) == 13 * sizeof(Real) && offsetof(SolverBody, dynamic) < 128 &&
-                  alignof(SolverBody) == 64,
-              "a pass reads a body's first two cache lines only, the motion row ending on inv_mass");
 inline constexpr int kVelocityRow = 0, kMotionRow = 6;
 
 [[gnu::always_inline]] inline void gather_rows(const SolverBody* bodies, const std::uint32_t* index, int first,

@@ -10,26 +10,11 @@
 
 namespace spindle {
 
-// Aligned to a cache line, with what a constraint pass gathers and scatters (v, w, dp,
-// dq, and the flag it checks before writing back) in the first two: each of the two
-// bodies of a lane costs two lines per pass instead of three or four.
-struct alignas(64) SolverBody {
+struct SolverBody {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
     Vec3 dp = Vec3::Zero();      // position change since the step began
     Quat dq = Quat::Identity();  // rotation change since the step began
-    // After dq, so that the gather's row of eight doubles from dp ends on a plain number.
-    Real inv_mass = 0;       // along the free axes: zero along a locked one (locks)
-    bool dynamic = false;    // only dynamic bodies are written by constraints
-    std::uint8_t locks = 0;  // motion lock bits (motion_locks.hpp)
-    // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
-    // and no rotation lock. Kept here so integrate_positions reads no body description.
-    bool gyroscopic = false;
-    // BodyDesc::gravity_scale of a dynamic body (else 0) and whether it damps: the passes
-    // that read them once per body and substep or per contact stay off the cold
-    // descriptions, each a cache miss.
-    bool damped = false;
-    Real gravity_scale = 0;
     // Push-out velocities of the current substep (split impulse): they move the body out
     // of overlaps in integrate_positions and are then dropped, so pushing apart never
     // becomes real speed. Capped per body in integrate_positions: pushing never makes a
@@ -37,6 +22,17 @@ struct alignas(64) SolverBody {
     Vec3 push_v = Vec3::Zero();
     Vec3 push_w = Vec3::Zero();
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
+    Real inv_mass = 0;                // along the free axes: zero along a locked one (locks)
+    // BodyDesc::gravity_scale of a dynamic body (else 0) and whether it damps: the passes
+    // that read them once per body and substep or per contact stay off the cold
+    // descriptions, each a cache miss.
+    Real gravity_scale = 0;
+    bool damped = false;
+    bool dynamic = false;    // only dynamic bodies are written by constraints
+    std::uint8_t locks = 0;  // motion lock bits (motion_locks.hpp), in the padding
+    // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
+    // and no rotation lock. Kept here so integrate_positions reads no body description.
+    bool gyroscopic = false;
 };
 
 // The velocity change of an impulse (inverse mass times it): none along a locked axis.
