@@ -21,13 +21,16 @@ void mark_refit(BroadphaseState& bp, std::uint32_t slot) {
     bp.refit_slots.push_back(slot);
 }
 
-// Moves a body's proxy, noting when its fat box changed at all (grown or shrunk: either
-// can end an overlap).
+// Marks a body whose fat box changed at all (grown or shrunk: either can end an overlap).
+void note_fat_change(BroadphaseState& bp, std::uint32_t slot, const Aabb& before, const Aabb& after) {
+    if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
+}
+
+// Moves a body's proxy (its ancestors grown at once).
 void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
     const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
     bp.tree.move_proxy(bp.proxy[slot], box, displacement);
-    const Aabb& after = bp.tree.fat_aabb(bp.proxy[slot]);
-    if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
+    note_fat_change(bp, slot, before, bp.tree.fat_aabb(bp.proxy[slot]));
 }
 
 // The box a body's fat box must hold: its bounds swept over this step's motion (a
@@ -197,8 +200,7 @@ void update_broadphase(World& world, Real dt) {
         const std::uint32_t i = world.awake[k];
         const Vec3 d = b.v[i] * dt;
         const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept_bounds(b, i, d), d);
-        const Aabb& before = bp.tree.fat_aabb(bp.proxy[i]);
-        if (fat.min != before.min || fat.max != before.max) mark_refit(bp, i);
+        note_fat_change(bp, i, bp.tree.fat_aabb(bp.proxy[i]), fat);
         bp.tree.set_fat_box(bp.proxy[i], fat);
     }
 
