@@ -59,6 +59,60 @@ void expect_near(const Vec3& wide, const Vec3& scalar, const char* what, int joi
         << what << " of joint " << joint << ": lanes " << wide.transpose() << ", scalar " << scalar.transpose();
 }
 
+void expect_near(double wide, double scalar, const char* what, int joint) {
+    EXPECT_LT(std::abs(wide - scalar), 1e-4 * std::max(1.0, std::abs(scalar)))
+        << what << " of joint " << joint << ": lanes " << wide << ", scalar " << scalar;
+}
+
+// The scalar rows' side of a comparison: copies of the bodies and joints they pushed.
+struct ScalarSide {
+    std::vector<SolverBody> bodies;
+    std::vector<JointConstraint> joints;
+};
+
+// Prepares the packed lanes' blocks [0, blocks), then pushes them on scratch's bodies and
+// joints [0, scalar_count) by the scalar rows on copies: a warm start, then solve, relax,
+// solve; the lanes' impulses are stored back into scratch.joints.
+ScalarSide push_both_ways(SolverScratch& scratch, std::uint32_t scalar_count, std::uint32_t blocks) {
+    prepare_joint_lanes(scratch, 0, blocks);
+    ScalarSide scalar{scratch.bodies, scratch.joints};
+    const JointSolveParams solve{make_softness(60, 2, 1.0 / 240), 240, true};
+    const JointSolveParams relax{solve.soft, solve.inv_h, false};
+    EffectCounts wide_counts, scalar_counts;
+    for (std::uint32_t k = 0; k < scalar_count; ++k) warm_start_joint(scalar.joints[k], scalar.bodies.data());
+    for (WideJoint& wj : scratch.wide_joints) warm_start_joint_lanes(scratch, wj, scratch.bodies.data());
+    for (const JointSolveParams& params : {solve, relax, solve}) {
+        for (std::uint32_t k = 0; k < scalar_count; ++k)
+            solve_joint(scalar.joints[k], scalar.bodies.data(), params, scalar_counts);
+        for (WideJoint& wj : scratch.wide_joints)
+            solve_joint_lanes(scratch, wj, scratch.bodies.data(), params, wide_counts);
+    }
+    store_joint_lane_impulses(scratch, 0, blocks);
+    EXPECT_EQ(wide_counts.joints, scalar_counts.joints);
+    return scalar;
+}
+
+// Every impulse of joints [0, count) and the velocities of their bodies, lanes against scalar.
+void expect_pushed_alike(const SolverScratch& scratch, const ScalarSide& scalar, std::uint32_t count) {
+    for (std::uint32_t k = 0; k < count; ++k) {
+        const JointConstraint& jc = scalar.joints[k];
+        const JointConstraint& wide = scratch.joints[k];
+        const int i = static_cast<int>(k);
+        expect_near(wide.linear_impulse, jc.linear_impulse, "point impulse", i);
+        expect_near(wide.angular_impulse, jc.angular_impulse, "friction impulse", i);
+        expect_near(wide.swing_impulse, jc.swing_impulse, "swing impulse", i);
+        expect_near(wide.lower_impulse, jc.lower_impulse, "lower impulse", i);
+        expect_near(wide.upper_impulse, jc.upper_impulse, "upper impulse", i);
+        expect_near(wide.motor_impulse, jc.motor_impulse, "motor impulse", i);
+        expect_near(wide.align_impulse.x(), jc.align_impulse.x(), "first alignment impulse", i);
+        expect_near(wide.align_impulse.y(), jc.align_impulse.y(), "second alignment impulse", i);
+        for (const std::uint32_t b : {jc.a, jc.b}) {
+            expect_near(scratch.bodies[b].v, scalar.bodies[b].v, "v", i);
+            expect_near(scratch.bodies[b].w, scalar.bodies[b].w, "w", i);
+        }
+    }
+}
+
 }  // namespace
 
 TEST(JointLanes, BallSocketsPushAsTheScalarPointRowsInWarmStartSolveAndRelax) {
@@ -81,31 +135,8 @@ TEST(JointLanes, BallSocketsPushAsTheScalarPointRowsInWarmStartSolveAndRelax) {
     EXPECT_EQ(scratch.wide_joints[1].lanes, 3);
     ASSERT_EQ(scratch.joint_colors[0].size(), 1u);  // the locked body's joint
     EXPECT_EQ(scratch.joint_colors[0][0], 11u);
-    prepare_joint_lanes(scratch, 0, 2);
-
-    std::vector<SolverBody> scalar_bodies = scratch.bodies;
-    std::vector<JointConstraint> scalar_joints = scratch.joints;
-    const JointSolveParams solve{make_softness(60, 2, 1.0 / 240), 240, true};
-    const JointSolveParams relax{solve.soft, solve.inv_h, false};
-    EffectCounts wide_counts, scalar_counts;
-    for (std::uint32_t k = 0; k < 11; ++k) warm_start_joint(scalar_joints[k], scalar_bodies.data());
-    for (WideJoint& wj : scratch.wide_joints) warm_start_joint_lanes(scratch, wj, scratch.bodies.data());
-    for (const JointSolveParams& params : {solve, relax, solve}) {
-        for (std::uint32_t k = 0; k < 11; ++k)
-            solve_joint(scalar_joints[k], scalar_bodies.data(), params, scalar_counts);
-        for (WideJoint& wj : scratch.wide_joints)
-            solve_joint_lanes(scratch, wj, scratch.bodies.data(), params, wide_counts);
-    }
-    store_joint_lane_impulses(scratch, 0, 2);
-    EXPECT_EQ(wide_counts.joints, scalar_counts.joints);
-    for (int k = 0; k < 11; ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        expect_near(scratch.joints[i].linear_impulse, scalar_joints[i].linear_impulse, "impulse", k);
-        for (const std::uint32_t body : {scratch.joints[i].a, scratch.joints[i].b}) {
-            expect_near(scratch.bodies[body].v, scalar_bodies[body].v, "v", k);
-            expect_near(scratch.bodies[body].w, scalar_bodies[body].w, "w", k);
-        }
-    }
+    const ScalarSide scalar = push_both_ways(scratch, 11, 2);
+    expect_pushed_alike(scratch, scalar, 11);
     // The immovable body is shared by every colour: never written.
     EXPECT_EQ(scratch.bodies[immovable].v, Vec3::Zero());
     EXPECT_EQ(scratch.bodies[immovable].w, Vec3::Zero());
@@ -184,11 +215,6 @@ JointConstraint random_hinge(std::uint32_t a, std::uint32_t b, int k, std::mt199
     return jc;
 }
 
-void expect_near(double wide, double scalar, const char* what, int joint) {
-    EXPECT_LT(std::abs(wide - scalar), 1e-4 * std::max(1.0, std::abs(scalar)))
-        << what << " of joint " << joint << ": lanes " << wide << ", scalar " << scalar;
-}
-
 }  // namespace
 
 // Swing-twist joints and hinges, mixed with ball-sockets in one colour: one type to a
@@ -241,41 +267,12 @@ TEST(JointLanes, SwingTwistAndHingeRowsPushAsTheScalarRows) {
     EXPECT_EQ(scratch.wide_swing_twists.size(), 2u);
     EXPECT_EQ(scratch.wide_hinges.size(), 2u);
     const auto blocks = static_cast<std::uint32_t>(scratch.wide_joints.size());
-    prepare_joint_lanes(scratch, 0, blocks);
-
-    std::vector<SolverBody> scalar_bodies = scratch.bodies;
-    std::vector<JointConstraint> scalar_joints = scratch.joints;
-    const JointSolveParams solve{make_softness(60, 2, 1.0 / 240), 240, true};
-    const JointSolveParams relax{solve.soft, solve.inv_h, false};
-    EffectCounts wide_counts, scalar_counts;
-    for (std::uint32_t k = 0; k < lane_joints; ++k) warm_start_joint(scalar_joints[k], scalar_bodies.data());
-    for (WideJoint& wj : scratch.wide_joints) warm_start_joint_lanes(scratch, wj, scratch.bodies.data());
-    for (const JointSolveParams& params : {solve, relax, solve}) {
-        for (std::uint32_t k = 0; k < lane_joints; ++k)
-            solve_joint(scalar_joints[k], scalar_bodies.data(), params, scalar_counts);
-        for (WideJoint& wj : scratch.wide_joints)
-            solve_joint_lanes(scratch, wj, scratch.bodies.data(), params, wide_counts);
-    }
-    store_joint_lane_impulses(scratch, 0, blocks);
-    EXPECT_EQ(wide_counts.joints, scalar_counts.joints);
+    const ScalarSide scalar = push_both_ways(scratch, lane_joints, blocks);
+    expect_pushed_alike(scratch, scalar, lane_joints);
     // The limits and the motors were in play, not only the point rows.
     int pushing = 0;
     for (std::uint32_t k = 0; k < lane_joints; ++k) {
-        const JointConstraint& jc = scalar_joints[k];
-        const int i = static_cast<int>(k);
-        const JointConstraint& wide = scratch.joints[k];
-        expect_near(wide.linear_impulse, jc.linear_impulse, "point impulse", i);
-        expect_near(wide.angular_impulse, jc.angular_impulse, "friction impulse", i);
-        expect_near(wide.swing_impulse, jc.swing_impulse, "swing impulse", i);
-        expect_near(wide.lower_impulse, jc.lower_impulse, "lower impulse", i);
-        expect_near(wide.upper_impulse, jc.upper_impulse, "upper impulse", i);
-        expect_near(wide.motor_impulse, jc.motor_impulse, "motor impulse", i);
-        expect_near(wide.align_impulse.x(), jc.align_impulse.x(), "first alignment impulse", i);
-        expect_near(wide.align_impulse.y(), jc.align_impulse.y(), "second alignment impulse", i);
-        for (const std::uint32_t b : {jc.a, jc.b}) {
-            expect_near(scratch.bodies[b].v, scalar_bodies[b].v, "v", i);
-            expect_near(scratch.bodies[b].w, scalar_bodies[b].w, "w", i);
-        }
+        const JointConstraint& jc = scalar.joints[k];
         pushing += (jc.swing_impulse > 1e-3) + (jc.lower_impulse > 1e-3) + (jc.upper_impulse > 1e-3);
     }
     EXPECT_GE(pushing, 8);
@@ -308,4 +305,35 @@ TEST(JointLanes, Atan2IsWithinFloatRoundingInEveryOctant) {
     EXPECT_NEAR(wide_atan2(one, zero)[0], kPi / 2, 1e-6);
     EXPECT_NEAR(wide_atan2(-one, zero)[0], -kPi / 2, 1e-6);
     EXPECT_NEAR(wide_atan2(zero, -one)[0], kPi, 1e-6);
+}
+
+// Swing-twist joints swung nearly half a turn (150-178 degrees, where the arc that undoes
+// the swing is short of an axis and the float lanes' twist rests on 1 + cos(swing)): the
+// cone and twist rows still push as the scalar rows do.
+TEST(JointLanes, SwingTwistNearlyHalfATurnPushesAsTheScalarRows) {
+    std::mt19937 rng(23);
+    constexpr int kBodies = 32;
+    SolverScratch scratch;
+    scratch.bodies = random_bodies(kBodies, rng);
+    for (SolverBody& b : scratch.bodies) b.dq = Quat::Identity();  // the swing exactly as built
+    std::uniform_real_distribution<double> swing(2.6, 3.1), twist(-1, 1), about(0, 2 * kPi);
+    for (std::uint32_t k = 0; k < 16; ++k) {
+        JointConstraint jc = random_swing_twist(2 * k, 2 * k + 1, static_cast<int>(k), scratch.bodies, rng);
+        const Vec3 perp = Eigen::AngleAxisd(about(rng), jc.axis_a) * any_perpendicular(jc.axis_a);
+        const Quat swung(Eigen::AngleAxisd(swing(rng), perp));
+        const Quat rel = Quat(Eigen::AngleAxisd(twist(rng), swung * jc.axis_a)) * swung;
+        jc.axis_b = rel * jc.axis_a;
+        jc.ref_b = rel * jc.ref_a;
+        scratch.joints.push_back(jc);
+        scratch.joint_colors[0].push_back(k);
+    }
+    pack_joint_lanes(scratch);
+    ASSERT_TRUE(scratch.joint_colors[0].empty());
+    ASSERT_EQ(scratch.wide_swing_twists.size(), 2u);
+    const auto blocks = static_cast<std::uint32_t>(scratch.wide_joints.size());
+    const ScalarSide scalar = push_both_ways(scratch, 16, blocks);
+    expect_pushed_alike(scratch, scalar, 16);
+    int pushing = 0;
+    for (const JointConstraint& jc : scalar.joints) pushing += (jc.swing_impulse > 1e-3);
+    EXPECT_GE(pushing, 8);  // the cones (at most 46 degrees) are far exceeded: their rows push
 }
