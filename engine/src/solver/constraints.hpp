@@ -259,7 +259,12 @@ struct SupportEdge {
 };
 
 struct SolverScratch {
-    std::vector<SolverBody> bodies;      // awake bodies, then the static body
+    std::vector<SolverBody> bodies;  // awake bodies, then the static body
+    // Per solver body, apart from it (SolverBody says why): its push-out velocities, and
+    // BodyDesc::gravity_scale of a dynamic body (else 0) so that integrate_velocities and
+    // prepare_wide stay off the cold descriptions, each a cache miss.
+    std::vector<PushVelocity> push_velocities;
+    std::vector<Real> gravity_scales;
     std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
@@ -327,10 +332,11 @@ void pack_contacts(JobSystem& jobs, SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi);  // wide [lo, hi)
 // push_anchors: the wide contact's kLanes push-out anchors (SolverScratch::push_anchors).
-void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies);
+// push: the solver bodies' push-out velocities (SolverScratch::push_velocities).
+void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push);
 // The points whose rows ran are counted into `counts` (the worker's).
-void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
-                   EffectCounts& counts);
+void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
+                   const ContactSolveParams& params, EffectCounts& counts);
 void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts);
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 

@@ -247,8 +247,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.tracks_push = wc.tracks_push || contact.restitution > 0 || (contact.events & kContactReports) != 0;
         wc.radius_a[l] = m.radius_a;
         wc.radius_b[l] = m.radius_b;
-        wc.gravity_normal[l] =
-            m.normal.dot(project_linear(B.gravity_scale * g, B.locks) - project_linear(A.gravity_scale * g, A.locks));
+        wc.gravity_normal[l] = m.normal.dot(project_linear(scratch.gravity_scales[ref.b] * g, B.locks) -
+                                            project_linear(scratch.gravity_scales[ref.a] * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             ra[j].set_lane(l, contact.anchor_a(src));
@@ -346,8 +346,8 @@ const SolverBody& lane_body(const WideContact& wc, int lane, int side, const Sol
 // impulse), never by real speed, so a chain of deep overlaps separates without
 // launching anything. One row per manifold, through the overlap's depth-weighted centre,
 // so a face pushes straight and a tilted corner turns back.
-void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodies, Real excess, const Vec3& ra,
-              const Vec3& rb, const ContactSolveParams& params) {
+void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodies, PushVelocity* push_velocities,
+              Real excess, const Vec3& ra, const Vec3& rb, const ContactSolveParams& params) {
     SolverBody& A = bodies[wc.a[lane]];
     SolverBody& B = bodies[wc.b[lane]];
     const Vec3 normal = wc.normal.lane(lane);
@@ -358,19 +358,21 @@ void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodie
     ContactRow row;
     const Real mass = make_row(Am, Bm, ra, rb, normal, row);
     anchors = {ra, rb};
-    Velocities push = load_push(A, B);
+    PushVelocity& push_a = push_velocities[wc.a[lane]];
+    PushVelocity& push_b = push_velocities[wc.b[lane]];
+    Velocities push = load_push(push_a, push_b);
     const Real target = std::max(params.soft.bias_rate * excess, -params.push_out);
     const Real speed = row_speed(push, normal, row);
     const auto total = static_cast<float>(std::max(
         impulse - mass * params.soft.mass_scale * (speed + target) - params.soft.impulse_scale * impulse, Real(0)));
     apply_row(Am, Bm, push, normal, row, Real(total) - Real(impulse));
     impulse = total;
-    store_push(A, B, push);
+    store_push(A, B, push_a, push_b, push);
 }
 
 template <bool kBias, bool kLocked>
-void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
-                EffectCounts& counts) {
+void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
+                const ContactSolveParams& params, EffectCounts& counts) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
@@ -488,14 +490,15 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         for (int l = 0; l < kLanes; ++l) {
             if (deep_weight[l] <= 0) continue;
             const Real w = deep_weight[l];
-            push_out(wc, push_anchors[l], l, bodies, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
+            push_out(wc, push_anchors[l], l, bodies, push, deep_excess[l] / w, deep_ra.lane(l) / w, deep_rb.lane(l) / w,
                      params);
         }
     }
 }
 
 template <bool kLocked>
-void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
+void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies,
+                     PushVelocity* push_velocities) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
@@ -516,9 +519,11 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
         const Vec3 normal = wc.normal.lane(l);
         ContactRow row;
         make_row(Am, Bm, push_anchors[l].ra, push_anchors[l].rb, normal, row);
-        Velocities push = load_push(A, B);
+        PushVelocity& push_a = push_velocities[wc.a[l]];
+        PushVelocity& push_b = push_velocities[wc.b[l]];
+        Velocities push = load_push(push_a, push_b);
         apply_row(Am, Bm, push, normal, row, wc.push_impulse[l]);
-        store_push(A, B, push);
+        store_push(A, B, push_a, push_b, push);
     }
 }
 
@@ -563,22 +568,22 @@ void prepare_contacts(const World& world, SolverScratch& scratch, const ContactS
 
 // Each pass in two builds: with per-axis inverse masses where a lane's body has a
 // translation lock, with the scalar ones (no extra work) everywhere else.
-void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies) {
+void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push) {
     if (wc.locked) {
-        warm_start_wide<true>(wc, push_anchors, bodies);
+        warm_start_wide<true>(wc, push_anchors, bodies, push);
     } else {
-        warm_start_wide<false>(wc, push_anchors, bodies);
+        warm_start_wide<false>(wc, push_anchors, bodies, push);
     }
 }
 
-void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, const ContactSolveParams& params,
-                   EffectCounts& counts) {
+void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
+                   const ContactSolveParams& params, EffectCounts& counts) {
     if (wc.locked) {
-        params.use_bias ? solve_wide<true, true>(wc, push_anchors, bodies, params, counts)
-                        : solve_wide<false, true>(wc, push_anchors, bodies, params, counts);
+        params.use_bias ? solve_wide<true, true>(wc, push_anchors, bodies, push, params, counts)
+                        : solve_wide<false, true>(wc, push_anchors, bodies, push, params, counts);
     } else {
-        params.use_bias ? solve_wide<true, false>(wc, push_anchors, bodies, params, counts)
-                        : solve_wide<false, false>(wc, push_anchors, bodies, params, counts);
+        params.use_bias ? solve_wide<true, false>(wc, push_anchors, bodies, push, params, counts)
+                        : solve_wide<false, false>(wc, push_anchors, bodies, push, params, counts);
     }
 }
 

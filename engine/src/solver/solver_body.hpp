@@ -4,35 +4,45 @@
 // from small numbers even far from the origin.
 #pragma once
 
+#include <cstddef>
+
 #include <spindle/engine/math.hpp>
 
 #include "solver/motion_locks.hpp"
 
 namespace spindle {
 
-struct SolverBody {
+// 192 bytes, aligned to a cache line: what the passes over the constraints read and
+// write (v, w, dp, dq, the dynamic flag) fills its first two lines, and three lines a
+// body is not a power-of-two stride, whose bodies would crowd a quarter of the cache
+// sets (a 256-byte body did). What the passes never read lives in arrays of its own
+// (PushVelocity, SolverScratch::gravity_scales).
+struct alignas(64) SolverBody {
     Vec3 v = Vec3::Zero();
     Vec3 w = Vec3::Zero();
     Vec3 dp = Vec3::Zero();      // position change since the step began
     Quat dq = Quat::Identity();  // rotation change since the step began
-    // Push-out velocities of the current substep (split impulse): they move the body out
-    // of overlaps in integrate_positions and are then dropped, so pushing apart never
-    // becomes real speed. Capped per body in integrate_positions: pushing never makes a
-    // body move faster than the push-out speed or its own speed, whichever is larger.
-    Vec3 push_v = Vec3::Zero();
-    Vec3 push_w = Vec3::Zero();
-    Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
-    Real inv_mass = 0;                // along the free axes: zero along a locked one (locks)
-    // BodyDesc::gravity_scale of a dynamic body (else 0) and whether it damps: the passes
-    // that read them once per body and substep or per contact stay off the cold
-    // descriptions, each a cache miss.
-    Real gravity_scale = 0;
-    bool damped = false;
-    bool dynamic = false;    // only dynamic bodies are written by constraints
-    std::uint8_t locks = 0;  // motion lock bits (motion_locks.hpp), in the padding
+    Real inv_mass = 0;           // along the free axes: zero along a locked one (locks)
+    bool dynamic = false;        // only dynamic bodies are written by constraints
+    std::uint8_t locks = 0;      // motion lock bits (motion_locks.hpp)
+    bool damped = false;         // damps: integrate_velocities reads the description only then
     // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
     // and no rotation lock. Kept here so integrate_positions reads no body description.
     bool gyroscopic = false;
+    Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
+};
+static_assert(sizeof(SolverBody) == 192 && offsetof(SolverBody, gyroscopic) < 128,
+              "a solver body is three cache lines, with what the passes touch in the first two");
+
+// Push-out velocities of a solver body in the current substep (split impulse), at the
+// same index: they move the body out of overlaps in integrate_positions and are then
+// dropped, so pushing apart never becomes real speed. Capped per body in
+// integrate_positions: pushing never makes a body move faster than the push-out speed
+// or its own speed, whichever is larger. Only deep overlap writes them (rare), so the
+// passes' body lines stay without them.
+struct PushVelocity {
+    Vec3 v = Vec3::Zero();
+    Vec3 w = Vec3::Zero();
 };
 
 // The velocity change of an impulse (inverse mass times it): none along a locked axis.
@@ -47,28 +57,25 @@ struct Velocities {
 };
 
 inline Velocities load(const SolverBody& A, const SolverBody& B) { return {A.v, A.w, B.v, B.w}; }
-inline Velocities load_push(const SolverBody& A, const SolverBody& B) {
-    return {A.push_v, A.push_w, B.push_v, B.push_w};
-}
+inline Velocities load_push(const PushVelocity& A, const PushVelocity& B) { return {A.v, A.w, B.v, B.w}; }
 
-// Stores into the members v and w (the real or the push-out velocities). Only dynamic
-// bodies are written: static and kinematic ones are shared by constraints of every colour.
-template <Vec3 SolverBody::*V, Vec3 SolverBody::*W>
-inline void store_into(SolverBody& A, SolverBody& B, const Velocities& s) {
+// Stores the velocities of a constraint's bodies. Only dynamic bodies are written: static
+// and kinematic ones are shared by constraints of every colour.
+inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
     if (A.dynamic) {
-        A.*V = s.va;
-        A.*W = s.wa;
+        A.v = s.va;
+        A.w = s.wa;
     }
     if (B.dynamic) {
-        B.*V = s.vb;
-        B.*W = s.wb;
+        B.v = s.vb;
+        B.w = s.wb;
     }
 }
-inline void store(SolverBody& A, SolverBody& B, const Velocities& s) {
-    store_into<&SolverBody::v, &SolverBody::w>(A, B, s);
-}
-inline void store_push(SolverBody& A, SolverBody& B, const Velocities& s) {
-    store_into<&SolverBody::push_v, &SolverBody::push_w>(A, B, s);
+// The same for their push-out velocities (A and B: the bodies at the same index).
+inline void store_push(const SolverBody& A, const SolverBody& B, PushVelocity& push_a, PushVelocity& push_b,
+                       const Velocities& s) {
+    if (A.dynamic) push_a = {s.va, s.wa};
+    if (B.dynamic) push_b = {s.vb, s.wb};
 }
 
 // An impulse at the anchors ra, rb (from each centre of mass): -impulse on A, +impulse on B.

@@ -41,8 +41,8 @@ void rotate_keeping_momentum(SolverBody& sb, const Quat& start, const Mat3& iner
 
 }  // namespace
 
-void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
-                          EffectCounts& c) {
+void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
+                          std::uint32_t hi, EffectCounts& c) {
     const Bodies& b = world.bodies;
     const Vec3 gravity = world.settings.gravity;
     const Real max_linear = world.settings.solver.max_linear_speed;
@@ -56,8 +56,8 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
             continue;
         }
         const std::uint32_t i = world.awake[k];
-        if (sb.gravity_scale != 0) {
-            sb.v += project_linear(h * sb.gravity_scale * gravity, sb.locks);
+        if (gravity_scales[k] != 0) {
+            sb.v += project_linear(h * gravity_scales[k] * gravity, sb.locks);
             ++c.gravity;
         }
         // At worst infinite components, which the limit turns back.
@@ -75,31 +75,31 @@ void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_
     }
 }
 
-void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
-                         EffectCounts& c) {
+void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
+                         std::uint32_t hi, EffectCounts& c) {
     const Bodies& b = world.bodies;
     const Real push_out = world.settings.solver.push_out_speed;
     for (std::uint32_t k = lo; k < hi; ++k) {
         SolverBody& sb = bodies[k];
+        PushVelocity& pv = push[k];
         // The push-out velocity is capped per body, not only per contact: a chain of
         // overlaps would otherwise add up each contact's push-out speed.
-        const Vec3 moving = sb.v + sb.push_v;
+        const Vec3 moving = sb.v + pv.v;
         const Real limit_sq = std::max(sb.v.squaredNorm(), push_out * push_out);
         const Real moving_sq = moving.squaredNorm();
-        if (moving_sq > limit_sq) sb.push_v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
-        sb.dp += h * (sb.v + sb.push_v);
+        if (moving_sq > limit_sq) pv.v = std::sqrt(limit_sq / moving_sq) * moving - sb.v;
+        sb.dp += h * (sb.v + pv.v);
         // The momentum-keeping turn knows nothing of the locks: a body with a rotation lock
         // turns by its (projected) spin, which about a single free axis is exact anyway
         // (SolverBody::gyroscopic is false for it).
         if (sb.gyroscopic) {
             const std::uint32_t i = world.awake[k];
-            rotate_keeping_momentum(sb, b.q[i], b.inertia_local[i], b.inv_inertia_local[i], sb.push_w, h);
+            rotate_keeping_momentum(sb, b.q[i], b.inertia_local[i], b.inv_inertia_local[i], pv.w, h);
             ++c.gyro;
         } else {
-            sb.dq = integrate_rotation(sb.dq, sb.w + sb.push_w, h);
+            sb.dq = integrate_rotation(sb.dq, sb.w + pv.w, h);
         }
-        sb.push_v = Vec3::Zero();
-        sb.push_w = Vec3::Zero();
+        pv = PushVelocity{};
     }
 }
 

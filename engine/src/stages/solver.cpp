@@ -50,6 +50,8 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     scratch.bodies.resize(n + 1);
+    scratch.push_velocities.resize(n + 1);
+    scratch.gravity_scales.resize(n + 1);
     // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
     // by the grain): equal over all of them, no body is lighter than another it carries.
     const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
@@ -61,15 +63,14 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             SolverBody& sb = scratch.bodies[k];
             sb.v = b.v[i];
             sb.w = b.w[i];
-            sb.push_v = Vec3::Zero();
-            sb.push_w = Vec3::Zero();
+            scratch.push_velocities[k] = PushVelocity{};
             sb.dp = Vec3::Zero();
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
             const BodyDesc& d = b.desc[i];
             sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
-            sb.gravity_scale = sb.dynamic ? d.gravity_scale : 0;
+            scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
             sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
@@ -80,6 +81,8 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
         }
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
+    scratch.push_velocities[n] = PushVelocity{};
+    scratch.gravity_scales[n] = 0;
     Real least = kHuge, greatest = -kHuge;
     for (const auto& [chunk_least, chunk_greatest] : scratch.chunk_inv_mass) {
         least = std::min(least, chunk_least);
@@ -316,6 +319,8 @@ void solve(World& world, Real dt) {
         world.counters.constraint_colorings += 1;
     }
     SolverBody* bodies = scratch.bodies.data();
+    PushVelocity* push = scratch.push_velocities.data();
+    const Real* gravity_scales = scratch.gravity_scales.data();
 
     ContactSolveParams solve_params;
     // The contact spring: an eighth of the substep rate unless set (Box3D's), never stiffer
@@ -357,28 +362,34 @@ void solve(World& world, Real dt) {
                 case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
                 case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
-                case Pass::IntegrateVelocities: integrate_velocities(world, bodies, h, lo, hi, counts); break;
-                case Pass::IntegratePositions: integrate_positions(world, bodies, h, lo, hi, counts); break;
+                case Pass::IntegrateVelocities:
+                    integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
+                    break;
+                case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi, counts); break;
                 case Pass::WarmStart:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
                         [&](WideJoint& wj) { warm_start_joint_lanes(scratch, wj, bodies); },
                         [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-                        [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies); });
+                        [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies, push); });
                     break;
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
                         [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_solve, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
-                        [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, solve_params, counts); });
+                        [&](WideContact& wc) {
+                            solve_contact(wc, push_anchors(wc), bodies, push, solve_params, counts);
+                        });
                     break;
                 case Pass::Relax:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
                         [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_relax, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
-                        [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, relax_params, counts); });
+                        [&](WideContact& wc) {
+                            solve_contact(wc, push_anchors(wc), bodies, push, relax_params, counts);
+                        });
                     break;
                 case Pass::Restitution:
                     for_colored<false>(

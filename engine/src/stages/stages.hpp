@@ -26,10 +26,11 @@ void sweep_fast_bodies(World& world);
 // integrator.cpp (called by the solver once per substep, in blocks of the awake
 // bodies [lo, hi); effects used are counted into `counts`).
 struct SolverBody;
-void integrate_velocities(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
-                          EffectCounts& counts);
-void integrate_positions(World& world, SolverBody* bodies, Real h, std::uint32_t lo, std::uint32_t hi,
-                         EffectCounts& counts);
+struct PushVelocity;
+void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
+                          std::uint32_t hi, EffectCounts& counts);
+void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
+                         std::uint32_t hi, EffectCounts& counts);
 // record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
 void record(World& world);
 
