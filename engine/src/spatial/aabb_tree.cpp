@@ -128,6 +128,7 @@ void DynamicAabbTree::create_proxies(std::span<const Aabb> tight, std::span<cons
     }
     m_proxy_count += static_cast<std::int32_t>(tight.size());
     build_from_leaves(jobs);
+    m_built_cost = build_cost();
     // Once, not every step: the scratch is not kept at the size of the whole tree.
     m_build_leaves = {};
     m_build_pool = {};

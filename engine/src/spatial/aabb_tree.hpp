@@ -84,9 +84,14 @@ public:
     // unchanged. Costs nothing when no proxy moved since the last rebuild. With `jobs`,
     // the lower parts are built in parallel (the same tree for any worker count); the
     // caller waits for them, and nothing else may touch the tree meanwhile.
+    // When most of the tree is flagged (proxies moving together), the flagged nodes are
+    // first refitted in place, and kept so while their SAH cost per unit of leaf area stays
+    // within kRefitSlack of the last build of most of the tree; else they are rebuilt.
     void rebuild_enlarged(JobSystem* jobs = nullptr);
     // Internal nodes flagged by moves and not rebuilt yet.
     std::int32_t enlarged_node_count() const noexcept { return m_enlarged_nodes; }
+    // rebuild_enlarged() calls that kept the flagged nodes refitted instead of rebuilding them.
+    std::int64_t refit_count() const noexcept { return m_refit_count; }
 
     const Aabb& fat_aabb(std::int32_t id) const {
         check_proxy(id);
@@ -163,9 +168,13 @@ private:
     }
     // rebuild() helpers (aabb_tree_build.cpp).
     struct BuildTask;
+    struct BuildCost;
     void build_from_leaves(JobSystem* jobs);
     std::int32_t place(const BuildTask& task, std::vector<BuildTask>& tasks);
     std::uint32_t partition_sah(std::uint32_t begin, std::uint32_t end);
+    bool builds_most_of_tree() const noexcept;
+    BuildCost build_cost() const;
+    bool refit_holds(const BuildCost& refitted) const noexcept;
 
     AabbTreeSettings m_settings;
     std::vector<Node> m_nodes;
@@ -181,6 +190,18 @@ private:
     // set_fat_box() left flagged nodes' boxes short of their children's; the next rebuild
     // of the flagged nodes makes them whole.
     bool m_stale_boxes = false;
+    // A refit keeps the tree's shape, which stays good while proxies keep their neighbours
+    // (a pile falling together) and decays as they mix. Kept while the refitted nodes' SAH
+    // cost is within kRefitSlack of the last build of most of the tree, both as it is and
+    // per unit of the build leaves' half areas (boxes that all shrink hide a worse shape
+    // from the first, boxes that all grow from the second); no reference before that build.
+    struct BuildCost {
+        Real nodes = 0;   // the built (or refitted) nodes' summed half areas
+        Real leaves = 0;  // the build leaves' summed half areas
+    };
+    static constexpr Real kRefitSlack = Real(1.1);
+    BuildCost m_built_cost;
+    std::int64_t m_refit_count = 0;
 
     // Scratch for the rebuilds, kept so that a rebuild in steady state does not allocate.
     // A range of build leaves to place under `parent` (child `slot`), with the pool nodes

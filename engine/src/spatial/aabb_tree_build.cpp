@@ -31,6 +31,7 @@ void DynamicAabbTree::rebuild() {
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
     build_from_leaves(nullptr);
+    m_built_cost = build_cost();
     validate_if_enabled();
 }
 
@@ -60,8 +61,38 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     }
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
+    const bool most = builds_most_of_tree();
+    if (most && m_built_cost.leaves > 0) {
+        // The pool is in pre-order: walking it backwards fits children first.
+        for (auto it = m_build_pool.rbegin(); it != m_build_pool.rend(); ++it) refit(*it);
+        if (refit_holds(build_cost())) {
+            ++m_refit_count;
+            validate_if_enabled();
+            return;
+        }
+    }
     build_from_leaves(jobs);
+    if (most) m_built_cost = build_cost();
     validate_if_enabled();
+}
+
+// Whether the build in m_build_pool makes at least half of the internal nodes: only such
+// builds are compared, as the quality of a small part says little about the whole.
+bool DynamicAabbTree::builds_most_of_tree() const noexcept {
+    return 2 * m_build_pool.size() + 1 >= static_cast<std::size_t>(m_proxy_count);
+}
+
+// The half areas of the nodes in m_build_pool and of the leaves in m_build_leaves, as they are now.
+DynamicAabbTree::BuildCost DynamicAabbTree::build_cost() const {
+    BuildCost cost;
+    for (const std::int32_t id : m_build_pool) cost.nodes += m_nodes[static_cast<std::size_t>(id)].box.perimeter();
+    for (const std::int32_t id : m_build_leaves) cost.leaves += m_nodes[static_cast<std::size_t>(id)].box.perimeter();
+    return cost;
+}
+
+bool DynamicAabbTree::refit_holds(const BuildCost& refitted) const noexcept {
+    return refitted.nodes <= kRefitSlack * m_built_cost.nodes &&
+           refitted.nodes * m_built_cost.leaves <= kRefitSlack * m_built_cost.nodes * refitted.leaves;
 }
 
 // Places one range of build leaves: a leaf or kept subtree for one, else the pool node

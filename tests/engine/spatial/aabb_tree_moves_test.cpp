@@ -304,6 +304,91 @@ TEST(AabbTreeMoves, SetFatBox_RebuildGivesTheTreeMoveProxyGives) {
     }
 }
 
+// Sets every proxy's fat box to its tight box moved by `step[k]`, as the broadphase does.
+// Without `stretch`, the fat box is not stretched along the step (a teleport).
+void set_all(DynamicAabbTree& tree, const std::vector<std::int32_t>& live, const std::vector<Vec3>& step,
+             bool stretch = true) {
+    for (std::size_t k = 0; k < live.size(); ++k) {
+        const Aabb fat = tree.fat_aabb(live[k]);
+        const Aabb tight = Aabb::from_center_extents(fat.center() + step[k], Vec3::Constant(0.5));
+        tree.set_fat_box(live[k], tree.fat_box(tight, stretch ? step[k] : Vec3::Zero()));
+    }
+}
+
+// A pile falling together (junkyard's rocks): every proxy leaves its fat box at once, but
+// none changes neighbours, so the flagged nodes are refitted where they are instead of
+// rebuilt. The refitted tree keeps its shape (the same walk order), answers every query as
+// a tree rebuilt from the same boxes does, and costs no more than that tree.
+TEST(AabbTreeMoves, RebuildEnlarged_ProxiesMovingTogether_RefitsAndQueriesAsARebuild) {
+    Rng rng(20);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    std::vector<Aabb> tight;
+    std::vector<std::uint64_t> users;
+    for (int i = 0; i < 400 * kScale; ++i) {
+        tight.push_back(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)));
+        users.push_back(std::uint64_t(i));
+    }
+    live.resize(tight.size());
+    tree.create_proxies(tight, users, live);
+    for (int round = 0; round < 8; ++round) {
+        const std::vector<std::int32_t> order = walk_order(tree);
+        const Vec3 fall(0, -Real(0.6), 0);  // a steady fall: the boxes keep their size
+        set_all(tree, live, std::vector<Vec3>(live.size(), fall));
+        ASSERT_GT(2 * tree.enlarged_node_count() + 1, tree.proxy_count());  // most of the tree
+        const std::int64_t refits = tree.refit_count();
+        const Snapshot before = snapshot(tree, live);
+        tree.rebuild_enlarged();
+        tree.validate();
+        EXPECT_EQ(tree.enlarged_node_count(), 0);
+        EXPECT_EQ(tree.refit_count(), refits + 1) << "round " << round;
+        EXPECT_EQ(walk_order(tree), order) << "round " << round;  // refitted, not rebuilt
+        expect_same_proxies(tree, live, before);
+        DynamicAabbTree rebuilt = tree;
+        rebuilt.rebuild();
+        EXPECT_LE(tree.area_cost(), rebuilt.area_cost() * 1.01) << "round " << round;
+        for (int q = 0; q < 40; ++q) {
+            const Aabb box = rng.box(50, 6);
+            const std::vector<std::int32_t> expected = brute_sorted(tree, live, box);
+            ASSERT_EQ(query_sorted(tree, box), expected) << "round " << round;
+            ASSERT_EQ(query_sorted(rebuilt, box), expected) << "round " << round;
+        }
+    }
+}
+
+// Proxies that all move but change neighbours (each to a random place, teleported or
+// stretched along the jump): a refit would keep ancestors stretched across the world, so
+// the cost test rebuilds them instead.
+TEST(AabbTreeMoves, RebuildEnlarged_ProxiesScattered_RebuildsInsteadOfRefitting) {
+    Rng rng(21);
+    DynamicAabbTree tree;
+    std::vector<std::int32_t> live;
+    std::vector<Aabb> tight;
+    std::vector<std::uint64_t> users;
+    for (int i = 0; i < 400 * kScale; ++i) {
+        tight.push_back(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)));
+        users.push_back(std::uint64_t(i));
+    }
+    live.resize(tight.size());
+    tree.create_proxies(tight, users, live);
+    for (int round = 0; round < 4; ++round) {
+        std::vector<Vec3> jump;
+        for (std::size_t k = 0; k < live.size(); ++k)
+            jump.push_back(rng.vec(-40, 40) - tree.fat_aabb(live[k]).center());
+        set_all(tree, live, jump, round % 2 == 0);
+        tree.rebuild_enlarged();
+        tree.validate();
+        DynamicAabbTree rebuilt = tree;
+        rebuilt.rebuild();
+        EXPECT_LE(tree.area_cost(), rebuilt.area_cost() * 1.25) << "round " << round;
+        for (int q = 0; q < 20; ++q) {
+            const Aabb box = rng.box(50, 6);
+            ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box)) << "round " << round;
+        }
+    }
+    EXPECT_EQ(tree.refit_count(), 0);
+}
+
 TEST(AabbTreeMoves, ProxyTrees_UpdatePairsRebuildsWhatMoved) {
     Rng rng(16);
     ProxyTrees trees;
