@@ -266,6 +266,9 @@ struct SolverScratch {
     std::vector<PushVelocity> push_velocities;
     std::vector<Real> gravity_scales;
     std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
+    // list_manifolds' per-range lists and whether each has restitution, before they are joined.
+    std::vector<std::vector<ManifoldRef>> listed;
+    std::vector<std::uint8_t> listed_restitution;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
     std::vector<ManifoldRef> colored_manifolds;

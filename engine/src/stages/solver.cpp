@@ -45,6 +45,8 @@ constexpr std::uint32_t kConstraintGrain = 1;
 constexpr std::uint32_t kWideGrain = 1;
 // Joints per block when storing their impulses.
 constexpr std::uint32_t kJointGrain = 32;
+// Awake contacts per range when listing their manifolds (a parallel_for).
+constexpr std::uint32_t kListGrain = 512;
 
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
@@ -92,7 +94,9 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
-// any has restitution. Reads only the packed keys and summaries, never a contact.
+// any has restitution. Reads only the packed keys and summaries, never a contact. Fixed
+// ranges of contacts list into their own buffers in parallel, joined in range order, so
+// the list does not depend on who listed which range.
 bool list_manifolds(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
@@ -100,21 +104,41 @@ bool list_manifolds(World& world, SolverScratch& scratch) {
         const std::int32_t k = b.awake_index[slot];
         return k >= 0 ? static_cast<std::uint32_t>(k) : n;
     };
-    bool restitution = false;
-    scratch.manifolds.clear();
-    for (std::uint32_t c : awake_contacts(world)) {
-        const std::uint32_t summary = world.contact_summaries[c];
-        SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]), "solver: a contact's packed summary is stale");
-        const std::uint64_t key = world.contact_keys[c];
-        const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
-        const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
-        constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
-        std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
-        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
-            if ((point_counts & kCountMask) == 0) continue;
-            scratch.manifolds.push_back({c, m, a, bb});
-            restitution = restitution || (summary & kSummaryRestitution) != 0;
+    const std::vector<std::uint32_t>& contacts = awake_contacts(world);
+    const auto count = static_cast<std::uint32_t>(contacts.size());
+    const std::uint32_t ranges = (count + kListGrain - 1) / kListGrain;
+    if (scratch.listed.size() < ranges) scratch.listed.resize(ranges);  // capacity kept from step to step
+    scratch.listed_restitution.assign(ranges, 0);
+    world.jobs->parallel_for("ListManifolds", 0, count, kListGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        std::vector<ManifoldRef>& listed = scratch.listed[lo / kListGrain];
+        listed.clear();
+        bool restitution = false;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            const std::uint32_t c = contacts[k];
+            const std::uint32_t summary = world.contact_summaries[c];
+            SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]),
+                           "solver: a contact's packed summary is stale");
+            const std::uint64_t key = world.contact_keys[c];
+            const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
+            const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
+            constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
+            std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
+            for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
+                if ((point_counts & kCountMask) == 0) continue;
+                listed.push_back({c, m, a, bb});
+                restitution = restitution || (summary & kSummaryRestitution) != 0;
+            }
         }
+        scratch.listed_restitution[lo / kListGrain] = restitution ? 1 : 0;
+    });
+    std::size_t total = 0;
+    for (std::uint32_t r = 0; r < ranges; ++r) total += scratch.listed[r].size();
+    scratch.manifolds.resize(total);
+    bool restitution = false;
+    ManifoldRef* out = scratch.manifolds.data();
+    for (std::uint32_t r = 0; r < ranges; ++r) {
+        out = std::copy(scratch.listed[r].begin(), scratch.listed[r].end(), out);
+        restitution = restitution || scratch.listed_restitution[r] != 0;
     }
     return restitution;
 }
