@@ -45,8 +45,11 @@ void fit_capacity(std::vector<T>& v) {
 // Has the OS map the pages of v's room for elements [v.size(), end) (end <= capacity) now,
 // split over jobs, before one thread constructs them there. A first step fills tens of
 // megabytes of new arrays, and a page's first touch (a fault, the kernel zeroing it) costs
-// more than writing it: in jobs, the workers share that cost. A hint: nothing for room of
-// less than a megabyte (not worth the jobs), or where the OS has no such call.
+// more than writing it: in jobs, the workers share that cost. On some virtual machines a
+// mapped page's first write from the program is still a fault of its own (the hypervisor's,
+// unseen by the kernel), so each job also writes a byte of each of its pages (raw room: no
+// element lives there yet). A hint: nothing for room of less than a megabyte (not worth the
+// jobs), or where the OS has no such call.
 template <typename T>
 void map_room(JobSystem& jobs, std::vector<T>& v, std::size_t end) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
@@ -63,6 +66,8 @@ void map_room(JobSystem& jobs, std::vector<T>& v, std::size_t end) {
                           // Errors (an old kernel without the call) leave the pages to fault as before.
                           madvise(reinterpret_cast<void*>((first + lo) * kPage), (hi - lo) * kPage,
                                   MADV_POPULATE_WRITE);
+                          for (std::uintptr_t page = first + lo; page < first + hi; ++page)
+                              *reinterpret_cast<volatile unsigned char*>(page * kPage) = 0;
                       });
 #else
     (void)jobs, (void)v, (void)end;
