@@ -315,6 +315,20 @@ void set_all(DynamicAabbTree& tree, const std::vector<std::int32_t>& live, const
     }
 }
 
+// `count` unit boxes in [-40, 40]^3 made in one create_proxies call, as a scene's bodies
+// are: a build of the whole tree, the reference a refit's cost is compared with.
+std::vector<std::int32_t> unit_boxes_built_at_once(DynamicAabbTree& tree, Rng& rng, int count) {
+    std::vector<Aabb> tight;
+    std::vector<std::uint64_t> users;
+    for (int i = 0; i < count; ++i) {
+        tight.push_back(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)));
+        users.push_back(std::uint64_t(i));
+    }
+    std::vector<std::int32_t> live(tight.size());
+    tree.create_proxies(tight, users, live);
+    return live;
+}
+
 // A pile falling together (junkyard's rocks): every proxy leaves its fat box at once, but
 // none changes neighbours, so the flagged nodes are refitted where they are instead of
 // rebuilt. The refitted tree keeps its shape (the same walk order), answers every query as
@@ -322,15 +336,7 @@ void set_all(DynamicAabbTree& tree, const std::vector<std::int32_t>& live, const
 TEST(AabbTreeMoves, RebuildEnlarged_ProxiesMovingTogether_RefitsAndQueriesAsARebuild) {
     Rng rng(20);
     DynamicAabbTree tree;
-    std::vector<std::int32_t> live;
-    std::vector<Aabb> tight;
-    std::vector<std::uint64_t> users;
-    for (int i = 0; i < 400 * kScale; ++i) {
-        tight.push_back(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)));
-        users.push_back(std::uint64_t(i));
-    }
-    live.resize(tight.size());
-    tree.create_proxies(tight, users, live);
+    const std::vector<std::int32_t> live = unit_boxes_built_at_once(tree, rng, 400 * kScale);
     for (int round = 0; round < 8; ++round) {
         const std::vector<std::int32_t> order = walk_order(tree);
         const Vec3 fall(0, -Real(0.6), 0);  // a steady fall: the boxes keep their size
@@ -362,15 +368,7 @@ TEST(AabbTreeMoves, RebuildEnlarged_ProxiesMovingTogether_RefitsAndQueriesAsAReb
 TEST(AabbTreeMoves, RebuildEnlarged_ProxiesScattered_RebuildsInsteadOfRefitting) {
     Rng rng(21);
     DynamicAabbTree tree;
-    std::vector<std::int32_t> live;
-    std::vector<Aabb> tight;
-    std::vector<std::uint64_t> users;
-    for (int i = 0; i < 400 * kScale; ++i) {
-        tight.push_back(Aabb::from_center_extents(rng.vec(-40, 40), Vec3::Constant(0.5)));
-        users.push_back(std::uint64_t(i));
-    }
-    live.resize(tight.size());
-    tree.create_proxies(tight, users, live);
+    const std::vector<std::int32_t> live = unit_boxes_built_at_once(tree, rng, 400 * kScale);
     for (int round = 0; round < 4; ++round) {
         std::vector<Vec3> jump;
         for (std::size_t k = 0; k < live.size(); ++k)
