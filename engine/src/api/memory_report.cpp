@@ -30,8 +30,8 @@ std::size_t solver_other_bytes(const SolverScratch& s) {
                         held(s.support_by_lower) + held(s.support_queue) + held(s.supported) + held(s.phases) +
                         held(s.plan);
     for (int c = 0; c < kColorCount; ++c) bytes += held(s.colors[c]) + held(s.joint_colors[c]);
-    for (const auto& listed : s.listed) bytes += held(listed);
-    bytes += held(s.listed) + held(s.listed_restitution);
+    for (const auto& range : s.listed) bytes += held(range.refs);
+    bytes += held(s.listed);
     return bytes;
 }
 

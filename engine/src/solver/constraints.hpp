@@ -266,9 +266,12 @@ struct SolverScratch {
     std::vector<PushVelocity> push_velocities;
     std::vector<Real> gravity_scales;
     std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
-    // list_manifolds' per-range lists and whether each has restitution, before they are joined.
-    std::vector<std::vector<ManifoldRef>> listed;
-    std::vector<std::uint8_t> listed_restitution;
+    // list_manifolds' lists of its fixed ranges of contacts, before they are joined.
+    struct ListedRange {
+        std::vector<ManifoldRef> refs;
+        bool restitution = false;  // any of them has restitution
+    };
+    std::vector<ListedRange> listed;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
     std::vector<ManifoldRef> colored_manifolds;

@@ -12,6 +12,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <span>
 #include <type_traits>
 
 #include <spindle/platform/assert.hpp>
@@ -108,10 +109,9 @@ bool list_manifolds(World& world, SolverScratch& scratch) {
     const auto count = static_cast<std::uint32_t>(contacts.size());
     const std::uint32_t ranges = (count + kListGrain - 1) / kListGrain;
     if (scratch.listed.size() < ranges) scratch.listed.resize(ranges);  // capacity kept from step to step
-    scratch.listed_restitution.assign(ranges, 0);
     world.jobs->parallel_for("ListManifolds", 0, count, kListGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        std::vector<ManifoldRef>& listed = scratch.listed[lo / kListGrain];
-        listed.clear();
+        SolverScratch::ListedRange& range = scratch.listed[lo / kListGrain];
+        range.refs.clear();
         bool restitution = false;
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t c = contacts[k];
@@ -125,20 +125,21 @@ bool list_manifolds(World& world, SolverScratch& scratch) {
             std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
             for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
                 if ((point_counts & kCountMask) == 0) continue;
-                listed.push_back({c, m, a, bb});
+                range.refs.push_back({c, m, a, bb});
                 restitution = restitution || (summary & kSummaryRestitution) != 0;
             }
         }
-        scratch.listed_restitution[lo / kListGrain] = restitution ? 1 : 0;
+        range.restitution = restitution;
     });
+    const std::span<const SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
     std::size_t total = 0;
-    for (std::uint32_t r = 0; r < ranges; ++r) total += scratch.listed[r].size();
+    for (const auto& range : listed) total += range.refs.size();
     scratch.manifolds.resize(total);
     bool restitution = false;
     ManifoldRef* out = scratch.manifolds.data();
-    for (std::uint32_t r = 0; r < ranges; ++r) {
-        out = std::copy(scratch.listed[r].begin(), scratch.listed[r].end(), out);
-        restitution = restitution || scratch.listed_restitution[r] != 0;
+    for (const auto& range : listed) {
+        out = std::copy(range.refs.begin(), range.refs.end(), out);
+        restitution = restitution || range.restitution;
     }
     return restitution;
 }
