@@ -1,0 +1,77 @@
+// map_room (stages/capacity.hpp): the room of a growing array mapped in jobs before its
+// elements are made there, its whole 2 MB spans as huge pages where the system gives
+// them on request. Mapping is a hint: the elements and their count stay as they were.
+#include <spindle/scheduler/work_stealing.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "stages/capacity.hpp"
+
+using namespace spindle;
+
+namespace {
+
+constexpr std::size_t kRoomBytes = std::size_t{16} << 20;  // several whole huge pages, wherever it starts
+
+// The system's transparent huge page mode, the bracketed word of its setting ("always",
+// "madvise", "never"), or "" where there is none.
+std::string huge_page_mode() {
+    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+    std::string text;
+    std::getline(in, text);
+    const auto open = text.find('[');
+    const auto close = text.find(']');
+    return open != std::string::npos && close > open ? text.substr(open + 1, close - open - 1) : "";
+}
+
+// Kilobytes of huge pages in the mappings that hold any of [begin, end), from
+// /proc/self/smaps.
+std::uint64_t huge_page_kb_over(std::uintptr_t begin, std::uintptr_t end) {
+    std::ifstream smaps("/proc/self/smaps");
+    std::uint64_t kb = 0;
+    bool inside = false;
+    for (std::string line; std::getline(smaps, line);) {
+        std::uintptr_t from = 0, to = 0;
+        char dash = 0;
+        std::istringstream head(line);
+        if (head >> std::hex >> from >> dash >> to && dash == '-') {
+            inside = from < end && begin < to;
+        } else if (inside && line.rfind("AnonHugePages:", 0) == 0) {
+            kb += std::stoull(line.substr(line.find(':') + 1));
+        }
+    }
+    return kb;
+}
+
+}  // namespace
+
+TEST(MapRoom, LeavesTheElementsAndTheirCountAsTheyWere) {
+    const auto jobs = make_job_system({0, 0}, false);
+    std::vector<std::uint64_t> v(1000);
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = i * 7919;
+    v.reserve(kRoomBytes / sizeof(std::uint64_t));
+    map_room(*jobs, v, v.capacity());
+    ASSERT_EQ(v.size(), 1000u);
+    for (std::size_t i = 0; i < v.size(); ++i) ASSERT_EQ(v[i], i * 7919) << "element " << i;
+    v.resize(v.capacity());  // the mapped room takes elements as any room does
+    EXPECT_EQ(v.back(), 0u);
+    EXPECT_EQ(v[999], 999u * 7919);
+}
+
+TEST(MapRoom, AsksForHugePagesForTheRoom) {
+    // Only where huge pages come on request does the request show: "always" gives them
+    // unasked, "never" not at all.
+    if (huge_page_mode() != "madvise") GTEST_SKIP() << "transparent huge pages are not given on request here";
+    const auto jobs = make_job_system({0, 0}, false);
+    std::vector<unsigned char> v;
+    v.reserve(kRoomBytes);
+    map_room(*jobs, v, v.capacity());
+    const auto begin = reinterpret_cast<std::uintptr_t>(v.data());
+    EXPECT_GT(huge_page_kb_over(begin, begin + v.capacity()), 0u);
+}
