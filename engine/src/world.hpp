@@ -26,6 +26,7 @@
 #include "collision/collide.hpp"
 #include "solver/motion_locks.hpp"
 #include "stages/contact_index.hpp"
+#include "stages/huge_page_vector.hpp"
 
 namespace spindle {
 
@@ -246,7 +247,7 @@ struct World {
     // Collision: contacts in a deterministic order (creation order from canonical
     // pair lists; removal keeps the order of the rest).
     std::unique_ptr<BroadphaseState> broadphase;
-    std::vector<Contact> contacts;
+    HugePageVector<Contact> contacts;
     ContactIndex contact_index;  // key -> position in contacts
     std::vector<std::uint64_t>
         contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact

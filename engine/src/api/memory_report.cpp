@@ -9,8 +9,8 @@
 namespace spindle {
 namespace {
 
-template <typename T>
-std::size_t held(const std::vector<T>& v) {
+template <typename T, typename A>
+std::size_t held(const std::vector<T, A>& v) {
     return v.capacity() * sizeof(T);
 }
 

@@ -259,7 +259,7 @@ struct SupportEdge {
 };
 
 struct SolverScratch {
-    std::vector<SolverBody> bodies;  // awake bodies, then the static body
+    HugePageVector<SolverBody> bodies;  // awake bodies, then the static body
     // Per solver body, apart from it (SolverBody says why): its push-out velocities, and
     // BodyDesc::gravity_scale of a dynamic body (else 0) so that integrate_velocities and
     // prepare_wide stay off the cold descriptions, each a cache miss.
@@ -281,8 +281,8 @@ struct SolverScratch {
     bool reuse_colors = true;                            // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
     std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
-    std::vector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
-    std::vector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
+    HugePageVector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
+    HugePageVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed

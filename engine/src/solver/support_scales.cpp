@@ -46,7 +46,7 @@ void find_support_scales(const World& world, SolverScratch& scratch) {
     const Real g = gravity.norm();
     if (!(g > 0)) return;
     const Vec3 up = -gravity / g;
-    const std::vector<SolverBody>& bodies = scratch.bodies;
+    const HugePageVector<SolverBody>& bodies = scratch.bodies;
     const std::vector<ManifoldRef>& refs = scratch.manifolds;
     // The manifold's normal points from A to B: B rests on A when it points up.
     auto up_component = [&](const ManifoldRef& ref) {

@@ -12,6 +12,8 @@
 
 #include <spindle/scheduler/job_system.hpp>
 
+#include "stages/huge_page_vector.hpp"
+
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -19,8 +21,8 @@
 namespace spindle {
 
 // Room for at least `needed` elements.
-template <typename T>
-void reserve_for(std::vector<T>& v, std::size_t needed) {
+template <typename T, typename A>
+void reserve_for(std::vector<T, A>& v, std::size_t needed) {
     if (v.capacity() < needed) v.reserve(std::max(needed, v.capacity() + v.capacity() / 4));
 }
 
@@ -34,9 +36,9 @@ inline bool far_above_use(std::size_t capacity, std::size_t size) {
 }
 
 // Moves the elements into an array with a quarter to spare.
-template <typename T>
-void fit_capacity(std::vector<T>& v) {
-    std::vector<T> fitted;
+template <typename T, typename A>
+void fit_capacity(std::vector<T, A>& v) {
+    std::vector<T, A> fitted;
     fitted.reserve(v.size() + v.size() / 4);
     std::move(v.begin(), v.end(), std::back_inserter(fitted));
     v.swap(fitted);
@@ -45,33 +47,24 @@ void fit_capacity(std::vector<T>& v) {
 // Has the OS map the pages of v's room for elements [v.size(), end) (end <= capacity) now,
 // split over jobs, before one thread constructs them there. A first step fills tens of
 // megabytes of new arrays, and a page's first touch (a fault, the kernel zeroing it) costs
-// more than writing it: in jobs, the workers share that cost. The room's whole 2 MB spans
-// are asked for as huge pages (transparent huge pages, where the system allows them on
-// request): one fault and one mapping for 512 small pages. On some virtual machines a
-// mapped small page's first write from the program is still a fault of its own (the
-// hypervisor's, unseen by the kernel), so each job also writes a byte of each of its pages
-// (raw room: no element lives there yet). A hint: nothing for room of less than a megabyte
-// (not worth the jobs), or where the OS has no such call.
+// more than writing it: in jobs, the workers share that cost. A job maps one huge page's
+// span (the array's blocks of a huge page or more are whole huge pages: huge_page_vector.hpp),
+// so no two jobs fault the same page. On some virtual machines a mapped small page's first
+// write from the program is still a fault of its own (the hypervisor's, unseen by the
+// kernel), so each job also writes a byte of each of its small pages (raw room: no element
+// lives there yet). A hint: nothing for room of less than a megabyte (not worth the jobs),
+// or where the OS has no such call.
 template <typename T>
-void map_room(JobSystem& jobs, std::vector<T>& v, std::size_t end) {
+void map_room(JobSystem& jobs, HugePageVector<T>& v, std::size_t end) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::uintptr_t kPage = 4096;
-    constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-    constexpr std::uintptr_t kPagesPerJob = kHugePage / kPage;  // a huge page's: jobs never share one
+    constexpr std::uintptr_t kPagesPerJob = kHugePageBytes / kPage;
     constexpr std::size_t kMinBytes = std::size_t{1} << 20;
     if (end <= v.size() || (end - v.size()) * sizeof(T) < kMinBytes) return;
     // Whole pages inside the room only: the pages it shares with live elements are mapped.
-    const auto room_begin = reinterpret_cast<std::uintptr_t>(v.data() + v.size());
-    const auto room_end = reinterpret_cast<std::uintptr_t>(v.data() + end);
-    const std::uintptr_t huge_begin = (room_begin + kHugePage - 1) / kHugePage * kHugePage;
-    const std::uintptr_t huge_end = room_end / kHugePage * kHugePage;
-    // Errors (no huge pages here, an old kernel) leave the pages small.
-    if (huge_end > huge_begin) madvise(reinterpret_cast<void*>(huge_begin), huge_end - huge_begin, MADV_HUGEPAGE);
-    const auto first = (room_begin + kPage - 1) / kPage;
-    const auto last = room_end / kPage;
+    const auto first = (reinterpret_cast<std::uintptr_t>(v.data() + v.size()) + kPage - 1) / kPage;
+    const auto last = reinterpret_cast<std::uintptr_t>(v.data() + end) / kPage;
     if (last <= first) return;
-    // One job per huge page's span of small pages (clipped to the room): no two jobs
-    // fault the same huge page.
     const std::uintptr_t first_span = first / kPagesPerJob;
     const auto spans = static_cast<std::uint32_t>((last - 1) / kPagesPerJob - first_span + 1);
     jobs.parallel_for("MapPages", 0, spans, 1, [first, last, first_span](std::uint32_t lo, std::uint32_t hi, unsigned) {

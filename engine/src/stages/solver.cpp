@@ -18,6 +18,7 @@
 #include <spindle/platform/assert.hpp>
 
 #include "solver/speed_limit.hpp"
+#include "stages/capacity.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -52,6 +53,9 @@ constexpr std::uint32_t kListGrain = 512;
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
+    // A first step's are megabytes of new pages: mapped in jobs before the resize writes them.
+    reserve_for(scratch.bodies, n + 1);
+    map_room(*world.jobs, scratch.bodies, n + 1);
     scratch.bodies.resize(n + 1);
     scratch.push_velocities.resize(n + 1);
     scratch.gravity_scales.resize(n + 1);

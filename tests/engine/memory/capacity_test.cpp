@@ -1,6 +1,7 @@
 // map_room (stages/capacity.hpp): the room of a growing array mapped in jobs before its
-// elements are made there, its whole 2 MB spans as huge pages where the system gives
-// them on request. Mapping is a hint: the elements and their count stay as they were.
+// elements are made there; the array's block (stages/huge_page_vector.hpp) whole huge
+// pages where the system gives them on request. Mapping is a hint: the elements and
+// their count stay as they were.
 #include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "stages/capacity.hpp"
+#include "stages/huge_page_vector.hpp"
 
 using namespace spindle;
 
@@ -53,7 +55,7 @@ std::uint64_t huge_page_kb_over(std::uintptr_t begin, std::uintptr_t end) {
 
 TEST(MapRoom, LeavesTheElementsAndTheirCountAsTheyWere) {
     const auto jobs = make_job_system({0, 0}, false);
-    std::vector<std::uint64_t> v(1000);
+    HugePageVector<std::uint64_t> v(1000);
     for (std::size_t i = 0; i < v.size(); ++i) v[i] = i * 7919;
     v.reserve(kRoomBytes / sizeof(std::uint64_t));
     map_room(*jobs, v, v.capacity());
@@ -64,14 +66,31 @@ TEST(MapRoom, LeavesTheElementsAndTheirCountAsTheyWere) {
     EXPECT_EQ(v[999], 999u * 7919);
 }
 
-TEST(MapRoom, AsksForHugePagesForTheRoom) {
+TEST(MapRoom, MapsTheWholeRoomOnHugePages) {
     // Only where huge pages come on request does the request show: "always" gives them
     // unasked, "never" not at all.
     if (huge_page_mode() != "madvise") GTEST_SKIP() << "transparent huge pages are not given on request here";
     const auto jobs = make_job_system({0, 0}, false);
-    std::vector<unsigned char> v;
+    HugePageVector<unsigned char> v;
     v.reserve(kRoomBytes);
-    map_room(*jobs, v, v.capacity());
     const auto begin = reinterpret_cast<std::uintptr_t>(v.data());
-    EXPECT_GT(huge_page_kb_over(begin, begin + v.capacity()), 0u);
+    EXPECT_EQ(begin % kHugePageBytes, 0u) << "a block of huge pages starts on one";
+    map_room(*jobs, v, v.capacity());
+    // Every page of the room a huge one: none left small at either end.
+    EXPECT_EQ(huge_page_kb_over(begin, begin + v.capacity()), kRoomBytes / 1024);
+}
+
+TEST(HugePageVector, SmallBlocksAreOrdinaryOnes) {
+    HugePageVector<double> v(1000);
+    v.push_back(1);
+    EXPECT_EQ(v.back(), 1);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(v.data()) % alignof(double), 0u);
+    // Grown past a huge page and back: each block freed the way it was allocated (the
+    // sanitizer builds check the pairing).
+    v.resize(kHugePageBytes / sizeof(double) + 1, 2.0);
+    EXPECT_EQ(v[999], 0);
+    EXPECT_EQ(v[1000], 1);
+    v.resize(10);
+    v.shrink_to_fit();
+    EXPECT_EQ(v.size(), 10u);
 }
