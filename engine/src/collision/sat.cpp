@@ -164,6 +164,18 @@ void prepare_lanes(const ArcEdge* edges, const std::uint32_t* indices, std::uint
     }
 }
 
+// Edge j with what arc_reach needs, in the polyhedron's own frame (no origin).
+ArcEdge own_arc_edge(const PolyView& v, std::uint32_t j) {
+    const HullEdge& e = v.edges[j];
+    ArcEdge a;
+    a.direction = v.vertices[e.v1] - v.vertices[e.v0];
+    a.n0 = v.faces[e.f0].normal;
+    a.n1 = v.faces[e.f1].normal;
+    a.t0 = a.direction.cross(a.n0);
+    a.t1 = a.n1.cross(a.direction);
+    return a;
+}
+
 // How far along d any direction on an edge's Gauss-map arc reaches: the largest L . d
 // over the arc, where d's projection on the arc's great circle falls, else at an end.
 Real arc_reach(const ArcEdge& e, const Vec3& d) {
@@ -197,12 +209,16 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
         if (arc_reach(edges_a[j], d) > needed) kept_a[count_a++] = j;
     }
     if (count_a == 0) return {floor};
+    // B's edges are bounded in B's own frame (-d turned into it): only those kept are turned.
+    const Vec3 d_in_b = b.r.transpose() * -d;
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
     for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
-        edges_b[j] = arc_edge(b, j);
-        if (arc_reach(edges_b[j], -d) > needed) kept_b[count_b++] = j;
+        if (arc_reach(own_arc_edge(b.view, j), d_in_b) > needed) {
+            kept_b[count_b] = j;
+            edges_b[count_b++] = arc_edge(b, j);
+        }
     }
     if (count_b == 0) return {floor};
     ScratchBuffer<EdgeLanes, kInlineVertices> lanes((count_a + 3) / 4);
@@ -212,7 +228,7 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     EdgeQuery best{floor};
     for (std::uint32_t kb = 0; kb < count_b; ++kb) {
         const std::uint32_t jb = kept_b[kb];
-        const ArcEdge& eb = edges_b[jb];
+        const ArcEdge& eb = edges_b[kb];
         const Lanes bn0x = Lanes{} + eb.n0.x(), bn0y = Lanes{} + eb.n0.y(), bn0z = Lanes{} + eb.n0.z();
         const Lanes bn1x = Lanes{} + eb.n1.x(), bn1y = Lanes{} + eb.n1.y(), bn1z = Lanes{} + eb.n1.z();
         const Lanes bdx = Lanes{} + eb.direction.x(), bdy = Lanes{} + eb.direction.y(),
