@@ -320,6 +320,17 @@ void ConvexHull::compute_volume_properties() {
     m_volume = volume;
     m_centroid = r + c;
     m_covariance = second - volume * c * c.transpose();
+    // A merged face's vertices may stray from its plane by the merge tolerance; the ball
+    // keeps that far clear of every plane so that it stays inside the vertices' hull.
+    Real stray = 0;
+    m_inner_radius = kHuge;
+    for (const HullFace& f : m_faces) {
+        m_inner_radius = std::min(m_inner_radius, f.offset - f.normal.dot(m_centroid));
+        for (std::uint32_t k = 0; k < f.count; ++k) {
+            stray = std::max(stray, std::abs(f.normal.dot(m_vertices[m_face_vertices[f.first + k]]) - f.offset));
+        }
+    }
+    m_inner_radius = std::max(m_inner_radius - stray, Real(0));
 }
 
 std::uint32_t ConvexHull::support_index(const Vec3& d) const noexcept {

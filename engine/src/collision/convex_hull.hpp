@@ -43,6 +43,9 @@ public:
     // Centre of the volume (uniform density) and the volume itself.
     const Vec3& centroid() const noexcept { return m_centroid; }
     Real volume() const noexcept { return m_volume; }
+    // Distance from the centroid to the nearest face plane: the ball of this radius about
+    // the centroid lies inside the hull (the SAT bounds its separations with it).
+    Real inner_radius() const noexcept { return m_inner_radius; }
     // Second moment of volume about the centroid, integral of (x - c)(x - c)^T dV; the
     // inertia tensor for density rho is rho * (trace(C) I - C).
     const Mat3& covariance() const noexcept { return m_covariance; }
@@ -61,6 +64,7 @@ private:
     std::vector<HullEdge> m_edges;
     Vec3 m_centroid = Vec3::Zero();
     Real m_volume = 0;
+    Real m_inner_radius = 0;
     Mat3 m_covariance = Mat3::Zero();
     Aabb m_bounds;
 };

@@ -39,8 +39,10 @@ constexpr std::uint32_t kTriangleLoops[6] = {0, 1, 2, 0, 2, 1};
 constexpr HullEdge kTriangleEdges[3] = {{0, 1, 0, 1}, {1, 2, 0, 1}, {2, 0, 0, 1}};
 
 PolyView make_view(std::span<const Vec3> vertices, std::span<const HullFace> faces, const std::uint32_t* face_vertices,
-                   std::span<const HullEdge> edges) {
+                   std::span<const HullEdge> edges, const Vec3& inner_centre, Real inner_radius) {
     PolyView v;
+    v.inner_centre = inner_centre;
+    v.inner_radius = inner_radius;
     v.vertices = vertices.data();
     v.vertex_count = static_cast<std::uint32_t>(vertices.size());
     v.faces = faces.data();
@@ -54,7 +56,8 @@ PolyView make_view(std::span<const Vec3> vertices, std::span<const HullFace> fac
 }  // namespace
 
 PolyView view_of(const ConvexHull& hull) {
-    return make_view(hull.vertices(), hull.faces(), hull.face_vertices().data(), hull.edges());
+    return make_view(hull.vertices(), hull.faces(), hull.face_vertices().data(), hull.edges(), hull.centroid(),
+                     hull.inner_radius());
 }
 
 BoxPoly::BoxPoly(const Vec3& h) {
@@ -73,7 +76,10 @@ BoxPoly::BoxPoly(const Vec3& h) {
     }
 }
 
-PolyView BoxPoly::view() const { return make_view(m_vertices, m_faces, kBoxLoops, box_topology().edges); }
+PolyView BoxPoly::view() const {
+    const Vec3 half_extents = m_vertices[7];  // the corner with every sign positive
+    return make_view(m_vertices, m_faces, kBoxLoops, box_topology().edges, Vec3::Zero(), half_extents.minCoeff());
+}
 
 TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vertices{a, b, c} {
     const Vec3 n = (b - a).cross(c - a).normalized();
@@ -81,7 +87,10 @@ TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vert
     m_faces[1] = {-n, -n.dot(a), 3, 3};
 }
 
-PolyView TrianglePoly::view() const { return make_view(m_vertices, m_faces, kTriangleLoops, kTriangleEdges); }
+PolyView TrianglePoly::view() const {
+    const Vec3 centroid = (m_vertices[0] + m_vertices[1] + m_vertices[2]) / 3;
+    return make_view(m_vertices, m_faces, kTriangleLoops, kTriangleEdges, centroid, 0);
+}
 
 std::uint32_t collect_edges(const HullFace* faces, std::uint32_t face_count, const std::uint32_t* face_vertices,
                             HullEdge* out, std::uint32_t capacity) {

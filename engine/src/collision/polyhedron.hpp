@@ -18,6 +18,11 @@ struct PolyView {
     std::uint32_t vertex_count = 0;
     std::uint32_t face_count = 0;
     std::uint32_t edge_count = 0;
+    // A ball inside the polyhedron (radius 0 for a triangle): along any direction L the
+    // polyhedron reaches at least L . inner_centre + inner_radius, which bounds what any
+    // SAT axis can show before its support points are looked at.
+    Vec3 inner_centre = Vec3::Zero();
+    Real inner_radius = 0;
 
     std::uint32_t support_index(const Vec3& d) const {
         std::uint32_t best = 0;

@@ -28,6 +28,7 @@ struct Posed {
     const VertexLanes* lanes;
     Mat3 r;
     Vec3 t;
+    Vec3 inner_centre;  // view.inner_centre in the common frame
 
     Vec3 normal(std::uint32_t f) const { return r * view.faces[f].normal; }
     Real offset(std::uint32_t f, const Vec3& n) const { return view.faces[f].offset + n.dot(t); }
@@ -74,11 +75,33 @@ struct EdgeQuery {
     return n.dot(other.vertices[other.support(-n)]) - p.offset(f, n);
 }
 
-// Largest separation of `other` from the face planes of p. Stops early past `limit`.
+// Part of a bound on a separation kept in hand against rounding, relative to the sizes
+// involved: far more than the arithmetic's error (edge pairs closer to parallel than
+// edge_pair_axis admits included), far less than any gap that matters.
+constexpr Real kBoundRounding = 1e-7;
+
+// Largest separation of `other` from the face planes of p, the first face of equals.
+// Stops at the first face past `limit`, as a walk over the faces in order would. Face f
+// shows at most n . c - offset - r, (c, r) being other's inner ball in p's frame: faces
+// whose bound is below the separation of the face with the highest bound, and not past
+// `limit`, can neither win nor stop the walk, and are not walked.
 FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
+    const Vec3 c = p.r.transpose() * (other.inner_centre - p.t);
+    const Real r = other.view.inner_radius;
+    const Real scale = c.norm() + r;
+    ScratchBuffer<Real, 2 * kInlineVertices> bound(p.view.face_count);
+    std::uint32_t first = 0;
+    for (std::uint32_t f = 0; f < p.view.face_count; ++f) {
+        const HullFace& face = p.view.faces[f];
+        const Real slack = kBoundRounding * (std::abs(face.offset) + scale);
+        bound[f] = face.normal.dot(c) - face.offset - r + slack;
+        if (bound[f] > bound[first]) first = f;
+    }
+    const Real first_separation = face_separation(p, other, first);
     FaceQuery best;
     for (std::uint32_t f = 0; f < p.view.face_count; ++f) {
-        const Real s = face_separation(p, other, f);
+        if (f != first && bound[f] < first_separation && bound[f] <= limit) continue;
+        const Real s = f == first ? first_separation : face_separation(p, other, f);
         if (s > best.separation) best = {s, f};
         if (s > limit) break;
     }
@@ -123,36 +146,89 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
     return true;
 }
 
-void prepare_lanes(const ArcEdge* edges, std::uint32_t count, EdgeLanes* out) {
-    for (std::uint32_t j = 0; j < count; ++j) {
-        EdgeLanes& l = out[j / 4];
-        const std::uint32_t k = j % 4;
-        const ArcEdge& e = edges[j];
-        l.dx[k] = e.direction.x(), l.dy[k] = e.direction.y(), l.dz[k] = e.direction.z();
-        l.n0x[k] = e.n0.x(), l.n0y[k] = e.n0.y(), l.n0z[k] = e.n0.z();
-        l.n1x[k] = e.n1.x(), l.n1y[k] = e.n1.y(), l.n1z[k] = e.n1.z();
+// Edges edges[indices[k]] in lanes of four, lane k % 4 of group k / 4 holding the k-th.
+void prepare_lanes(const ArcEdge* edges, const std::uint32_t* indices, std::uint32_t count, EdgeLanes* out) {
+    for (std::uint32_t k = 0; k < count; ++k) {
+        EdgeLanes& l = out[k / 4];
+        const std::uint32_t lane = k % 4;
+        const ArcEdge& e = edges[indices[k]];
+        l.dx[lane] = e.direction.x(), l.dy[lane] = e.direction.y(), l.dz[lane] = e.direction.z();
+        l.n0x[lane] = e.n0.x(), l.n0y[lane] = e.n0.y(), l.n0z[lane] = e.n0.z();
+        l.n1x[lane] = e.n1.x(), l.n1y[lane] = e.n1.y(), l.n1z[lane] = e.n1.z();
     }
-    for (std::uint32_t j = count; j % 4 != 0; ++j) {  // lanes past the last edge: never tested further
-        EdgeLanes& l = out[j / 4];
-        const std::uint32_t k = j % 4;
-        l.dx[k] = l.dy[k] = l.dz[k] = l.n0x[k] = l.n0y[k] = l.n0z[k] = l.n1x[k] = l.n1y[k] = l.n1z[k] = 0;
+    for (std::uint32_t k = count; k % 4 != 0; ++k) {  // lanes past the last edge: never tested further
+        EdgeLanes& l = out[k / 4];
+        const std::uint32_t lane = k % 4;
+        l.dx[lane] = l.dy[lane] = l.dz[lane] = l.n0x[lane] = l.n0y[lane] = l.n0z[lane] = l.n1x[lane] = l.n1y[lane] =
+            l.n1z[lane] = 0;
     }
 }
 
+// Edge j with what arc_reach needs, in the polyhedron's own frame (no origin).
+ArcEdge own_arc_edge(const PolyView& v, std::uint32_t j) {
+    const HullEdge& e = v.edges[j];
+    ArcEdge a;
+    a.direction = v.vertices[e.v1] - v.vertices[e.v0];
+    a.n0 = v.faces[e.f0].normal;
+    a.n1 = v.faces[e.f1].normal;
+    a.t0 = a.direction.cross(a.n0);
+    a.t1 = a.n1.cross(a.direction);
+    return a;
+}
+
+// How far along d any direction on an edge's Gauss-map arc reaches: the largest L . d
+// over the arc, where d's projection on the arc's great circle falls, else at an end.
+Real arc_reach(const ArcEdge& e, const Vec3& d) {
+    if (d.dot(e.t0) >= 0 && d.dot(e.t1) >= 0) {
+        const Real along = d.dot(e.direction);
+        return std::sqrt(std::max(d.squaredNorm() - along * along / e.direction.squaredNorm(), Real(0)));
+    }
+    return std::max(e.n0.dot(d), e.n1.dot(d));
+}
+
 // Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
-// negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb). Most pairs
-// fail the first two tests of edge_pair_axis (an arc that does not cross the other's
-// great circle): those run on four of A's edges at once, each lane computing what the
-// scalar test computes in the same order, so the pairs kept are the same.
-EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, const Posed& b, Real limit) {
+// negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb). Only a pair
+// that shows more than `floor` (the deepest face's separation) can change the SAT's
+// answer, and along L the pair shows at most L . d - rA - rB (d from A's inner ball's
+// centre to B's, rA and rB their radii: each shape reaches past its ball), so an edge
+// whose arc never reaches that far along d (B's: along -d) is in no such pair and is
+// dropped before the pairs are formed. Of the pairs left, most fail the first two tests
+// of edge_pair_axis (an arc that does not cross the other's great circle): those run on
+// four of A's edges at once, each lane computing what the scalar test computes in the
+// same order. The pairs tested keep their order, so the answer is the whole query's
+// whenever it beats `floor`; otherwise it is `floor` with no pair found.
+EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, const Posed& b, Real floor, Real limit) {
+    const Vec3 d = b.inner_centre - a.inner_centre;
+    const Real radii = a.view.inner_radius + b.view.inner_radius;
+    const Real needed = floor + radii - kBoundRounding * (d.norm() + radii + std::abs(floor));
+
     const ArcEdge* edges_a = prepared_a.edges();
-    const EdgeLanes* lanes = prepared_a.edge_lanes();
+    ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_a(a.view.edge_count);
+    std::uint32_t count_a = 0;
+    for (std::uint32_t j = 0; j < a.view.edge_count; ++j) {
+        if (arc_reach(edges_a[j], d) > needed) kept_a[count_a++] = j;
+    }
+    if (count_a == 0) return {floor};
+    // B's edges are bounded in B's own frame (-d turned into it): only those kept are turned.
+    const Vec3 d_in_b = b.r.transpose() * -d;
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
-    prepare_edges(b, edges_b.data());
-    const std::uint32_t groups = (a.view.edge_count + 3) / 4;
-    EdgeQuery best;
-    for (std::uint32_t jb = 0; jb < b.view.edge_count; ++jb) {
-        const ArcEdge& eb = edges_b[jb];
+    ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
+    std::uint32_t count_b = 0;
+    for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
+        if (arc_reach(own_arc_edge(b.view, j), d_in_b) > needed) {
+            kept_b[count_b] = j;
+            edges_b[count_b++] = arc_edge(b, j);
+        }
+    }
+    if (count_b == 0) return {floor};
+    ScratchBuffer<EdgeLanes, kInlineVertices> lanes((count_a + 3) / 4);
+    prepare_lanes(edges_a, kept_a.data(), count_a, lanes.data());
+
+    const std::uint32_t groups = (count_a + 3) / 4;
+    EdgeQuery best{floor};
+    for (std::uint32_t kb = 0; kb < count_b; ++kb) {
+        const std::uint32_t jb = kept_b[kb];
+        const ArcEdge& eb = edges_b[kb];
         const Lanes bn0x = Lanes{} + eb.n0.x(), bn0y = Lanes{} + eb.n0.y(), bn0z = Lanes{} + eb.n0.z();
         const Lanes bn1x = Lanes{} + eb.n1.x(), bn1y = Lanes{} + eb.n1.y(), bn1z = Lanes{} + eb.n1.z();
         const Lanes bdx = Lanes{} + eb.direction.x(), bdy = Lanes{} + eb.direction.y(),
@@ -166,12 +242,12 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
             // Lanes past the last edge (all zero) pass; their indices are dropped below.
             for (unsigned crossing = lane_bits((b0 * b1 <= 0) & (a0 * a1 <= 0)); crossing != 0;
                  crossing &= crossing - 1) {
-                const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
-                if (ja >= a.view.edge_count) break;
+                const std::uint32_t ka = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
+                if (ka >= count_a) break;
                 Vec3 unit;
                 Real s;
-                if (!edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
-                if (s > best.separation) best = {s, ja, jb, unit, true};
+                if (!edge_pair_axis(edges_a[kept_a[ka]], eb, unit, s)) continue;
+                if (s > best.separation) best = {s, kept_a[ka], jb, unit, true};
                 if (s > limit) return best;
             }
         }
@@ -333,19 +409,16 @@ bool cached_manifold(const FeatureCache& cache, const CachedAxis& axis, const Po
 }  // namespace
 
 PreparedPolyhedron::PreparedPolyhedron(const PolyView& view)
-    : m_view(view),
-      m_vertex_lanes((view.vertex_count + 3) / 4),
-      m_edges(view.edge_count),
-      m_edge_lanes((view.edge_count + 3) / 4) {
+    : m_view(view), m_vertex_lanes((view.vertex_count + 3) / 4), m_edges(view.edge_count) {
     fill_lanes(view.vertices, view.vertex_count, m_vertex_lanes.data());
 }
 
 void PreparedPolyhedron::prepare_edges() const {
     if (m_edges_ready) return;
     m_edges_ready = true;
-    const Posed own{m_view, m_view.vertices, m_vertex_lanes.data(), Mat3::Identity(), Vec3::Zero()};
+    const Posed own{m_view,           m_view.vertices, m_vertex_lanes.data(),
+                    Mat3::Identity(), Vec3::Zero(),    m_view.inner_centre};
     detail::prepare_edges(own, m_edges.data());
-    prepare_lanes(m_edges.data(), m_view.edge_count, m_edge_lanes.data());
 }
 
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,
@@ -363,8 +436,8 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
     ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
     fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
-    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero()};
-    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t};
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre};
+    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t};
 
     using Kind = FeatureCache::Kind;
     if (cache && cache->kind() != Kind::None) {
@@ -386,7 +459,7 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
         remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
         return false;
     }
-    const EdgeQuery edge = query_edges(prepared, pa, pb, speculative);
+    const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation), speculative);
     if (edge.separation > speculative) {
         remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
         return false;

@@ -40,7 +40,7 @@ struct ArcEdge {
 };
 
 // Four of A's edges for the edge query's cheap rejections: the components of each edge's
-// direction and two face normals, lane k holding edge 4i + k.
+// direction and two face normals.
 struct EdgeLanes {
     Lanes dx, dy, dz, n0x, n0y, n0z, n1x, n1y, n1z;
 };
@@ -58,14 +58,10 @@ public:
 
     const PolyView& view() const noexcept { return m_view; }
     const VertexLanes* vertex_lanes() const noexcept { return m_vertex_lanes.data(); }
-    // The edges with their face normals, and the same in lanes of four.
+    // The edges with their face normals.
     const ArcEdge* edges() const {
         prepare_edges();
         return m_edges.data();
-    }
-    const EdgeLanes* edge_lanes() const {
-        prepare_edges();
-        return m_edge_lanes.data();
     }
 
 private:
@@ -75,7 +71,6 @@ private:
     ScratchBuffer<VertexLanes, kInlineVertices / 4> m_vertex_lanes;
     mutable bool m_edges_ready = false;
     mutable ScratchBuffer<ArcEdge, 2 * kInlineVertices> m_edges;
-    mutable ScratchBuffer<EdgeLanes, kInlineVertices> m_edge_lanes;
 };
 
 }  // namespace spindle::detail
