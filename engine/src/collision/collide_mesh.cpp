@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <optional>
 
 #include "collision/clipping.hpp"
 #include "collision/manifold_slots.hpp"
@@ -121,19 +120,12 @@ void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& 
     if (deepest(m) < deepest(list[shallowest])) list[shallowest] = m;
 }
 
-}  // namespace
-
-int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                        Manifold* out, int capacity) {
-    const TriangleMesh& mesh = *b.mesh;
-    const Transform a_in_mesh = xb.inverse() * xa;
+// The walk over the triangles the mesh finds under a's bounds (a posed in the mesh's frame
+// by a_in_mesh); `polyhedron` is a box or hull prepared once for all of them, null for a
+// sphere or capsule.
+int collide_triangles(const Shape& a, const Transform& a_in_mesh, const PreparedPolyhedron* polyhedron,
+                      const TriangleMesh& mesh, const Transform& xb, Real speculative, Manifold* out, int capacity) {
     const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
-    // A sphere or capsule is not a polyhedron: nothing to prepare for it.
-    const BoxPoly box(a.type == ShapeType::Box ? a.half_extents : Vec3::Ones());
-    std::optional<PreparedPolyhedron> prepared;
-    if (a.type == ShapeType::Box) prepared.emplace(box.view());
-    if (a.type == ShapeType::ConvexHull) prepared.emplace(view_of(*a.hull));
-
     const ShapeSpan span(a, a_in_mesh);
 
     ManifoldSlots<kMaxMeshManifolds> found;
@@ -144,7 +136,7 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
         Manifold m;
-        if (!collide_triangle(a, a_in_mesh, prepared ? &*prepared : nullptr, poly, speculative, m)) return;
+        if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, m)) return;
         if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
             use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
             if (m.point_count == 0) return;
@@ -162,6 +154,28 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         manifold_to_world(out[i], xb);
     }
     return count;
+}
+
+}  // namespace
+
+int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int capacity) {
+    const TriangleMesh& mesh = *b.mesh;
+    const Transform a_in_mesh = xb.inverse() * xa;
+    // Each branch prepares its polyhedron in place: an empty std::optional of one had its
+    // whole room (tens of kilobytes, most of it for a hull's edges) zeroed on every call.
+    switch (a.type) {
+        case ShapeType::Box: {
+            const BoxPoly box(a.half_extents);
+            const PreparedPolyhedron prepared(box.view());
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity);
+        }
+        case ShapeType::ConvexHull: {
+            const PreparedPolyhedron prepared(view_of(*a.hull));
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity);
+        }
+        default: return collide_triangles(a, a_in_mesh, nullptr, mesh, xb, speculative, out, capacity);
+    }
 }
 
 }  // namespace spindle::detail

@@ -288,7 +288,34 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
     m_edges.resize(edge_count);
     SPINDLE_ASSERT(m_vertices.size() + m_faces.size() == m_edges.size() + 2, "hull must satisfy V - E + F = 2");
     for (const Vec3& v : m_vertices) m_bounds.include(v);
+    m_vertex_lanes.resize((m_vertices.size() + 3) / 4);
+    for (std::size_t i = 0; i < 4 * m_vertex_lanes.size(); ++i) {
+        const Vec3& v = m_vertices[i < m_vertices.size() ? i : 0];
+        detail::VertexLanes& group = m_vertex_lanes[i / 4];
+        group.x[i % 4] = v.x(), group.y[i % 4] = v.y(), group.z[i % 4] = v.z();
+    }
     compute_volume_properties();
+}
+
+Aabb ConvexHull::bounds(const Transform& x) const {
+    using detail::Lanes;
+    const Mat3 r = x.q.toRotationMatrix();
+    Lanes lo[3], hi[3];
+    for (std::size_t g = 0; g < m_vertex_lanes.size(); ++g) {
+        const detail::VertexLanes& v = m_vertex_lanes[g];
+        for (int i = 0; i < 3; ++i) {
+            // Eigen sums a row of r * v as r0 v0 + (r1 v1 + r2 v2).
+            const Lanes world = x.p[i] + (r(i, 0) * v.x + (r(i, 1) * v.y + r(i, 2) * v.z));
+            lo[i] = g == 0 ? world : (world < lo[i] ? world : lo[i]);
+            hi[i] = g == 0 ? world : (world > hi[i] ? world : hi[i]);
+        }
+    }
+    Aabb box;
+    for (int i = 0; i < 3; ++i) {
+        box.min[i] = std::min(std::min(lo[i][0], lo[i][1]), std::min(lo[i][2], lo[i][3]));
+        box.max[i] = std::max(std::max(hi[i][0], hi[i][1]), std::max(hi[i][2], hi[i][3]));
+    }
+    return box;
 }
 
 void ConvexHull::compute_volume_properties() {

@@ -8,6 +8,8 @@
 
 #include <spindle/engine/math.hpp>
 
+#include "collision/lanes.hpp"
+
 namespace spindle {
 
 // A face: the plane normal . x = offset (normal unit, pointing out) and a loop of vertex
@@ -50,6 +52,10 @@ public:
     // inertia tensor for density rho is rho * (trace(C) I - C).
     const Mat3& covariance() const noexcept { return m_covariance; }
     const Aabb& local_bounds() const noexcept { return m_bounds; }
+    // Exact world bounds under x: the vertices moved into the world, four at a time, each
+    // coordinate rounded as x.p + r * v rounds it: the values of a loop over vertices() (a
+    // zero's sign aside, where equal minima may be taken in another order).
+    Aabb bounds(const Transform& x) const;
 
     // The vertex index farthest along direction d (any length).
     std::uint32_t support_index(const Vec3& d) const noexcept;
@@ -62,6 +68,7 @@ private:
     std::vector<HullFace> m_faces;
     std::vector<std::uint32_t> m_face_vertices;
     std::vector<HullEdge> m_edges;
+    std::vector<detail::VertexLanes> m_vertex_lanes;
     Vec3 m_centroid = Vec3::Zero();
     Real m_volume = 0;
     Real m_inner_radius = 0;

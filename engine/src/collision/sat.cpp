@@ -21,17 +21,22 @@ void fill_lanes(const Vec3* vertices, std::uint32_t count, VertexLanes* out) {
 }
 
 // A polyhedron placed in the common frame: its vertices already there, its normals
-// rotated by r and its plane offsets shifted by t on demand.
+// rotated by r and its plane offsets shifted by t on demand; or, when it is `at_home` (the
+// frame is its own, A's), its normals and offsets as stored. Turning a normal by the
+// identity gives it back (a zero's sign aside), so both read the same planes.
 struct Posed {
     const PolyView& view;
     const Vec3* vertices;  // in the common frame
     const VertexLanes* lanes;
-    Mat3 r;
-    Vec3 t;
-    Vec3 inner_centre;  // view.inner_centre in the common frame
+    Mat3 r = Mat3::Identity();
+    Vec3 t = Vec3::Zero();
+    Vec3 inner_centre = Vec3::Zero();  // view.inner_centre in the common frame
+    bool at_home = false;              // the common frame is the view's own: r and t are the identity
 
-    Vec3 normal(std::uint32_t f) const { return r * view.faces[f].normal; }
-    Real offset(std::uint32_t f, const Vec3& n) const { return view.faces[f].offset + n.dot(t); }
+    Vec3 normal(std::uint32_t f) const { return at_home ? view.faces[f].normal : Vec3(r * view.faces[f].normal); }
+    Real offset(std::uint32_t f, const Vec3& n) const {
+        return at_home ? view.faces[f].offset : view.faces[f].offset + n.dot(t);
+    }
     // The vertex farthest along d, the first of equals: four vertices a step, each lane
     // keeping its own best and the first index it was found at.
     std::uint32_t support(const Vec3& d) const {
@@ -416,8 +421,8 @@ PreparedPolyhedron::PreparedPolyhedron(const PolyView& view)
 void PreparedPolyhedron::prepare_edges() const {
     if (m_edges_ready) return;
     m_edges_ready = true;
-    const Posed own{m_view,           m_view.vertices, m_vertex_lanes.data(),
-                    Mat3::Identity(), Vec3::Zero(),    m_view.inner_centre};
+    const Posed own{m_view, m_view.vertices, m_vertex_lanes.data(), Mat3::Identity(), Vec3::Zero(), m_view.inner_centre,
+                    true};
     detail::prepare_edges(own, m_edges.data());
 }
 
@@ -436,8 +441,8 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
     ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
     fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
-    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre};
-    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t};
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
+    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
 
     using Kind = FeatureCache::Kind;
     if (cache && cache->kind() != Kind::None) {

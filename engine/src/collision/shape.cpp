@@ -124,13 +124,8 @@ Aabb Shape::bounds(const Transform& x) const {
             return Aabb::from_center_extents(x.p, extents);
         }
         case ShapeType::Box: return rotated_box_bounds(x, Vec3::Zero(), half_extents);
-        case ShapeType::ConvexHull: {
-            // Exact: hulls are small, and tight bounds save broadphase pairs.
-            Aabb box;
-            const Mat3 r = x.q.toRotationMatrix();
-            for (const Vec3& v : hull->vertices()) box.include(x.p + r * v);
-            return box;
-        }
+        // Exact: hulls are small, and tight bounds save broadphase pairs.
+        case ShapeType::ConvexHull: return hull->bounds(x);
         case ShapeType::Plane: return plane_bounds(*this, x);
         case ShapeType::TriangleMesh: {
             const Aabb& local = mesh->local_bounds();
