@@ -92,8 +92,8 @@ void ProxyTrees::unmark_enlarged(ProxyId id) {
 
 // Pairs of one enlarged proxy: moving proxies look in both trees, static ones only in
 // the moving tree. When both proxies are enlarged, both searches meet the pair; only
-// the proxy with the smaller key reports it.
-void ProxyTrees::find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const {
+// the proxy with the smaller key reports it, unless the caller knows it.
+void ProxyTrees::find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const {
     const Aabb& box = fat_aabb(proxy);
     const std::uint64_t user_p = user(proxy);
     for (int t = proxy.is_static() ? 0 : 1; t >= 0; --t) {
@@ -102,13 +102,18 @@ void ProxyTrees::find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const {
             const ProxyId other = ProxyId::make(tree_id, t == 1);
             if (other == proxy) return true;
             if (other.key() < proxy.key() && is_enlarged(other)) return true;
-            out.push_back(make_pair(proxy, user_p, other, tree.user(tree_id)));
+            const Pair pair = make_pair(proxy, user_p, other, tree.user(tree_id));
+            if (!known(pair.user_a, pair.user_b)) out.push_back(pair);
             return true;
         });
     }
 }
 
 void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
+    update_pairs(jobs, new_pairs, [](std::uint64_t, std::uint64_t) { return false; });
+}
+
+void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, KnownPair known) {
     new_pairs.clear();
     // The moves since the last call left the trees valid but loose where proxies went:
     // one rebuild of those parts, before the searches walk them.
@@ -126,7 +131,7 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
     // sorted there: the merge below puts the sorted runs together.
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
-        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], out);
+        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, out);
         std::sort(out.begin(), out.end(), canonical_less);
     });
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <spindle/engine/math.hpp>
+#include <spindle/scheduler/function_ref.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
 #include "spatial/aabb_tree.hpp"
@@ -86,15 +87,23 @@ public:
     // the trees in between (DynamicAabbTree::set_fat_box).
     void set_fat_box(ProxyId id, const Aabb& fat);
 
+    // Whether the caller already has the pair of these user values (user_a <= user_b).
+    // Called from the pair jobs, many at once: it may only read.
+    using KnownPair = FunctionRef<bool(std::uint64_t user_a, std::uint64_t user_b)>;
+
     // Replaces new_pairs with every pair of proxies whose fat boxes overlap and of which at
     // least one was enlarged (created or grown) since the last call; never static with
     // static, each pair once, sorted by (user_a, user_b, proxy_a.key, proxy_b.key), so
     // the result does not depend on the worker count or on which job ran first. Pairs
-    // found before are found again if one of them grew: the caller skips pairs it has.
+    // found before are found again if one of them grew; those `known` accepts are left
+    // out where they are found (Box2D's pair set), so a step where many proxies grow
+    // around pairs they have does not collect, sort and merge them only to drop them.
     // Clears the enlarged marks, and first rebuilds the parts of the trees that moves
     // enlarged (DynamicAabbTree::rebuild_enlarged). Who may call: the thread that owns the broadphase; it
     // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
     // meanwhile). Safe from inside a job: parallel_for may nest.
+    void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, KnownPair known);
+    // As above, every pair reported.
     void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs);
 
     // Whether the fat boxes of a and b overlap (the engine drops a contact when not).
@@ -134,7 +143,7 @@ private:
     std::vector<std::int32_t>& slots_of(ProxyId id) { return m_enlarged_slot[id.is_static() ? 1 : 0]; }
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
-    void find_pairs_of(ProxyId proxy, std::vector<Pair>& out) const;
+    void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;
     void merge_runs(JobSystem& jobs, std::vector<Pair>& pairs);
     void validate_enlarged() const;
     // The trees validate themselves after each change; this adds the enlarged list.

@@ -150,9 +150,6 @@ void make_contacts(World& world, BroadphaseState& bp) {
                             return false;
                         }
                         key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
-                        // A pair found again (one of its proxies grew) has its contact: skipped here, in
-                        // parallel, not at the serial index inserts. The index is only read meanwhile.
-                        if (world.contact_index.contains(key)) return false;
                         if (joint_blocks_pair(world, i, j)) return false;  // jointed bodies collide only if asked
                         return true;
                     });
@@ -204,8 +201,12 @@ void update_broadphase(World& world, Real dt) {
         bp.tree.set_fat_box(bp.proxy[i], fat);
     }
 
-    bp.pairs.clear();
-    bp.tree.update_pairs(*world.jobs, bp.pairs);  // sorted: the same order for any worker count
+    // A pair found again (one of its proxies grew) has its contact: left out by the pair
+    // jobs, which only read the index meanwhile.
+    const auto has_contact = [&world](std::uint64_t i, std::uint64_t j) {
+        return world.contact_index.contains((i << 32) | j);  // user values are slots, i <= j
+    };
+    bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact);  // sorted: the same order for any worker count
     make_contacts(world, bp);
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box

@@ -181,6 +181,37 @@ TEST(BroadphaseContacts, SameListsOnThreadsRunningRangesInReverse) {
     EXPECT_LT(reference[1].keys.size(), reference[0].keys.size());  // the teleported layer lost contacts
 }
 
+// A body moved most of a box along (out of its fat box) overlaps again many of the boxes
+// it had contacts with: the pair search leaves those out where it finds them, so the
+// step's new pairs are only pairs without a contact, and the contacts it kept stay.
+TEST(BroadphaseContacts, PairsFoundAgainAroundAGrownBox_AreNotNewPairs) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    block.space.update();
+    const std::size_t moved = 24 * 12 + 12;  // inside the bottom layer, dynamic, no sensor
+    ASSERT_TRUE(block.dynamic[moved]);
+    const std::uint32_t body = block.bodies[moved].index;  // the body's slot
+    const std::set<std::uint64_t> before(world.contact_keys.begin(), world.contact_keys.end());
+    block.space.set_position(block.bodies[moved], block.space.internal_position(block.bodies[moved]) + Vec3(0.9, 0, 0));
+    block.space.update();
+    const std::set<std::uint64_t> after(world.contact_keys.begin(), world.contact_keys.end());
+    std::size_t kept = 0;
+    for (const std::uint64_t key : before) {
+        const bool involves = (key >> 32) == body || (key & 0xffffffffu) == body;
+        kept += involves && after.count(key) != 0 ? 1u : 0u;
+    }
+    ASSERT_GT(kept, 0u);  // pairs a search without the contact index would report again
+    const std::vector<Pair>& pairs = world.broadphase->pairs;
+    bool found_moved = false;
+    for (const Pair& p : pairs) {
+        EXPECT_EQ(before.count(p.user_a << 32 | p.user_b), 0u) << "pair " << p.user_a << ", " << p.user_b;
+        found_moved = found_moved || p.user_a == body || p.user_b == body;
+    }
+    EXPECT_TRUE(found_moved);  // its new neighbours are found
+    expect_contacts_are_the_allowed_overlaps(world);
+}
+
 }  // namespace
 }  // namespace spindle
 

@@ -57,6 +57,36 @@ TEST(ProxyTrees, NewProxies_ReportEachOverlapOnceAndNeverStaticWithStatic) {
     EXPECT_TRUE(pairs.empty());  // nothing moved
 }
 
+// Pairs the caller says it has are left out; the rest are the pairs a search without
+// the callback reports, in the same order, whether found by a moving or a static proxy.
+TEST(ProxyTrees, KnownPairs_LeftOutAndTheRestInOrder) {
+    const auto build = [](ProxyTrees& bp) {
+        bp.create_proxy(cube(Vec3(0, 0, 0), 1), 20, true);
+        for (std::uint64_t k = 0; k < 8; ++k) bp.create_proxy(cube(Vec3(Real(k), 1.5, 0), 1), k, false);
+    };
+    ProxyTrees all, some;
+    build(all);
+    build(some);
+    SingleThreadedJobSystem jobs;
+    std::vector<Pair> every, rest;
+    all.update_pairs(jobs, every);
+    std::vector<UserPair> asked;
+    const auto known = [&asked](std::uint64_t a, std::uint64_t b) {
+        asked.emplace_back(a, b);
+        return (a + b) % 3 == 0;  // {0, 3}, {1, 2}, {1, 20}, ... known
+    };
+    some.update_pairs(jobs, rest, known);
+    std::vector<UserPair> expected;
+    for (const UserPair& p : user_pairs(every)) {
+        if ((p.first + p.second) % 3 != 0) expected.push_back(p);
+    }
+    ASSERT_LT(expected.size(), every.size());
+    EXPECT_EQ(user_pairs(rest), expected);
+    for (const UserPair& p : asked) EXPECT_LE(p.first, p.second);
+    std::sort(asked.begin(), asked.end());
+    EXPECT_EQ(asked, user_pairs(every));  // each found pair asked about once, in canonical order
+}
+
 TEST(ProxyTrees, MoveInsideFatBox_ReportsNothing_MoveOutside_ReportsAgain) {
     ProxyTrees bp(BroadphaseSettings{.margin = 0.2});
     SingleThreadedJobSystem jobs;
