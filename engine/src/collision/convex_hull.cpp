@@ -294,6 +294,17 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
         detail::VertexLanes& group = m_vertex_lanes[i / 4];
         group.x[i % 4] = v.x(), group.y[i % 4] = v.y(), group.z[i % 4] = v.z();
     }
+    m_arc_edges.resize(m_edges.size());
+    for (std::size_t j = 0; j < m_edges.size(); ++j) {
+        const HullEdge& e = m_edges[j];
+        detail::ArcEdge& a = m_arc_edges[j];
+        a.origin = m_vertices[e.v0];
+        a.direction = m_vertices[e.v1] - a.origin;
+        a.n0 = m_faces[e.f0].normal;
+        a.n1 = m_faces[e.f1].normal;
+        a.t0 = a.direction.cross(a.n0);
+        a.t1 = a.n1.cross(a.direction);
+    }
     compute_volume_properties();
 }
 

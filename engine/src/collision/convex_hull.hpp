@@ -41,6 +41,11 @@ public:
     std::span<const HullFace> faces() const noexcept { return m_faces; }
     std::span<const std::uint32_t> face_vertices() const noexcept { return m_face_vertices; }
     std::span<const HullEdge> edges() const noexcept { return m_edges; }
+    // Made once with the hull, for the SAT, which would otherwise make them for every pair
+    // the hull is in: the vertices in lanes, and each edge of edges() with its Gauss-map arc
+    // in the hull's own frame.
+    std::span<const detail::VertexLanes> vertex_lanes() const noexcept { return m_vertex_lanes; }
+    std::span<const detail::ArcEdge> arc_edges() const noexcept { return m_arc_edges; }
 
     // Centre of the volume (uniform density) and the volume itself.
     const Vec3& centroid() const noexcept { return m_centroid; }
@@ -69,6 +74,7 @@ private:
     std::vector<std::uint32_t> m_face_vertices;
     std::vector<HullEdge> m_edges;
     std::vector<detail::VertexLanes> m_vertex_lanes;
+    std::vector<detail::ArcEdge> m_arc_edges;
     Vec3 m_centroid = Vec3::Zero();
     Real m_volume = 0;
     Real m_inner_radius = 0;

@@ -1,8 +1,11 @@
 // Four doubles worked on together, and a polyhedron's vertices laid out that way: what the
-// SAT's support queries (sat.cpp) and a hull's bounds (convex_hull.cpp) loop over.
+// SAT's support queries (sat.cpp) and a hull's bounds (convex_hull.cpp) loop over; and an
+// edge with its Gauss-map arc, which a hull keeps made for the SAT.
 #pragma once
 
 #include <cstdint>
+
+#include <spindle/engine/math.hpp>
 
 namespace spindle::detail {
 
@@ -24,6 +27,15 @@ inline unsigned lane_bits(LaneMask m) {
 // and leaves a minimum or maximum as it is.
 struct VertexLanes {
     Lanes x, y, z;
+};
+
+// An edge in the common frame with what the Gauss-map test needs: the edge's arc
+// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
+struct ArcEdge {
+    Vec3 origin;
+    Vec3 direction;
+    Vec3 n0, n1;  // normals of the two faces
+    Vec3 t0, t1;  // direction x n0, n1 x direction
 };
 
 }  // namespace spindle::detail

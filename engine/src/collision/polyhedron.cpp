@@ -56,8 +56,11 @@ PolyView make_view(std::span<const Vec3> vertices, std::span<const HullFace> fac
 }  // namespace
 
 PolyView view_of(const ConvexHull& hull) {
-    return make_view(hull.vertices(), hull.faces(), hull.face_vertices().data(), hull.edges(), hull.centroid(),
-                     hull.inner_radius());
+    PolyView v = make_view(hull.vertices(), hull.faces(), hull.face_vertices().data(), hull.edges(), hull.centroid(),
+                           hull.inner_radius());
+    v.vertex_lanes = hull.vertex_lanes().data();
+    v.arc_edges = hull.arc_edges().data();
+    return v;
 }
 
 BoxPoly::BoxPoly(const Vec3& h) {

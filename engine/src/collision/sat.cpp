@@ -220,7 +220,7 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
     for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
-        if (arc_reach(own_arc_edge(b.view, j), d_in_b) > needed) {
+        if (arc_reach(b.view.arc_edges ? b.view.arc_edges[j] : own_arc_edge(b.view, j), d_in_b) > needed) {
             kept_b[count_b] = j;
             edges_b[count_b++] = arc_edge(b, j);
         }
@@ -414,16 +414,18 @@ bool cached_manifold(const FeatureCache& cache, const CachedAxis& axis, const Po
 }  // namespace
 
 PreparedPolyhedron::PreparedPolyhedron(const PolyView& view)
-    : m_view(view), m_vertex_lanes((view.vertex_count + 3) / 4), m_edges(view.edge_count) {
-    fill_lanes(view.vertices, view.vertex_count, m_vertex_lanes.data());
+    : m_view(view),
+      m_lane_buffer(view.vertex_lanes ? 0 : (view.vertex_count + 3) / 4),
+      m_lanes(view.vertex_lanes ? view.vertex_lanes : m_lane_buffer.data()),
+      m_edge_buffer(view.arc_edges ? 0 : view.edge_count),
+      m_edges(view.arc_edges) {
+    if (!view.vertex_lanes) fill_lanes(view.vertices, view.vertex_count, m_lane_buffer.data());
 }
 
 void PreparedPolyhedron::prepare_edges() const {
-    if (m_edges_ready) return;
-    m_edges_ready = true;
-    const Posed own{m_view, m_view.vertices, m_vertex_lanes.data(), Mat3::Identity(), Vec3::Zero(), m_view.inner_centre,
-                    true};
-    detail::prepare_edges(own, m_edges.data());
+    const Posed own{m_view, m_view.vertices, m_lanes, Mat3::Identity(), Vec3::Zero(), m_view.inner_centre, true};
+    detail::prepare_edges(own, m_edge_buffer.data());
+    m_edges = m_edge_buffer.data();
 }
 
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,

@@ -11,15 +11,6 @@
 
 namespace spindle::detail {
 
-// An edge in the common frame with what the Gauss-map test needs: the edge's arc
-// holds direction x when x . t0 >= 0 and x . t1 >= 0 (see on_edge_arc).
-struct ArcEdge {
-    Vec3 origin;
-    Vec3 direction;
-    Vec3 n0, n1;  // normals of the two faces
-    Vec3 t0, t1;  // direction x n0, n1 x direction
-};
-
 // Four of A's edges for the edge query's cheap rejections: the components of each edge's
 // direction and two face normals.
 struct EdgeLanes {
@@ -30,7 +21,8 @@ inline constexpr std::size_t kInlineVertices = 64;
 
 // A polyhedron in its own frame (the frame sat.cpp works in, the first polyhedron's),
 // with its vertices in lanes, and its edges prepared on first use: most tests of a pair
-// that stays apart end on a face before any edge is looked at.
+// that stays apart end on a face before any edge is looked at. A hull's view brings both
+// made (PolyView::vertex_lanes, arc_edges), and they are read from there.
 class PreparedPolyhedron {
 public:
     explicit PreparedPolyhedron(const PolyView& view);
@@ -38,20 +30,21 @@ public:
     PreparedPolyhedron& operator=(const PreparedPolyhedron&) = delete;
 
     const PolyView& view() const noexcept { return m_view; }
-    const VertexLanes* vertex_lanes() const noexcept { return m_vertex_lanes.data(); }
+    const VertexLanes* vertex_lanes() const noexcept { return m_lanes; }
     // The edges with their face normals.
     const ArcEdge* edges() const {
-        prepare_edges();
-        return m_edges.data();
+        if (m_edges == nullptr) prepare_edges();
+        return m_edges;
     }
 
 private:
     void prepare_edges() const;
 
     PolyView m_view;
-    ScratchBuffer<VertexLanes, kInlineVertices / 4> m_vertex_lanes;
-    mutable bool m_edges_ready = false;
-    mutable ScratchBuffer<ArcEdge, 2 * kInlineVertices> m_edges;
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> m_lane_buffer;  // used when the view brings none
+    const VertexLanes* m_lanes;
+    mutable ScratchBuffer<ArcEdge, 2 * kInlineVertices> m_edge_buffer;
+    mutable const ArcEdge* m_edges;
 };
 
 }  // namespace spindle::detail

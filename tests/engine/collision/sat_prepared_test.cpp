@@ -1,0 +1,118 @@
+// What a hull keeps made for the SAT (its vertices in lanes, its edges' Gauss-map arcs)
+// must be what the SAT would make from the hull's vertices, faces and edges: read in
+// place of arcs made per pair, it must give the same bits.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "collision/pair_functions.hpp"
+#include "collision/polyhedron.hpp"
+#include "collision_test_util.hpp"
+
+namespace spindle {
+namespace {
+
+using test::at;
+
+std::vector<Vec3> sphere_points(std::mt19937& random, Real r, int count) {
+    std::normal_distribution<Real> normal(0, 1);
+    std::vector<Vec3> points;
+    for (int i = 0; i < count; ++i)
+        points.push_back(r * Vec3(normal(random), normal(random), normal(random)).normalized());
+    return points;
+}
+
+Quat random_turn(std::mt19937& random) {
+    std::normal_distribution<Real> normal(0, 1);
+    return Quat(normal(random), normal(random), normal(random), normal(random)).normalized();
+}
+
+// The hull's view without what it keeps made: the SAT makes the lanes and arcs per test.
+detail::PolyView unprepared(const ConvexHull& hull) {
+    detail::PolyView v = detail::view_of(hull);
+    v.vertex_lanes = nullptr;
+    v.arc_edges = nullptr;
+    return v;
+}
+
+void expect_same_bits(const Vec3& got, const Vec3& expected, const char* what, std::size_t j) {
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(got[i], expected[i]) << what << " of edge " << j << ", coordinate " << i;
+}
+
+TEST(SatPrepared, HullKeepsTheArcsOfItsEdges) {
+    std::mt19937 random(11);
+    for (const int count : {4, 8, 32, 64}) {
+        const ConvexHull hull(sphere_points(random, 1.5, count));
+        const auto vertices = hull.vertices();
+        const auto faces = hull.faces();
+        ASSERT_EQ(hull.arc_edges().size(), hull.edges().size());
+        for (std::size_t j = 0; j < hull.edges().size(); ++j) {
+            const HullEdge& e = hull.edges()[j];
+            const detail::ArcEdge& a = hull.arc_edges()[j];
+            const Vec3 direction = vertices[e.v1] - vertices[e.v0];
+            expect_same_bits(a.origin, vertices[e.v0], "origin", j);
+            expect_same_bits(a.direction, direction, "direction", j);
+            expect_same_bits(a.n0, faces[e.f0].normal, "n0", j);
+            expect_same_bits(a.n1, faces[e.f1].normal, "n1", j);
+            expect_same_bits(a.t0, direction.cross(faces[e.f0].normal), "t0", j);
+            expect_same_bits(a.t1, faces[e.f1].normal.cross(direction), "t1", j);
+        }
+        ASSERT_EQ(hull.vertex_lanes().size(), (vertices.size() + 3) / 4);
+        for (std::size_t i = 0; i < 4 * hull.vertex_lanes().size(); ++i) {
+            const detail::VertexLanes& group = hull.vertex_lanes()[i / 4];
+            const Vec3& v = vertices[i < vertices.size() ? i : 0];  // past the end: vertex 0
+            EXPECT_EQ(group.x[i % 4], v.x()) << "lane " << i;
+            EXPECT_EQ(group.y[i % 4], v.y()) << "lane " << i;
+            EXPECT_EQ(group.z[i % 4], v.z()) << "lane " << i;
+        }
+    }
+}
+
+// Hull-hull and box-hull pairs near touching, the hull as A and as B, through the SAT with
+// the hulls' kept lanes and arcs and through the SAT making them per test: the same
+// manifold and the same cached feature, bit for bit, in every pose.
+TEST(SatPrepared, KeptArcsGiveTheBitsOfArcsMadePerTest) {
+    std::mt19937 random(5);
+    const ConvexHull big(sphere_points(random, 2, 32));
+    const ConvexHull small(sphere_points(random, 1.2, 8));
+    const detail::BoxPoly box(Vec3(1.5, 0.4, 0.9));
+    const detail::PolyView views[] = {detail::view_of(big), detail::view_of(small), box.view()};
+    const detail::PolyView plain[] = {unprepared(big), unprepared(small), box.view()};
+    std::normal_distribution<Real> normal(0, 1);
+    std::uniform_real_distribution<Real> gap(-1.0, 0.2);
+    const Real speculative = 0.04;
+    int touching = 0, edge_pairs = 0;
+    for (int pose = 0; pose < 600; ++pose) {
+        const int ia = pose % 3, ib = (pose / 3) % 2;  // B is always a hull
+        const Transform xa = at(Vec3(normal(random), normal(random), normal(random)), random_turn(random));
+        const Vec3 u = Vec3(normal(random), normal(random), normal(random)).normalized();
+        const Transform xb = at(xa.p + (2.5 + gap(random)) * u, random_turn(random));
+        FeatureCache kept_cache, plain_cache;
+        for (int repeat = 0; repeat < 2; ++repeat) {  // the second time from the cached feature
+            Manifold kept, made;
+            const bool kept_touch = detail::collide_polyhedra(views[ia], xa, views[ib], xb, speculative, kept,
+                                                              &kept_cache, 0.01);
+            const bool made_touch = detail::collide_polyhedra(plain[ia], xa, plain[ib], xb, speculative, made,
+                                                              &plain_cache, 0.01);
+            ASSERT_EQ(kept_touch, made_touch) << "pose " << pose;
+            EXPECT_EQ(kept_cache, plain_cache) << "pose " << pose;
+            if (!kept_touch) continue;
+            ++touching;
+            if (kept_cache.kind() == FeatureCache::Kind::EdgePair) ++edge_pairs;
+            ASSERT_EQ(kept.point_count, made.point_count) << "pose " << pose;
+            for (int i = 0; i < 3; ++i) EXPECT_EQ(kept.normal[i], made.normal[i]) << "pose " << pose;
+            for (int k = 0; k < kept.point_count; ++k) {
+                for (int i = 0; i < 3; ++i)
+                    EXPECT_EQ(kept.points[k].point[i], made.points[k].point[i]) << "pose " << pose;
+                EXPECT_EQ(kept.points[k].separation, made.points[k].separation) << "pose " << pose;
+                EXPECT_EQ(kept.points[k].id, made.points[k].id) << "pose " << pose;
+            }
+        }
+    }
+    // The poses reach both kinds of answer, else the comparison says little.
+    EXPECT_GT(touching, 200);
+    EXPECT_GT(edge_pairs, 10);
+}
+
+}  // namespace
+}  // namespace spindle
