@@ -135,6 +135,29 @@ TEST(Interpolation, ReadsUnderOneHoldShowOneInstant) {
     EXPECT_EQ(alpha_first, alpha_second);
 }
 
+// Reads that name no clock take the runner's from the published time, which each flip
+// writes: they read it under the lock (ThreadSanitizer caught the clock read before it).
+// Each read lies between the body's start and where the runner's time has taken it.
+TEST(Interpolation, ReadsNamingNoClockAreSafeWhileTheRunnerFlips) {
+    Space space = runner_space(0.001);  // a flip every millisecond
+    const BodyHandle body = space.create_body(moving(true));
+    AsyncRunner runner(space);
+    const std::int64_t started = now_nanoseconds();
+    runner.start();
+    const std::uint64_t first = space.motion_states().published_steps();
+    int reads = 0;
+    while (space.motion_states().published_steps() < first + 50 && reads < 1'000'000) {
+        MotionState out;
+        space.motion_states().get_motion_states(std::span(&body, 1), std::span(&out, 1));
+        const double since_start = static_cast<double>(now_nanoseconds() - started) * 1e-9;
+        ASSERT_GE(out.position.x(), 0);
+        ASSERT_LE(out.position.x(), since_start + 1e-9);
+        ++reads;
+    }
+    runner.stop();
+    EXPECT_GT(reads, 50);
+}
+
 // A runner asked for the seed's blend: reads stand still between flips.
 TEST(Interpolation, RunnerWithTheUpdateClockKeepsTheSeedsBlend) {
     Space space = runner_space(0.1);

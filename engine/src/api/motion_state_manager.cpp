@@ -178,7 +178,10 @@ std::size_t MotionStateManager::get_all_motion_states(std::vector<BodyHandle>& h
     return count;
 }
 
+// The clock of reads that name none is part of the published time a flip writes: read
+// under the lock (the overload's hold below takes nothing more).
 void MotionStateManager::get_motion_states(std::span<const BodyHandle> bodies, std::span<MotionState> out) const {
+    const MotionStateLock::Hold guard(m_lock);
     get_motion_states(bodies, out, m_time.reads);
 }
 
