@@ -263,9 +263,9 @@ struct SolverScratch {
     // Per solver body, apart from it (SolverBody says why): its push-out velocities, and
     // BodyDesc::gravity_scale of a dynamic body (else 0) so that integrate_velocities and
     // prepare_wide stay off the cold descriptions, each a cache miss.
-    std::vector<PushVelocity> push_velocities;
-    std::vector<Real> gravity_scales;
-    std::vector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
+    HugePageVector<PushVelocity> push_velocities;
+    HugePageVector<Real> gravity_scales;
+    HugePageVector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
     // list_manifolds' lists of its fixed ranges of contacts, before they are joined.
     struct ListedRange {
         std::vector<ManifoldRef> refs;
@@ -274,7 +274,7 @@ struct SolverScratch {
     std::vector<ListedRange> listed;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
-    std::vector<ManifoldRef> colored_manifolds;
+    HugePageVector<ManifoldRef> colored_manifolds;
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
     std::vector<JointRef> colored_joints;                // the joint list then
@@ -295,7 +295,7 @@ struct SolverScratch {
     std::vector<WideHinge> wide_hinges;             // and of their hinge blocks
     std::uint32_t wide_joint_begin[kColorCount + 1] = {};
     std::vector<std::uint32_t> joint_overflow;
-    std::vector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
+    HugePageVector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
     // Per manifold ref, or empty when every scale is 1 (most steps of most scenes).
     std::vector<SupportScale> support_scales;
     // Whether every awake dynamic body has the same inverse mass (prepare_bodies, from the

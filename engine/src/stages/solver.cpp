@@ -186,8 +186,8 @@ void color(SolverScratch& scratch) {
     }
 }
 
-template <typename T>
-bool same_bytes(const std::vector<T>& x, const std::vector<T>& y) {
+template <typename T, typename A>
+bool same_bytes(const std::vector<T, A>& x, const std::vector<T, A>& y) {
     return x.size() == y.size() && (x.empty() ||  // memcmp may not see the null data of an empty vector
                                     std::memcmp(x.data(), y.data(), x.size() * sizeof(T)) == 0);
 }

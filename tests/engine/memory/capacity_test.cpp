@@ -1,7 +1,8 @@
 // map_room (stages/capacity.hpp): the room of a growing array mapped in jobs before its
 // elements are made there; the array's block (stages/huge_page_vector.hpp) whole huge
 // pages where the system gives them on request. Mapping is a hint: the elements and
-// their count stay as they were.
+// their count stay as they were. A smaller block of a few pages has its pages mapped by
+// the allocation.
 #include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
@@ -11,6 +12,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include "stages/capacity.hpp"
 #include "stages/huge_page_vector.hpp"
@@ -49,6 +53,19 @@ std::uint64_t huge_page_kb_over(std::uintptr_t begin, std::uintptr_t end) {
         }
     }
     return kb;
+}
+
+// Whether every whole page inside [begin, end) is mapped (mincore).
+bool all_pages_mapped(std::uintptr_t begin, std::uintptr_t end) {
+    const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
+    const std::uintptr_t first = (begin + page - 1) / page * page;
+    const std::uintptr_t last = end / page * page;
+    std::vector<unsigned char> mapped((last - first) / page);
+    if (mincore(reinterpret_cast<void*>(first), last - first, mapped.data()) != 0) return false;
+    for (const unsigned char m : mapped) {
+        if ((m & 1) == 0) return false;
+    }
+    return true;
 }
 
 }  // namespace
@@ -95,4 +112,15 @@ TEST(HugePageVector, SmallBlocksAreOrdinaryOnes) {
     v.resize(10);
     v.shrink_to_fit();
     EXPECT_EQ(v.size(), 10u);
+}
+
+TEST(HugePageVector, MapsTheSmallPagesOfABlockOfAFewPagesAtOnce) {
+    // Under a huge page but over kMapAtOnceBytes: an ordinary block, its pages mapped by
+    // the allocation itself, before anything is written there.
+    HugePageVector<unsigned char> v;
+    v.reserve(kHugePageBytes / 2);
+    ASSERT_LT(v.capacity(), kHugePageBytes);
+    ASSERT_GE(v.capacity(), kMapAtOnceBytes);
+    const auto begin = reinterpret_cast<std::uintptr_t>(v.data());
+    EXPECT_TRUE(all_pages_mapped(begin, begin + v.capacity()));
 }
