@@ -3,9 +3,10 @@
 // closest points between segments.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -76,13 +77,19 @@ struct ContactCandidate {
 // already covered) are dropped even from small sets, as when manifolds are merged.
 void reduce_to_manifold(const ContactCandidate* candidates, int count, Manifold& m, bool prune = false);
 
-// Scratch space that lives on the stack unless a (rare) large hull needs more.
+// Scratch space that lives on the stack unless a (rare) large hull needs more. Only the
+// `size` elements asked for are made, default-initialised (left as they are for vectors
+// and numbers): a room of N made with the array did every element's initialisers each
+// time, such as a compound pair's 32 identity poses and empty boxes.
 template <typename T, std::size_t N>
 class ScratchBuffer {
+    static_assert(std::is_trivially_destructible_v<T>, "the elements made in place are never destroyed");
+
 public:
     explicit ScratchBuffer(std::size_t size) {
         if (size > N) m_heap.resize(size);
-        m_data = size > N ? m_heap.data() : m_inline.data();
+        m_data = size > N ? m_heap.data()
+                          : std::uninitialized_default_construct_n(reinterpret_cast<T*>(m_inline), size) - size;
     }
     ScratchBuffer(const ScratchBuffer&) = delete;
     ScratchBuffer& operator=(const ScratchBuffer&) = delete;
@@ -91,7 +98,7 @@ public:
     T& operator[](std::size_t i) { return m_data[i]; }
 
 private:
-    std::array<T, N> m_inline;
+    alignas(T) std::byte m_inline[N * sizeof(T)];
     std::vector<T> m_heap;
     T* m_data;
 };

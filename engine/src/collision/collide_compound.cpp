@@ -3,6 +3,7 @@
 // it were a body of its own, and its manifolds are labelled with the part indices.
 #include <algorithm>
 #include <array>
+#include <span>
 
 #include "collision/clipping.hpp"
 #include "collision/compound.hpp"
@@ -58,6 +59,7 @@ public:
         : m_compound(parts),
           m_x(x),
           m_rotation(x.q.toRotationMatrix()),
+          m_abs_rotation(m_rotation.cwiseAbs()),
           m_poses(parts.size()),
           m_exact(parts.size()),
           m_loose(parts.size()),
@@ -92,7 +94,7 @@ public:
 private:
     Aabb turned(const Aabb& local) const {
         const Vec3 c = m_x.p + m_rotation * local.center();
-        const Vec3 e = m_rotation.cwiseAbs() * local.extents();
+        const Vec3 e = m_abs_rotation * local.extents();
         const Real pad = kLooseRelative * (c.cwiseAbs().maxCoeff() + e.maxCoeff());
         return Aabb::from_center_extents(c, e.array() + pad);
     }
@@ -100,18 +102,30 @@ private:
     const Compound& m_compound;
     Transform m_x;
     Mat3 m_rotation;
+    Mat3 m_abs_rotation;  // turns each part's extents: made once, not once a part
     ScratchBuffer<Transform, kInlineParts> m_poses;
     ScratchBuffer<Aabb, kInlineParts> m_exact;
     ScratchBuffer<Aabb, kInlineParts> m_loose;
     ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
 };
 
-// Shape a (part `part_a` of its body, 0 if it is whole) against every part of compound b
-// near it; a_box is a's exact bounds fattened by the speculative distance.
-void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
-                   Real speculative, Gathered& g) {
-    Manifold found[kPerPair];
+// The parts of b whose loose boxes overlap `box`, in part order; returns their count.
+std::uint32_t parts_near(PosedParts& b, const Aabb& box, std::uint32_t* out) {
+    std::uint32_t n = 0;
     for (std::uint32_t i = 0; i < b.size(); ++i) {
+        if (box.overlaps(b.loose(i))) out[n++] = i;
+    }
+    return n;
+}
+
+// Shape a (part `part_a` of its body, 0 if it is whole) against each of compound b's
+// parts listed in `near` (in part order) that comes near it; a_box is a's exact bounds
+// fattened by the speculative distance, and `near` must hold every part whose loose box
+// it overlaps.
+void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
+                   std::span<const std::uint32_t> near, Real speculative, Gathered& g) {
+    Manifold found[kPerPair];
+    for (const std::uint32_t i : near) {
         if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
         const int n = collide(a, xa, b.shape(i), b.pose(i), speculative, found, kPerPair);
         for (int m = 0; m < n; ++m) {
@@ -148,7 +162,9 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
     Gathered g;
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
     PosedParts parts(*b.parts, xb);
-    collide_parts(a, xa, 0, a_box, parts, speculative, g);
+    ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
+    const std::uint32_t count = parts_near(parts, a_box, near.data());
+    collide_parts(a, xa, 0, a_box, parts, {near.data(), count}, speculative, g);
     return emit(g, out, capacity);
 }
 
@@ -159,10 +175,15 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
     const Real margin = std::max(speculative, Real(0));
     PosedParts a_parts(parts, xa), b_parts(*b.parts, xb);
     const Aabb b_box = b_parts.loose_all();
-    for (std::uint32_t j = 0; j < parts.size(); ++j) {
+    // Each of a's parts lies inside a's whole loose box (padded as each part's is), so a
+    // part of b whose loose box misses that box, fattened as a part's box is, meets none of
+    // them: it is left out once here instead of once for each of a's parts.
+    ScratchBuffer<std::uint32_t, kInlineParts> near(b_parts.size());
+    const std::uint32_t count = parts_near(b_parts, a_parts.loose_all().fattened(margin), near.data());
+    for (std::uint32_t j = 0; j < parts.size() && count > 0; ++j) {
         if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
         const Aabb part_box = a_parts.exact(j).fattened(margin);
-        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, speculative, g);
+        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, {near.data(), count}, speculative, g);
     }
     return emit(g, out, capacity);
 }

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 
 #include "collision/convex_hull.hpp"
+#include "collision/lanes.hpp"
 
 namespace spindle::detail {
 namespace {
@@ -50,16 +52,19 @@ void ShapeSpan::along(const Vec3& n, Real& lo, Real& hi) const {
             return;
         }
         case ShapeType::ConvexHull: {
+            // Four vertices a step from the hull's lanes (the padding repeats a vertex).
             const Vec3 local = m_rotation.transpose() * n;
-            Real low = kHuge, high = -kHuge;
-            for (const Vec3& v : m_hull->vertices()) {
-                const Real d = local.dot(v);
-                low = std::min(low, d);
-                high = std::max(high, d);
+            const Lanes x = Lanes{} + local.x(), y = Lanes{} + local.y(), z = Lanes{} + local.z();
+            const std::span<const VertexLanes> lanes = m_hull->vertex_lanes();
+            Lanes low = (lanes[0].x * x + lanes[0].y * y) + lanes[0].z * z, high = low;
+            for (std::size_t g = 1; g < lanes.size(); ++g) {
+                const Lanes d = (lanes[g].x * x + lanes[g].y * y) + lanes[g].z * z;
+                low = d < low ? d : low;
+                high = d > high ? d : high;
             }
             const Real c = n.dot(m_center);
-            lo = c + low;
-            hi = c + high;
+            lo = c + std::min(std::min(low[0], low[1]), std::min(low[2], low[3]));
+            hi = c + std::max(std::max(high[0], high[1]), std::max(high[2], high[3]));
             return;
         }
         default: lo = -kHuge, hi = kHuge;  // no span known: never clear of a plane

@@ -102,6 +102,27 @@ TEST(CompoundCollide, CompoundOnCompoundLabelsBothParts) {
     EXPECT_TRUE(collide_all(table(), Transform{}, dumbbell(), above).empty());
 }
 
+TEST(CompoundCollide, CompoundOnCompoundMeetsWithinTheSpeculativeDistance) {
+    // The bells hang 5 mm over the table's top, within collide_all's 10 mm: each part of one
+    // compound lies clear of the other's whole box, but not of that box fattened by the
+    // speculative distance, and still meets a part of the other. Both ways round.
+    const Transform over{Vec3(0, kTableHeight + kBell + 0.005, 0), Quat::Identity()};
+    const std::vector<Manifold> m = collide_all(table(), Transform{}, dumbbell(), over);
+    ASSERT_EQ(m.size(), 2u);
+    const std::vector<Manifold> flipped = collide_all(dumbbell(), over, table(), Transform{});
+    ASSERT_EQ(flipped.size(), 2u);
+    for (std::uint32_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(m[i].part_a, 0u);
+        EXPECT_EQ(m[i].part_b, i);
+        EXPECT_EQ(flipped[i].part_a, i);
+        EXPECT_EQ(flipped[i].part_b, 0u);
+        for (const Manifold* each : {&m[i], &flipped[i]}) {
+            ASSERT_EQ(each->point_count, 1);
+            EXPECT_NEAR(each->points[0].separation, 0.005, 1e-9);
+        }
+    }
+}
+
 TEST(CompoundCollide, ContactKeepsAManifoldPerTouchingLegAndStandsStill) {
     SpaceSettings settings;
     settings.sleep.enabled = false;
