@@ -299,3 +299,41 @@ TEST(MotionStates, CopyOfAllWithoutHolesBlendsOnlyWhereNeeded) {
         EXPECT_EQ(blended, any_interpolates ? 3 : 0);
     }
 }
+
+// Creation and destruction publish to both buffers and both query scenes at once, so the
+// flips after them copy nothing for those bodies (a world of a million static bodies
+// would otherwise be copied twice more); reads and queries still see every body on each
+// buffer, and a change outside a step is still published at the next two flips.
+TEST(Buffering, CreatedAndDestroyedBodiesAreNotPublishedAgainAtTheFlips) {
+    Space space(weightless());
+    std::vector<BodyHandle> floor;
+    std::vector<BodyHandle> hits;
+    EXPECT_EQ(space.overlap_box(Aabb{Vec3(-1, -1, -1), Vec3(1, 1, 1)}, hits), 0u);  // the query scenes exist
+    for (int i = 0; i < 40; ++i) {
+        BodyDesc d = ball(Vec3(i, 0, 0), MotionType::Static);
+        d.user_data = 100 + static_cast<std::uint64_t>(i);
+        floor.push_back(space.create_body(d));
+    }
+    const BodyHandle moving = space.create_body(ball(Vec3(0, 5, 0)));
+    space.destroy_body(floor[7]);
+    const Aabb everything{Vec3(-10, -10, -10), Vec3(50, 10, 10)};
+    for (int flip = 0; flip < 3; ++flip) {
+        space.update();
+        EXPECT_EQ(space.counters().changed_publishes, 0u) << "flip " << flip;
+        EXPECT_FALSE(space.contains(floor[7]));
+        for (int i = 0; i < 40; ++i) {
+            if (i == 7) continue;
+            EXPECT_EQ(space.position(floor[i]), Vec3(i, 0, 0)) << "flip " << flip;
+            EXPECT_EQ(space.user_data(floor[i]), 100u + static_cast<std::uint64_t>(i)) << "flip " << flip;
+        }
+        EXPECT_EQ(space.overlap_box(everything, hits), 40u) << "flip " << flip;  // 39 static and the ball
+    }
+    EXPECT_EQ(space.position(moving), Vec3(0, 5, 0));
+
+    space.set_position(floor[3], Vec3(3, -4, 0));  // a write: published at the next two flips
+    for (int flip = 0; flip < 3; ++flip) {
+        space.update();
+        EXPECT_EQ(space.position(floor[3]), Vec3(3, -4, 0)) << "flip " << flip;
+    }
+    EXPECT_EQ(space.counters().changed_publishes, 2u);
+}

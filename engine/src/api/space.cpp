@@ -123,7 +123,6 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     if (b.is_fast(slot)) w.fast_bodies += 1;
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
-    w.changed_now.push_back(slot);
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
@@ -148,7 +147,6 @@ void Space::destroy_body(BodyHandle body) {
     w.bodies.live -= 1;
     w.bodies.desc[slot] = BodyDesc{};  // drop the shape's geometry now
     w.bodies.free_slots.push_back(slot);
-    w.changed_now.push_back(slot);
     w.body_set_version += 1;
     w.body_count.store(w.bodies.live, std::memory_order_release);
     publish_now(w, slot);

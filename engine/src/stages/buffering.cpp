@@ -219,11 +219,15 @@ void publish_now(World& world, std::uint32_t slot) {
     // scene is refreshed there for it, as a changed body; WorkCounters::query_publishes_deferred).
     // Read under the lock: a first query holding it may have built the scenes while this
     // thread waited for it (and holds the front one: then the body is deferred).
+    // Otherwise both buffers and both scenes hold the slot now, so the flips need not
+    // publish it again: a million bodies created before the first step would otherwise be
+    // copied twice more, at the first two flips.
     QueryScene* front = world.query_scenes[1 - back].get();
     if (front && front->holders.load(std::memory_order_acquire) == 0) {
         front->refresh(world, slot, interpolating);
     } else if (front) {
         world.counters.query_publishes_deferred += 1;
+        world.changed_now.push_back(slot);
     }
     manager.set_query_scene_locked(world.query_scenes[1 - back]);
 }
@@ -272,6 +276,7 @@ void flip_read_buffers(World& world) {
             publish_user_data(world, i, back);
             if (!b.alive[i] || b.awake_index[i] < 0) publish(i);
         }
+        world.counters.changed_publishes += changed->size();
     }
     const bool awake_stale = world.published_version[k] != world.awake_version ||
                              world.published_interpolating[k] != interpolating;

@@ -60,6 +60,10 @@ struct WorkCounters {
     std::uint64_t swept_tests = 0;            // continuous-collision sweeps
     std::uint64_t interpolated_publishes = 0;  // bodies published with a previous pose to blend
     std::uint64_t awake_publishes = 0;         // awake bodies' entries refilled by FlipReadBuffers
+    // Entries refilled by FlipReadBuffers for changes outside a step (writes, sleep, waking,
+    // set_internal_motion_state), each at two flips (both buffers). Creation and destruction
+    // publish to both buffers at once and count here only while a query held the scene.
+    std::uint64_t changed_publishes = 0;
     // Query scenes the physics thread copied because a query still held the one it was
     // about to update (query/query_scene.hpp): a query never holds up a step.
     std::uint64_t query_scene_copies = 0;
