@@ -297,7 +297,7 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     EXPECT_LE(a4, 4.0);
     EXPECT_GE(a8, a4);
     EXPECT_GE(a16, a8);
-    EXPECT_LE(a16, 1 / serial_work + 1e-9);
+    EXPECT_LE(a16, 1 / serial_work + 0.01);  // printed to two decimals: near 1 on a loaded machine
     EXPECT_EQ(field(summary, "traced_steps"), 19.0);
     EXPECT_GE(field(summary, "all_steps_serial_fraction"), serial - 1e-4);  // the quieter half's is the least
     const double code = field(summary, "serial_code_fraction");
