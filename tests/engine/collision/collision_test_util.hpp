@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 #include "collision/collide.hpp"
@@ -14,6 +15,12 @@ namespace spindle::test {
 
 inline Transform at(const Vec3& p, const Quat& q = Quat::Identity()) { return {p, q}; }
 inline Quat about(const Vec3& axis, Real angle) { return Quat(Eigen::AngleAxis<Real>(angle, axis.normalized())); }
+
+// A turn drawn uniformly over all turns.
+inline Quat random_turn(std::mt19937& random) {
+    std::normal_distribution<Real> normal(0, 1);
+    return Quat(normal(random), normal(random), normal(random), normal(random)).normalized();
+}
 
 inline std::vector<Manifold> run(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                                  Real speculative = 0, int capacity = 8) {

@@ -15,7 +15,7 @@ using test::at;
 using test::run;
 
 // n x n unit quads in y = 0 from (0, 0) to (n, n), two triangles each, facing +y.
-Shape flat_grid(int n) {
+Shape unit_grid(int n) {
     std::vector<Vec3> v;
     std::vector<std::uint32_t> idx;
     for (int z = 0; z <= n; ++z) {
@@ -40,14 +40,14 @@ Shape valley() {
 }
 
 TEST(ConvexMesh, SphereOnASeamVertexGetsOneFaceNormal) {
-    const auto m = run(Shape::sphere(0.5), at(Vec3(2, 0.45, 2)), flat_grid(4), at(Vec3::Zero()));
+    const auto m = run(Shape::sphere(0.5), at(Vec3(2, 0.45, 2)), unit_grid(4), at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
     EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
 }
 
 TEST(ConvexMesh, BoxOnGridMergesIntoOneFourPointManifold) {
-    const auto m = run(Shape::box(Vec3(0.7, 0.5, 0.6)), at(Vec3(2.1, 0.49, 1.9)), flat_grid(4), at(Vec3::Zero()));
+    const auto m = run(Shape::box(Vec3(0.7, 0.5, 0.6)), at(Vec3(2.1, 0.49, 1.9)), unit_grid(4), at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
     ASSERT_EQ(m[0].point_count, 4);
@@ -57,7 +57,7 @@ TEST(ConvexMesh, BoxOnGridMergesIntoOneFourPointManifold) {
 }
 
 TEST(ConvexMesh, SlidingBoxNeverCatchesOnInteriorEdges) {
-    const Shape ground = flat_grid(6);
+    const Shape ground = unit_grid(6);
     const Shape box = Shape::box(Vec3(0.3, 0.3, 0.3));
     for (int step = 0; step < 100; ++step) {
         const Transform xb = at(Vec3(1.05 + 0.04 * step, 0.295, 3.0), about(Vec3::UnitY(), 0.3));
@@ -69,7 +69,7 @@ TEST(ConvexMesh, SlidingBoxNeverCatchesOnInteriorEdges) {
 }
 
 TEST(ConvexMesh, RollingCapsuleAndHullStayOnFaceNormals) {
-    const Shape ground = flat_grid(4);
+    const Shape ground = unit_grid(4);
     const Shape capsule = Shape::capsule(0.6, 0.2);
     const Shape hull = test::hull_box(Vec3(0.3, 0.2, 0.4));
     for (int step = 0; step < 40; ++step) {
@@ -113,7 +113,7 @@ TEST(ConvexMesh, SphereInAValleyGetsTwoManifoldsDeepestFirst) {
 }
 
 TEST(ConvexMesh, SwappedOrderFlipsAndFarAwayGivesNothing) {
-    const Shape ground = flat_grid(2);
+    const Shape ground = unit_grid(2);
     const auto m = run(ground, at(Vec3::Zero()), Shape::sphere(0.5), at(Vec3(1, 0.4, 1)));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, 1, 0), 1e-9);
@@ -125,7 +125,7 @@ TEST(ConvexMesh, MovedAndRotatedMeshKeepsWorldResults) {
     const Quat q = about(Vec3(1, 0, 1), 0.7);
     const Transform xm = at(Vec3(3, -1, 2), q);
     const Vec3 c = xm.apply(Vec3(1, 0.45, 1));
-    const auto m = run(Shape::sphere(0.5), at(c), flat_grid(2), xm);
+    const auto m = run(Shape::sphere(0.5), at(c), unit_grid(2), xm);
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(q * Vec3(0, -1, 0)), 1e-9);
     EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);

@@ -14,6 +14,7 @@ namespace spindle {
 namespace {
 
 using test::at;
+using test::random_turn;
 
 // A hull of `count` points on a sphere of radius r (as Box3D's convex_pile draws them).
 Shape random_hull(std::mt19937& random, Real r, int count) {
@@ -22,11 +23,6 @@ Shape random_hull(std::mt19937& random, Real r, int count) {
     for (int i = 0; i < count; ++i)
         points.push_back(r * Vec3(normal(random), normal(random), normal(random)).normalized());
     return Shape::convex_hull(points);
-}
-
-Quat random_turn(std::mt19937& random) {
-    std::normal_distribution<Real> normal(0, 1);
-    return Quat(normal(random), normal(random), normal(random), normal(random)).normalized();
 }
 
 // A shape's vertices, face normals and edge directions in the world.

@@ -13,6 +13,7 @@ namespace spindle {
 namespace {
 
 using test::at;
+using test::random_turn;
 
 std::vector<Vec3> sphere_points(std::mt19937& random, Real r, int count) {
     std::normal_distribution<Real> normal(0, 1);
@@ -20,11 +21,6 @@ std::vector<Vec3> sphere_points(std::mt19937& random, Real r, int count) {
     for (int i = 0; i < count; ++i)
         points.push_back(r * Vec3(normal(random), normal(random), normal(random)).normalized());
     return points;
-}
-
-Quat random_turn(std::mt19937& random) {
-    std::normal_distribution<Real> normal(0, 1);
-    return Quat(normal(random), normal(random), normal(random), normal(random)).normalized();
 }
 
 // The hull's view without what it keeps made: the SAT makes the lanes and arcs per test.

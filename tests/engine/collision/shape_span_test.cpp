@@ -23,13 +23,6 @@ std::vector<Shape> shapes() {
     return {Shape::sphere(0.5), Shape::capsule(0.5, 0.3), Shape::box(Vec3(0.4, 0.5, 0.6)), Shape::convex_hull(rock)};
 }
 
-Quat random_turn(std::mt19937& rng) {
-    std::normal_distribution<Real> g;
-    Quat q(g(rng), g(rng), g(rng), g(rng));
-    q.normalize();
-    return q;
-}
-
 // The pair test the mesh walk runs on a triangle (mesh frame = identity).
 bool pair_test_touches(const Shape& a, const Transform& xa, const detail::TrianglePoly& tri, Real speculative) {
     Manifold m;

@@ -31,10 +31,6 @@ BodyHandle add_box(Space& space) {
     return space.create_body(d);
 }
 
-void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
-
 }  // namespace
 
 TEST(ContactPoints, RestingBoxShowsItsFourCornersWithTheNormalAndTheWeight) {

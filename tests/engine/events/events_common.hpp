@@ -11,6 +11,10 @@
 
 namespace spindle::test {
 
+inline void run(Space& space, int steps) {
+    for (int i = 0; i < steps; ++i) space.update();
+}
+
 inline BodyHandle add_ground(Space& space, bool contact_events = false) {
     BodyDesc g;
     g.type = MotionType::Static;

@@ -22,10 +22,6 @@ using namespace spindle::test;
 
 namespace {
 
-void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
-
 // A ball dropped 1.5 m onto the ground, run until it has rested a while (it falls asleep).
 struct Landing {
     Space space;

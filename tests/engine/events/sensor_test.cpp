@@ -12,10 +12,6 @@ using namespace spindle::test;
 
 namespace {
 
-void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
-
 BodyDesc sensor_box(MotionType type, const Vec3& position, const Vec3& half = Vec3(2, 0.5, 2)) {
     BodyDesc d;
     d.type = type;

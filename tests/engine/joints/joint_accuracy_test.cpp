@@ -16,8 +16,6 @@ using namespace spindle::test;
 
 namespace {
 
-constexpr double kG = 9.81;
-
 // Times at which f(step) changes sign, linearly interpolated between steps.
 class ZeroCrossings {
 public:

@@ -9,6 +9,9 @@
 
 namespace spindle::test {
 
+constexpr double kG = 9.81;         // gravity's magnitude, m/s^2, as SpaceSettings has it
+constexpr double kDt = 1.0 / 60.0;  // the default step
+
 inline BodyHandle add_static(Space& space, const Vec3& p, Real radius = 0.05) {
     BodyDesc d;
     d.type = MotionType::Static;

@@ -16,13 +16,6 @@
 using namespace spindle;
 using namespace spindle::test;
 
-namespace {
-
-constexpr double kG = 9.81;
-constexpr double kDt = 1.0 / 60.0;
-
-}  // namespace
-
 TEST(Motor, BringsABodyToItsTargetPose) {
     Space space;
     space.set_gravity(Vec3::Zero());

@@ -16,9 +16,6 @@ using namespace spindle::test;
 
 namespace {
 
-constexpr double kG = 9.81;
-constexpr double kDt = 1.0 / 60.0;
-
 // A box (0.2 m cube) on a slider from a static anchor at the origin along `axis`.
 struct Slider {
     BodyHandle anchor, body;

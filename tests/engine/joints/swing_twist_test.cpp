@@ -15,9 +15,6 @@ using namespace spindle::test;
 
 namespace {
 
-constexpr double kG = 9.81;
-constexpr double kDt = 1.0 / 60.0;
-
 // A 10 kg bar (0.2 x 1 x 0.2 m) hanging from a swing-twist joint at the origin, its
 // twist axis down the bar.
 struct HangingBar {

@@ -15,6 +15,8 @@
 #include <tuple>
 #include <vector>
 
+#include "scene_test_util.hpp"
+
 namespace spindle {
 namespace {
 
@@ -36,22 +38,6 @@ enum Part : std::uint32_t {
 };
 constexpr std::size_t kJoints = 11;
 constexpr Real kDegree = kPi / 180;
-
-std::string parse_error(const std::string& text) {
-    try {
-        parse_scene(text, "bad.toml");
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
-
-#define EXPECT_REJECTED(text, where, what)                                                                \
-    do {                                                                                                  \
-        const std::string message = parse_error(text);                                                    \
-        EXPECT_NE(message.find(std::string("bad.toml:") + (where) + ": "), std::string::npos) << message; \
-        EXPECT_NE(message.find(what), std::string::npos) << message;                                      \
-    } while (0)
 
 // The index of the scene joint between bodies a and b.
 std::size_t joint_between(const SceneDesc& scene, std::uint32_t a, std::uint32_t b) {

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "scene_test_util.hpp"
+
 namespace spindle {
 namespace {
 
@@ -30,16 +32,6 @@ std::vector<std::filesystem::path> scene_files() {
 
 SceneDesc load(const char* name) { return load_scene((kScenes / (std::string(name) + ".toml")).string()); }
 
-// The message of the spindle::Error that parsing `text` (as "bad.toml") throws.
-std::string parse_error(const std::string& text) {
-    try {
-        parse_scene(text, "bad.toml");
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
-
 // The message of the spindle::Error that building `scene` throws.
 std::string build_error(const SceneDesc& scene, Space& space) {
     try {
@@ -49,13 +41,6 @@ std::string build_error(const SceneDesc& scene, Space& space) {
     }
     return "(no error)";
 }
-
-#define EXPECT_REJECTED(text, where, what)                                                                \
-    do {                                                                                                  \
-        const std::string message = parse_error(text);                                                    \
-        EXPECT_NE(message.find(std::string("bad.toml:") + (where) + ": "), std::string::npos) << message; \
-        EXPECT_NE(message.find(what), std::string::npos) << message;                                      \
-    } while (0)
 
 TEST(SceneFiles, EveryConfigScene_Parses) {
     const std::vector<std::filesystem::path> files = scene_files();

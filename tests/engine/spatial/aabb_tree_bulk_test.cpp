@@ -35,15 +35,6 @@ std::vector<std::int32_t> add(DynamicAabbTree& tree, const Batch& batch, JobSyst
     return ids;
 }
 
-std::vector<std::int32_t> walk_order(const DynamicAabbTree& tree) {
-    std::vector<std::int32_t> order;
-    tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(1e9)), [&](std::int32_t id) {
-        order.push_back(id);
-        return true;
-    });
-    return order;
-}
-
 void expect_proxies(const DynamicAabbTree& tree, const std::vector<std::int32_t>& ids, const Batch& batch) {
     for (std::size_t k = 0; k < ids.size(); ++k) {
         ASSERT_TRUE(tree.is_proxy(ids[k])) << "proxy " << k;

@@ -216,15 +216,6 @@ TEST(AabbTreeMoves, Churn_FlagsStayConsistentThroughInsertsRemovalsAndRotations)
     }
 }
 
-std::vector<std::int32_t> walk_order(const DynamicAabbTree& tree) {
-    std::vector<std::int32_t> order;
-    tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(1e9)), [&](std::int32_t id) {
-        order.push_back(id);
-        return true;
-    });
-    return order;
-}
-
 // The lower parts of a big rebuild are built as jobs: on three threads, in reverse chunk
 // order, the tree comes out the same as on the calling thread alone (the same walk order,
 // the same cost to the bit), and valid.

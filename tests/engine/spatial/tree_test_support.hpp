@@ -52,4 +52,14 @@ inline std::vector<std::int32_t> brute_sorted(const DynamicAabbTree& tree, const
     return ids;
 }
 
+// Every proxy in the order the tree's query walks them.
+inline std::vector<std::int32_t> walk_order(const DynamicAabbTree& tree) {
+    std::vector<std::int32_t> order;
+    tree.query(Aabb::from_center_extents(Vec3::Zero(), Vec3::Constant(1e9)), [&](std::int32_t id) {
+        order.push_back(id);
+        return true;
+    });
+    return order;
+}
+
 }  // namespace spindle::test
