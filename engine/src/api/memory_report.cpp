@@ -42,7 +42,9 @@ MemoryReport memory_report(const Space& space) {
     MemoryReport report;
     report.bodies = body_bytes(world.bodies) + held(world.awake) + held(world.awake_pending);
     report.contacts = held(world.contacts);
-    for (const Contact& contact : world.contacts) report.contact_extras += held(contact.extra);
+    for (const Contact& contact : world.contacts) {
+        report.contact_extras += held(contact.extra) + held(contact.triangle_features);
+    }
     report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +
                             held(world.contact_summaries) + held(world.awake_contact_list);
     const SolverScratch& solver = *world.solver;

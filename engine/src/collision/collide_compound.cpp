@@ -121,13 +121,14 @@ std::uint32_t parts_near(PosedParts& b, const Aabb& box, std::uint32_t* out) {
 // Shape a (part `part_a` of its body, 0 if it is whole) against each of compound b's
 // parts listed in `near` (in part order) that comes near it; a_box is a's exact bounds
 // fattened by the speculative distance, and `near` must hold every part whose loose box
-// it overlaps.
-void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
-                   std::span<const std::uint32_t> near, Real speculative, Gathered& g) {
+// it overlaps. `pair(i, found)` collides a with part i as collide() does.
+template <class PairFn>
+void collide_parts(std::uint32_t part_a, const Aabb& a_box, PosedParts& b, std::span<const std::uint32_t> near,
+                   Gathered& g, PairFn&& pair) {
     Manifold found[kPerPair];
     for (const std::uint32_t i : near) {
         if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
-        const int n = collide(a, xa, b.shape(i), b.pose(i), speculative, found, kPerPair);
+        const int n = pair(i, found);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -155,17 +156,40 @@ int emit(Gathered& g, Manifold* out, int capacity) {
     return g.count;
 }
 
-}  // namespace
-
-int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                           Manifold* out, int capacity) {
+// Shape a against each of compound b's parts near it, through `pair` (as collide_parts).
+template <class PairFn>
+int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int capacity, PairFn&& pair) {
     Gathered g;
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
     PosedParts parts(*b.parts, xb);
     ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
     const std::uint32_t count = parts_near(parts, a_box, near.data());
-    collide_parts(a, xa, 0, a_box, parts, {near.data(), count}, speculative, g);
+    collide_parts(0, a_box, parts, {near.data(), count}, g,
+                  [&](std::uint32_t i, Manifold* found) { return pair(parts.shape(i), parts.pose(i), i, found); });
     return emit(g, out, capacity);
+}
+
+}  // namespace
+
+int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                           Manifold* out, int capacity) {
+    return collide_shape_parts(a, xa, b, xb, speculative, out, capacity,
+                               [&](const Shape& part, const Transform& x, std::uint32_t, Manifold* found) {
+                                   return collide(a, xa, part, x, speculative, found, kPerPair);
+                               });
+}
+
+int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
+                                 Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk) {
+    return collide_shape_parts(mesh, xm, b, xb, speculative, out, capacity,
+                               [&](const Shape& part, const Transform& x, std::uint32_t i, Manifold* found) {
+                                   // The mesh's pair function has the part as A: turned round as collide() does.
+                                   const int n = collide_convex_mesh_cached(part, x, mesh, xm, speculative, found,
+                                                                            kPerPair, i, walk);
+                                   for (int m = 0; m < n; ++m) flip_manifold(found[m]);
+                                   return n;
+                               });
 }
 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
@@ -183,7 +207,11 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
     for (std::uint32_t j = 0; j < parts.size() && count > 0; ++j) {
         if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
         const Aabb part_box = a_parts.exact(j).fattened(margin);
-        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, {near.data(), count}, speculative, g);
+        const Shape& part = parts.shape(j);
+        const Transform& pose = a_parts.pose(j);
+        collide_parts(j, part_box, b_parts, {near.data(), count}, g, [&](std::uint32_t i, Manifold* found) {
+            return collide(part, pose, b_parts.shape(i), b_parts.pose(i), speculative, found, kPerPair);
+        });
     }
     return emit(g, out, capacity);
 }

@@ -244,7 +244,7 @@ void update_narrowphase(World& world) {
             const Shape& shape_a = b.desc[a].shape;
             const Shape& shape_b = b.desc[bb].shape;
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         settings.linear_slop);
+                                         contact.triangle_features, settings.linear_slop);
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;
