@@ -19,7 +19,7 @@ struct MemoryReport {
     std::size_t wide_contacts = 0;   // the solver's contacts eight by eight (kLanes)
     std::size_t push_rows = 0;       // their push-out rows (the anchors they are made from)
     std::size_t solver_other = 0;    // solver bodies, manifold lists, colours, joints, phases
-    std::size_t broadphase = 0;      // AABB trees, per-slot proxies, pair lists
+    std::size_t broadphase = 0;      // AABB trees, per-slot proxies, pair lists, compounds' part boxes
     std::size_t query_scenes = 0;    // both published query scenes
 
     std::size_t total() const noexcept {
