@@ -160,6 +160,9 @@ struct Contact {
     Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
     ContactManifold manifold;            // the first (and for convex pairs only) manifold
     std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
+    // A box, hull or compound against a triangle mesh: each triangle's feature, as `feature`
+    // is for a convex pair (collide_cached).
+    TriangleFeatures triangle_features;
 
     Vec3 anchor_a(const ContactPoint& p) const { return p.point - cached_xa; }
     Vec3 anchor_b(const ContactPoint& p) const { return p.point - cached_xb; }

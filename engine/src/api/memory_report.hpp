@@ -14,12 +14,12 @@ namespace spindle {
 struct MemoryReport {
     std::size_t bodies = 0;          // the per-slot body arrays, descriptions included
     std::size_t contacts = 0;        // contact records, with their first manifold
-    std::size_t contact_extras = 0;  // further manifolds (meshes, compounds)
+    std::size_t contact_extras = 0;  // further manifolds and triangle features (meshes, compounds)
     std::size_t contact_lookup = 0;  // pair index, keys, summaries, awake list
     std::size_t wide_contacts = 0;   // the solver's contacts eight by eight (kLanes)
     std::size_t push_rows = 0;       // their push-out rows (the anchors they are made from)
     std::size_t solver_other = 0;    // solver bodies, manifold lists, colours, joints, phases
-    std::size_t broadphase = 0;      // AABB trees, per-slot proxies, pair lists
+    std::size_t broadphase = 0;      // AABB trees, per-slot proxies, pair lists, compounds' part boxes
     std::size_t query_scenes = 0;    // both published query scenes
 
     std::size_t total() const noexcept {

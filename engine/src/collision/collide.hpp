@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include <spindle/engine/math.hpp>
 #include <spindle/engine/shape.hpp>
@@ -69,12 +71,33 @@ private:
     float m_separation = 0;
 };
 
-// collide() with the pair's cache, for the narrowphase: box-hull and hull-hull pairs
-// read and write it; any other pair clears it. `feature_slop`: how far the separation
-// along a cached touching feature may drift before the whole SAT runs again (the
-// solver's linear slop; 0 never reuses a touching feature).
+// One mesh triangle's FeatureCache against a box or hull, whole or a compound's part: a
+// shape against a mesh meets many triangles, each a pair of its own to the SAT (the idea of
+// Box3D's mesh contact, which keeps its triangles' caches between steps).
+struct TriangleFeature {
+    std::uint32_t part = 0;      // the compound part (0 for a whole shape)
+    std::uint32_t triangle = 0;  // its index in the mesh
+    FeatureCache feature;
+};
+// A contact's triangle features from its last collide, sorted by part, then triangle.
+using TriangleFeatures = std::vector<TriangleFeature>;
+
+// A compound's parts' world boxes under the pose it is collided at, as Compound::bounds
+// writes them (the broadphase's), for a and b; empty where not at hand (the walk makes them).
+struct PartBoxes {
+    std::span<const Aabb> a, b;
+};
+
+// collide() with the pair's caches, for the narrowphase: box-hull and hull-hull pairs
+// read and write `cache`; a box, hull or compound against a triangle mesh reads and
+// rewrites `triangles` (the triangles it met this time, each with its feature); any other
+// pair clears what it does not use. `feature_slop`: how far the separation along a cached
+// touching feature may drift before the whole SAT runs again (the solver's linear slop;
+// 0 never reuses a touching feature). A compound's walk takes its part boxes from `boxes`
+// where given: the same boxes, not made again.
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-                   Manifold* out, int capacity, FeatureCache& cache, Real feature_slop);
+                   Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
+                   const PartBoxes& boxes = {});
 
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns

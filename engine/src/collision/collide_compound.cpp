@@ -52,18 +52,23 @@ void keep(Gathered& g, const Manifold& m) {
 // once for every part of the other shape they are tested against. A part's exact bounds
 // (its hull's vertices moved into the world) are what decide whether it meets the other
 // shape, as they did when each pair was tested alone; its compound-frame box turned with
-// the compound is a cheap superset that rules most parts out first.
+// the compound is a cheap superset that rules most parts out first. Exact bounds given
+// (the broadphase's, made by the same expression) stand for both.
 class PosedParts {
 public:
-    PosedParts(const Compound& parts, const Transform& x)
+    PosedParts(const Compound& parts, const Transform& x, std::span<const Aabb> given = {})
         : m_compound(parts),
           m_x(x),
           m_rotation(x.q.toRotationMatrix()),
           m_abs_rotation(m_rotation.cwiseAbs()),
+          m_given(given.empty() ? nullptr : given.data()),
           m_poses(parts.size()),
-          m_exact(parts.size()),
-          m_loose(parts.size()),
-          m_has_exact(parts.size()) {
+          m_exact(m_given ? 0 : parts.size()),
+          m_loose(m_given ? 0 : parts.size()),
+          m_has_pose(parts.size()),
+          m_has_exact(m_given ? 0 : parts.size()) {
+        for (std::uint32_t i = 0; i < parts.size(); ++i) m_has_pose[i] = false;
+        if (m_given) return;
         for (std::uint32_t i = 0; i < parts.size(); ++i) {
             m_loose[i] = turned(parts.part_bounds(i));
             m_has_exact[i] = false;
@@ -75,20 +80,23 @@ public:
 
     // Part i's world pose and exact bounds, made the first time they are asked for.
     const Transform& pose(std::uint32_t i) {
-        exact(i);
+        if (!m_has_pose[i]) {
+            m_poses[i] = m_x * m_compound.pose(i);
+            m_has_pose[i] = true;
+        }
         return m_poses[i];
     }
     const Aabb& exact(std::uint32_t i) {
+        if (m_given) return m_given[i];
         if (!m_has_exact[i]) {
-            m_poses[i] = m_x * m_compound.pose(i);
-            m_exact[i] = m_compound.shape(i).bounds(m_poses[i]);
+            m_exact[i] = m_compound.shape(i).bounds(pose(i));
             m_has_exact[i] = true;
         }
         return m_exact[i];
     }
     // A box holding part i's exact bounds: its compound-frame bounds turned into the world,
     // widened by far more than the two computations' rounding can differ.
-    const Aabb& loose(std::uint32_t i) { return m_loose[i]; }
+    const Aabb& loose(std::uint32_t i) { return m_given ? m_given[i] : m_loose[i]; }
     Aabb loose_all() const { return turned(m_compound.local_bounds()); }
 
 private:
@@ -103,9 +111,11 @@ private:
     Transform m_x;
     Mat3 m_rotation;
     Mat3 m_abs_rotation;  // turns each part's extents: made once, not once a part
+    const Aabb* m_given;  // each part's exact bounds, or null
     ScratchBuffer<Transform, kInlineParts> m_poses;
     ScratchBuffer<Aabb, kInlineParts> m_exact;
     ScratchBuffer<Aabb, kInlineParts> m_loose;
+    ScratchBuffer<std::uint8_t, kInlineParts> m_has_pose;
     ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
 };
 
@@ -121,13 +131,14 @@ std::uint32_t parts_near(PosedParts& b, const Aabb& box, std::uint32_t* out) {
 // Shape a (part `part_a` of its body, 0 if it is whole) against each of compound b's
 // parts listed in `near` (in part order) that comes near it; a_box is a's exact bounds
 // fattened by the speculative distance, and `near` must hold every part whose loose box
-// it overlaps.
-void collide_parts(const Shape& a, const Transform& xa, std::uint32_t part_a, const Aabb& a_box, PosedParts& b,
-                   std::span<const std::uint32_t> near, Real speculative, Gathered& g) {
+// it overlaps. `pair(i, found)` collides a with part i as collide() does.
+template <class PairFn>
+void collide_parts(std::uint32_t part_a, const Aabb& a_box, PosedParts& b, std::span<const std::uint32_t> near,
+                   Gathered& g, PairFn&& pair) {
     Manifold found[kPerPair];
     for (const std::uint32_t i : near) {
         if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
-        const int n = collide(a, xa, b.shape(i), b.pose(i), speculative, found, kPerPair);
+        const int n = pair(i, found);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -155,25 +166,59 @@ int emit(Gathered& g, Manifold* out, int capacity) {
     return g.count;
 }
 
+// Shape a against each of compound b's parts near it, through `pair` (as collide_parts).
+template <class PairFn>
+int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                        std::span<const Aabb> b_boxes, Real speculative, Manifold* out, int capacity, PairFn&& pair) {
+    Gathered g;
+    const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
+    PosedParts parts(*b.parts, xb, b_boxes);
+    ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
+    const std::uint32_t count = parts_near(parts, a_box, near.data());
+    collide_parts(0, a_box, parts, {near.data(), count}, g,
+                  [&](std::uint32_t i, Manifold* found) { return pair(parts.shape(i), parts.pose(i), i, found); });
+    return emit(g, out, capacity);
+}
+
 }  // namespace
 
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                            Manifold* out, int capacity) {
-    Gathered g;
-    const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
-    PosedParts parts(*b.parts, xb);
-    ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
-    const std::uint32_t count = parts_near(parts, a_box, near.data());
-    collide_parts(a, xa, 0, a_box, parts, {near.data(), count}, speculative, g);
-    return emit(g, out, capacity);
+    return collide_shape_compound_boxed(a, xa, b, xb, speculative, out, capacity, {});
+}
+
+int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                 Real speculative, Manifold* out, int capacity, std::span<const Aabb> b_boxes) {
+    return collide_shape_parts(a, xa, b, xb, b_boxes, speculative, out, capacity,
+                               [&](const Shape& part, const Transform& x, std::uint32_t, Manifold* found) {
+                                   return collide(a, xa, part, x, speculative, found, kPerPair);
+                               });
+}
+
+int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
+                                 Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
+                                 std::span<const Aabb> b_boxes) {
+    return collide_shape_parts(mesh, xm, b, xb, b_boxes, speculative, out, capacity,
+                               [&](const Shape& part, const Transform& x, std::uint32_t i, Manifold* found) {
+                                   // The mesh's pair function has the part as A: turned round as collide() does.
+                                   const int n = collide_convex_mesh_cached(part, x, mesh, xm, speculative, found,
+                                                                            kPerPair, i, walk);
+                                   for (int m = 0; m < n; ++m) flip_manifold(found[m]);
+                                   return n;
+                               });
 }
 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                               Real speculative, Manifold* out, int capacity) {
+    return collide_compound_compound_boxed(a, xa, b, xb, speculative, out, capacity, {});
+}
+
+int collide_compound_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                    Real speculative, Manifold* out, int capacity, const PartBoxes& boxes) {
     Gathered g;
     const Compound& parts = *a.parts;
     const Real margin = std::max(speculative, Real(0));
-    PosedParts a_parts(parts, xa), b_parts(*b.parts, xb);
+    PosedParts a_parts(parts, xa, boxes.a), b_parts(*b.parts, xb, boxes.b);
     const Aabb b_box = b_parts.loose_all();
     // Each of a's parts lies inside a's whole loose box (padded as each part's is), so a
     // part of b whose loose box misses that box, fattened as a part's box is, meets none of
@@ -183,7 +228,11 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
     for (std::uint32_t j = 0; j < parts.size() && count > 0; ++j) {
         if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
         const Aabb part_box = a_parts.exact(j).fattened(margin);
-        collide_parts(parts.shape(j), a_parts.pose(j), j, part_box, b_parts, {near.data(), count}, speculative, g);
+        const Shape& part = parts.shape(j);
+        const Transform& pose = a_parts.pose(j);
+        collide_parts(j, part_box, b_parts, {near.data(), count}, g, [&](std::uint32_t i, Manifold* found) {
+            return collide(part, pose, b_parts.shape(i), b_parts.pose(i), speculative, found, kPerPair);
+        });
     }
     return emit(g, out, capacity);
 }

@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 
+#include <spindle/platform/assert.hpp>
+
 #include "collision/clipping.hpp"
 #include "collision/manifold_slots.hpp"
 #include "collision/pair_functions.hpp"
@@ -23,9 +25,10 @@ constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face 
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
 
 // Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
-// prepared once for all the triangles of the query.
+// prepared once for all the triangles of the query, and with the triangle's cache when
+// the contact keeps them (null: the whole SAT).
 bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                      const TrianglePoly& tri, Real speculative, Manifold& m) {
+                      const TrianglePoly& tri, Real speculative, FeatureCache* cache, Real feature_slop, Manifold& m) {
     const Transform identity;
     switch (a.type) {
         case ShapeType::Sphere:
@@ -35,7 +38,8 @@ bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhed
             return collide_rounded_polyhedron(p0, p1, a.radius, xa, tri.view(), identity, speculative, m);
         }
         case ShapeType::Box:
-        case ShapeType::ConvexHull: return collide_polyhedra(*polyhedron, xa, tri.view(), identity, speculative, m);
+        case ShapeType::ConvexHull:
+            return collide_polyhedra(*polyhedron, xa, tri.view(), identity, speculative, m, cache, feature_slop);
         default: return false;
     }
 }
@@ -122,9 +126,11 @@ void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& 
 
 // The walk over the triangles the mesh finds under a's bounds (a posed in the mesh's frame
 // by a_in_mesh); `polyhedron` is a box or hull prepared once for all of them, null for a
-// sphere or capsule.
+// sphere or capsule. With a walk, a polyhedron's SATs read and keep their triangles'
+// features as part `part`.
 int collide_triangles(const Shape& a, const Transform& a_in_mesh, const PreparedPolyhedron* polyhedron,
-                      const TriangleMesh& mesh, const Transform& xb, Real speculative, Manifold* out, int capacity) {
+                      const TriangleMesh& mesh, const Transform& xb, Real speculative, Manifold* out, int capacity,
+                      std::uint32_t part, TriangleFeatureWalk* walk) {
     const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
     const ShapeSpan span(a, a_in_mesh);
 
@@ -136,7 +142,8 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
         Manifold m;
-        if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, m)) return;
+        FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
+        if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, cache, walk ? walk->slop() : 0, m)) return;
         if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
             use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
             if (m.point_count == 0) return;
@@ -158,8 +165,28 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
 
 }  // namespace
 
-int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                        Manifold* out, int capacity) {
+FeatureCache* TriangleFeatureWalk::next(std::uint32_t part, std::uint32_t triangle) {
+    // Parts come in order and a mesh query visits its triangles in increasing t, so the
+    // last collide's features and this one's are both in key order: one merge finds them.
+    const std::uint64_t key = order_key(part, triangle);
+    SPINDLE_ASSERT(m_features.size() == m_last || order_key(m_features.back().part, m_features.back().triangle) < key,
+                   "TriangleFeatureWalk: triangles out of order");
+    while (m_cursor < m_last && order_key(m_features[m_cursor].part, m_features[m_cursor].triangle) < key) ++m_cursor;
+    const bool kept = m_cursor < m_last && m_features[m_cursor].part == part &&
+                      m_features[m_cursor].triangle == triangle;
+    m_features.push_back({part, triangle, kept ? m_features[m_cursor].feature : FeatureCache()});
+    return &m_features.back().feature;
+}
+
+void TriangleFeatureWalk::finish() {
+    m_features.erase(m_features.begin(), m_features.begin() + static_cast<std::ptrdiff_t>(m_last));
+    m_last = m_cursor = 0;
+}
+
+namespace {
+
+int collide_convex_mesh_with(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                             Manifold* out, int capacity, std::uint32_t part, TriangleFeatureWalk* walk) {
     const TriangleMesh& mesh = *b.mesh;
     const Transform a_in_mesh = xb.inverse() * xa;
     // Each branch prepares its polyhedron in place: an empty std::optional of one had its
@@ -168,14 +195,27 @@ int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, con
         case ShapeType::Box: {
             const BoxPoly box(a.half_extents);
             const PreparedPolyhedron prepared(box.view());
-            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity);
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk);
         }
         case ShapeType::ConvexHull: {
             const PreparedPolyhedron prepared(view_of(*a.hull));
-            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity);
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk);
         }
-        default: return collide_triangles(a, a_in_mesh, nullptr, mesh, xb, speculative, out, capacity);
+        default: return collide_triangles(a, a_in_mesh, nullptr, mesh, xb, speculative, out, capacity, part, walk);
     }
+}
+
+}  // namespace
+
+int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                        Manifold* out, int capacity) {
+    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, 0, nullptr);
+}
+
+int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                               Real speculative, Manifold* out, int capacity, std::uint32_t part,
+                               TriangleFeatureWalk& walk) {
+    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, part, &walk);
 }
 
 }  // namespace spindle::detail

@@ -71,6 +71,15 @@ Aabb Compound::bounds(const Transform& x) const {
     return box;
 }
 
+Aabb Compound::bounds(const Transform& x, std::span<Aabb> parts) const {
+    Aabb box;
+    for (std::uint32_t i = 0; i < size(); ++i) {
+        parts[i] = m_parts[i].shape.bounds(x * m_poses[i]);
+        box = box.merged(parts[i]);
+    }
+    return box;
+}
+
 MassProperties Compound::mass_properties(Real density) const {
     MassProperties total;
     std::vector<MassProperties> each(m_parts.size());

@@ -31,12 +31,51 @@ int collide_hull_hull(const Shape&, const Transform&, const Shape&, const Transf
 // collide_plane.cpp: every convex shape against a plane (B).
 int collide_convex_plane(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 
+// A contact's triangle features through one collide (collide_mesh.cpp): those kept from
+// the last are looked up, this collide's are written behind them (in the same order:
+// parts in order, each part's triangles in increasing index, as a mesh query visits
+// them), and finish() leaves only the new ones.
+class TriangleFeatureWalk {
+public:
+    TriangleFeatureWalk(TriangleFeatures& features, Real slop)
+        : m_features(features), m_last(features.size()), m_slop(slop) {}
+    // The cache of (part, triangle) for this collide's SAT, holding the feature it had
+    // last time (none if it was not met then); valid until the next call. Calls come in
+    // increasing (part, triangle).
+    FeatureCache* next(std::uint32_t part, std::uint32_t triangle);
+    Real slop() const { return m_slop; }
+    void finish();
+
+private:
+    static std::uint64_t order_key(std::uint32_t part, std::uint32_t triangle) {
+        return std::uint64_t{part} << 32 | triangle;
+    }
+    TriangleFeatures& m_features;
+    std::size_t m_last;        // m_features[0, m_last) are the last collide's
+    std::size_t m_cursor = 0;  // where the last collide's are merged up to
+    Real m_slop;
+};
+
 // collide_mesh.cpp: every convex shape against a triangle mesh (B).
 int collide_convex_mesh(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+// The same with each triangle's SAT reading and writing its feature in `walk` (a box or
+// hull; a sphere or capsule has none) as compound part `part` (0 for a whole shape).
+int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                               Real speculative, Manifold* out, int capacity, std::uint32_t part,
+                               TriangleFeatureWalk& walk);
 
 // collide_compound.cpp: any shape against a compound (B), and two compounds, part by part.
 int collide_shape_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 int collide_compound_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
+// The same with compound b's part boxes (PartBoxes; empty: made by the walk).
+int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                 Real speculative, Manifold* out, int capacity, std::span<const Aabb> b_boxes);
+int collide_compound_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                                    Real speculative, Manifold* out, int capacity, const PartBoxes& boxes);
+// collide_shape_compound for a triangle mesh A, each part's triangles met through `walk`.
+int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
+                                 Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
+                                 std::span<const Aabb> b_boxes);
 
 // ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and

@@ -72,8 +72,48 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
 }
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-                   Manifold* out, int capacity, FeatureCache& cache, Real feature_slop) {
+                   Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
+                   const PartBoxes& boxes) {
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
+    const bool mesh_a = a.type == ShapeType::TriangleMesh;
+    const bool mesh_b = b.type == ShapeType::TriangleMesh;
+    const Shape& shape = mesh_a ? b : a;  // the one against the mesh, if one is a mesh
+    if (capacity > 0 && mesh_a != mesh_b && (polyhedron(shape) || shape.type == ShapeType::Compound)) {
+        cache = FeatureCache();
+        const Shape& mesh = mesh_a ? a : b;
+        const Transform& x_mesh = mesh_a ? xa : xb;
+        const Transform& x_shape = mesh_a ? xb : xa;
+        detail::TriangleFeatureWalk walk(triangles, feature_slop);
+        // The pair functions' normals: from the mesh to a compound, from a convex shape to the mesh.
+        const bool from_mesh = shape.type == ShapeType::Compound;
+        const int count = from_mesh
+                              ? detail::collide_mesh_compound_cached(mesh, x_mesh, shape, x_shape, speculative_distance,
+                                                                     out, capacity, walk, mesh_a ? boxes.b : boxes.a)
+                              : detail::collide_convex_mesh_cached(shape, x_shape, mesh, x_mesh, speculative_distance,
+                                                                   out, capacity, 0, walk);
+        walk.finish();
+        if (from_mesh != mesh_a) {
+            for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);
+        }
+        return count;
+    }
+    triangles.clear();
+    const bool compound_a = a.type == ShapeType::Compound;
+    const bool compound_b = b.type == ShapeType::Compound;
+    if (capacity > 0 && (compound_a || compound_b)) {
+        cache = FeatureCache();
+        if (compound_a && compound_b) {
+            return detail::collide_compound_compound_boxed(a, xa, b, xb, speculative_distance, out, capacity, boxes);
+        }
+        if (compound_b) {
+            return detail::collide_shape_compound_boxed(a, xa, b, xb, speculative_distance, out, capacity, boxes.b);
+        }
+        // The table's order: the compound is B.
+        const int count = detail::collide_shape_compound_boxed(b, xb, a, xa, speculative_distance, out, capacity,
+                                                               boxes.a);
+        for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);
+        return count;
+    }
     // Box-box has its own 15-axis test.
     if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
         cache = FeatureCache();

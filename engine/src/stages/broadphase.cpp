@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "collision/compound.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -182,10 +183,23 @@ void update_broadphase(World& world, Real dt) {
     // Bounds, and whether each proxy must move, in parallel; the tree is single-writer,
     // so the few proxies that left their fat boxes are moved after, in awake order.
     bp.moving.resize(n);
+    if (bp.part_boxes.size() < b.capacity()) {
+        bp.part_boxes.resize(b.capacity());
+        bp.part_boxes_step.resize(b.capacity(), 0);
+    }
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
-            b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            const Shape& shape = b.desc[i].shape;
+            if (shape.type == ShapeType::Compound) {
+                // Kept for the narrowphase's part walks, which would make the same boxes again.
+                std::vector<Aabb>& parts = bp.part_boxes[i];
+                parts.resize(shape.parts->size());
+                b.bounds[i] = shape.parts->bounds(b.transform(i), parts);
+                bp.part_boxes_step[i] = world.steps + 1;
+            } else {
+                b.bounds[i] = shape.bounds(b.transform(i));
+            }
             const Vec3 d = b.v[i] * dt;
             bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
         }

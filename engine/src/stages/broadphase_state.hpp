@@ -21,7 +21,18 @@ struct BroadphaseState {
     std::vector<std::uint8_t> moving;         // scratch, per awake body: its proxy must move this step
     std::vector<std::uint64_t> new_keys;      // scratch: keys of the new pairs that may make contacts
     std::vector<std::uint32_t> range_counts;  // scratch: values kept per job range (broadphase.cpp)
+    // Per body slot: a compound's parts' world boxes, made with its bounds by this step's
+    // Bounds jobs, and the step they were made in plus one (0: never). The narrowphase
+    // reads them in that step only: a body asleep or moved since has others.
+    std::vector<std::vector<Aabb>> part_boxes;
+    std::vector<std::uint64_t> part_boxes_step;
 };
+
+// Body i's part boxes when the broadphase made them this step, else empty.
+inline std::span<const Aabb> step_part_boxes(const BroadphaseState& bp, std::uint32_t i, std::uint64_t step) {
+    if (i >= bp.part_boxes_step.size() || bp.part_boxes_step[i] != step + 1) return {};
+    return bp.part_boxes[i];
+}
 
 // Whether bodies on layers a and b collide, per the space's layer table.
 inline bool layers_collide(const World& world, std::uint32_t a, std::uint32_t b) {

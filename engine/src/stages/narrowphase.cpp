@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "collision/compound.hpp"
+#include "stages/broadphase_state.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
 
@@ -243,8 +244,14 @@ void update_narrowphase(World& world) {
             const Real speculative = settings.speculative_distance + closing;
             const Shape& shape_a = b.desc[a].shape;
             const Shape& shape_b = b.desc[bb].shape;
+            // A compound's part boxes, where the broadphase made them this step.
+            const auto part_boxes = [&](const Shape& shape, std::uint32_t i) {
+                return shape.type == ShapeType::Compound ? step_part_boxes(*world.broadphase, i, world.steps)
+                                                         : std::span<const Aabb>();
+            };
+            const PartBoxes boxes{part_boxes(shape_a, a), part_boxes(shape_b, bb)};
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         settings.linear_slop);
+                                         contact.triangle_features, settings.linear_slop, boxes);
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;

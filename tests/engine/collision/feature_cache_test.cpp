@@ -86,6 +86,7 @@ struct Tumble {
         const Real shallow = 4 * slop;
         const Real neighbour_angle = std::max(widest_neighbour_angle(a), widest_neighbour_angle(b));
         FeatureCache cache;
+        TriangleFeatures triangles;  // unused: no mesh
         std::mt19937 random(seed);
         std::uniform_real_distribution<Real> u(-1, 1);
         const Vec3 axis_a(u(random), u(random), u(random)), axis_b(u(random), u(random), u(random));
@@ -96,7 +97,7 @@ struct Tumble {
             const Transform xb = at(start + t * (end - start), about(axis_b, 5 * t));
             const FeatureCache before = cache;
             Manifold cached[8], plain[8];
-            const int nc = collide_cached(a, xa, b, xb, kSpeculative, cached, 8, cache, slop);
+            const int nc = collide_cached(a, xa, b, xb, kSpeculative, cached, 8, cache, triangles, slop);
             const int np = collide(a, xa, b, xb, kSpeculative, plain, 8);
             EXPECT_NE(cache.kind(), FeatureCache::Kind::None) << "step " << step;
             if (np == 0) {
@@ -175,6 +176,7 @@ TEST(FeatureCache, HullSlidingOnAFloorKeepsTheFloorsFace) {
     const Shape hull = random_hull(7, 1.5);
     const Vec3 down = hull.hull->support(Vec3(0, -1, 0));
     FeatureCache cache;
+    TriangleFeatures triangles;
     int reused = 0;
     constexpr int kSteps = 200;
     for (int step = 0; step < kSteps; ++step) {
@@ -183,7 +185,7 @@ TEST(FeatureCache, HullSlidingOnAFloorKeepsTheFloorsFace) {
         const Transform xb = at(Vec3(0.05 * step, -0.002 - down.y(), 0.02 * step), about(Vec3::UnitY(), 0.05 * step));
         const FeatureCache before = cache;
         Manifold cached[8], plain[8];
-        ASSERT_EQ(collide_cached(floor, xa, hull, xb, 0.1, cached, 8, cache, 0.005), 1) << "step " << step;
+        ASSERT_EQ(collide_cached(floor, xa, hull, xb, 0.1, cached, 8, cache, triangles, 0.005), 1) << "step " << step;
         ASSERT_EQ(collide(floor, xa, hull, xb, 0.1, plain, 8), 1) << "step " << step;
         EXPECT_EQ(cache.kind(), FeatureCache::Kind::FaceA) << "step " << step;  // the box is the pair function's A
         reused += before == cache;
@@ -202,10 +204,12 @@ TEST(FeatureCache, EdgesThatNoLongerCrossAreNotKept) {
     const Transform xa = at(Vec3::Zero(), about(Vec3::UnitZ(), kPi / 4));  // top edge along z
     const Quat qb = about(Vec3::UnitX(), kPi / 4);                         // bottom edge along x
     FeatureCache cache;
+    TriangleFeatures triangles;
     Manifold out[8];
-    ASSERT_EQ(collide_cached(cube, xa, cube, at(Vec3(0, 2 * s2 - 0.1, 0), qb), 0, out, 8, cache, 0.005), 1);
+    ASSERT_EQ(collide_cached(cube, xa, cube, at(Vec3(0, 2 * s2 - 0.1, 0), qb), 0, out, 8, cache, triangles, 0.005), 1);
     ASSERT_EQ(cache.kind(), FeatureCache::Kind::EdgePair);
-    EXPECT_EQ(collide_cached(cube, xa, cube, at(Vec3(0, 2 * s2 - 0.1, 1.5), qb), 0, out, 8, cache, 0.005), 0);
+    EXPECT_EQ(collide_cached(cube, xa, cube, at(Vec3(0, 2 * s2 - 0.1, 1.5), qb), 0, out, 8, cache, triangles, 0.005),
+              0);
 }
 
 // With no slop allowed, a touching pair never keeps its feature: the same manifolds,
@@ -249,11 +253,120 @@ TEST(FeatureCache, HullPileComesToRestAndSleeps) {
     for (BodyHandle h : hulls) EXPECT_GT(space.position(h).y(), 0) << "a hull sank through the floor";
 }
 
+// A flat mesh of 1 m squares (two triangles each) on y = 0, 10 m a side about the origin.
+Shape flat_mesh() {
+    constexpr int kCells = 10;
+    std::vector<Vec3> v;
+    std::vector<std::uint32_t> idx;
+    for (int z = 0; z <= kCells; ++z)
+        for (int x = 0; x <= kCells; ++x) v.emplace_back(x - kCells / 2, 0, z - kCells / 2);
+    for (int z = 0; z < kCells; ++z) {
+        for (int x = 0; x < kCells; ++x) {
+            const auto i = static_cast<std::uint32_t>(z * (kCells + 1) + x);
+            const std::uint32_t row = kCells + 1;
+            for (const std::uint32_t k : {i, i + row, i + 1, i + 1, i + row, i + row + 1}) idx.push_back(k);
+        }
+    }
+    return Shape::triangle_mesh(v, idx);
+}
+
+// Two box hulls side by side and a round hull: flat faces that lie on a flat mesh, each
+// part meeting triangles of its own and some the others meet too.
+Shape three_parts() {
+    const std::vector<CompoundPart> parts = {{test::hull_box(Vec3(0.6, 0.3, 0.4)), Vec3(-0.8, 0, 0)},
+                                             {test::hull_box(Vec3(0.5, 0.3, 0.5)), Vec3(0.6, 0, 0.3),
+                                              about(Vec3::UnitY(), 0.4)},
+                                             {random_hull(5, 0.5), Vec3(0, 0.9, 0)}};
+    return Shape::compound(parts);
+}
+
+// The compound posed by q at (x, z), sunk `depth` into the plane y = 0.
+Transform sunk(const Shape& shape, Real x, Real z, const Quat& q, Real depth) {
+    return at(Vec3(x, -depth - shape.bounds(at(Vec3::Zero(), q)).min.y(), z), q);
+}
+
+// Each manifold of the cached collide against the whole SAT's, either way round: the same
+// count, normals and deepest points (exactly, but for rounding).
+void expect_close(const Manifold* x, int nx, const Manifold* y, int ny, int step) {
+    ASSERT_EQ(nx, ny) << "step " << step;
+    for (int m = 0; m < nx; ++m) {
+        EXPECT_NEAR(x[m].normal.dot(y[m].normal), 1, 1e-12) << "step " << step;
+        EXPECT_NEAR(min_separation(x[m]), min_separation(y[m]), 1e-12) << "step " << step;
+        EXPECT_EQ(x[m].part_a, y[m].part_a) << "step " << step;
+        EXPECT_EQ(x[m].part_b, y[m].part_b) << "step " << step;
+    }
+}
+
+// A compound sliding and spinning on a mesh, its flat faces a few mm in: the triangles it met
+// the call before keep the face that lay on them, found again by part and triangle; the
+// manifolds are the whole SAT's.
+TEST(FeatureCache, CompoundSlidingOnAMeshKeepsItsTrianglesFeatures) {
+    const Shape mesh = flat_mesh();
+    const Shape tree = three_parts();
+    const Transform xm = at(Vec3::Zero());
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    constexpr int kSteps = 60;
+    for (int step = 0; step < kSteps; ++step) {
+        const Quat q = about(Vec3::UnitY(), 0.05 * step);
+        // 2 to 3 mm in: a feature the whole SAT found again would hold the new depth.
+        const Transform xt = sunk(tree, -2 + 0.05 * step, -1 + 0.03 * step, q, 0.002 + 0.0005 * (step % 3));
+        const TriangleFeatures before = triangles;
+        Manifold cached[8], plain[8];
+        for (const bool mesh_first : {true, false}) {
+            triangles = before;
+            const int nc = mesh_first ? collide_cached(mesh, xm, tree, xt, 0.1, cached, 8, cache, triangles, 0.005)
+                                      : collide_cached(tree, xt, mesh, xm, 0.1, cached, 8, cache, triangles, 0.005);
+            const int np = mesh_first ? collide(mesh, xm, tree, xt, 0.1, plain, 8)
+                                      : collide(tree, xt, mesh, xm, 0.1, plain, 8);
+            EXPECT_GT(np, 0) << "step " << step;
+            expect_close(cached, nc, plain, np, step);
+        }
+        ASSERT_FALSE(triangles.empty());
+        EXPECT_TRUE(std::is_sorted(triangles.begin(), triangles.end(), [](const auto& x, const auto& y) {
+            return std::pair(x.part, x.triangle) < std::pair(y.part, y.triangle);
+        }));
+        int kept = 0;
+        for (const TriangleFeature& now : triangles) {
+            for (const TriangleFeature& was : before) {
+                kept += was.part == now.part && was.triangle == now.triangle &&
+                        was.feature.kind() != FeatureCache::Kind::None && was.feature == now.feature;
+            }
+        }
+        // Both boxes stay on triangles they were on.
+        if (step > 0) {
+            EXPECT_GE(kept, 2) << "step " << step;
+        }
+    }
+}
+
+// The same compound resting flat, then turned 0.4 rad about a level axis (still 2 mm in),
+// then slid 3 m: the boxes' faces kept on the triangles no longer lie on them, or the
+// triangles are others, and each collide must be the whole SAT's, bit for bit.
+TEST(FeatureCache, MeshTrianglesFeaturesGoStaleWhenTheCompoundTurnsOrMoves) {
+    const Shape mesh = flat_mesh();
+    const Shape tree = three_parts();
+    const Transform xm = at(Vec3::Zero());
+    const Quat turned = about(Vec3(1, 0, 0.5), 0.4);
+    const Transform poses[] = {sunk(tree, 0.2, 0.1, Quat::Identity(), 0.002), sunk(tree, 0.2, 0.1, turned, 0.002),
+                               sunk(tree, 3.2, 0.1, turned, 0.002)};
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    for (int step = 0; step < 3; ++step) {
+        Manifold cached[8], plain[8];
+        const int nc = collide_cached(tree, poses[step], mesh, xm, 0.1, cached, 8, cache, triangles, 0.005);
+        const int np = collide(tree, poses[step], mesh, xm, 0.1, plain, 8);
+        EXPECT_GT(np, 0) << "step " << step;
+        expect_same(cached, nc, plain, np, step);
+    }
+}
+
 TEST(FeatureCache, OtherPairsClearIt) {
     FeatureCache cache(FeatureCache::Kind::FaceA, 3, 0);
+    TriangleFeatures triangles;
     Manifold out[8];
     const Shape box = Shape::box(Vec3(1, 1, 1));
-    EXPECT_EQ(collide_cached(box, at(Vec3::Zero()), box, at(Vec3(0, 1.9, 0)), 0, out, 8, cache, 0.005), 1);
+    EXPECT_EQ(collide_cached(box, at(Vec3::Zero()), box, at(Vec3(0, 1.9, 0)), 0, out, 8, cache, triangles, 0.005), 1);
     EXPECT_EQ(cache.kind(), FeatureCache::Kind::None);
 }
 

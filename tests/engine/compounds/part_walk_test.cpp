@@ -1,6 +1,7 @@
 // The compound walk's shortcuts (parts posed and bounded once per pair, a loose box before
-// the exact one, a mesh searched once for all parts) give, bit for bit, the manifolds of
-// every part pair tested alone through collide() with the parts' exact bounds as the cull.
+// the exact one, a mesh searched once for all parts, the broadphase's part boxes taken as
+// the exact ones) give, bit for bit, the manifolds of every part pair tested alone through
+// collide() with the parts' exact bounds as the cull.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -105,6 +106,27 @@ std::vector<Manifold> walked(const Shape& a, const Transform& xa, const Shape& b
     return out;
 }
 
+// The narrowphase's call: collide_cached with each compound's part boxes as the broadphase
+// makes them (Compound::bounds), and fresh caches with no slop (the whole SAT).
+std::vector<Manifold> boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                            Real speculative) {
+    const auto boxes_of = [](const Shape& s, const Transform& x) {
+        std::vector<Aabb> boxes;
+        if (s.type == ShapeType::Compound) {
+            boxes.resize(s.parts->size());
+            s.parts->bounds(x, boxes);
+        }
+        return boxes;
+    };
+    const std::vector<Aabb> boxes_a = boxes_of(a, xa), boxes_b = boxes_of(b, xb);
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    std::vector<Manifold> out(64);
+    out.resize(static_cast<std::size_t>(
+        collide_cached(a, xa, b, xb, speculative, out.data(), 64, cache, triangles, 0, PartBoxes{boxes_a, boxes_b})));
+    return out;
+}
+
 // Equal to the bit: the same parts, normals, points, separations and ids in the same order.
 void expect_same(const std::vector<Manifold>& expected, const std::vector<Manifold>& got, int sample) {
     ASSERT_EQ(got.size(), expected.size()) << "sample " << sample;
@@ -141,6 +163,12 @@ TEST(CompoundPartWalk, TwoCompoundsGiveWhatEachPartPairGivesAlone) {
         const Real speculative = sample % 2 ? 0.04 : 0.2;
         const std::vector<Manifold> expected = part_by_part(a, xa, b, xb, speculative);
         expect_same(expected, walked(a, xa, b, xb, speculative), sample);
+        expect_same(expected, boxed(a, xa, b, xb, speculative), sample);
+        // One part alone against the other compound, either way round: as collide() gives it
+        // (the compound's order turns a convex pair round, which is not the pair's own order).
+        const Shape& alone = a.parts->shape(static_cast<std::uint32_t>(sample) % a.parts->size());
+        expect_same(walked(alone, xa, b, xb, speculative), boxed(alone, xa, b, xb, speculative), sample);
+        expect_same(walked(b, xb, alone, xa, speculative), boxed(b, xb, alone, xa, speculative), sample);
         touching += expected.empty() ? 0 : 1;
         total += static_cast<int>(expected.size());
     }
@@ -163,9 +191,11 @@ TEST(CompoundPartWalk, ACompoundOnAMeshGivesWhatEachPartGivesAlone) {
         const Real speculative = sample % 2 ? 0.04 : 0.2;
         const std::vector<Manifold> expected = part_by_part(terrain, mesh_pose, trunk, xt, speculative);
         expect_same(expected, walked(terrain, mesh_pose, trunk, xt, speculative), sample);
+        expect_same(expected, boxed(terrain, mesh_pose, trunk, xt, speculative), sample);
         // The other order: the compound first, normals turned round.
-        expect_same(part_by_part(trunk, xt, terrain, mesh_pose, speculative),
-                    walked(trunk, xt, terrain, mesh_pose, speculative), sample);
+        const std::vector<Manifold> turned_round = part_by_part(trunk, xt, terrain, mesh_pose, speculative);
+        expect_same(turned_round, walked(trunk, xt, terrain, mesh_pose, speculative), sample);
+        expect_same(turned_round, boxed(trunk, xt, terrain, mesh_pose, speculative), sample);
         touching += expected.empty() ? 0 : 1;
         total += static_cast<int>(expected.size());
     }
