@@ -2,13 +2,15 @@
 // their push-out anchors, solver bodies) are placed on whole huge pages. A first step
 // fills tens of megabytes of them, and on virtual machines a small page's first touch
 // costs microseconds (the guest's fault and the hypervisor's): 512 of them per 2 MB
-// where a huge page takes one. Blocks of a huge page or more are allocated aligned to it
-// and rounded up to whole huge pages, so no small page is left at either end, and the
-// whole block is asked for as transparent huge pages. Smaller blocks are ordinary ones,
-// but from a few pages up their pages are mapped at once, in one call: a fresh block's
-// pages faulted one by one cost about 14 us each on this project's VM, mapped in one
-// madvise about 1 us each (1.5 MB: 5.1-8.4 ms against 0.34-0.66 ms, docs/benchmarks.md).
-// Pages already mapped (a block from reused heap memory) stay as they are.
+// where a huge page takes one. Blocks of half a huge page or more are allocated aligned
+// to it and rounded up to whole huge pages, so no small page is left at either end, and
+// the whole block is asked for as transparent huge pages. Smaller blocks are ordinary
+// ones, but from a few pages up their pages are mapped at once, in one call: a fresh
+// block's pages faulted one by one cost about 14 us each on this project's VM, mapped in
+// one madvise about 1 us each (1.5 MB: 5.1-8.4 ms against 0.34-0.66 ms, docs/benchmarks.md).
+// Even so mapped, a small page's first write still costs the hypervisor's fault on such
+// machines, which only a huge page spares. Pages already mapped (a block from reused
+// heap memory) stay as they are.
 #pragma once
 
 #include <cstddef>
@@ -24,6 +26,10 @@
 namespace spindle {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+// From here a block goes on whole huge pages. Rounding up to them holds at most twice
+// the block's bytes, while its small pages would each cost a first write's fault: a
+// block just under a huge page (a 10k-body scene's solver bodies) paid 500 of them.
+inline constexpr std::size_t kOnHugePagesBytes = kHugePageBytes / 2;
 // Below this a small block mostly comes from heap memory already mapped, and the call's
 // own cost is about that of the few faults it would save.
 inline constexpr std::size_t kMapAtOnceBytes = std::size_t{64} << 10;
@@ -49,7 +55,7 @@ struct HugePageAllocator {
     template <typename U>
     HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
-    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kHugePageBytes; }
+    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kOnHugePagesBytes; }
     static std::size_t rounded_bytes(std::size_t n) {
         return (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
