@@ -47,6 +47,39 @@ inline void map_pages_now(void* p, std::size_t bytes) {
 #endif
 }
 
+// A block of `bytes` (whole huge pages) starting on a huge page. On Linux a mapping of
+// its own, not the heap's: heap memory a program freed before keeps the small pages it
+// was written on, and asking for huge pages does not replace those, so a block from it
+// paid the small pages' faults again wherever the heap had been used. A hint: where the
+// system gives no huge pages on request, the block stays small pages.
+inline void* map_huge_pages(std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    // Over-map by a huge page, then give back the ends outside the aligned block.
+    void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    const auto begin = reinterpret_cast<std::uintptr_t>(raw);
+    const std::uintptr_t aligned = (begin + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    if (aligned > begin) munmap(raw, aligned - begin);
+    if (const std::uintptr_t tail = begin + kHugePageBytes - aligned; tail > 0)
+        munmap(reinterpret_cast<void*>(aligned + bytes), tail);
+    madvise(reinterpret_cast<void*>(aligned), bytes, MADV_HUGEPAGE);
+    return reinterpret_cast<void*>(aligned);
+#else
+    void* p = std::aligned_alloc(kHugePageBytes, bytes);
+    if (p == nullptr) throw std::bad_alloc();
+    return p;
+#endif
+}
+
+inline void unmap_huge_pages(void* p, std::size_t bytes) noexcept {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    munmap(p, bytes);
+#else
+    (void)bytes;
+    std::free(p);
+#endif
+}
+
 template <typename T>
 struct HugePageAllocator {
     using value_type = T;
@@ -67,19 +100,13 @@ struct HugePageAllocator {
             return static_cast<T*>(p);
         }
         if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-        void* p = std::aligned_alloc(kHugePageBytes, rounded_bytes(n));
-        if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-        // A hint: where the system gives no huge pages on request, the block stays small pages.
-        madvise(p, rounded_bytes(n), MADV_HUGEPAGE);
-#endif
-        return static_cast<T*>(p);
+        return static_cast<T*>(map_huge_pages(rounded_bytes(n)));
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (!on_huge_pages(n)) {
             ::operator delete (p, std::align_val_t{alignof(T)});
         } else {
-            std::free(p);
+            unmap_huge_pages(p, rounded_bytes(n));
         }
     }
 
