@@ -48,7 +48,7 @@ void fit_capacity(std::vector<T, A>& v) {
 // split over jobs, before one thread constructs them there. A first step fills tens of
 // megabytes of new arrays, and a page's first touch (a fault, the kernel zeroing it) costs
 // more than writing it: in jobs, the workers share that cost. A job maps one huge page's
-// span (the array's blocks of a huge page or more are whole huge pages: huge_page_vector.hpp),
+// span (the array's blocks of half a huge page or more are whole huge pages: huge_page_vector.hpp),
 // so no two jobs fault the same page. On some virtual machines a mapped small page's first
 // write from the program is still a fault of its own (the hypervisor's, unseen by the
 // kernel), so each job also writes a byte of each of its small pages (raw room: no element

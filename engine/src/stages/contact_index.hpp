@@ -1,12 +1,14 @@
 // ContactIndex: pair key -> position in World::contacts, an open-addressing table (linear
 // probing, keys and positions in flat arrays). A first step makes tens of thousands of
 // contacts: a node-based map allocated one node per contact and took twice the memory.
-// Never iterated, so its order cannot reach results.
+// Never iterated, so its order cannot reach results. Its arrays are on the huge-page
+// allocator: a first step's rehashes fill megabytes of fresh memory from one thread.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
-#include <vector>
+
+#include "stages/huge_page_vector.hpp"
 
 namespace spindle {
 
@@ -80,8 +82,8 @@ private:
     std::size_t next(std::size_t i) const noexcept { return (i + 1) & (m_keys.size() - 1); }
 
     void rehash(std::size_t slots) {
-        std::vector<std::uint64_t> keys(slots, kEmpty);
-        std::vector<std::uint32_t> positions(slots);
+        HugePageVector<std::uint64_t> keys(slots, kEmpty);
+        HugePageVector<std::uint32_t> positions(slots);
         keys.swap(m_keys);
         positions.swap(m_positions);
         m_shift = 64;
@@ -92,8 +94,8 @@ private:
         }
     }
 
-    std::vector<std::uint64_t> m_keys;  // kEmpty where free; a power of two long
-    std::vector<std::uint32_t> m_positions;
+    HugePageVector<std::uint64_t> m_keys;  // kEmpty where free; a power of two long
+    HugePageVector<std::uint32_t> m_positions;
     std::size_t m_size = 0;
     int m_shift = 64;
 };

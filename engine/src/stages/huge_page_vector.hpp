@@ -2,13 +2,15 @@
 // their push-out anchors, solver bodies) are placed on whole huge pages. A first step
 // fills tens of megabytes of them, and on virtual machines a small page's first touch
 // costs microseconds (the guest's fault and the hypervisor's): 512 of them per 2 MB
-// where a huge page takes one. Blocks of a huge page or more are allocated aligned to it
-// and rounded up to whole huge pages, so no small page is left at either end, and the
-// whole block is asked for as transparent huge pages. Smaller blocks are ordinary ones,
-// but from a few pages up their pages are mapped at once, in one call: a fresh block's
-// pages faulted one by one cost about 14 us each on this project's VM, mapped in one
-// madvise about 1 us each (1.5 MB: 5.1-8.4 ms against 0.34-0.66 ms, docs/benchmarks.md).
-// Pages already mapped (a block from reused heap memory) stay as they are.
+// where a huge page takes one. Blocks of half a huge page or more are allocated aligned
+// to it and rounded up to whole huge pages, so no small page is left at either end, and
+// the whole block is asked for as transparent huge pages. Smaller blocks are ordinary
+// ones, but from a few pages up their pages are mapped at once, in one call: a fresh
+// block's pages faulted one by one cost about 14 us each on this project's VM, mapped in
+// one madvise about 1 us each (1.5 MB: 5.1-8.4 ms against 0.34-0.66 ms, docs/benchmarks.md).
+// Even so mapped, a small page's first write still costs the hypervisor's fault on such
+// machines, which only a huge page spares. Pages already mapped (a block from reused
+// heap memory) stay as they are.
 #pragma once
 
 #include <cstddef>
@@ -24,6 +26,10 @@
 namespace spindle {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+// From here a block goes on whole huge pages. Rounding up to them holds at most twice
+// the block's bytes, while its small pages would each cost a first write's fault: a
+// block just under a huge page (a 10k-body scene's solver bodies) paid 500 of them.
+inline constexpr std::size_t kOnHugePagesBytes = kHugePageBytes / 2;
 // Below this a small block mostly comes from heap memory already mapped, and the call's
 // own cost is about that of the few faults it would save.
 inline constexpr std::size_t kMapAtOnceBytes = std::size_t{64} << 10;
@@ -41,6 +47,39 @@ inline void map_pages_now(void* p, std::size_t bytes) {
 #endif
 }
 
+// A block of `bytes` (whole huge pages) starting on a huge page. On Linux a mapping of
+// its own, not the heap's: heap memory a program freed before keeps the small pages it
+// was written on, and asking for huge pages does not replace those, so a block from it
+// paid the small pages' faults again wherever the heap had been used. A hint: where the
+// system gives no huge pages on request, the block stays small pages.
+inline void* map_huge_pages(std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    // Over-map by a huge page, then give back the ends outside the aligned block.
+    void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    const auto begin = reinterpret_cast<std::uintptr_t>(raw);
+    const std::uintptr_t aligned = (begin + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    if (aligned > begin) munmap(raw, aligned - begin);
+    if (const std::uintptr_t tail = begin + kHugePageBytes - aligned; tail > 0)
+        munmap(reinterpret_cast<void*>(aligned + bytes), tail);
+    madvise(reinterpret_cast<void*>(aligned), bytes, MADV_HUGEPAGE);
+    return reinterpret_cast<void*>(aligned);
+#else
+    void* p = std::aligned_alloc(kHugePageBytes, bytes);
+    if (p == nullptr) throw std::bad_alloc();
+    return p;
+#endif
+}
+
+inline void unmap_huge_pages(void* p, std::size_t bytes) noexcept {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    munmap(p, bytes);
+#else
+    (void)bytes;
+    std::free(p);
+#endif
+}
+
 template <typename T>
 struct HugePageAllocator {
     using value_type = T;
@@ -49,7 +88,7 @@ struct HugePageAllocator {
     template <typename U>
     HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
-    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kHugePageBytes; }
+    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kOnHugePagesBytes; }
     static std::size_t rounded_bytes(std::size_t n) {
         return (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
@@ -61,19 +100,13 @@ struct HugePageAllocator {
             return static_cast<T*>(p);
         }
         if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-        void* p = std::aligned_alloc(kHugePageBytes, rounded_bytes(n));
-        if (p == nullptr) throw std::bad_alloc();
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-        // A hint: where the system gives no huge pages on request, the block stays small pages.
-        madvise(p, rounded_bytes(n), MADV_HUGEPAGE);
-#endif
-        return static_cast<T*>(p);
+        return static_cast<T*>(map_huge_pages(rounded_bytes(n)));
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (!on_huge_pages(n)) {
             ::operator delete (p, std::align_val_t{alignof(T)});
         } else {
-            std::free(p);
+            unmap_huge_pages(p, rounded_bytes(n));
         }
     }
 
