@@ -7,7 +7,7 @@ BUILD ?= build
 CMAKE_COMMON = -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
 # Sanitizer builds: optimised a little so Eigen-heavy tests stay quick; asserts on; line
 # tables only (-g1: the reports' file:line, not locals), far cheaper to compile than -g.
-SAN_FLAGS = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DSPINDLE_BUILD_BENCH=OFF
+SAN_FLAGS = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DSPINDLE_BUILD_BENCH=OFF -DSPINDLE_UNITY_ENGINE=ON
 # The C++ sources under version control, at any depth below these folders (generated and
 # build files are not tracked); a folder that does not exist matches nothing.
 SOURCE_DIRS = engine scheduler platform scene apps tests bench

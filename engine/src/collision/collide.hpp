@@ -2,6 +2,7 @@
 // a table of pair functions filled once (no virtual call per pair).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -26,6 +27,13 @@ struct Manifold {
     // The parts that touch when a shape is a compound (their indices in it); else 0.
     std::uint32_t part_a = 0, part_b = 0;
 };
+
+// The manifold's least separation: its deepest point's (kHuge when it has none).
+inline Real deepest(const Manifold& m) {
+    Real d = kHuge;
+    for (int i = 0; i < m.point_count; ++i) d = std::min(d, m.points[i].separation);
+    return d;
+}
 
 // Writes the manifolds of a (posed by xa) against b (posed by xb) into out[0..capacity)
 // and returns how many. Points are produced while the shapes are closer than

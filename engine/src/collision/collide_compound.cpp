@@ -25,12 +25,6 @@ struct Gathered {
     int count = 0;
 };
 
-Real deepest(const Manifold& m) {
-    Real d = kHuge;
-    for (int i = 0; i < m.point_count; ++i) d = std::min(d, m.points[i].separation);
-    return d;
-}
-
 void keep(Gathered& g, const Manifold& m) {
     if (g.count < kMaxGathered) {
         g.list.fill(static_cast<std::size_t>(g.count++), m);

@@ -92,12 +92,6 @@ void use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const Tri
     m.point_count = kept;
 }
 
-Real deepest(const Manifold& m) {
-    Real d = kHuge;
-    for (int i = 0; i < m.point_count; ++i) d = std::min(d, m.points[i].separation);
-    return d;
-}
-
 // Adds m to the list, merging it into a manifold with nearly the same normal; when the
 // list is full a deeper manifold replaces the shallowest.
 void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& m) {
