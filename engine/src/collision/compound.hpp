@@ -34,8 +34,8 @@ public:
     MassProperties mass_properties(Real density) const;
 
 private:
-    // Part i's bounds in the world under the compound's pose x.
-    Aabb posed_part_bounds(std::uint32_t i, const Transform& x) const;
+    // Part i's bounds in the world under the compound's pose x (r: x's rotation matrix).
+    Aabb posed_part_bounds(std::uint32_t i, const Transform& x, const Mat3& r) const;
 
     std::vector<CompoundPart> m_parts;
     std::vector<Transform> m_poses;
