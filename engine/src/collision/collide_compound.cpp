@@ -160,7 +160,8 @@ int emit(Gathered& g, Manifold* out, int capacity) {
     return g.count;
 }
 
-// Shape a against each of compound b's parts near it, through `pair` (as collide_parts).
+// Shape a against each of compound b's parts near it, through `pair(part, pose, exact bounds,
+// i, found)` (as collide_parts).
 template <class PairFn>
 int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                         std::span<const Aabb> b_boxes, Real speculative, Manifold* out, int capacity, PairFn&& pair) {
@@ -169,8 +170,9 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
     PosedParts parts(*b.parts, xb, b_boxes);
     ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
     const std::uint32_t count = parts_near(parts, a_box, near.data());
-    collide_parts(0, a_box, parts, {near.data(), count}, g,
-                  [&](std::uint32_t i, Manifold* found) { return pair(parts.shape(i), parts.pose(i), i, found); });
+    collide_parts(0, a_box, parts, {near.data(), count}, g, [&](std::uint32_t i, Manifold* found) {
+        return pair(parts.shape(i), parts.pose(i), parts.exact(i), i, found);
+    });
     return emit(g, out, capacity);
 }
 
@@ -184,7 +186,7 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
 int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, std::span<const Aabb> b_boxes) {
     return collide_shape_parts(a, xa, b, xb, b_boxes, speculative, out, capacity,
-                               [&](const Shape& part, const Transform& x, std::uint32_t, Manifold* found) {
+                               [&](const Shape& part, const Transform& x, const Aabb&, std::uint32_t, Manifold* found) {
                                    return collide(a, xa, part, x, speculative, found, kPerPair);
                                });
 }
@@ -192,14 +194,15 @@ int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shap
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
                                  std::span<const Aabb> b_boxes) {
-    return collide_shape_parts(mesh, xm, b, xb, b_boxes, speculative, out, capacity,
-                               [&](const Shape& part, const Transform& x, std::uint32_t i, Manifold* found) {
-                                   // The mesh's pair function has the part as A: turned round as collide() does.
-                                   const int n = collide_convex_mesh_cached(part, x, mesh, xm, speculative, found,
-                                                                            kPerPair, i, walk);
-                                   for (int m = 0; m < n; ++m) flip_manifold(found[m]);
-                                   return n;
-                               });
+    return collide_shape_parts(
+        mesh, xm, b, xb, b_boxes, speculative, out, capacity,
+        [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found) {
+            // The mesh's pair function has the part as A: turned round as collide() does.
+            // The part's exact box, which the walk's cull has made or was given.
+            const int n = collide_convex_mesh_cached(part, x, mesh, xm, speculative, found, kPerPair, i, walk, &box);
+            for (int m = 0; m < n; ++m) flip_manifold(found[m]);
+            return n;
+        });
 }
 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,

@@ -118,14 +118,20 @@ void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& 
     if (deepest(m) < deepest(list[shallowest])) list[shallowest] = m;
 }
 
+// True when x leaves every point where it is: the mesh's frame is then the world's.
+bool is_identity(const Transform& x) { return x.p == Vec3::Zero() && x.q.coeffs() == Quat::Identity().coeffs(); }
+
 // The walk over the triangles the mesh finds under a's bounds (a posed in the mesh's frame
 // by a_in_mesh); `polyhedron` is a box or hull prepared once for all of them, null for a
 // sphere or capsule. With a walk, a polyhedron's SATs read and keep their triangles'
-// features as part `part`.
+// features as part `part`. `a_world_bounds`, when given, are a's bounds in the world: with
+// the mesh at the identity they are its bounds in the mesh's frame too (a_in_mesh is then
+// a's pose to the bit, but for the signs of zeros), and are not made again.
 int collide_triangles(const Shape& a, const Transform& a_in_mesh, const PreparedPolyhedron* polyhedron,
                       const TriangleMesh& mesh, const Transform& xb, Real speculative, Manifold* out, int capacity,
-                      std::uint32_t part, TriangleFeatureWalk* walk) {
-    const Aabb query = a.bounds(a_in_mesh).fattened(std::max(speculative, Real(0)));
+                      std::uint32_t part, TriangleFeatureWalk* walk, const Aabb* a_world_bounds) {
+    const Aabb bounds = a_world_bounds && is_identity(xb) ? *a_world_bounds : a.bounds(a_in_mesh);
+    const Aabb query = bounds.fattened(std::max(speculative, Real(0)));
     const ShapeSpan span(a, a_in_mesh);
 
     ManifoldSlots<kMaxMeshManifolds> found;
@@ -180,7 +186,8 @@ void TriangleFeatureWalk::finish() {
 namespace {
 
 int collide_convex_mesh_with(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                             Manifold* out, int capacity, std::uint32_t part, TriangleFeatureWalk* walk) {
+                             Manifold* out, int capacity, std::uint32_t part, TriangleFeatureWalk* walk,
+                             const Aabb* a_bounds) {
     const TriangleMesh& mesh = *b.mesh;
     const Transform a_in_mesh = xb.inverse() * xa;
     // Each branch prepares its polyhedron in place: an empty std::optional of one had its
@@ -189,13 +196,16 @@ int collide_convex_mesh_with(const Shape& a, const Transform& xa, const Shape& b
         case ShapeType::Box: {
             const BoxPoly box(a.half_extents);
             const PreparedPolyhedron prepared(box.view());
-            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk);
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk,
+                                     a_bounds);
         }
         case ShapeType::ConvexHull: {
             const PreparedPolyhedron prepared(view_of(*a.hull));
-            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk);
+            return collide_triangles(a, a_in_mesh, &prepared, mesh, xb, speculative, out, capacity, part, walk,
+                                     a_bounds);
         }
-        default: return collide_triangles(a, a_in_mesh, nullptr, mesh, xb, speculative, out, capacity, part, walk);
+        default:
+            return collide_triangles(a, a_in_mesh, nullptr, mesh, xb, speculative, out, capacity, part, walk, a_bounds);
     }
 }
 
@@ -203,13 +213,13 @@ int collide_convex_mesh_with(const Shape& a, const Transform& xa, const Shape& b
 
 int collide_convex_mesh(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                         Manifold* out, int capacity) {
-    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, 0, nullptr);
+    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, 0, nullptr, nullptr);
 }
 
 int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                                Real speculative, Manifold* out, int capacity, std::uint32_t part,
-                               TriangleFeatureWalk& walk) {
-    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, part, &walk);
+                               TriangleFeatureWalk& walk, const Aabb* a_bounds) {
+    return collide_convex_mesh_with(a, xa, b, xb, speculative, out, capacity, part, &walk, a_bounds);
 }
 
 }  // namespace spindle::detail

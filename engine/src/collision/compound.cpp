@@ -5,6 +5,7 @@
 
 #include <spindle/platform/error.hpp>
 
+#include "collision/convex_hull.hpp"
 #include "collision/error_text.hpp"
 
 namespace spindle {
@@ -57,24 +58,37 @@ Compound::Compound(std::span<const CompoundPart> parts) : m_parts(parts.begin(),
     for (std::uint32_t i = 0; i < size(); ++i) check_part(i, m_parts[i]);
     m_poses.reserve(m_parts.size());
     m_part_bounds.reserve(m_parts.size());
+    m_at_origin.reserve(m_parts.size());
     for (CompoundPart& part : m_parts) {
         part.orientation.normalize();
         m_poses.push_back({part.position, part.orientation});
+        m_at_origin.push_back(part.position == Vec3::Zero() && part.orientation.coeffs() == Quat::Identity().coeffs());
         m_part_bounds.push_back(part.shape.bounds(m_poses.back()));
         m_bounds = m_bounds.merged(m_part_bounds.back());
     }
 }
 
+Aabb Compound::posed_part_bounds(std::uint32_t i, const Transform& x, const Mat3& r) const {
+    // x * identity is x again but for the signs of zeros (products by one, sums with
+    // zero), which no box comparison tells apart: the same box as the product's. A hull
+    // takes x's matrix made once for all the parts, as its own bounds(x) would make it.
+    const Shape& shape = m_parts[i].shape;
+    if (!m_at_origin[i]) return shape.bounds(x * m_poses[i]);
+    return shape.type == ShapeType::ConvexHull ? shape.hull->bounds(r, x.p) : shape.bounds(x);
+}
+
 Aabb Compound::bounds(const Transform& x) const {
+    const Mat3 r = x.q.toRotationMatrix();
     Aabb box;
-    for (std::uint32_t i = 0; i < size(); ++i) box = box.merged(m_parts[i].shape.bounds(x * m_poses[i]));
+    for (std::uint32_t i = 0; i < size(); ++i) box = box.merged(posed_part_bounds(i, x, r));
     return box;
 }
 
 Aabb Compound::bounds(const Transform& x, std::span<Aabb> parts) const {
+    const Mat3 r = x.q.toRotationMatrix();
     Aabb box;
     for (std::uint32_t i = 0; i < size(); ++i) {
-        parts[i] = m_parts[i].shape.bounds(x * m_poses[i]);
+        parts[i] = posed_part_bounds(i, x, r);
         box = box.merged(parts[i]);
     }
     return box;

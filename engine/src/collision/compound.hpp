@@ -34,8 +34,14 @@ public:
     MassProperties mass_properties(Real density) const;
 
 private:
+    // Part i's bounds in the world under the compound's pose x (r: x's rotation matrix).
+    Aabb posed_part_bounds(std::uint32_t i, const Transform& x, const Mat3& r) const;
+
     std::vector<CompoundPart> m_parts;
     std::vector<Transform> m_poses;
+    // Parts at the compound's origin, unturned (hulls often have their place baked into
+    // their points): their world pose is the compound's, with no product to make.
+    std::vector<std::uint8_t> m_at_origin;
     std::vector<Aabb> m_part_bounds;
     Aabb m_bounds;
 };

@@ -308,15 +308,18 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
     compute_volume_properties();
 }
 
-Aabb ConvexHull::bounds(const Transform& x) const {
+namespace {
+
+// Both bounds() inline this, so the one taking x keeps its matrix local, as it was before the
+// one taking the matrix existed.
+inline Aabb lanes_bounds(std::span<const detail::VertexLanes> lanes, const Mat3& r, const Vec3& p) {
     using detail::Lanes;
-    const Mat3 r = x.q.toRotationMatrix();
     Lanes lo[3], hi[3];
-    for (std::size_t g = 0; g < m_vertex_lanes.size(); ++g) {
-        const detail::VertexLanes& v = m_vertex_lanes[g];
+    for (std::size_t g = 0; g < lanes.size(); ++g) {
+        const detail::VertexLanes& v = lanes[g];
         for (int i = 0; i < 3; ++i) {
             // Eigen sums a row of r * v as r0 v0 + (r1 v1 + r2 v2).
-            const Lanes world = x.p[i] + (r(i, 0) * v.x + (r(i, 1) * v.y + r(i, 2) * v.z));
+            const Lanes world = p[i] + (r(i, 0) * v.x + (r(i, 1) * v.y + r(i, 2) * v.z));
             lo[i] = g == 0 ? world : (world < lo[i] ? world : lo[i]);
             hi[i] = g == 0 ? world : (world > hi[i] ? world : hi[i]);
         }
@@ -328,6 +331,12 @@ Aabb ConvexHull::bounds(const Transform& x) const {
     }
     return box;
 }
+
+}  // namespace
+
+Aabb ConvexHull::bounds(const Transform& x) const { return lanes_bounds(m_vertex_lanes, x.q.toRotationMatrix(), x.p); }
+
+Aabb ConvexHull::bounds(const Mat3& r, const Vec3& p) const { return lanes_bounds(m_vertex_lanes, r, p); }
 
 void ConvexHull::compute_volume_properties() {
     // Sum signed tetrahedra (r, a, b, c) over a fan of each face, r inside the hull; the

@@ -61,6 +61,8 @@ public:
     // coordinate rounded as x.p + r * v rounds it: the values of a loop over vertices() (a
     // zero's sign aside, where equal minima may be taken in another order).
     Aabb bounds(const Transform& x) const;
+    // The same with x's rotation as a matrix, for callers that bound many hulls under one x.
+    Aabb bounds(const Mat3& r, const Vec3& p) const;
 
     // The vertex index farthest along direction d (any length).
     std::uint32_t support_index(const Vec3& d) const noexcept;

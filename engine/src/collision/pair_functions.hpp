@@ -60,9 +60,10 @@ private:
 int collide_convex_mesh(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
 // The same with each triangle's SAT reading and writing its feature in `walk` (a box or
 // hull; a sphere or capsule has none) as compound part `part` (0 for a whole shape).
+// `a_bounds`: a.bounds(xa) where the caller has them (null: made here when needed).
 int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                                Real speculative, Manifold* out, int capacity, std::uint32_t part,
-                               TriangleFeatureWalk& walk);
+                               TriangleFeatureWalk& walk, const Aabb* a_bounds = nullptr);
 
 // collide_compound.cpp: any shape against a compound (B), and two compounds, part by part.
 int collide_shape_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);

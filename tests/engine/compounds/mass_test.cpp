@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+#include <vector>
+
+#include "collision/compound.hpp"
 #include "compound_test_util.hpp"
 
 namespace spindle {
@@ -98,6 +102,50 @@ TEST(CompoundBounds, AreTheUnionOfThePartsBounds) {
     const Aabb turned = dumbbell().bounds({Vec3::Zero(), Quat(Eigen::AngleAxisd(kPi / 2, Vec3::UnitZ()))});
     EXPECT_NEAR(turned.max.y(), kBellOffset + kBell, 1e-12);
     EXPECT_NEAR(turned.max.x(), kBell, 1e-12);
+}
+
+// Parts at the compound's origin, unturned, skip the pose product; moved or turned ones
+// must not: each part's world box is its shape's under the compound's pose times its own.
+// A part at the origin gives the same bits as the product's; a moved or turned part's product
+// may round otherwise here than in the engine (either compiler may fuse multiply-adds), so
+// those are compared to far below what leaving their pose out would move them.
+TEST(CompoundBounds, EachPartsBoxIsItsShapeUnderItsWorldPose) {
+    constexpr Real kRounding = 1e-12;  // metres-sized boxes: a few ulps
+    const std::vector<Vec3> wedge = {Vec3(0.2, 0, 0.1), Vec3(1, 0.1, 0), Vec3(0.3, 0.9, 0.2), Vec3(0.4, 0.2, 1.1)};
+    const CompoundPart parts[] = {
+        {Shape::convex_hull(wedge), Vec3::Zero(), Quat::Identity()},
+        {Shape::convex_hull(wedge), Vec3(0.5, -0.3, 0.2), Quat::Identity()},
+        {Shape::convex_hull(wedge), Vec3::Zero(), Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 0).normalized()))},
+        {Shape::box(Vec3(0.4, 0.1, 0.2)), Vec3::Zero(), Quat::Identity()},
+        {Shape::box(Vec3(0.4, 0.1, 0.2)), Vec3(-1, 0, 0.5), Quat(Eigen::AngleAxisd(-0.4, Vec3::UnitY()))},
+        {Shape::capsule(0.3, 0.2), Vec3::Zero(), Quat::Identity()},
+        {Shape::capsule(0.3, 0.2), Vec3(0, 0.8, 0), Quat(Eigen::AngleAxisd(1.1, Vec3::UnitX()))},
+    };
+    const Shape shape = Shape::compound(parts);
+    const Compound& compound = *shape.parts;
+    std::mt19937 rng(44);
+    std::normal_distribution<Real> g;
+    std::vector<Aabb> boxes(compound.size());
+    for (int sample = 0; sample < 50; ++sample) {
+        const Quat q = Quat(g(rng), g(rng), g(rng), g(rng)).normalized();
+        const Transform x{Vec3(3 * g(rng), 3 * g(rng), 3 * g(rng)), q};
+        const Aabb all = compound.bounds(x, boxes);
+        Aabb expected_all;
+        for (std::uint32_t i = 0; i < compound.size(); ++i) {
+            const Aabb expected = compound.shape(i).bounds(x * compound.pose(i));
+            const bool at_origin = compound.pose(i).p == Vec3::Zero() && compound.pose(i).q.vec() == Vec3::Zero();
+            const Real tolerance = at_origin ? 0 : kRounding;
+            EXPECT_LE((boxes[i].min - expected.min).cwiseAbs().maxCoeff(), tolerance)
+                << "sample " << sample << " part " << i;
+            EXPECT_LE((boxes[i].max - expected.max).cwiseAbs().maxCoeff(), tolerance)
+                << "sample " << sample << " part " << i;
+            expected_all = expected_all.merged(boxes[i]);
+        }
+        EXPECT_EQ(all.min, expected_all.min) << "sample " << sample;
+        EXPECT_EQ(all.max, expected_all.max) << "sample " << sample;
+        EXPECT_EQ(compound.bounds(x).min, expected_all.min) << "sample " << sample;
+        EXPECT_EQ(compound.bounds(x).max, expected_all.max) << "sample " << sample;
+    }
 }
 
 }  // namespace

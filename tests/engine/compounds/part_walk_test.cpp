@@ -180,7 +180,10 @@ TEST(CompoundPartWalk, TwoCompoundsGiveWhatEachPartPairGivesAlone) {
 
 TEST(CompoundPartWalk, ACompoundOnAMeshGivesWhatEachPartGivesAlone) {
     const Shape trunk = tree(), terrain = ground();
-    const Transform mesh_pose{Vec3(0.3, -0.2, 0.1), Quat(Eigen::AngleAxis<Real>(0.05, Vec3(1, 0, 1).normalized()))};
+    // Moved and turned, and at the identity, where a part's mesh query takes its world box
+    // as the box in the mesh's frame: half the samples each.
+    const Transform moved_mesh{Vec3(0.3, -0.2, 0.1), Quat(Eigen::AngleAxis<Real>(0.05, Vec3(1, 0, 1).normalized()))};
+    const Transform world_mesh;
     std::mt19937 rng(7);
     std::uniform_real_distribution<Real> spread(-10, 10), height(-0.5, 1.5);
     int touching = 0, total = 0;
@@ -189,6 +192,7 @@ TEST(CompoundPartWalk, ACompoundOnAMeshGivesWhatEachPartGivesAlone) {
         const Quat q = random_turn(rng);
         const Transform xt{Vec3(spread(rng), height(rng), spread(rng)), q};
         const Real speculative = sample % 2 ? 0.04 : 0.2;
+        const Transform& mesh_pose = sample % 4 < 2 ? moved_mesh : world_mesh;
         const std::vector<Manifold> expected = part_by_part(terrain, mesh_pose, trunk, xt, speculative);
         expect_same(expected, walked(terrain, mesh_pose, trunk, xt, speculative), sample);
         expect_same(expected, boxed(terrain, mesh_pose, trunk, xt, speculative), sample);
