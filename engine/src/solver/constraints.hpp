@@ -258,31 +258,37 @@ struct SupportEdge {
     std::uint32_t lower = 0, upper = 0;  // solver bodies
 };
 
+// The arrays on RawRoomAllocator are written whole before they are read in every step
+// that grows them (their comments say where): a resize does not zero them.
 struct SolverScratch {
-    HugePageVector<SolverBody> bodies;  // awake bodies, then the static body
+    RawRoomVector<SolverBody> bodies;  // awake bodies, then the static body (prepare_bodies)
     // Per solver body, apart from it (SolverBody says why): its push-out velocities, and
     // BodyDesc::gravity_scale of a dynamic body (else 0) so that integrate_velocities and
-    // prepare_wide stay off the cold descriptions, each a cache miss.
-    HugePageVector<PushVelocity> push_velocities;
-    HugePageVector<Real> gravity_scales;
-    HugePageVector<ManifoldRef> manifolds;  // touching manifolds of awake contacts, in contact order
+    // prepare_wide stay off the cold descriptions, each a cache miss (prepare_bodies).
+    RawRoomVector<PushVelocity> push_velocities;
+    RawRoomVector<Real> gravity_scales;
+    // Touching manifolds of awake contacts, in contact order (list_manifolds' ranges).
+    RawRoomVector<ManifoldRef> manifolds;
     // list_manifolds' lists of its fixed ranges of contacts, before they are joined.
     struct ListedRange {
         std::vector<ManifoldRef> refs;
         bool restitution = false;  // any of them has restitution
+        std::size_t first = 0;     // where its refs go in manifolds
     };
     std::vector<ListedRange> listed;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
-    HugePageVector<ManifoldRef> colored_manifolds;
+    RawRoomVector<ManifoldRef> colored_manifolds;  // a copy of manifolds
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
     std::vector<JointRef> colored_joints;                // the joint list then
     bool reuse_colors = true;                            // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
     std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
-    HugePageVector<WideContact> wide;          // the colours' manifolds kLanes at a time, then the overflow one by one
-    HugePageVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (written before read)
+    // The colours' manifolds kLanes at a time, then the overflow one by one (pack_contacts
+    // writes their lanes, prepare_wide every other field).
+    RawRoomVector<WideContact> wide;
+    RawRoomVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (push_out, before read)
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed

@@ -25,6 +25,9 @@ namespace spindle {
 namespace {
 
 constexpr Real kEmptySeparation = 1e18;  // an empty point slot: far apart, never touching
+// Wide contacts per job when packing: each writes a few lines of its wide contact, so
+// blocks are long enough that a job's overhead stays small beside them.
+constexpr std::uint32_t kPackGrain = 256;
 
 // A tangent basis for a unit normal, the same for the same normal every time.
 void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
@@ -296,41 +299,51 @@ void prefetch_contacts(const World& world, const SolverScratch& scratch, const W
 }  // namespace
 
 // Lays the colours' manifold refs out kLanes at a time, then the overflow one per
-// WideContact (its manifolds may share bodies, so they are solved one at a time).
+// WideContact (its manifolds may share bodies, so they are solved one at a time), in
+// jobs: each wide contact's place follows from the colours' sizes alone.
 void pack_contacts(JobSystem& jobs, SolverScratch& scratch) {
-    std::size_t count = scratch.overflow.size();
-    for (const std::vector<std::uint32_t>& refs : scratch.colors) count += (refs.size() + kLanes - 1) / kLanes;
+    std::uint32_t count = 0;
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.wide_begin[c] = count;
+        count += static_cast<std::uint32_t>((scratch.colors[c].size() + kLanes - 1) / kLanes);
+    }
+    scratch.wide_begin[kColorCount] = count;
+    count += static_cast<std::uint32_t>(scratch.overflow.size());
     // Kept from step to step (prepare_wide writes every field, push_out a row before it
     // is read), at about the size of the step's. A first step's are megabytes of new
-    // pages: mapped in jobs before the resize below writes them on one thread.
+    // pages: mapped in jobs, and not zeroed by the resizes (raw room).
     reserve_for(scratch.wide, count);
     map_room(jobs, scratch.wide, count);
     scratch.wide.resize(count);
     if (far_above_use(scratch.wide.capacity(), count)) fit_capacity(scratch.wide);
-    reserve_for(scratch.push_anchors, count * kLanes);
-    map_room(jobs, scratch.push_anchors, count * kLanes);
-    scratch.push_anchors.resize(count * kLanes);
-    if (far_above_use(scratch.push_anchors.capacity(), count * kLanes)) fit_capacity(scratch.push_anchors);
+    reserve_for(scratch.push_anchors, std::size_t{count} * kLanes);
+    map_room(jobs, scratch.push_anchors, std::size_t{count} * kLanes);
+    scratch.push_anchors.resize(std::size_t{count} * kLanes);
+    if (far_above_use(scratch.push_anchors.capacity(), std::size_t{count} * kLanes)) fit_capacity(scratch.push_anchors);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
-    std::size_t next = 0;
-    auto add = [&](const std::uint32_t* refs, int lanes) {
-        WideContact& wc = scratch.wide[next++];
-        wc.lanes = lanes;
-        for (int l = 0; l < kLanes; ++l) {
-            wc.ref[l] = l < lanes ? refs[l] : 0;
-            wc.a[l] = l < lanes ? scratch.manifolds[refs[l]].a : immovable;
-            wc.b[l] = l < lanes ? scratch.manifolds[refs[l]].b : immovable;
+    jobs.parallel_for("PackContacts", 0, count, kPackGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        int c = 0;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            while (c < kColorCount && k >= scratch.wide_begin[c + 1]) ++c;
+            const std::uint32_t* refs;
+            int lanes = 1;
+            if (c < kColorCount) {
+                const std::vector<std::uint32_t>& color = scratch.colors[c];
+                const std::size_t first = std::size_t{k - scratch.wide_begin[c]} * kLanes;
+                refs = color.data() + first;
+                lanes = static_cast<int>(std::min<std::size_t>(kLanes, color.size() - first));
+            } else {
+                refs = &scratch.overflow[k - scratch.wide_begin[kColorCount]];
+            }
+            WideContact& wc = scratch.wide[k];
+            wc.lanes = lanes;
+            for (int l = 0; l < kLanes; ++l) {
+                wc.ref[l] = l < lanes ? refs[l] : 0;
+                wc.a[l] = l < lanes ? scratch.manifolds[refs[l]].a : immovable;
+                wc.b[l] = l < lanes ? scratch.manifolds[refs[l]].b : immovable;
+            }
         }
-    };
-    for (int c = 0; c < kColorCount; ++c) {
-        scratch.wide_begin[c] = static_cast<std::uint32_t>(next);
-        const std::vector<std::uint32_t>& refs = scratch.colors[c];
-        for (std::size_t k = 0; k < refs.size(); k += kLanes) {
-            add(refs.data() + k, static_cast<int>(std::min<std::size_t>(kLanes, refs.size() - k)));
-        }
-    }
-    scratch.wide_begin[kColorCount] = static_cast<std::uint32_t>(next);
-    for (const std::uint32_t& ref : scratch.overflow) add(&ref, 1);
+    });
 }
 
 namespace {

@@ -46,8 +46,8 @@ void find_support_scales(const World& world, SolverScratch& scratch) {
     const Real g = gravity.norm();
     if (!(g > 0)) return;
     const Vec3 up = -gravity / g;
-    const HugePageVector<SolverBody>& bodies = scratch.bodies;
-    const HugePageVector<ManifoldRef>& refs = scratch.manifolds;
+    const RawRoomVector<SolverBody>& bodies = scratch.bodies;
+    const RawRoomVector<ManifoldRef>& refs = scratch.manifolds;
     // The manifold's normal points from A to B: B rests on A when it points up.
     auto up_component = [&](const ManifoldRef& ref) {
         return world.contacts[ref.contact].manifold_at(static_cast<int>(ref.manifold)).normal.dot(up);

@@ -54,8 +54,8 @@ void fit_capacity(std::vector<T, A>& v) {
 // kernel), so each job also writes a byte of each of its small pages (raw room: no element
 // lives there yet). A hint: nothing for room of less than a megabyte (not worth the jobs),
 // or where the OS has no such call.
-template <typename T>
-void map_room(JobSystem& jobs, HugePageVector<T>& v, std::size_t end) {
+template <typename T, typename A>
+void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::uintptr_t kPage = 4096;
     constexpr std::uintptr_t kPagesPerJob = kHugePageBytes / kPage;

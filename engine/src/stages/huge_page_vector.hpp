@@ -17,6 +17,8 @@
 #include <cstdint>
 #include <cstdlib>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #if defined(__linux__)
@@ -118,5 +120,29 @@ struct HugePageAllocator {
 
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
+
+// HugePageAllocator whose resize leaves the new elements' bytes as they are: for arrays
+// that the code after each resize writes whole, element by element, before anything
+// reads them (the solver's per-step arrays). A first step's megabytes are then first
+// written by the jobs that fill them, split over the workers, instead of zeroed by the
+// resizing thread first. Copies and moves construct as usual.
+template <typename T>
+struct RawRoomAllocator : HugePageAllocator<T> {
+    RawRoomAllocator() = default;
+    template <typename U>
+    RawRoomAllocator(const RawRoomAllocator<U>&) noexcept {}
+
+    template <typename U>
+    void construct(U*) noexcept {
+        static_assert(std::is_trivially_destructible_v<U>, "raw room holds no object that needs destroying");
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+template <typename T>
+using RawRoomVector = std::vector<T, RawRoomAllocator<T>>;
 
 }  // namespace spindle

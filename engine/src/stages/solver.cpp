@@ -135,16 +135,23 @@ bool list_manifolds(World& world, SolverScratch& scratch) {
         }
         range.restitution = restitution;
     });
-    const std::span<const SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
+    const std::span<SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
     std::size_t total = 0;
-    for (const auto& range : listed) total += range.refs.size();
-    scratch.manifolds.resize(total);
     bool restitution = false;
-    ManifoldRef* out = scratch.manifolds.data();
-    for (const auto& range : listed) {
-        out = std::copy(range.refs.begin(), range.refs.end(), out);
+    for (auto& range : listed) {
+        range.first = total;
+        total += range.refs.size();
         restitution = restitution || range.restitution;
     }
+    // Joined in jobs too: a first step's list is hundreds of new pages, each a fault on
+    // its first write.
+    scratch.manifolds.resize(total);
+    world.jobs->parallel_for("JoinManifolds", 0, ranges, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t r = lo; r < hi; ++r) {
+            std::copy(listed[r].refs.begin(), listed[r].refs.end(),
+                      scratch.manifolds.begin() + static_cast<std::ptrdiff_t>(listed[r].first));
+        }
+    });
     return restitution;
 }
 

@@ -19,10 +19,10 @@ namespace {
 // Random bodies: turned, moving and already moved, with uneven inertias (a general
 // symmetric inverse inertia in world), masses over two decades. The last is the
 // immovable partner of static bodies, as in a step.
-HugePageVector<SolverBody> random_bodies(int count, std::mt19937& rng) {
+RawRoomVector<SolverBody> random_bodies(int count, std::mt19937& rng) {
     std::uniform_real_distribution<double> unit(-1, 1), mass(0.5, 50);
     auto vec = [&] { return Vec3(unit(rng), unit(rng), unit(rng)); };
-    HugePageVector<SolverBody> bodies(static_cast<std::size_t>(count) + 1);
+    RawRoomVector<SolverBody> bodies(static_cast<std::size_t>(count) + 1, SolverBody{});  // raw room: filled
     for (int i = 0; i < count; ++i) {
         SolverBody& b = bodies[static_cast<std::size_t>(i)];
         b.v = vec();
@@ -66,7 +66,7 @@ void expect_near(double wide, double scalar, const char* what, int joint) {
 
 // The scalar rows' side of a comparison: copies of the bodies and joints they pushed.
 struct ScalarSide {
-    HugePageVector<SolverBody> bodies;
+    RawRoomVector<SolverBody> bodies;
     std::vector<JointConstraint> joints;
 };
 
@@ -160,7 +160,7 @@ Vec3 any_perpendicular(const Vec3& n) {
 // B turned from A by up to a radian about a random axis: swings and twists of either
 // sign, some beyond the random cones and twist ranges, some within. Every fourth has no
 // cone, every third no twist range, every other friction.
-JointConstraint random_swing_twist(std::uint32_t a, std::uint32_t b, int k, const HugePageVector<SolverBody>& bodies,
+JointConstraint random_swing_twist(std::uint32_t a, std::uint32_t b, int k, const RawRoomVector<SolverBody>& bodies,
                                    std::mt19937& rng) {
     std::uniform_real_distribution<double> turn(0, 1), cone(0.2, 0.8), range(0.1, 0.6), impulse(0, 0.05);
     JointConstraint jc = random_joint(a, b, rng);
