@@ -53,7 +53,8 @@ constexpr std::uint32_t kListGrain = 512;
 void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
-    // A first step's are megabytes of new pages: mapped in jobs before the resize writes them.
+    // A first step's are megabytes of new pages: mapped in jobs, then first written by the
+    // PrepareBodies jobs (raw room: the resizes write nothing).
     reserve_for(scratch.bodies, n + 1);
     map_room(*world.jobs, scratch.bodies, n + 1);
     scratch.bodies.resize(n + 1);
