@@ -16,8 +16,8 @@ namespace {
 
 constexpr std::size_t kMaxShots = 100;   // the oldest shot ball is retired beyond this
 constexpr std::size_t kMaxCrates = 400;  // and the oldest dropped crate beyond this
-constexpr Real kBallRadius = 0.25;
-constexpr Real kShotSpeed = 25;          // m/s
+constexpr Real kShotBallRadius = 0.25;
+constexpr Real kShotBallSpeed = 25;      // m/s
 constexpr Real kRayLength = 1000;        // m: picks and shots reach this far
 constexpr int kDropCount = 8;            // crates per press of "drop"
 constexpr Real kDragGain = 8;            // 1/s: the grabbed body closes this share of the gap per second
@@ -63,7 +63,7 @@ LiveView::LiveView(Session& session, ViewServer& server, double render_hz)
         m_bodies.push_back({b.shape, b.desc.type != MotionType::Static, false, b.desc.sensor});
     }
     m_handles = session.handles;
-    m_ball_shape = add_shape(sphere_spec(kBallRadius));
+    m_ball_shape = add_shape(sphere_spec(kShotBallRadius));
     m_crate_shape = add_shape(box_spec(Vec3(0.3, 0.3, 0.3)));
     m_probe.attach(m_runner, kPollInterval);
     // Something to serve before the first frame's turn: the URL is printed before run().
@@ -206,8 +206,8 @@ void LiveView::collect_created() {
 void LiveView::shoot(const Vec3& origin, const Vec3& direction) {
     BodyDesc ball;
     ball.shape = m_shapes[m_ball_shape].make();
-    ball.position = origin + direction * (2 * kBallRadius);  // clear of the camera's near plane
-    ball.linear_velocity = direction * kShotSpeed;
+    ball.position = origin + direction * (2 * kShotBallRadius);  // clear of the camera's near plane
+    ball.linear_velocity = direction * kShotBallSpeed;
     ball.fast = true;
     ball.contact_events = true;
     create(ball, {m_ball_shape, true, true});
