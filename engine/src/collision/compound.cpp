@@ -77,19 +77,13 @@ Aabb Compound::posed_part_bounds(std::uint32_t i, const Transform& x, const Mat3
     return shape.type == ShapeType::ConvexHull ? shape.hull->bounds(r, x.p) : shape.bounds(x);
 }
 
-Aabb Compound::bounds(const Transform& x) const {
-    const Mat3 r = x.q.toRotationMatrix();
-    Aabb box;
-    for (std::uint32_t i = 0; i < size(); ++i) box = box.merged(posed_part_bounds(i, x, r));
-    return box;
-}
-
 Aabb Compound::bounds(const Transform& x, std::span<Aabb> parts) const {
     const Mat3 r = x.q.toRotationMatrix();
     Aabb box;
     for (std::uint32_t i = 0; i < size(); ++i) {
-        parts[i] = posed_part_bounds(i, x, r);
-        box = box.merged(parts[i]);
+        const Aabb part = posed_part_bounds(i, x, r);
+        if (!parts.empty()) parts[i] = part;
+        box = box.merged(part);
     }
     return box;
 }
