@@ -132,6 +132,15 @@ struct ContactManifold {
     Vec3 friction_impulse = Vec3::Zero();
 };
 
+// What only mesh and compound pairs keep, apart from the record: a pile of convex
+// pairs, most of the memory a scene holds, carries one pointer for it per contact.
+struct ContactExtra {
+    std::vector<ContactManifold> manifolds;  // the manifolds after Contact::manifold
+    // A box, hull or compound against a triangle mesh: each triangle's feature, as
+    // Contact::feature is for a convex pair (collide_cached).
+    TriangleFeatures triangle_features;
+};
+
 // Contact::events: the pair reports events (a body asked, or is a sensor); a body is a
 // sensor (the pair exerts no force: no solver rows, no island link).
 inline constexpr std::uint8_t kContactReports = 1u << 0;
@@ -158,11 +167,8 @@ struct Contact {
     // stay attached to their bodies while the manifolds are recycled, and the solver pushes
     // each body at its own anchor. Kept once per contact rather than twice per point.
     Vec3 cached_xa = Vec3::Zero(), cached_xb = Vec3::Zero();
-    ContactManifold manifold;            // the first (and for convex pairs only) manifold
-    std::vector<ContactManifold> extra;  // further manifolds (triangle meshes, compounds)
-    // A box, hull or compound against a triangle mesh: each triangle's feature, as `feature`
-    // is for a convex pair (collide_cached).
-    TriangleFeatures triangle_features;
+    ContactManifold manifold;             // the first (and for convex pairs only) manifold
+    std::unique_ptr<ContactExtra> extra;  // made by the first collide that needs it (mesh and compound pairs)
 
     Vec3 anchor_a(const ContactPoint& p) const { return p.point - cached_xa; }
     Vec3 anchor_b(const ContactPoint& p) const { return p.point - cached_xb; }
@@ -170,9 +176,15 @@ struct Contact {
     // values: the same bits it had when collided.
     Vec3 cached_position() const { return cached_qa.conjugate() * (cached_xb - cached_xa); }
 
-    ContactManifold& manifold_at(int i) { return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)]; }
+    ContactManifold& manifold_at(int i) {
+        return i == 0 ? manifold : extra->manifolds[static_cast<std::size_t>(i - 1)];
+    }
     const ContactManifold& manifold_at(int i) const {
-        return i == 0 ? manifold : extra[static_cast<std::size_t>(i - 1)];
+        return i == 0 ? manifold : extra->manifolds[static_cast<std::size_t>(i - 1)];
+    }
+    ContactExtra& made_extra() {
+        if (!extra) extra = std::make_unique<ContactExtra>();
+        return *extra;
     }
 };
 

@@ -43,7 +43,10 @@ MemoryReport memory_report(const Space& space) {
     report.bodies = body_bytes(world.bodies) + held(world.awake) + held(world.awake_pending);
     report.contacts = held(world.contacts);
     for (const Contact& contact : world.contacts) {
-        report.contact_extras += held(contact.extra) + held(contact.triangle_features);
+        if (contact.extra) {
+            report.contact_extras += sizeof(ContactExtra) + held(contact.extra->manifolds) +
+                                     held(contact.extra->triangle_features);
+        }
     }
     report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +
                             held(world.contact_summaries) + held(world.awake_contact_list);
@@ -53,8 +56,7 @@ MemoryReport memory_report(const Space& space) {
     report.solver_other = solver_other_bytes(solver);
     const BroadphaseState& bp = *world.broadphase;
     report.broadphase = bp.tree.heap_bytes() + held(bp.proxy) + held(bp.pairs) + held(bp.refit) + held(bp.refit_slots) +
-                        held(bp.moving) + held(bp.part_boxes) + held(bp.part_boxes_step);
-    for (const std::vector<Aabb>& parts : bp.part_boxes) report.broadphase += held(parts);
+                        held(bp.moving) + bp.part_boxes.heap_bytes();
     for (const std::shared_ptr<QueryScene>& scene : world.query_scenes) {
         if (scene) report.query_scenes += scene->heap_bytes();
     }

@@ -35,15 +35,22 @@ inline Real deepest(const Manifold& m) {
     return d;
 }
 
+// A compound's parts' world boxes under the pose it is collided at, as Compound::bounds
+// writes them (the broadphase's), for a and b; empty where not at hand (the walk makes them).
+struct PartBoxes {
+    std::span<const Aabb> a, b;
+};
+
 // Writes the manifolds of a (posed by xa) against b (posed by xb) into out[0..capacity)
 // and returns how many. Points are produced while the shapes are closer than
 // `speculative_distance` (speculative contacts have separation > 0). Convex pairs give
 // at most one manifold; a triangle mesh may give several (one per distinct normal, the
 // deepest four), a compound one (or a mesh's several) per touching part pair, in part
 // order, the deepest `capacity` of them when more touch.
-// Any order of shape types is accepted; normals always point from a to b.
+// Any order of shape types is accepted; normals always point from a to b. A compound's
+// walk takes its part boxes from `boxes` where given: the same boxes, not made again.
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-            Manifold* out, int capacity);
+            Manifold* out, int capacity, const PartBoxes& boxes = {});
 
 // What the last whole test of a box or hull pair decided on, kept with the contact (the
 // idea of Box3D's b3SATCache): the feature whose axis separated the two or made their
@@ -90,19 +97,12 @@ struct TriangleFeature {
 // A contact's triangle features from its last collide, sorted by part, then triangle.
 using TriangleFeatures = std::vector<TriangleFeature>;
 
-// A compound's parts' world boxes under the pose it is collided at, as Compound::bounds
-// writes them (the broadphase's), for a and b; empty where not at hand (the walk makes them).
-struct PartBoxes {
-    std::span<const Aabb> a, b;
-};
-
 // collide() with the pair's caches, for the narrowphase: box-hull and hull-hull pairs
 // read and write `cache`; a box, hull or compound against a triangle mesh reads and
 // rewrites `triangles` (the triangles it met this time, each with its feature); any other
 // pair clears what it does not use. `feature_slop`: how far the separation along a cached
 // touching feature may drift before the whole SAT runs again (the solver's linear slop;
-// 0 never reuses a touching feature). A compound's walk takes its part boxes from `boxes`
-// where given: the same boxes, not made again.
+// 0 never reuses a touching feature). `boxes` as for collide().
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
                    const PartBoxes& boxes = {});

@@ -179,13 +179,8 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
 }  // namespace
 
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                           Manifold* out, int capacity) {
-    return collide_shape_compound_boxed(a, xa, b, xb, speculative, out, capacity, {});
-}
-
-int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                                 Real speculative, Manifold* out, int capacity, std::span<const Aabb> b_boxes) {
-    return collide_shape_parts(a, xa, b, xb, b_boxes, speculative, out, capacity,
+                           Manifold* out, int capacity, const PartBoxes& boxes) {
+    return collide_shape_parts(a, xa, b, xb, boxes.b, speculative, out, capacity,
                                [&](const Shape& part, const Transform& x, const Aabb&, std::uint32_t, Manifold* found) {
                                    return collide(a, xa, part, x, speculative, found, kPerPair);
                                });
@@ -206,12 +201,7 @@ int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const S
 }
 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                              Real speculative, Manifold* out, int capacity) {
-    return collide_compound_compound_boxed(a, xa, b, xb, speculative, out, capacity, {});
-}
-
-int collide_compound_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                                    Real speculative, Manifold* out, int capacity, const PartBoxes& boxes) {
+                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes) {
     Gathered g;
     const Compound& parts = *a.parts;
     const Real margin = std::max(speculative, Real(0));

@@ -77,21 +77,20 @@ Aabb Compound::posed_part_bounds(std::uint32_t i, const Transform& x, const Mat3
     return shape.type == ShapeType::ConvexHull ? shape.hull->bounds(r, x.p) : shape.bounds(x);
 }
 
-Aabb Compound::bounds(const Transform& x) const {
-    const Mat3 r = x.q.toRotationMatrix();
-    Aabb box;
-    for (std::uint32_t i = 0; i < size(); ++i) box = box.merged(posed_part_bounds(i, x, r));
-    return box;
-}
-
 Aabb Compound::bounds(const Transform& x, std::span<Aabb> parts) const {
     const Mat3 r = x.q.toRotationMatrix();
-    Aabb box;
-    for (std::uint32_t i = 0; i < size(); ++i) {
-        parts[i] = posed_part_bounds(i, x, r);
-        box = box.merged(parts[i]);
-    }
-    return box;
+    // One loop, made twice: the broadphase's, which keeps every part's box, asks nothing per part.
+    const auto merged = [&](auto&& keep) {
+        Aabb box;
+        for (std::uint32_t i = 0; i < size(); ++i) {
+            const Aabb part = posed_part_bounds(i, x, r);
+            keep(i, part);
+            box = box.merged(part);
+        }
+        return box;
+    };
+    if (parts.empty()) return merged([](std::uint32_t, const Aabb&) {});
+    return merged([parts](std::uint32_t i, const Aabb& part) { parts[i] = part; });
 }
 
 MassProperties Compound::mass_properties(Real density) const {

@@ -25,10 +25,9 @@ public:
     const Aabb& local_bounds() const noexcept { return m_bounds; }
     std::span<const CompoundPart> parts() const noexcept { return m_parts; }
 
-    // World bounds under x: the union of the parts' own; the second also writes each
-    // part's (parts.size() == size()), the boxes a pair walk would make.
-    Aabb bounds(const Transform& x) const;
-    Aabb bounds(const Transform& x, std::span<Aabb> parts) const;
+    // World bounds under x: the union of the parts' own. Given room (parts.size() ==
+    // size()), also writes each part's, the boxes a pair walk would make.
+    Aabb bounds(const Transform& x, std::span<Aabb> parts = {}) const;
     // The parts' mass properties for one density, summed about their common centre of
     // mass (parallel axis theorem).
     MassProperties mass_properties(Real density) const;

@@ -65,14 +65,12 @@ int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape&
                                Real speculative, Manifold* out, int capacity, std::uint32_t part,
                                TriangleFeatureWalk& walk, const Aabb* a_bounds = nullptr);
 
-// collide_compound.cpp: any shape against a compound (B), and two compounds, part by part.
-int collide_shape_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
-int collide_compound_compound(const Shape&, const Transform&, const Shape&, const Transform&, Real, Manifold*, int);
-// The same with compound b's part boxes (PartBoxes; empty: made by the walk).
-int collide_shape_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                                 Real speculative, Manifold* out, int capacity, std::span<const Aabb> b_boxes);
-int collide_compound_compound_boxed(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                                    Real speculative, Manifold* out, int capacity, const PartBoxes& boxes);
+// collide_compound.cpp: any shape against a compound (B), and two compounds, part by part,
+// each compound's part boxes taken from `boxes` where given (empty: made by the walk).
+int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                           Manifold* out, int capacity, const PartBoxes& boxes);
+int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
+                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes);
 // collide_shape_compound for a triangle mesh A, each part's triangles met through `walk`.
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,

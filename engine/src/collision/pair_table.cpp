@@ -1,6 +1,7 @@
 // collide(): one table lookup per pair. The table is filled once with the pair
 // functions for (lower type, higher type) and flipping wrappers for the other order.
 #include <array>
+#include <type_traits>
 
 #include <spindle/platform/assert.hpp>
 
@@ -13,20 +14,33 @@ namespace detail {
 namespace {
 
 constexpr int kTypeCount = static_cast<int>(ShapeType::Count);
-using Table = std::array<std::array<PairFunction, kTypeCount>, kTypeCount>;
+// A table entry: a pair function, given the compounds' part boxes (only a compound's reads them).
+using Entry = int (*)(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
+                      Manifold* out, int capacity, const PartBoxes& boxes);
+using Table = std::array<std::array<Entry, kTypeCount>, kTypeCount>;
+
+template <auto Fn>
+int call(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative, Manifold* out,
+         int capacity, const PartBoxes& boxes) {
+    if constexpr (std::is_same_v<decltype(Fn), PairFunction>) {
+        return Fn(a, xa, b, xb, speculative, out, capacity);
+    } else {
+        return Fn(a, xa, b, xb, speculative, out, capacity, boxes);
+    }
+}
 
 // Calls Fn with the shapes swapped and turns the normals round, so they point from a to b.
-template <PairFunction Fn>
+template <auto Fn>
 int swapped(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative, Manifold* out,
-            int capacity) {
-    const int count = Fn(b, xb, a, xa, speculative, out, capacity);
+            int capacity, const PartBoxes& boxes) {
+    const int count = call<Fn>(b, xb, a, xa, speculative, out, capacity, PartBoxes{boxes.b, boxes.a});
     for (int i = 0; i < count; ++i) flip_manifold(out[i]);
     return count;
 }
 
-template <PairFunction Fn>
+template <auto Fn>
 void add(Table& table, ShapeType a, ShapeType b) {
-    table[static_cast<int>(a)][static_cast<int>(b)] = Fn;
+    table[static_cast<int>(a)][static_cast<int>(b)] = call<Fn>;
     if (a != b) table[static_cast<int>(b)][static_cast<int>(a)] = swapped<Fn>;
 }
 
@@ -63,12 +77,12 @@ const Table& table() {
 }  // namespace detail
 
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-            Manifold* out, int capacity) {
+            Manifold* out, int capacity, const PartBoxes& boxes) {
     SPINDLE_ASSERT(a.type < ShapeType::Count && b.type < ShapeType::Count, "collide: invalid shape type");
     if (capacity <= 0) return 0;
-    const detail::PairFunction fn = detail::table()[static_cast<int>(a.type)][static_cast<int>(b.type)];
+    const detail::Entry fn = detail::table()[static_cast<int>(a.type)][static_cast<int>(b.type)];
     if (fn == nullptr) return 0;
-    return fn(a, xa, b, xb, speculative_distance, out, capacity);
+    return fn(a, xa, b, xb, speculative_distance, out, capacity, boxes);
 }
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
@@ -98,26 +112,10 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         return count;
     }
     triangles.clear();
-    const bool compound_a = a.type == ShapeType::Compound;
-    const bool compound_b = b.type == ShapeType::Compound;
-    if (capacity > 0 && (compound_a || compound_b)) {
-        cache = FeatureCache();
-        if (compound_a && compound_b) {
-            return detail::collide_compound_compound_boxed(a, xa, b, xb, speculative_distance, out, capacity, boxes);
-        }
-        if (compound_b) {
-            return detail::collide_shape_compound_boxed(a, xa, b, xb, speculative_distance, out, capacity, boxes.b);
-        }
-        // The table's order: the compound is B.
-        const int count = detail::collide_shape_compound_boxed(b, xb, a, xa, speculative_distance, out, capacity,
-                                                               boxes.a);
-        for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);
-        return count;
-    }
-    // Box-box has its own 15-axis test.
+    // Box-box has its own 15-axis test; a compound's walk takes its part boxes.
     if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
         cache = FeatureCache();
-        return collide(a, xa, b, xb, speculative_distance, out, capacity);
+        return collide(a, xa, b, xb, speculative_distance, out, capacity, boxes);
     }
     // The pair functions' order: the lower type is A (box before hull), as in the table.
     const bool swap = b.type < a.type;

@@ -46,12 +46,47 @@ Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
 
 }  // namespace
 
+void CompoundPartBoxes::add(const Bodies& bodies, std::uint32_t slot) {
+    if (bodies.desc[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
+    m_members.push_back(slot);
+    m_changed = true;
+}
+
+void CompoundPartBoxes::remove(std::uint32_t slot) {
+    const auto it = std::find(m_members.begin(), m_members.end(), slot);
+    if (it == m_members.end()) return;
+    *it = m_members.back();
+    m_members.pop_back();
+    m_changed = true;
+}
+
+void CompoundPartBoxes::lay_out(const Bodies& bodies) {
+    if (!m_changed) return;
+    m_changed = false;
+    const std::uint32_t end = m_members.empty() ? 0 : *std::max_element(m_members.begin(), m_members.end()) + 1;
+    m_index.assign(end, kNone);
+    m_first.assign(m_members.size() + 1, 0);
+    for (std::uint32_t k = 0; k < m_members.size(); ++k) {
+        m_index[m_members[k]] = k;
+        m_first[k + 1] = m_first[k] + bodies.desc[m_members[k]].shape.parts->size();
+    }
+    m_made.assign(m_members.size(), 0);  // a slot's compound may be another now
+    m_boxes.resize(m_first.back());
+}
+
+std::size_t CompoundPartBoxes::heap_bytes() const noexcept {
+    return m_members.capacity() * sizeof(std::uint32_t) + m_index.capacity() * sizeof(std::uint32_t) +
+           m_first.capacity() * sizeof(std::uint32_t) + m_made.capacity() * sizeof(std::uint64_t) +
+           m_boxes.capacity() * sizeof(Aabb);
+}
+
 void add_proxy(World& world, std::uint32_t slot) {
     BroadphaseState& bp = *world.broadphase;
     const Bodies& b = world.bodies;
     if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
     if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
     bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
+    bp.part_boxes.add(b, slot);
     mark_refit(bp, slot);
 }
 
@@ -59,6 +94,7 @@ void remove_proxy(World& world, std::uint32_t slot) {
     BroadphaseState& bp = *world.broadphase;
     bp.tree.destroy_proxy(bp.proxy[slot]);
     bp.proxy[slot] = ProxyId{};
+    bp.part_boxes.remove(slot);
 }
 
 void refresh_proxy(World& world, std::uint32_t slot) {
@@ -183,20 +219,14 @@ void update_broadphase(World& world, Real dt) {
     // Bounds, and whether each proxy must move, in parallel; the tree is single-writer,
     // so the few proxies that left their fat boxes are moved after, in awake order.
     bp.moving.resize(n);
-    if (bp.part_boxes.size() < b.capacity()) {
-        bp.part_boxes.resize(b.capacity());
-        bp.part_boxes_step.resize(b.capacity(), 0);
-    }
+    bp.part_boxes.lay_out(b);
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             const Shape& shape = b.desc[i].shape;
             if (shape.type == ShapeType::Compound) {
                 // Kept for the narrowphase's part walks, which would make the same boxes again.
-                std::vector<Aabb>& parts = bp.part_boxes[i];
-                parts.resize(shape.parts->size());
-                b.bounds[i] = shape.parts->bounds(b.transform(i), parts);
-                bp.part_boxes_step[i] = world.steps + 1;
+                b.bounds[i] = shape.parts->bounds(b.transform(i), bp.part_boxes.fill(i, world.steps));
             } else {
                 b.bounds[i] = shape.bounds(b.transform(i));
             }

@@ -10,6 +10,52 @@
 
 namespace spindle {
 
+// The moving compounds' part boxes: each one's parts' world boxes, made with its bounds by
+// a step's Bounds jobs, which the narrowphase's part walks read in that step instead of
+// making them again. Only compound bodies that can move have room here, so a scene
+// without them holds nothing.
+class CompoundPartBoxes {
+public:
+    // A body's proxy was added (kept when the body is a compound that can move) or removed
+    // (add_proxy, remove_proxy): the room is laid out again at the next broadphase, before
+    // its Bounds jobs.
+    void add(const Bodies& bodies, std::uint32_t slot);
+    void remove(std::uint32_t slot);
+    // Gives each compound its range of boxes, when the compounds changed.
+    void lay_out(const Bodies& bodies);
+    // Body `slot`'s boxes for the Bounds job to fill in `step` (empty: not a kept compound).
+    // A job writes its bodies' ranges only, so the jobs may run at once.
+    std::span<Aabb> fill(std::uint32_t slot, std::uint64_t step) {
+        const std::uint32_t k = find(slot);
+        if (k == kNone) return {};
+        m_made[k] = step + 1;
+        return std::span<Aabb>(m_boxes).subspan(m_first[k], m_first[k + 1] - m_first[k]);
+    }
+    // Body `slot`'s boxes when the broadphase made them in `step`, else empty: a compound
+    // asleep, static or moved since has others.
+    std::span<const Aabb> made_in(std::uint32_t slot, std::uint64_t step) const {
+        const std::uint32_t k = find(slot);
+        if (k == kNone || m_made[k] != step + 1) return {};
+        return std::span<const Aabb>(m_boxes).subspan(m_first[k], m_first[k + 1] - m_first[k]);
+    }
+    std::size_t heap_bytes() const noexcept;
+
+private:
+    static constexpr std::uint32_t kNone = ~std::uint32_t{0};
+    // The compound's place in the layout, or kNone.
+    std::uint32_t find(std::uint32_t slot) const { return slot < m_index.size() ? m_index[slot] : kNone; }
+
+    std::vector<std::uint32_t> m_members;  // the kept compounds' slots, in the order they came
+    bool m_changed = false;                // m_members differs from the layout
+    // The layout: per slot up to the highest kept compound's, its place (kNone: none), so
+    // that a part walk finds its boxes at once; per place, the first of its boxes (one
+    // more at the end) and the step they were made in plus one (0: never).
+    std::vector<std::uint32_t> m_index;
+    std::vector<std::uint32_t> m_first;
+    std::vector<std::uint64_t> m_made;
+    std::vector<Aabb> m_boxes;
+};
+
 struct BroadphaseState {
     ProxyTrees tree;             // moving and static AABB trees; proxy user value = body slot
     std::vector<ProxyId> proxy;  // per body slot
@@ -21,18 +67,8 @@ struct BroadphaseState {
     std::vector<std::uint8_t> moving;         // scratch, per awake body: its proxy must move this step
     std::vector<std::uint64_t> new_keys;      // scratch: keys of the new pairs that may make contacts
     std::vector<std::uint32_t> range_counts;  // scratch: values kept per job range (broadphase.cpp)
-    // Per body slot: a compound's parts' world boxes, made with its bounds by this step's
-    // Bounds jobs, and the step they were made in plus one (0: never). The narrowphase
-    // reads them in that step only: a body asleep or moved since has others.
-    std::vector<std::vector<Aabb>> part_boxes;
-    std::vector<std::uint64_t> part_boxes_step;
+    CompoundPartBoxes part_boxes;
 };
-
-// Body i's part boxes when the broadphase made them this step, else empty.
-inline std::span<const Aabb> step_part_boxes(const BroadphaseState& bp, std::uint32_t i, std::uint64_t step) {
-    if (i >= bp.part_boxes_step.size() || bp.part_boxes_step[i] != step + 1) return {};
-    return bp.part_boxes[i];
-}
 
 // Whether bodies on layers a and b collide, per the space's layer table.
 inline bool layers_collide(const World& world, std::uint32_t a, std::uint32_t b) {

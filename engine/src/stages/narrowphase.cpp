@@ -212,6 +212,7 @@ void update_narrowphase(World& world) {
         // Per range, not per pair, and reset only as far as used: a convex pair fills one
         // of the kMaxManifolds a compound may need.
         ContactManifold fresh[kMaxManifolds];
+        TriangleFeatures no_triangles;  // what a pair of no mesh is given (it only clears them)
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
             // Only a pair without points is ruled out. The packed summary says so unless
@@ -246,12 +247,15 @@ void update_narrowphase(World& world) {
             const Shape& shape_b = b.desc[bb].shape;
             // A compound's part boxes, where the broadphase made them this step.
             const auto part_boxes = [&](const Shape& shape, std::uint32_t i) {
-                return shape.type == ShapeType::Compound ? step_part_boxes(*world.broadphase, i, world.steps)
+                return shape.type == ShapeType::Compound ? world.broadphase->part_boxes.made_in(i, world.steps)
                                                          : std::span<const Aabb>();
             };
             const PartBoxes boxes{part_boxes(shape_a, a), part_boxes(shape_b, bb)};
+            // Only a mesh pair keeps triangle features; the others' record has no room for them.
+            const bool mesh = shape_a.type == ShapeType::TriangleMesh || shape_b.type == ShapeType::TriangleMesh;
+            TriangleFeatures& triangles = mesh ? contact.made_extra().triangle_features : no_triangles;
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         contact.triangle_features, settings.linear_slop, boxes);
+                                         triangles, settings.linear_slop, boxes);
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;
@@ -270,7 +274,7 @@ void update_narrowphase(World& world) {
             }
             contact.manifold_count = static_cast<std::uint8_t>(n);
             if (n > 0) contact.manifold = fresh[0];
-            if (n > 1) contact.extra.assign(fresh + 1, fresh + n);
+            if (n > 1) contact.made_extra().manifolds.assign(fresh + 1, fresh + n);
             remember(contact, b);
             // New manifolds, new summary (a cached pair, above, keeps both).
             world.contact_summaries[awake[k]] = contact_summary(contact);

@@ -36,7 +36,7 @@ TEST(BoxBox, SeparatedGivesNothingOrSpeculativePoints) {
 TEST(BoxBox, TouchingHasZeroSeparation) {
     const auto m = run(kFloor, at(Vec3::Zero()), kCube, at(Vec3(0, 1.0, 0)));
     ASSERT_EQ(m.size(), 1u);
-    EXPECT_NEAR(test::min_separation(m[0]), 0, 1e-12);
+    EXPECT_NEAR(deepest(m[0]), 0, 1e-12);
 }
 
 TEST(BoxBox, RotatedCubeKeepsItsRotatedCorners) {
@@ -46,7 +46,7 @@ TEST(BoxBox, RotatedCubeKeepsItsRotatedCorners) {
     const Real r = std::sqrt(0.5);
     EXPECT_TRUE(test::has_point(m[0], Vec3(r, 0.49, 0), 1e-12));
     EXPECT_TRUE(test::has_point(m[0], Vec3(0, 0.49, -r), 1e-12));
-    EXPECT_NEAR(test::min_separation(m[0]), -0.02, 1e-12);
+    EXPECT_NEAR(deepest(m[0]), -0.02, 1e-12);
 }
 
 TEST(BoxBox, TiltedCubeRestsOnOneEdgeWithTwoPoints) {
@@ -67,7 +67,7 @@ TEST(BoxBox, DeepOverlapPushesOutAlongShallowestFace) {
     const auto m = run(cube, at(Vec3::Zero()), cube, at(Vec3(0.2, 1.5, 0.1)));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, 1, 0), 1e-12);
-    EXPECT_NEAR(test::min_separation(m[0]), -0.5, 1e-12);
+    EXPECT_NEAR(deepest(m[0]), -0.5, 1e-12);
     EXPECT_EQ(m[0].point_count, 4);
 }
 
@@ -132,7 +132,7 @@ TEST(BoxBox, MatchesHullHullOnRandomPoses) {
         ASSERT_EQ(boxes.size(), hulls.size()) << "trial " << trial;
         if (boxes.empty()) continue;
         ++compared;
-        EXPECT_NEAR(test::min_separation(boxes[0]), test::min_separation(hulls[0]), 1e-6) << "trial " << trial;
+        EXPECT_NEAR(deepest(boxes[0]), deepest(hulls[0]), 1e-6) << "trial " << trial;
         EXPECT_GT(boxes[0].normal.dot(hulls[0].normal), 0.999) << "trial " << trial;
     }
     EXPECT_GT(compared, 30);
@@ -153,7 +153,7 @@ TEST(BoxBox, CardsMeetingAtAnApexPushAlongTheBisector) {
     const auto apex = run(card, left, card, right, 0.01);
     ASSERT_EQ(apex.size(), 1u);
     EXPECT_NEAR(apex[0].normal.x(), 1, 1e-9);
-    EXPECT_NEAR(test::min_separation(apex[0]), 0, 1e-9);
+    EXPECT_NEAR(deepest(apex[0]), 0, 1e-9);
 
     const Vec3 down_the_face = -Vec3(c, s, 0) * 0.001;
     const auto lower = run(card, left, card, at(right.p + down_the_face, right.q), 0.01);

@@ -41,12 +41,6 @@ inline std::vector<Manifold> run(const Shape& a, const Transform& xa, const Shap
     return out;
 }
 
-inline Real min_separation(const Manifold& m) {
-    Real s = kHuge;
-    for (int i = 0; i < m.point_count; ++i) s = std::min(s, m.points[i].separation);
-    return s;
-}
-
 // Whether the manifold has a point within tol of p.
 inline bool has_point(const Manifold& m, const Vec3& p, Real tol = 1e-6) {
     for (int i = 0; i < m.point_count; ++i) {

@@ -107,7 +107,7 @@ TEST(ConvexConsistency, SwappedOrderFlipsNormalAndKeepsDepth) {
                 // Mixed types run the same pair function underneath. Equal types may pick
                 // the other shape's face as reference (the choice is biased towards A
                 // within 2%), so their depths agree only to that tolerance.
-                const Real sa = test::min_separation(ab[0]), sb = test::min_separation(ba[0]);
+                const Real sa = deepest(ab[0]), sb = deepest(ba[0]);
                 EXPECT_NEAR(sa, sb, a.type != b.type ? 1e-9 : 0.021 * std::abs(sa) + 6e-4);
                 if (a.type != b.type) {
                     SPINDLE_EXPECT_VEC_NEAR(ab[0].normal, Vec3(-ba[0].normal), 1e-12);
@@ -145,7 +145,7 @@ TEST(ConvexConsistency, DepthMatchesBruteForcePenetration) {
                 // No point is deeper than the overlap along the normal; mostly the deepest
                 // point has exactly that depth (not when the deepest corner of one shape
                 // lies beside the other's reference face: clipping drops it).
-                const Real sep = test::min_separation(m[0]);
+                const Real sep = deepest(m[0]);
                 EXPECT_GE(sep, -along_normal - 1e-9) << "trial " << trial;
                 if (std::abs(sep + along_normal) < 1e-6) ++exact;
                 // Between polyhedra, each clipped point's two surface points (a point lies
@@ -194,11 +194,11 @@ TEST(ConvexPairs, SeparatedTouchingAndPenetratingAlongX) {
             auto m = test::run(a.shape, xa, b.shape, pose_b(0.1), 0.2);
             ASSERT_EQ(m.size(), 1u);
             SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(1, 0, 0), 1e-9);
-            EXPECT_NEAR(test::min_separation(m[0]), 0.1, 1e-9);
+            EXPECT_NEAR(deepest(m[0]), 0.1, 1e-9);
             // Touching.
             m = test::run(a.shape, xa, b.shape, pose_b(0), 1e-9);
             ASSERT_EQ(m.size(), 1u);
-            EXPECT_NEAR(test::min_separation(m[0]), 0, 1e-9);
+            EXPECT_NEAR(deepest(m[0]), 0, 1e-9);
             // Resting 0.02 deep: every point at that depth, midway between the surfaces.
             m = test::run(a.shape, xa, b.shape, pose_b(-0.02));
             ASSERT_EQ(m.size(), 1u);

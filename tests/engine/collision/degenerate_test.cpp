@@ -36,10 +36,10 @@ TEST(Degenerate, IdenticalBoxesAndCapsulesPushApartAlongAnAxis) {
     const Transform x = at(Vec3(0.5, 1, -2), about(Vec3(1, 2, 3), 0.4));
     const auto boxes = run(Shape::box(Vec3(1, 1, 1)), x, Shape::box(Vec3(1, 1, 1)), x);
     ASSERT_EQ(boxes.size(), 1u);
-    EXPECT_NEAR(test::min_separation(boxes[0]), -2, 1e-9);
+    EXPECT_NEAR(deepest(boxes[0]), -2, 1e-9);
     const auto capsules = run(Shape::capsule(1, 0.5), x, Shape::capsule(1, 0.5), x);
     ASSERT_EQ(capsules.size(), 1u);
-    EXPECT_NEAR(test::min_separation(capsules[0]), -1, 1e-12);
+    EXPECT_NEAR(deepest(capsules[0]), -1, 1e-12);
     EXPECT_NEAR(capsules[0].normal.dot(x.rotate(Vec3::UnitY())), 0, 1e-12);  // across the axis
 }
 
@@ -66,7 +66,7 @@ TEST(Degenerate, SphereCentreOnCapsuleAxisAndInsideHull) {
     const auto h = run(Shape::sphere(0.2), at(Vec3(0, 0, 0)), test::hull_box(Vec3(1, 2, 3)), at(Vec3::Zero()));
     ASSERT_EQ(h.size(), 1u);
     EXPECT_NEAR(std::abs(h[0].normal.x()), 1, 1e-12);  // out through the nearest face, x = +-1
-    EXPECT_NEAR(test::min_separation(h[0]), -1.2, 1e-12);
+    EXPECT_NEAR(deepest(h[0]), -1.2, 1e-12);
 }
 
 TEST(Degenerate, ZeroThicknessHullIsRejectedAtBuild) {

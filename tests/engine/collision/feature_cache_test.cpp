@@ -40,12 +40,6 @@ Real plane_distance(const Shape& shape, const Transform& x, const Vec3& world) {
     return d;
 }
 
-Real min_separation(const Manifold& m) {
-    Real s = kHuge;
-    for (int j = 0; j < m.point_count; ++j) s = std::min(s, m.points[j].separation);
-    return s;
-}
-
 void expect_same(const Manifold* x, int nx, const Manifold* y, int ny, int step) {
     ASSERT_EQ(nx, ny) << "step " << step;
     for (int m = 0; m < nx; ++m) {
@@ -130,14 +124,14 @@ struct Tumble {
             // Overlapping deeply (a path through A, never a resting pair), the whole SAT's
             // least overlap jumps between far apart axes, and a kept feature may be any of
             // them: only the above holds there.
-            if (min_separation(p) < -shallow) continue;
+            if (deepest(p) < -shallow) continue;
             // Near touching, the kept feature is the whole SAT's or, where the SAT has just
             // moved on to a neighbour, that neighbour's: its normal is at most one
             // neighbouring face's angle off, and its deepest point within the slop of the
             // SAT's (the kept separation along its axis drifted by less than the slop).
             const Real angle = std::acos(std::clamp(c.normal.dot(p.normal), Real(-1), Real(1)));
             EXPECT_LE(angle, neighbour_angle) << "step " << step;
-            EXPECT_NEAR(min_separation(c), min_separation(p), slop) << "step " << step;
+            EXPECT_NEAR(deepest(c), deepest(p), slop) << "step " << step;
         }
     }
 };
@@ -190,7 +184,7 @@ TEST(FeatureCache, HullSlidingOnAFloorKeepsTheFloorsFace) {
         EXPECT_EQ(cache.kind(), FeatureCache::Kind::FaceA) << "step " << step;  // the box is the pair function's A
         reused += before == cache;
         EXPECT_NEAR(cached[0].normal.dot(plain[0].normal), 1, 1e-12) << "step " << step;
-        EXPECT_NEAR(min_separation(cached[0]), min_separation(plain[0]), 1e-12) << "step " << step;
+        EXPECT_NEAR(deepest(cached[0]), deepest(plain[0]), 1e-12) << "step " << step;
     }
     EXPECT_EQ(reused, kSteps - 1);
 }
@@ -291,7 +285,7 @@ void expect_close(const Manifold* x, int nx, const Manifold* y, int ny, int step
     ASSERT_EQ(nx, ny) << "step " << step;
     for (int m = 0; m < nx; ++m) {
         EXPECT_NEAR(x[m].normal.dot(y[m].normal), 1, 1e-12) << "step " << step;
-        EXPECT_NEAR(min_separation(x[m]), min_separation(y[m]), 1e-12) << "step " << step;
+        EXPECT_NEAR(deepest(x[m]), deepest(y[m]), 1e-12) << "step " << step;
         EXPECT_EQ(x[m].part_a, y[m].part_a) << "step " << step;
         EXPECT_EQ(x[m].part_b, y[m].part_b) << "step " << step;
     }

@@ -42,7 +42,7 @@ TEST(HullHull, SpeculativeFaceContact) {
     const auto m = run(cube, at(Vec3::Zero()), cube, at(Vec3(0, 1.2, 0)), 0.25);
     ASSERT_EQ(m.size(), 1u);
     EXPECT_EQ(m[0].point_count, 4);
-    EXPECT_NEAR(test::min_separation(m[0]), 0.2, 1e-12);
+    EXPECT_NEAR(deepest(m[0]), 0.2, 1e-12);
 }
 
 TEST(HullHull, FeatureIdsHoldWhileSliding) {

@@ -43,7 +43,7 @@ TEST(ConvexMesh, SphereOnASeamVertexGetsOneFaceNormal) {
     const auto m = run(Shape::sphere(0.5), at(Vec3(2, 0.45, 2)), unit_grid(4), at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
-    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+    EXPECT_NEAR(deepest(m[0]), -0.05, 1e-9);
 }
 
 TEST(ConvexMesh, BoxOnGridMergesIntoOneFourPointManifold) {
@@ -64,7 +64,7 @@ TEST(ConvexMesh, SlidingBoxNeverCatchesOnInteriorEdges) {
         const auto m = run(box, xb, ground, at(Vec3::Zero()));
         ASSERT_EQ(m.size(), 1u) << "step " << step;
         SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
-        EXPECT_NEAR(test::min_separation(m[0]), -0.005, 1e-9) << "step " << step;
+        EXPECT_NEAR(deepest(m[0]), -0.005, 1e-9) << "step " << step;
     }
 }
 
@@ -93,7 +93,7 @@ TEST(ConvexMesh, SphereOnARidgeTakesTheEdgeNormal) {
     const auto m = run(Shape::sphere(0.5), at(Vec3(0, 1.45, 0)), roof, at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
-    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+    EXPECT_NEAR(deepest(m[0]), -0.05, 1e-9);
 }
 
 TEST(ConvexMesh, SphereInAValleyGetsTwoManifoldsDeepestFirst) {
@@ -105,8 +105,8 @@ TEST(ConvexMesh, SphereInAValleyGetsTwoManifoldsDeepestFirst) {
     const Vec3 right = Vec3(1, -1, 0).normalized(), left = Vec3(-1, -1, 0).normalized();
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, right, 1e-9);
     SPINDLE_EXPECT_VEC_NEAR(m[1].normal, left, 1e-9);
-    EXPECT_NEAR(test::min_separation(m[0]), (c.y() - c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
-    EXPECT_NEAR(test::min_separation(m[1]), (c.y() + c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
+    EXPECT_NEAR(deepest(m[0]), (c.y() - c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
+    EXPECT_NEAR(deepest(m[1]), (c.y() + c.x()) / std::sqrt(2.0) - 0.5, 1e-9);
     const auto capped = run(Shape::sphere(0.5), at(c), v, at(Vec3::Zero()), 0, 1);
     ASSERT_EQ(capped.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(capped[0].normal, right, 1e-9);
@@ -128,7 +128,7 @@ TEST(ConvexMesh, MovedAndRotatedMeshKeepsWorldResults) {
     const auto m = run(Shape::sphere(0.5), at(c), unit_grid(2), xm);
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(q * Vec3(0, -1, 0)), 1e-9);
-    EXPECT_NEAR(test::min_separation(m[0]), -0.05, 1e-9);
+    EXPECT_NEAR(deepest(m[0]), -0.05, 1e-9);
 }
 
 TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
@@ -155,8 +155,7 @@ TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
                                    about(Vec3(rnd(), rnd(), rnd()), 3 * rnd()));
             const auto m = run(s, x, mesh, at(Vec3::Zero()), 0.05, 4);
             hits += m.empty() ? 0 : 1;
-            for (std::size_t i = 1; i < m.size(); ++i)
-                EXPECT_LE(test::min_separation(m[i - 1]), test::min_separation(m[i]));
+            for (std::size_t i = 1; i < m.size(); ++i) EXPECT_LE(deepest(m[i - 1]), deepest(m[i]));
         }
     }
     EXPECT_GT(hits, 100);

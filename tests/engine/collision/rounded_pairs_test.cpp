@@ -121,7 +121,7 @@ TEST(CapsuleBox, CoreInsideBoxUsesSat) {
     const auto m = run(Shape::capsule(0.5, 0.25), at(Vec3(0, 1.4, 0)), Shape::box(Vec3(1, 1, 1)), at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-12);
-    EXPECT_NEAR(test::min_separation(m[0]), -0.35, 1e-12);
+    EXPECT_NEAR(deepest(m[0]), -0.35, 1e-12);
 }
 
 TEST(CapsuleBox, CapsuleOverBoxEdgeTakesEdgeNormal) {
@@ -132,7 +132,7 @@ TEST(CapsuleBox, CapsuleOverBoxEdgeTakesEdgeNormal) {
                        at(Vec3::Zero()));
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(-1, -1, 0).normalized(), 1e-9);
-    EXPECT_NEAR(test::min_separation(m[0]), std::sqrt(0.08) - 0.3, 1e-9);
+    EXPECT_NEAR(deepest(m[0]), std::sqrt(0.08) - 0.3, 1e-9);
 }
 
 TEST(SphereHull, MatchesSphereBox) {
@@ -163,7 +163,7 @@ TEST(CapsuleHull, MatchesCapsuleBox) {
         if (expected.empty()) continue;
         SPINDLE_EXPECT_VEC_NEAR(actual[0].normal, expected[0].normal, 1e-9);
         EXPECT_EQ(actual[0].point_count, expected[0].point_count);
-        EXPECT_NEAR(test::min_separation(actual[0]), test::min_separation(expected[0]), 1e-9);
+        EXPECT_NEAR(deepest(actual[0]), deepest(expected[0]), 1e-9);
     }
 }
 

@@ -57,11 +57,16 @@ Shape floor_mesh() {
 constexpr Real kLandingSlide = 0.015;
 constexpr Real kLandingTurn = 0.012;
 
+// Steps until the body sleeps (at most kSettleSteps).
+void step_until_asleep(Space& space, BodyHandle handle) {
+    for (int i = 0; i < kSettleSteps && space.internal_is_awake(handle); ++i) space.update();
+}
+
 // Steps until the body sleeps or kSettleSteps pass; expects it asleep near where it
 // started in x and z, at `height`, hardly turned from `orientation`.
 void expect_rests(Space& space, BodyHandle handle, const Vec3& start, Real height, const Quat& orientation,
                   const char* what) {
-    for (int i = 0; i < kSettleSteps && space.internal_is_awake(handle); ++i) space.update();
+    step_until_asleep(space, handle);
     const Vec3 p = space.position(handle);
     EXPECT_FALSE(space.internal_is_awake(handle)) << what << ": still awake after " << kSettleSteps << " steps";
     EXPECT_NEAR(p.y(), height, kRestDepth) << what;
@@ -260,6 +265,53 @@ TEST(CompoundResting, CompoundOfOneBallRollsAsTheBall) {
     EXPECT_NEAR(ball_p.y(), 0.5, 1e-3);
     EXPECT_LT((compound_p - ball_p).norm(), 1e-9) << compound_p.transpose() << " vs " << ball_p.transpose();
     EXPECT_LT(compound_q.angularDistance(ball_q), 1e-9);
+}
+
+// A cube dropped onto the top of a table standing at `place` rests on the top, not on the floor.
+void expect_cube_lands_on_table(Space& space, const Vec3& place, const char* what) {
+    constexpr Real kHalf = 0.15;
+    const Vec3 start = place + Vec3(0.2, kTableHeight + kHalf + 0.1, 0.1);
+    const BodyHandle cube = space.create_body(body(Shape::box(Vec3::Constant(kHalf)), start));
+    step_until_asleep(space, cube);
+    EXPECT_NEAR(space.position(cube).y(), kTableHeight + kHalf, kRestDepth) << what;
+    space.destroy_body(cube);
+}
+
+// The narrowphase takes a compound's part boxes from the broadphase only in the step it
+// made them: a compound that slept, was struck and slid away, or was made static and then
+// moved, is met where it is, not where its boxes were last made.
+TEST(CompoundResting, TableIsMetWhereItIsAfterSleepingBeingStruckAndBeingMadeStaticAndMoved) {
+    Space space;
+    add_plane(space);
+    const BodyHandle t = space.create_body(body(table(), Vec3(0, 0.02, 0)));
+    step_until_asleep(space, t);
+    ASSERT_FALSE(space.internal_is_awake(t));
+    expect_cube_lands_on_table(space, space.position(t), "asleep");
+
+    // A bar flies into the sleeping table's legs, low, and sends it sliding along x.
+    step_until_asleep(space, t);
+    ASSERT_FALSE(space.internal_is_awake(t));
+    const Vec3 before = space.position(t);
+    BodyDesc bar = body(Shape::box(Vec3(0.1, 0.1, 0.7)), before + Vec3(-2, 0.25, 0));
+    bar.density = 5000;
+    bar.linear_velocity = Vec3(5, 0, 0);
+    bar.gravity_scale = 0;
+    const BodyHandle hit = space.create_body(bar);
+    for (int i = 0; i < 60; ++i) space.update();
+    space.destroy_body(hit);
+    step_until_asleep(space, t);
+    ASSERT_FALSE(space.internal_is_awake(t));
+    const Vec3 struck = space.position(t);
+    ASSERT_GT(struck.x() - before.x(), 0.5) << "the ball did not move the table";
+    expect_cube_lands_on_table(space, struck, "struck and moved");
+
+    // Made static where it stands, then moved: a static body's parts have no boxes made.
+    space.set_motion_type(t, MotionType::Static);
+    space.update();
+    const Vec3 moved = struck + Vec3(-4, 0, 3);
+    space.set_position(t, moved);
+    space.update();
+    expect_cube_lands_on_table(space, moved, "made static and moved");
 }
 
 }  // namespace
