@@ -188,6 +188,11 @@ struct Contact {
     }
 };
 
+// A contact moved to a removed one's place (remove_contacts).
+struct ContactMove {
+    std::uint32_t from = 0, to = 0;
+};
+
 // The most manifolds one contact keeps: a compound's touching part pairs (a triangle
 // mesh keeps fewer, collide_mesh.cpp).
 inline constexpr int kMaxContactManifolds = 8;
@@ -259,8 +264,8 @@ struct World {
     std::vector<std::uint32_t> awake_pending;
     std::size_t awake_left_from = kNoPosition;
 
-    // Collision: contacts in a deterministic order (creation order from canonical
-    // pair lists; removal keeps the order of the rest).
+    // Collision: contacts in a deterministic order (creation order from canonical pair
+    // lists; removed places taken by the last contacts, remove_contacts).
     std::unique_ptr<BroadphaseState> broadphase;
     HugePageVector<Contact> contacts;
     ContactIndex contact_index;  // key -> position in contacts
@@ -334,7 +339,9 @@ struct World {
     std::vector<ContactCounts> contact_counts;                   // per worker (narrowphase.cpp)
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     std::vector<std::uint32_t> scratch_lost;
-    std::vector<FastStart> fast_starts;  // continuous.cpp
+    std::vector<ContactMove> scratch_contact_moves;  // remove_contacts (contact_list.cpp)
+    std::vector<std::uint32_t> scratch_moved_awake;  // the same: the moved contacts that are awake
+    std::vector<FastStart> fast_starts;              // continuous.cpp
     // Live bodies that are fast (create_body, destroy_body): without any, a step skips
     // the Continuous stage instead of walking the awake bodies to find none.
     std::uint32_t fast_bodies = 0;

@@ -103,7 +103,8 @@ void remove_contacts_of(World& world, std::uint32_t slot);
 void create_contacts(World& world, std::span<const std::uint64_t> keys);
 // Gives back the contact arrays' room when it is far above their use (a pile came apart).
 void fit_contacts(World& world);
-// Removes contacts by their positions in world.contacts (ascending), keeping the order of the rest.
+// Removes contacts by their positions in world.contacts (ascending); the kept contacts
+// past the new end take the removed places below it, in order (the rest stay in place).
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);
 
 }  // namespace spindle

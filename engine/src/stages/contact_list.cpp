@@ -1,5 +1,6 @@
-// Contact bookkeeping: creation from pair keys, removal that keeps the order of the
-// remaining contacts (so the solver's order, and so its result, is deterministic).
+// Contact bookkeeping: creation from pair keys, and removal that fills the removed places
+// with the last contacts (in a fixed order, so the solver's order, and so its result, is
+// deterministic).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -31,17 +32,36 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
     contact.events = contact_event_flags(world, a, b);
 }
 
-// Takes the removed positions (ascending) out of an up-to-date awake list and moves the
-// rest down as the removal moved their contacts: the list a rebuild would give, without
-// reading the records.
-void drop_from_awake_list(std::vector<std::uint32_t>& awake, const std::vector<std::uint32_t>& removed) {
-    std::size_t write = 0, r = 0;
+// Takes the removed positions (ascending) out of an up-to-date awake list and renames the
+// moved contacts as remove_contacts moved them: the ascending list a rebuild would give,
+// without reading the records. Every position at or past `size` (the new count) was either
+// removed or moved; the moves are in ascending order of both ends, so the awake ones among
+// them are gathered in order of their new places and merged in.
+void drop_from_awake_list(std::vector<std::uint32_t>& awake, const std::vector<std::uint32_t>& removed,
+                          const std::vector<ContactMove>& moves, std::uint32_t size,
+                          std::vector<std::uint32_t>& moved_awake) {
+    moved_awake.clear();
+    std::size_t write = 0, r = 0, m = 0;
     for (const std::uint32_t c : awake) {
+        if (c >= size) {
+            while (m < moves.size() && moves[m].from < c) ++m;
+            if (m < moves.size() && moves[m].from == c) moved_awake.push_back(moves[m].to);
+            continue;
+        }
         while (r < removed.size() && removed[r] < c) ++r;
         if (r < removed.size() && removed[r] == c) continue;
-        awake[write++] = c - static_cast<std::uint32_t>(r);
+        awake[write++] = c;
     }
-    awake.resize(write);
+    // Merged from the back, so no kept position is overwritten before it is read.
+    awake.resize(write + moved_awake.size());
+    std::size_t kept = write, from_moved = moved_awake.size(), out = awake.size();
+    while (from_moved > 0) {
+        if (kept > 0 && awake[kept - 1] > moved_awake[from_moved - 1]) {
+            awake[--out] = awake[--kept];
+        } else {
+            awake[--out] = moved_awake[--from_moved];
+        }
+    }
 }
 
 }  // namespace
@@ -112,29 +132,39 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
         note_contact_removed(world, world.contacts[p]);  // a touching one ends its touch
         world.contact_index.erase(world.contact_keys[p]);
     }
-    // The contacts before the first removed one keep their places (and their index entries).
-    std::size_t next = 0, write = positions[0];
-    for (std::size_t read = positions[0]; read < world.contacts.size(); ++read) {
-        if (next < positions.size() && positions[next] == read) {
-            ++next;
-            continue;
-        }
-        world.contacts[write] = std::move(world.contacts[read]);
-        world.contact_keys[write] = world.contact_keys[read];
-        world.contact_summaries[write] = world.contact_summaries[read];
-        ++write;
+    // The kept contacts past the new end fill the removed places below it, both taken in
+    // ascending order (Box3D swaps the last contact into a removed one's place): each
+    // record moves at most once and no more move than are removed, where keeping the
+    // order moved every record after the first removed one.
+    const auto size = static_cast<std::uint32_t>(world.contacts.size() - positions.size());
+    const auto holes =
+        static_cast<std::size_t>(std::lower_bound(positions.begin(), positions.end(), size) - positions.begin());
+    std::vector<ContactMove>& moves = world.scratch_contact_moves;
+    moves.clear();
+    std::size_t tail_removed = holes;  // the first removed position at or past the new end not yet passed
+    std::uint32_t from = size;
+    for (std::size_t h = 0; h < holes; ++h, ++from) {
+        for (; tail_removed < positions.size() && positions[tail_removed] == from; ++tail_removed) ++from;
+        const std::uint32_t to = positions[h];
+        world.contacts[to] = std::move(world.contacts[from]);
+        world.contact_keys[to] = world.contact_keys[from];
+        world.contact_summaries[to] = world.contact_summaries[from];
+        moves.push_back({from, to});
     }
     // The index learns the moved contacts' positions: one lookup each, in parallel (each
     // writes only its own key's entry; no key is added or removed meanwhile).
-    world.jobs->parallel_for("MovedContacts", positions[0], static_cast<std::uint32_t>(write), kMovedContactGrain,
+    world.jobs->parallel_for("MovedContacts", 0, static_cast<std::uint32_t>(moves.size()), kMovedContactGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-                                 for (std::uint32_t c = lo; c < hi; ++c)
-                                     *world.contact_index.find(world.contact_keys[c]) = c;
+                                 for (std::uint32_t k = lo; k < hi; ++k) {
+                                     *world.contact_index.find(world.contact_keys[moves[k].to]) = moves[k].to;
+                                 }
                              });
-    world.contacts.resize(write);
-    world.contact_keys.resize(write);
-    world.contact_summaries.resize(write);
-    if (!world.awake_contacts_dirty) drop_from_awake_list(world.awake_contact_list, positions);
+    world.contacts.resize(size);
+    world.contact_keys.resize(size);
+    world.contact_summaries.resize(size);
+    if (!world.awake_contacts_dirty) {
+        drop_from_awake_list(world.awake_contact_list, positions, moves, size, world.scratch_moved_awake);
+    }
 }
 
 void remove_contacts_of(World& world, std::uint32_t slot) {

@@ -16,6 +16,7 @@
 #include "api/space_internals.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/contact_events.hpp"
+#include "stages/stages.hpp"
 #include "test_job_systems.hpp"
 #include "world.hpp"
 
@@ -220,7 +221,7 @@ namespace {
 
 // Balls thrown through each other in a space without gravity, never asleep: contacts are
 // made and lost in most steps, and the awake list the stages keep up to date (new
-// positions appended, removed ones dropped and the rest moved down) stays the list a
+// positions appended, removed ones dropped and the last ones renamed to their places) stays the list a
 // rebuild from the records gives.
 TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
     SpaceSettings settings;
@@ -255,6 +256,75 @@ TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
     EXPECT_GT(kept, 100);  // the list was up to date after most steps
     EXPECT_GT(made, 5);
     EXPECT_GT(lost, 5);
+}
+
+// A removal fills the removed places with the kept contacts past the new end, so each
+// record moves at most once and only as many move as are removed; the index follows the
+// moved ones, and the awake list (with sleeping contacts among the moved) stays the
+// ascending list a rebuild gives. Removed: the first place, places all through the list,
+// and the last two (taken away, not moved).
+TEST(BroadphaseContacts, RemovedContacts_TheLastContactsFillTheirPlaces) {
+    SpaceSettings settings;
+    settings.gravity = Vec3::Zero();
+    settings.sleep.enabled = false;
+    Space space(settings);
+    for (int i = 0; i < 100; ++i) {
+        BodyDesc d;
+        d.shape = Shape::sphere(0.5);
+        d.position = {Real(i % 10), Real(i / 10), 0};  // touching neighbours
+        space.create_body(d);
+    }
+    World& world = SpaceInternals::world(space);
+    space.update();
+    const auto count = static_cast<std::uint32_t>(world.contacts.size());
+    ASSERT_GT(count, 100u);
+    for (std::uint32_t c = 0; c < count; c += 3) world.contacts[c].sleeping = true;
+    world.awake_contacts_dirty = true;
+    (void)awake_contacts(world);  // up to date again, so the removal must keep it so
+
+    std::vector<std::uint32_t> removed{0};
+    for (std::uint32_t c = 7; c + 2 < count; c += 5) removed.push_back(c);
+    removed.push_back(count - 2);
+    removed.push_back(count - 1);
+    std::vector<std::uint64_t> expected = world.contact_keys, removed_keys;
+    for (std::uint32_t p : removed) removed_keys.push_back(expected[p]);
+    std::set<std::uint64_t> sleeping;
+    for (std::uint32_t c = 0; c < count; ++c) {
+        if (world.contacts[c].sleeping) sleeping.insert(world.contact_keys[c]);
+    }
+    for (std::uint32_t p : removed) sleeping.erase(expected[p]);
+    // The kept contacts past the new end, in order, into the removed places below it, in order.
+    const auto size = static_cast<std::uint32_t>(count - removed.size());
+    std::uint32_t from = size;
+    for (std::uint32_t p : removed) {
+        if (p >= size) break;
+        while (std::binary_search(removed.begin(), removed.end(), from)) ++from;
+        expected[p] = expected[from++];
+    }
+    expected.resize(size);
+    remove_contacts(world, removed);
+
+    ASSERT_EQ(world.contact_keys, expected);
+    ASSERT_EQ(world.contacts.size(), expected.size());
+    ContactIndex index = world.contact_index;
+    std::set<std::uint64_t> still_sleeping;
+    std::vector<std::uint32_t> rebuilt;
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const std::uint32_t* position = index.find(world.contact_keys[c]);
+        ASSERT_NE(position, nullptr);
+        ASSERT_EQ(*position, c);
+        ASSERT_EQ(world.contacts[c].body_a, world.contact_keys[c] >> 32);  // the record moved with its key
+        ASSERT_EQ(world.contacts[c].body_b, world.contact_keys[c] & 0xffffffffu);
+        if (world.contacts[c].sleeping) {
+            still_sleeping.insert(world.contact_keys[c]);
+        } else {
+            rebuilt.push_back(c);
+        }
+    }
+    for (std::uint64_t key : removed_keys) EXPECT_EQ(index.find(key), nullptr);
+    EXPECT_EQ(still_sleeping, sleeping);
+    ASSERT_FALSE(world.awake_contacts_dirty);
+    EXPECT_EQ(world.awake_contact_list, rebuilt);
 }
 
 }  // namespace
