@@ -1,0 +1,138 @@
+// A long pole thrown spinning end-first onto a floor lands with its end moving at 54 m/s,
+// 0.9 m a step, and goes half a metre under the floor within the step of impact (the
+// speculative margin follows the linear speed, not the spin). On a plane it is pushed
+// back out and lies down. On a flat triangle mesh (issue 19's trees on their wave mesh,
+// h45 and h50 in docs/benchmarks.md) the end stays under and goes deeper, and the pole
+// levers itself up about it, gaining energy: the mesh's triangles are two-sided, so an
+// end through a triangle is pushed on out of its back.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+using namespace spindle;
+
+namespace {
+
+constexpr int kPoleParts = 27;
+constexpr Real kPartLength = 2.0;  // 54 m, the trees scene's trees' height
+constexpr Real kPoleRadius = 0.25;
+constexpr Real kLandingGravity = 10;
+constexpr Real kPoleTilt = 0.1;  // the end thrown at the floor starts lower, so it lands first
+constexpr Real kPoleSpin = 2.0;  // rad/s: the ends move at 54 m/s
+constexpr int kThrowSteps = 300;
+// The impact takes most of the spin's energy (526 to 191 J/kg): less than this share of it
+// left marks the landing.
+constexpr Real kImpactLoss = 0.9;
+
+// A six-sided prism of radius kPoleRadius from y0 to y1.
+Shape pole_segment(Real y0, Real y1) {
+    std::vector<Vec3> points;
+    for (int k = 0; k < 6; ++k) {
+        const Real a = k * M_PI / 3;
+        for (Real y : {y0, y1}) points.emplace_back(kPoleRadius * std::cos(a), y, kPoleRadius * std::sin(a));
+    }
+    return Shape::convex_hull(points);
+}
+
+// The pole along its y axis from 0, a compound of segments as the trees scene's trees are.
+Shape segmented_pole() {
+    std::vector<CompoundPart> parts;
+    for (int i = 0; i < kPoleParts; ++i) parts.push_back({pole_segment(i * kPartLength, (i + 1) * kPartLength)});
+    return Shape::compound(parts);
+}
+
+// A flat mesh on y = 0: 100 x 100 cells of 1 m about the origin, two triangles each,
+// their fronts up.
+Shape flat_floor_mesh() {
+    constexpr int kCells = 100;
+    std::vector<Vec3> vertices;
+    std::vector<std::uint32_t> indices;
+    for (int i = 0; i <= kCells; ++i) {
+        for (int k = 0; k <= kCells; ++k) vertices.emplace_back(i - kCells / 2, 0, k - kCells / 2);
+    }
+    auto at = [](int i, int k) { return static_cast<std::uint32_t>(i * (kCells + 1) + k); };
+    for (int i = 0; i < kCells; ++i) {
+        for (int k = 0; k < kCells; ++k) {
+            for (std::uint32_t v : {at(i, k), at(i, k + 1), at(i + 1, k), at(i + 1, k), at(i, k + 1), at(i + 1, k + 1)})
+                indices.push_back(v);
+        }
+    }
+    return Shape::triangle_mesh(vertices, indices);
+}
+
+struct PoleLanding {
+    Real landed_energy = 0;  // per kg, potential plus kinetic, after the step of impact
+    Real most_energy = 0;    // the largest after that
+    Real lowest_end = 0;     // either end's axis point, lowest over the run
+    Real final_height = 0;   // of the centre of mass
+};
+
+// The pole lies along x, its centre 4 m above `floor_shape` and its +x end kPoleTilt
+// lower (0.86 m up), spinning about z so that end swings down.
+PoleLanding throw_pole_onto(const Shape& floor_shape) {
+    Space space;
+    space.set_gravity(Vec3(0, -kLandingGravity, 0));
+    BodyDesc floor;
+    floor.type = MotionType::Static;
+    floor.shape = floor_shape;
+    space.create_body(floor);
+    BodyDesc pole;
+    pole.shape = segmented_pole();
+    const Real length = kPoleParts * kPartLength;
+    pole.orientation = Quat(Eigen::AngleAxisd(-M_PI / 2 - kPoleTilt, Vec3::UnitZ()));
+    pole.position = Vec3(-length / 2 * std::cos(kPoleTilt), 4 + length / 2 * std::sin(kPoleTilt), 0);
+    pole.angular_velocity = Vec3(0, 0, -kPoleSpin);
+    pole.friction = 0.9;
+    const BodyHandle body = space.create_body(pole);
+    const MassProperties mass = pole.shape.mass_properties(1);
+
+    auto energy = [&](const MotionState& s) {
+        const Mat3 r = s.orientation.toRotationMatrix();
+        const Vec3 w = s.angular_velocity;
+        return kLandingGravity * s.center_of_mass.y() + 0.5 * s.linear_velocity.squaredNorm() +
+               0.5 * w.dot(r * mass.inertia * r.transpose() * w) / mass.mass;
+    };
+    PoleLanding run;
+    const Real thrown = energy(space.internal_motion_state(body));
+    run.lowest_end = 1e9;
+    for (int i = 0; i < kThrowSteps; ++i) {
+        space.update();
+        const MotionState s = space.internal_motion_state(body);
+        const Real e = energy(s);
+        if (run.landed_energy == 0 && e < kImpactLoss * thrown) run.landed_energy = run.most_energy = e;
+        run.most_energy = std::max(run.most_energy, e);
+        for (Real end : {Real(0), length})
+            run.lowest_end = std::min(run.lowest_end, (s.position + s.orientation * Vec3(0, end, 0)).y());
+        run.final_height = s.center_of_mass.y();
+    }
+    return run;
+}
+
+void expect_pole_lands(const PoleLanding& run) {
+    ASSERT_GT(run.landed_energy, 0) << "never landed";
+    // Contacts only take energy away; a little drift from the integrator is allowed.
+    EXPECT_LT(run.most_energy, run.landed_energy * 1.02) << "landed with " << run.landed_energy << " J/kg";
+    // On a plane the end's axis point goes 0.49 m under in the step of impact: not a
+    // whole metre.
+    EXPECT_GT(run.lowest_end, -1.0);
+    // Lying on the floor by the end: its centre of mass about a radius up.
+    EXPECT_LT(run.final_height, 4 * kPoleRadius);
+}
+
+}  // namespace
+
+TEST(MeshLanding, PoleThrownEndFirstOntoAPlaneLandsAndLiesDown) {
+    expect_pole_lands(throw_pole_onto(Shape::plane(Vec3::UnitY(), 0)));
+}
+
+// Disabled until a fast-turning body's landing on a mesh is fixed (fails on main at
+// ca7afeb: the energy after the impact goes from 191 to 438 J/kg, the end 3.0 m under
+// the floor, the centre of mass at 11.3 m after 300 steps). See h50's section in
+// docs/benchmarks.md.
+TEST(MeshLanding, DISABLED_PoleThrownEndFirstOntoAFlatMeshLandsAndLiesDown) {
+    expect_pole_lands(throw_pole_onto(flat_floor_mesh()));
+}
