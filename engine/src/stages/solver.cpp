@@ -402,7 +402,7 @@ void solve(World& world, Real dt) {
                 case Pass::IntegrateVelocities:
                     integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
                     break;
-                case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi, counts); break;
+                case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi); break;
                 case Pass::WarmStart:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,

@@ -30,7 +30,7 @@ struct PushVelocity;
 void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
                           std::uint32_t hi, EffectCounts& counts);
 void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
-                         std::uint32_t hi, EffectCounts& counts);
+                         std::uint32_t hi);
 // record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
 void record(World& world);
 

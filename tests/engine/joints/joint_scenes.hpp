@@ -45,7 +45,7 @@ struct Chain {
 // `direction`, joined end to end by ball-socket joints; with end_mass > 0, a ball of
 // that mass hangs from the last bar.
 inline Chain make_chain(Space& space, const Vec3& top, const Vec3& direction, int links, Real spacing, Real link_mass,
-                        Real end_mass = 0) {
+                        Real end_mass = 0, bool gyroscopic = false) {
     Chain chain;
     const Quat along = Quat::FromTwoVectors(Vec3::UnitX(), direction);
     BodyHandle previous = add_static(space, top);
@@ -60,6 +60,7 @@ inline Chain make_chain(Space& space, const Vec3& top, const Vec3& direction, in
         d.position = top + direction * (spacing * (i + 0.5));
         d.orientation = along;
         d.mass = link_mass;
+        d.gyroscopic = gyroscopic;
         attach(space.create_body(d), top + direction * (spacing * i));
     }
     if (end_mass > 0) {
