@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "compound_test_util.hpp"
+#include "grid_mesh.hpp"
 
 namespace spindle {
 namespace {
@@ -32,25 +33,8 @@ BodyHandle add_plane(Space& space) {
     return space.create_body(body(Shape::plane(Vec3::UnitY(), 0), Vec3::Zero(), MotionType::Static));
 }
 
-// A flat square of 8 x 8 cells, two triangles each, on y = 0.
-Shape floor_mesh() {
-    std::vector<Vec3> vertices;
-    std::vector<std::uint32_t> indices;
-    constexpr int kCells = 8;
-    constexpr Real kCell = 1.0;
-    for (int i = 0; i <= kCells; ++i) {
-        for (int k = 0; k <= kCells; ++k) vertices.emplace_back((i - kCells / 2) * kCell, 0, (k - kCells / 2) * kCell);
-    }
-    auto at = [](int i, int k) { return static_cast<std::uint32_t>(i * (kCells + 1) + k); };
-    for (int i = 0; i < kCells; ++i) {
-        for (int k = 0; k < kCells; ++k) {
-            // Counter-clockwise seen from above: the front faces +y.
-            for (std::uint32_t v : {at(i, k), at(i, k + 1), at(i + 1, k), at(i + 1, k), at(i, k + 1), at(i + 1, k + 1)})
-                indices.push_back(v);
-        }
-    }
-    return Shape::triangle_mesh(vertices, indices);
-}
+// A flat square of 8 x 8 cells of 1 m on y = 0.
+Shape floor_mesh() { return flat_grid_mesh(8, 1.0); }
 
 // A drop of a few centimetres lands with some slide and turn (a single box dropped 10 cm
 // slides 2 mm; a table on four separate leg manifolds up to 9 mm and 0.4 degrees).

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <vector>
 
+#include "grid_mesh.hpp"
+
 using namespace spindle;
 
 namespace {
@@ -45,24 +47,8 @@ Shape segmented_pole() {
     return Shape::compound(parts);
 }
 
-// A flat mesh on y = 0: 100 x 100 cells of 1 m about the origin, two triangles each,
-// their fronts up.
-Shape flat_floor_mesh() {
-    constexpr int kCells = 100;
-    std::vector<Vec3> vertices;
-    std::vector<std::uint32_t> indices;
-    for (int i = 0; i <= kCells; ++i) {
-        for (int k = 0; k <= kCells; ++k) vertices.emplace_back(i - kCells / 2, 0, k - kCells / 2);
-    }
-    auto at = [](int i, int k) { return static_cast<std::uint32_t>(i * (kCells + 1) + k); };
-    for (int i = 0; i < kCells; ++i) {
-        for (int k = 0; k < kCells; ++k) {
-            for (std::uint32_t v : {at(i, k), at(i, k + 1), at(i + 1, k), at(i + 1, k), at(i, k + 1), at(i + 1, k + 1)})
-                indices.push_back(v);
-        }
-    }
-    return Shape::triangle_mesh(vertices, indices);
-}
+// A flat mesh on y = 0: 100 x 100 cells of 1 m about the origin, their fronts up.
+Shape flat_floor_mesh() { return test::flat_grid_mesh(100, 1.0); }
 
 struct PoleLanding {
     Real landed_energy = 0;  // per kg, potential plus kinetic, after the step of impact
