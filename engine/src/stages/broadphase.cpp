@@ -48,15 +48,19 @@ Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
 
 void CompoundPartBoxes::add(const Bodies& bodies, std::uint32_t slot) {
     if (bodies.desc[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
+    if (m_member_place.size() <= slot) m_member_place.resize(slot + 1, kNone);
+    m_member_place[slot] = static_cast<std::uint32_t>(m_members.size());
     m_members.push_back(slot);
     m_changed = true;
 }
 
 void CompoundPartBoxes::remove(std::uint32_t slot) {
-    const auto it = std::find(m_members.begin(), m_members.end(), slot);
-    if (it == m_members.end()) return;
-    *it = m_members.back();
+    if (slot >= m_member_place.size() || m_member_place[slot] == kNone) return;
+    const std::uint32_t place = m_member_place[slot];
+    m_member_place[m_members.back()] = place;
+    m_members[place] = m_members.back();
     m_members.pop_back();
+    m_member_place[slot] = kNone;
     m_changed = true;
 }
 
@@ -75,9 +79,9 @@ void CompoundPartBoxes::lay_out(const Bodies& bodies) {
 }
 
 std::size_t CompoundPartBoxes::heap_bytes() const noexcept {
-    return m_members.capacity() * sizeof(std::uint32_t) + m_index.capacity() * sizeof(std::uint32_t) +
-           m_first.capacity() * sizeof(std::uint32_t) + m_made.capacity() * sizeof(std::uint64_t) +
-           m_boxes.capacity() * sizeof(Aabb);
+    return (m_members.capacity() + m_member_place.capacity()) * sizeof(std::uint32_t) +
+           m_index.capacity() * sizeof(std::uint32_t) + m_first.capacity() * sizeof(std::uint32_t) +
+           m_made.capacity() * sizeof(std::uint64_t) + m_boxes.capacity() * sizeof(Aabb);
 }
 
 void add_proxy(World& world, std::uint32_t slot) {

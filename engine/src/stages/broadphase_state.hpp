@@ -45,8 +45,11 @@ private:
     // The compound's place in the layout, or kNone.
     std::uint32_t find(std::uint32_t slot) const { return slot < m_index.size() ? m_index[slot] : kNone; }
 
-    std::vector<std::uint32_t> m_members;  // the kept compounds' slots, in the order they came
-    bool m_changed = false;                // m_members differs from the layout
+    std::vector<std::uint32_t> m_members;  // the kept compounds' slots (a removal moves the last in)
+    // Per slot up to the highest kept so far: its place in m_members (kNone: not kept), so
+    // that removing one of many compounds does not search the list.
+    std::vector<std::uint32_t> m_member_place;
+    bool m_changed = false;  // m_members differs from the layout
     // The layout: per slot up to the highest kept compound's, its place (kNone: none), so
     // that a part walk finds its boxes at once; per place, the first of its boxes (one
     // more at the end) and the step they were made in plus one (0: never).

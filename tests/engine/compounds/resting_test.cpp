@@ -298,5 +298,36 @@ TEST(CompoundResting, TableIsMetWhereItIsAfterSleepingBeingStruckAndBeingMadeSta
     expect_cube_lands_on_table(space, moved, "made static and moved");
 }
 
+// Destroying compounds moves others in the broadphase's list of moving compounds: the
+// ones left keep their part boxes, and a body made in a destroyed compound's slot is not
+// taken for a compound.
+TEST(CompoundResting, TablesLeftStandAfterOthersAreDestroyedAndTheirSlotsReused) {
+    Space space;
+    add_plane(space);
+    std::vector<BodyHandle> tables;
+    for (int i = 0; i < 4; ++i) tables.push_back(space.create_body(body(table(), Vec3(3.0 * i, 0.02, 0))));
+    space.update();
+    // The first goes (the last takes its place in the list), then the one that moved.
+    space.destroy_body(tables[0]);
+    space.update();
+    space.destroy_body(tables[3]);
+    space.update();
+    std::vector<BodyHandle> balls;
+    for (int i = 0; i < 2; ++i) balls.push_back(space.create_body(body(Shape::sphere(0.2), Vec3(3.0 * i, 0.2, 4))));
+    for (const int i : {1, 2}) {
+        step_until_asleep(space, tables[i]);
+        EXPECT_FALSE(space.internal_is_awake(tables[i]));
+        expect_cube_lands_on_table(space, space.position(tables[i]), "left standing");
+    }
+    // The balls in the destroyed tables' slots go, then the tables: none was left listed.
+    for (const BodyHandle handle : balls) space.destroy_body(handle);
+    space.update();
+    for (const int i : {2, 1}) {
+        space.destroy_body(tables[i]);
+        space.update();
+    }
+    EXPECT_EQ(space.body_count(), 1u);
+}
+
 }  // namespace
 }  // namespace spindle
