@@ -34,6 +34,10 @@ std::vector<BodyHandle> build(const SceneDesc& scene, Space& space, std::vector<
         }
     }
 
+    // Room for every body at once (before anything changes: it may throw): a million-body
+    // scene's per-body arrays would otherwise be moved dozens of times as they grow.
+    space.reserve_bodies(space.body_count() + scene.bodies.size());
+
     const SpaceSettings before = space.settings();
     // The layer pairs the scene turns off, with whether each collided before, to restore.
     std::vector<std::pair<std::array<std::uint32_t, 2>, bool>> layers_before;

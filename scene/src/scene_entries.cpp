@@ -235,7 +235,7 @@ void parse_entry(const TomlReader& r, std::string_view kind, const toml::table& 
                                    std::to_string(kMaxSceneBodies));
     }
     const toml::source_position at = entry.source().begin;
-    scene.bodies.reserve(scene.bodies.size() + static_cast<std::size_t>(total));
+    reserve_bodies(scene, static_cast<std::size_t>(total));
     for (std::int64_t cz = 0; cz < copies.count[2]; ++cz) {
         for (std::int64_t cy = 0; cy < copies.count[1]; ++cy) {
             for (std::int64_t cx = 0; cx < copies.count[0]; ++cx) {

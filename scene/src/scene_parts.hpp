@@ -4,6 +4,7 @@
 // scene_ragdoll.cpp: [[ragdoll]]).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
@@ -19,6 +20,14 @@ namespace spindle::scene_detail {
 // The largest scene the loader accepts (a typo such as count = [1000, 1000, 10] fails
 // clearly instead of exhausting memory); room for Box3D's large_world (1,000,100 bodies).
 inline constexpr std::size_t kMaxSceneBodies = 2'000'000;
+
+// Room for an entry's `more` bodies. The list at least doubles when it grows: a scene of
+// hundreds of small entries (washer's rows of 20 cubes) would otherwise move every body
+// made so far at each entry.
+inline void reserve_bodies(SceneDesc& scene, std::size_t more) {
+    const std::size_t need = scene.bodies.size() + more;
+    if (need > scene.bodies.capacity()) scene.bodies.reserve(std::max(need, 2 * scene.bodies.capacity()));
+}
 
 // A shape table such as { box = [1, 1, 1] }; `what` is its dotted key ("body.shape").
 ShapeSpec parse_shape(const TomlReader& reader, const toml::node& node, std::string_view what);

@@ -248,7 +248,7 @@ void parse_ragdoll(const TomlReader& r, const toml::table& entry, const BodyTemp
     const Quat turn = body.desc.orientation;
     const Vec3 velocity = body.desc.linear_velocity, spin = body.desc.angular_velocity;
     const toml::source_position at = entry.source().begin;
-    scene.bodies.reserve(scene.bodies.size() + static_cast<std::size_t>(total));
+    reserve_bodies(scene, static_cast<std::size_t>(total));
     for (std::int64_t cz = 0; cz < copies.count[2]; ++cz) {
         for (std::int64_t cy = 0; cy < copies.count[1]; ++cy) {
             for (std::int64_t cx = 0; cx < copies.count[0]; ++cx) {

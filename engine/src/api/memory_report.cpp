@@ -15,11 +15,9 @@ std::size_t held(const std::vector<T, A>& v) {
 }
 
 std::size_t body_bytes(const Bodies& b) {
-    return held(b.generation) + held(b.alive) + held(b.free_slots) + held(b.type) + held(b.x) + held(b.q) + held(b.v) +
-           held(b.w) + held(b.inv_mass) + held(b.inv_inertia_local) + held(b.inertia_local) + held(b.local_com) +
-           held(b.locks) + held(b.force) + held(b.torque) + held(b.bounds) + held(b.awake_index) + held(b.sleep_time) +
-           held(b.island) + held(b.layer) + held(b.group) + held(b.history_position[0]) + held(b.history_position[1]) +
-           held(b.history_orientation[0]) + held(b.history_orientation[1]) + held(b.interpolate) + held(b.desc);
+    std::size_t bytes = held(b.free_slots);
+    Bodies::for_each_slot_array(b, [&bytes](const auto& array) { bytes += held(array); });
+    return bytes;
 }
 
 std::size_t solver_other_bytes(const SolverScratch& s) {

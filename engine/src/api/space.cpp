@@ -8,7 +8,10 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <new>
 #include <sstream>
+#include <string>
 
 #include "api/describe.hpp"
 #include "api/validation.hpp"
@@ -77,15 +80,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
         b.free_slots.pop_back();
     } else {
         slot = b.capacity();
-        const std::size_t n = slot + 1;
-        grow(b.generation, n), grow(b.alive, n);
-        grow(b.type, n), grow(b.x, n), grow(b.q, n), grow(b.v, n), grow(b.w, n), grow(b.inv_mass, n);
-        grow(b.inv_inertia_local, n), grow(b.inertia_local, n), grow(b.local_com, n), grow(b.locks, n),
-            grow(b.force, n), grow(b.torque, n), grow(b.bounds, n);
-        grow(b.awake_index, n), grow(b.sleep_time, n), grow(b.island, n), grow(b.interpolate, n);
-        grow(b.layer, n), grow(b.group, n);
-        grow(b.history_position[0], n), grow(b.history_position[1], n);
-        grow(b.history_orientation[0], n), grow(b.history_orientation[1], n), grow(b.desc, n);
+        Bodies::for_each_slot_array(b, [n = std::size_t{slot} + 1](auto& array) { grow(array, n); });
     }
     b.generation[slot] += 1;
     if (b.generation[slot] == 0) b.generation[slot] = 1;  // 2^32 reuses: skip the invalid generation
@@ -127,6 +122,31 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
     return BodyHandle{slot, b.generation[slot]};
+}
+
+void Space::reserve_bodies(std::size_t count) {
+    const AccessGate::Structure access(m_world->gate, "reserve_bodies");
+    // A body handle's slot index is 32 bits.
+    constexpr std::size_t kMostBodies = std::numeric_limits<std::uint32_t>::max();
+    if (count > kMostBodies) {
+        throw Error("reserve_bodies: count " + std::to_string(count) + " is more than a space can hold (" +
+                    std::to_string(kMostBodies) + ")");
+    }
+    World& w = *m_world;
+    const auto room = [count](auto& array) {
+        if (array.capacity() < count) array.reserve(count);
+    };
+    try {
+        Bodies::for_each_slot_array(w.bodies, room);
+        room(w.awake);
+        room(w.awake_pending);
+        room(w.broadphase->proxy);
+        room(w.broadphase->refit);
+        reserve_published(w, count);
+    } catch (const std::bad_alloc&) {
+        // Only capacities changed: every body, handle and published state is as it was.
+        throw Error("reserve_bodies: no memory for " + std::to_string(count) + " bodies");
+    }
 }
 
 void Space::destroy_body(BodyHandle body) {

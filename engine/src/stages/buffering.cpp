@@ -192,6 +192,12 @@ static void publish_user_data(const World& world, std::uint32_t i, PublishedBuff
     p.user_data[i] = world.bodies.alive[i] ? world.bodies.desc[i].user_data : 0;
 }
 
+void reserve_published(World& world, std::size_t slots) {
+    MotionStatePublisher manager(world.motion_states);
+    const PublishingHold guard(manager);  // a read may be copying the front buffer
+    for (int k = 0; k < 2; ++k) manager.buffer_locked(k).reserve(slots);
+}
+
 void publish_now(World& world, std::uint32_t slot) {
     MotionStatePublisher manager(world.motion_states);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;

@@ -56,6 +56,9 @@ void wake_touching(World& world, std::uint32_t slot);
 // Writes a body's current state into both published buffers at once (create/destroy
 // between updates), so buffered reads see it before the next flip (buffering.cpp).
 void publish_now(World& world, std::uint32_t slot);
+// Room in both published buffers for `slots` body slots (Space::reserve_bodies), under the
+// motion-state lock (buffering.cpp).
+void reserve_published(World& world, std::size_t slots);
 // Records a body's motion type and shape kind where buffered writes check them lock-free
 // (MotionStateManager::published_motion_type), at once (buffering.cpp).
 void publish_kind(World& world, std::uint32_t slot);

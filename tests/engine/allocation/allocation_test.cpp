@@ -1,7 +1,9 @@
 // A steady-state step allocates nothing, on the single-threaded job system and on
-// work stealing: a counting global operator new (every thread's) proves it.
+// work stealing, and a scene's parse allocates in proportion to its bodies: a counting
+// global operator new (every thread's) proves it.
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/topology.hpp>
+#include <spindle/scene/scene.hpp>
 #include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
@@ -10,19 +12,23 @@
 #include <cstdlib>
 #include <memory>
 #include <new>
+#include <string>
 
 namespace {
 std::atomic<long> g_allocations{0};
+std::atomic<long> g_bytes{0};
 }  // namespace
 
 void* operator new(std::size_t size) {
     g_allocations.fetch_add(1, std::memory_order_relaxed);
+    g_bytes.fetch_add(static_cast<long>(size), std::memory_order_relaxed);
     if (void* p = std::malloc(size ? size : 1)) return p;
     throw std::bad_alloc();
 }
 void* operator new[](std::size_t size) { return operator new(size); }
 void* operator new(std::size_t size, std::align_val_t align) {
     g_allocations.fetch_add(1, std::memory_order_relaxed);
+    g_bytes.fetch_add(static_cast<long>(size), std::memory_order_relaxed);
     const auto a = static_cast<std::size_t>(align);
     if (void* p = std::aligned_alloc(a, (size + a - 1) / a * a)) return p;
     throw std::bad_alloc();
@@ -125,7 +131,30 @@ long jointed_scene_allocations(JobSystem* jobs) {
     return during;
 }
 
+// The bytes allocated while parsing a scene of `entries` rows of 20 cubes, as washer's.
+long scene_parse_bytes(int entries) {
+    std::string text = "[defaults]\nshape = { box = [0.2, 0.2, 0.2] }\n";
+    for (int i = 0; i < entries; ++i) {
+        text += "[[body]]\nposition = [" + std::to_string(i) + ", 0, 0]\n";
+        text += "copies = { count = [1, 1, 20], step = [0, 0, 0.8] }\n";
+    }
+    const long before = g_bytes.load();
+    const SceneDesc scene = parse_scene(text, "rows");
+    const long bytes = g_bytes.load() - before;
+    EXPECT_EQ(scene.bodies.size(), static_cast<std::size_t>(entries) * 20);
+    return bytes;
+}
+
 }  // namespace
+
+// Each entry's bodies are added to one list: grown to each entry's exact size, it moved
+// every body made so far at every entry, and twice the entries allocated four times the
+// bytes.
+TEST(Allocation, SceneOfTwiceTheEntriesParsesInAboutTwiceTheBytes) {
+    const long one = scene_parse_bytes(200);
+    const long two = scene_parse_bytes(400);
+    EXPECT_LT(static_cast<double>(two), 2.5 * static_cast<double>(one)) << one << " bytes, then " << two;
+}
 
 TEST(Allocation, SteadyStateStepAllocatesNothing) {
     EXPECT_EQ(resting_scene_allocations(nullptr), 0) << "allocations in 120 steady-state steps";

@@ -1,5 +1,6 @@
 // The heap a space holds follows its contacts, not their high-water mark: the pyramid's
-// bytes per body after its drop, and contact arrays given back when a pile comes apart
+// bytes per body after its drop, and contact arrays given back when a pile comes apart;
+// room reserved for a level's bodies is used as they are made
 // (api/memory_report.hpp counts capacities, so the numbers are the same on every run).
 #include <spindle/engine/space.hpp>
 #include <spindle/scene/scene.hpp>
@@ -11,6 +12,7 @@
 #include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
 #include "solver/constraints.hpp"
+#include "stages/broadphase_state.hpp"
 
 using namespace spindle;
 
@@ -99,4 +101,66 @@ TEST(Memory, ContactArraysStayPutWhileAPaddleStirsAHeap) {
         if (world.contacts.data() != before) ++moved;
     }
     EXPECT_LE(moved, 6);
+}
+
+namespace {
+
+constexpr int kLevelBodies = 1000;
+
+// A level of boxes: every third static, the rest dynamic (on the awake list).
+void make_level(Space& space) {
+    for (int i = 0; i < kLevelBodies; ++i) {
+        BodyDesc d;
+        d.type = i % 3 == 0 ? MotionType::Static : MotionType::Dynamic;
+        d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        d.position = Vec3(2.0 * (i % 40), 0.5, 2.0 * (i / 40));
+        space.create_body(d);
+    }
+}
+
+}  // namespace
+
+// Room reserved for a level's bodies: making them moves none of the per-body arrays.
+TEST(Memory, BodiesMadeInReservedRoomMoveNoPerBodyArray) {
+    Space grown;
+    const std::size_t empty = memory_report(grown).bodies;
+    make_level(grown);
+    ASSERT_GT(memory_report(grown).bodies, empty) << "without room reserved the arrays grow";
+
+    Space space;
+    space.reserve_bodies(kLevelBodies);
+    const World& world = SpaceInternals::world(space);
+    const std::size_t reserved = memory_report(space).bodies;
+    const Vec3* positions = world.bodies.x.data();
+    const BodyDesc* descriptions = world.bodies.desc.data();
+    const std::uint32_t* awake = world.awake.data();
+    const ProxyId* proxies = world.broadphase->proxy.data();
+    make_level(space);
+    space.update();
+    EXPECT_EQ(memory_report(space).bodies, reserved);
+    EXPECT_EQ(world.bodies.x.data(), positions);
+    EXPECT_EQ(world.bodies.desc.data(), descriptions);
+    EXPECT_EQ(world.awake.data(), awake);
+    EXPECT_EQ(world.broadphase->proxy.data(), proxies);
+    EXPECT_EQ(space.body_count(), static_cast<std::size_t>(kLevelBodies));
+}
+
+TEST(Memory, ReservingMoreBodiesThanAHandleCanIndexThrowsNamingTheCount) {
+    Space space;
+    BodyDesc d;
+    d.shape = Shape::sphere(0.5);
+    const BodyHandle body = space.create_body(d);
+    const std::size_t count = std::size_t{1} << 33;
+    try {
+        space.reserve_bodies(count);
+        FAIL() << "reserve_bodies(2^33) did not throw";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("reserve_bodies"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(std::to_string(count)), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(space.body_count(), 1u);
+    EXPECT_TRUE(space.contains(body));
+    space.create_body(d);
+    space.update();
+    EXPECT_EQ(space.body_count(), 2u);
 }

@@ -65,6 +65,13 @@ struct PublishedBuffer {
         previous.resize(slots);
         user_data.resize(slots);
     }
+    void reserve(std::size_t slots) {
+        generation.reserve(slots);
+        current.reserve(slots);
+        interpolate.reserve(slots);
+        previous.reserve(slots);
+        user_data.reserve(slots);
+    }
 };
 
 // The motion-state lock: a mutex that knows which thread holds it, so that a thread

@@ -53,6 +53,11 @@ public:
     void destroy_body(BodyHandle body);
     bool contains(BodyHandle body) const noexcept;  // any thread: as published
     std::size_t body_count() const noexcept;        // any thread
+    // Room for `count` bodies alive at once, for a level about to be made: creating bodies
+    // up to that many then moves none of the space's per-body arrays (scene build() asks
+    // for its bodies). Never shrinks. A count past the body handles' 32-bit index, or one
+    // the memory cannot hold, throws spindle::Error naming it and changes nothing else.
+    void reserve_bodies(std::size_t count);
 
     // Joints (same thread rule as bodies). create_joint validates first (bodies live
     // and different, at least one dynamic, finite anchors, non-zero axes, ordered
