@@ -59,37 +59,43 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
     return false;
 }
 
-// Replaces an edge or vertex normal by the face normal and re-measures the points
-// against the triangle's plane: a sphere or capsule from its deepest core point(s) along
-// the new normal, a polyhedron from its own points (they are its vertices or edge points).
-void use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const TrianglePoly& tri, const Vec3& on_plane,
-                     Real speculative) {
-    Real side = m.normal.dot(tri.normal());
-    if (side == 0) side = tri.normal().dot(on_plane - xa.p);
-    const Vec3 face = side < 0 ? Vec3(-tri.normal()) : tri.normal();
-    ContactCandidate c[kMaxManifoldPoints];
-    int n = 0;
-    if (a.type == ShapeType::Sphere || a.type == ShapeType::Capsule) {
-        Vec3 core[2];
-        rounded_core(a, core[0], core[1]);
-        const int ends = a.type == ShapeType::Sphere ? 1 : 2;
-        for (int i = 0; i < ends; ++i) {
-            const Vec3 on_a = xa.apply(core[i]) + face * a.radius;
-            c[n++] = {on_a, face.dot(on_plane - on_a), m.points[0].id + static_cast<std::uint32_t>(i)};
-        }
-    } else {
-        for (int i = 0; i < m.point_count; ++i) {
-            const Vec3 on_a = m.points[i].point - m.normal * (Real(0.5) * m.points[i].separation);
-            c[n++] = {on_a, face.dot(on_plane - on_a), m.points[i].id};
-        }
+// Replaces an edge or vertex normal by the face normal, on the side of the triangle's
+// plane the shape lies on (the SAT's side when it lies across it), and measures the
+// contact again against that face: a sphere or capsule from its deepest core point(s)
+// along the new normal, a polyhedron as its SAT would have had the face chosen (its
+// incident face clipped over the triangle, else its vertex deepest along the normal).
+// The SAT's own points do not serve: for shapes apart, its axis may be one beside the
+// triangle, whose points lie off both shapes. False when nothing is within reach.
+bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
+                     const ShapeSpan& span, const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
+    const Vec3& n = tri.normal();
+    const Real offset = n.dot(on_plane);
+    Real lo, hi;
+    span.along(n, lo, hi);
+    Real side = m.normal.dot(n);  // the normal points from the shape to the triangle
+    if (side == 0) side = n.dot(on_plane - xa.p);
+    bool front = side < 0;
+    if (lo >= offset) front = true;
+    else if (hi <= offset) front = false;
+    if (polyhedron) {
+        const Transform identity;
+        return face_of_b_manifold(*polyhedron, xa, tri.view(), identity, front ? 0 : 1, speculative, m);
     }
-    int kept = 0;
-    for (int i = 0; i < n; ++i) {
-        if (c[i].separation > speculative) continue;
-        m.points[kept++] = {c[i].point + face * (Real(0.5) * c[i].separation), c[i].separation, c[i].id};
+    const Vec3 face = front ? Vec3(-n) : n;
+    Vec3 core[2];
+    rounded_core(a, core[0], core[1]);
+    const int ends = a.type == ShapeType::Sphere ? 1 : 2;
+    const std::uint32_t id = m.points[0].id;
+    m.point_count = 0;
+    for (int i = 0; i < ends; ++i) {
+        const Vec3 on_a = xa.apply(core[i]) + face * a.radius;
+        const Real separation = face.dot(on_plane - on_a);
+        if (separation > speculative) continue;
+        m.points[m.point_count++] = {on_a + face * (Real(0.5) * separation), separation,
+                                     id + static_cast<std::uint32_t>(i)};
     }
     m.normal = face;
-    m.point_count = kept;
+    return m.point_count > 0;
 }
 
 // Adds m to the list, merging it into a manifold with nearly the same normal; when the
@@ -144,10 +150,9 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         Manifold m;
         FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
         if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, cache, walk ? walk->slop() : 0, m)) return;
-        if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges)) {
-            use_face_normal(m, a, a_in_mesh, poly, v[0], speculative);
-            if (m.point_count == 0) return;
-        }
+        if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges) &&
+            !use_face_normal(m, a, a_in_mesh, polyhedron, span, poly, v[0], speculative))
+            return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
         gather(found, found_count, m);

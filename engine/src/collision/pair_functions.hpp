@@ -89,6 +89,13 @@ class PreparedPolyhedron;
 bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
                        Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr, Real feature_slop = 0);
 
+// The manifold collide_polyhedra makes when its SAT picks face `face_b` of b as the
+// reference, whatever the SAT would pick: a's incident face clipped against that face, or
+// a's vertex deepest along it when nothing clipped is within reach. False when even that
+// vertex is farther than the speculative distance from the face's plane.
+bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                        std::uint32_t face_b, Real speculative_distance, Manifold& out);
+
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
 // radius) against polyhedron b: GJK distance between the cores while they are apart, SAT
 // when they overlap; a capsule lying on a face gets two points.

@@ -491,6 +491,23 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     return true;
 }
 
+bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
+                        std::uint32_t face_b, Real speculative, Manifold& m) {
+    // Posed as collide_polyhedra poses the pair.
+    const PolyView& a = prepared.view();
+    const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
+    const Vec3 t = xa.apply_inverse(xb.p);
+    ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
+    for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
+    fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
+    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
+    if (!face_manifold(pa, pb, face_b, true, speculative, false, m)) return false;
+    manifold_to_world(m, xa);
+    return true;
+}
+
 int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                      Manifold* out, int) {
     const BoxPoly box(a.half_extents);

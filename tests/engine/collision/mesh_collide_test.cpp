@@ -85,6 +85,48 @@ TEST(ConvexMesh, RollingCapsuleAndHullStayOnFaceNormals) {
     }
 }
 
+// A long body's end coming down on the flat mesh from well within a large speculative
+// distance (a fast-turning pole's end, h50 in docs/benchmarks.md): every triangle the
+// reach finds, beside the end as well as under it, must give the face normal and a gap no
+// less than the end's true height. The SAT's axis for a triangle beside the end is a
+// sideways one; its points lay off both shapes and measured the gap as zero, or, with the
+// side taken from a slanted end face, as a depth below the mesh with the normal upwards.
+TEST(ConvexMesh, CornerFarAboveTheMeshGetsItsHeightWithinALargeReach) {
+    std::vector<Vec3> prism;
+    for (int k = 0; k < 6; ++k) {
+        for (const Real y : {-1.0, 1.0})
+            prism.emplace_back(0.25 * std::cos(k * kPi / 3), y, 0.25 * std::sin(k * kPi / 3));
+    }
+    const Shape segment = Shape::convex_hull(prism);
+    const Shape cube = test::hull_box(Vec3(0.4, 0.4, 0.4));
+    const Shape box = Shape::box(Vec3(0.4, 0.4, 0.4));
+    const Shape ground = unit_grid(8);
+    constexpr Real kReach = 1.2;
+    struct Body {
+        const Shape* shape;
+        Quat q;
+    };
+    const Body bodies[] = {
+        {&segment, about(Vec3::UnitZ(), -kPi / 2 - 0.1)},          // lying along x, its +x end lower
+        {&cube, about(Vec3(1, 0, 1), std::atan(std::sqrt(2.0)))},  // a corner straight down
+        {&box, about(Vec3(1, 0, 1), std::atan(std::sqrt(2.0)))},
+        {&cube, about(Vec3(1, 0.3, -0.5), 0.6)},  // a corner, tilted
+    };
+    for (const Body& body : bodies) {
+        for (const Vec3& over : {Vec3(4, 0, 4.1), Vec3(4.3, 0, 3.8), Vec3(4.55, 0, 4.45)}) {
+            for (const Real height : {0.05, 0.1, 0.16, 0.3, 0.6, 0.9, 1.0}) {
+                const Transform x = at(over, body.q);
+                const Real lowest = body.shape->bounds(x).min.y();
+                const auto m = run(*body.shape, at(over + Vec3(0, height - lowest, 0), body.q), ground,
+                                   at(Vec3::Zero()), kReach);
+                ASSERT_EQ(m.size(), 1u) << "height " << height << " over " << over.transpose();
+                SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, -1, 0), 1e-9);
+                EXPECT_NEAR(deepest(m[0]), height, 1e-9) << "over " << over.transpose();
+            }
+        }
+    }
+}
+
 TEST(ConvexMesh, SphereOnARidgeTakesTheEdgeNormal) {
     // Roof ridge along x at y = 1: a sharp (active) edge.
     const std::vector<Vec3> v{Vec3(-2, 1, 0), Vec3(2, 1, 0),  Vec3(-2, 0, -1),
