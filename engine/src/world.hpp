@@ -85,10 +85,12 @@ struct Bodies {
     // reserving and counting them name each once. Self: Bodies or const Bodies.
     template <typename Self, typename F>
     static void for_each_slot_array(Self& b, F&& f) {
-        f(b.generation), f(b.alive), f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local);
-        f(b.inertia_local), f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.awake_index);
-        f(b.sleep_time), f(b.island), f(b.layer), f(b.group), f(b.history_position[0]), f(b.history_position[1]);
-        f(b.history_orientation[0]), f(b.history_orientation[1]), f(b.interpolate), f(b.desc);
+        f(b.generation), f(b.alive);
+        f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local), f(b.inertia_local);
+        f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.awake_index), f(b.sleep_time);
+        f(b.island), f(b.layer), f(b.group), f(b.interpolate);
+        f(b.history_position[0]), f(b.history_position[1]), f(b.history_orientation[0]), f(b.history_orientation[1]);
+        f(b.desc);
     }
     bool is_live(BodyHandle h) const noexcept {
         return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
