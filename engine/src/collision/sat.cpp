@@ -434,8 +434,14 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
     return collide_polyhedra(prepared, xa, b, xb, speculative, m, cache, feature_slop);
 }
 
-bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
-                       Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop) {
+namespace {
+
+// Poses b in a's frame (a's vertices as prepared, b's moved and laid out in lanes on the
+// stack) and returns with(pa, pb). Inlined: collide_polyhedra is the narrowphase's
+// hottest call.
+template <typename With>
+[[gnu::always_inline]] inline bool with_posed_pair(const PreparedPolyhedron& prepared, const Transform& xa,
+                                                   const PolyView& b, const Transform& xb, With&& with) {
     const PolyView& a = prepared.view();
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
@@ -445,67 +451,68 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
     const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
     const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
+    return with(pa, pb);
+}
 
-    using Kind = FeatureCache::Kind;
-    if (cache && cache->kind() != Kind::None) {
-        const CachedAxis axis = cached_axis(*cache, pa, pb);
-        if (axis.valid && axis.separation > speculative) return false;
-        if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
-            cached_manifold(*cache, axis, pa, pb, speculative, m)) {
+}  // namespace
+
+bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
+                       Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop) {
+    return with_posed_pair(prepared, xa, b, xb, [&](const Posed& pa, const Posed& pb) {
+        using Kind = FeatureCache::Kind;
+        if (cache && cache->kind() != Kind::None) {
+            const CachedAxis axis = cached_axis(*cache, pa, pb);
+            if (axis.valid && axis.separation > speculative) return false;
+            if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
+                cached_manifold(*cache, axis, pa, pb, speculative, m)) {
+                manifold_to_world(m, xa);
+                return true;
+            }
+        }
+        const FaceQuery face_a = query_faces(pa, pb, speculative);
+        if (face_a.separation > speculative) {
+            remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
+            return false;
+        }
+        const FaceQuery face_b = query_faces(pb, pa, speculative);
+        if (face_b.separation > speculative) {
+            remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
+            return false;
+        }
+        const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation),
+                                           speculative);
+        if (edge.separation > speculative) {
+            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+            return false;
+        }
+
+        if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
+            edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
+            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
             manifold_to_world(m, xa);
             return true;
         }
-    }
-    const FaceQuery face_a = query_faces(pa, pb, speculative);
-    if (face_a.separation > speculative) {
-        remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
-        return false;
-    }
-    const FaceQuery face_b = query_faces(pb, pa, speculative);
-    if (face_b.separation > speculative) {
-        remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
-        return false;
-    }
-    const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation), speculative);
-    if (edge.separation > speculative) {
-        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
-        return false;
-    }
 
-    if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
-        edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
-        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+        const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
+        const FaceQuery& reference = reference_is_b ? face_b : face_a;
+        if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
+            remember_axis(cache, Kind::None, 0, 0, 0);
+            return false;
+        }
+        if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
+        else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
         manifold_to_world(m, xa);
         return true;
-    }
-
-    const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-    const FaceQuery& reference = reference_is_b ? face_b : face_a;
-    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
-        remember_axis(cache, Kind::None, 0, 0, 0);
-        return false;
-    }
-    if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
-    else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
-    manifold_to_world(m, xa);
-    return true;
+    });
 }
 
 bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
                         std::uint32_t face_b, Real speculative, Manifold& m) {
-    // Posed as collide_polyhedra poses the pair.
-    const PolyView& a = prepared.view();
-    const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
-    const Vec3 t = xa.apply_inverse(xb.p);
-    ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
-    for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
-    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
-    fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
-    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
-    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
-    if (!face_manifold(pa, pb, face_b, true, speculative, false, m)) return false;
-    manifold_to_world(m, xa);
-    return true;
+    return with_posed_pair(prepared, xa, b, xb, [&](const Posed& pa, const Posed& pb) {
+        if (!face_manifold(pa, pb, face_b, true, speculative, false, m)) return false;
+        manifold_to_world(m, xa);
+        return true;
+    });
 }
 
 int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
