@@ -60,23 +60,20 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
 }
 
 // Replaces an edge or vertex normal by the face normal, on the side of the triangle's
-// plane the shape lies on (the SAT's side when it lies across it), and measures the
+// plane the shape reaches into (the front unless it lies wholly behind: one lying across
+// the plane has its centre in front, collide_triangles drops the others), and measures the
 // contact again against that face: a sphere or capsule from its deepest core point(s)
 // along the new normal, a polyhedron as its SAT would have had the face chosen (its
 // incident face clipped over the triangle, else its vertex deepest along the normal).
 // The SAT's own points do not serve: for shapes apart, its axis may be one beside the
-// triangle, whose points lie off both shapes. False when nothing is within reach.
+// triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
+// be measured from its far side. False when nothing is within reach.
 bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
                      const ShapeSpan& span, const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
     const Vec3& n = tri.normal();
-    const Real offset = n.dot(on_plane);
     Real lo, hi;
     span.along(n, lo, hi);
-    Real side = m.normal.dot(n);  // the normal points from the shape to the triangle
-    if (side == 0) side = n.dot(on_plane - xa.p);
-    bool front = side < 0;
-    if (lo >= offset) front = true;
-    else if (hi <= offset) front = false;
+    const bool front = hi > n.dot(on_plane);
     if (polyhedron) {
         const Transform identity;
         return face_of_b_manifold(*polyhedron, xa, tri.view(), identity, front ? 0 : 1, speculative, m);
@@ -139,6 +136,8 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
     const Aabb bounds = a_world_bounds && is_identity(xb) ? *a_world_bounds : a.bounds(a_in_mesh);
     const Aabb query = bounds.fattened(std::max(speculative, Real(0)));
     const ShapeSpan span(a, a_in_mesh);
+    // A sphere's or capsule's core, a box's centre, a hull's centroid.
+    const Vec3 centre = polyhedron ? a_in_mesh.apply(polyhedron->view().inner_centre) : a_in_mesh.p;
 
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
@@ -147,11 +146,27 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
         if (span.clear_of_plane(v, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2]);
+        // Triangles are one-sided for a shape lying across their plane (Box3D culls by the
+        // shape's centre too). With its centre behind, it has passed the middle and gets no
+        // contact here: pushed on out of the back while its body's other parts are pushed out
+        // of the front, it would lever the body up about them. One wholly behind is pushed on
+        // out of the back, as a shape that started there should be.
+        const bool centre_in_front = poly.normal().dot(centre - v[0]) >= 0;  // on the plane: in front
+        if (!centre_in_front) {
+            Real lo, hi;
+            span.along(poly.normal(), lo, hi);
+            if (hi > poly.normal().dot(v[0])) return;
+        }
         Manifold m;
         FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
         if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, cache, walk ? walk->slop() : 0, m)) return;
-        if (std::abs(m.normal.dot(poly.normal())) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, span, poly, v[0], speculative))
+        // With its centre in front, a normal that would push it on through the back (the back
+        // face, or an edge axis leaning that way, can win the SAT once it is deep) is measured
+        // again against the front face, from its deep side.
+        const Real facing = m.normal.dot(poly.normal());  // the normal points from the shape to the triangle
+        const bool through = centre_in_front && facing > 0;
+        const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
+        if ((through || off_face) && !use_face_normal(m, a, a_in_mesh, polyhedron, span, poly, v[0], speculative))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;

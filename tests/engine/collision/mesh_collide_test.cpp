@@ -127,6 +127,80 @@ TEST(ConvexMesh, CornerFarAboveTheMeshGetsItsHeightWithinALargeReach) {
     }
 }
 
+// A shape pushed into the mesh's front past the middle of its depth, its centre still in
+// front of the plane, is pushed back out of the front: the triangles count as one-sided for
+// it. Two-sided, an edge axis or the triangle's back face could win the SAT and push it on
+// through (issue 19: tree tops and pole ends sinking into the trees' mesh).
+TEST(ConvexMesh, ShapeDeepInTheFrontWithItsCentreInFrontIsPushedOutOfTheFront) {
+    std::vector<Vec3> prism;
+    for (int k = 0; k < 6; ++k) {
+        for (const Real y : {-1.0, 1.0})
+            prism.emplace_back(0.25 * std::cos(k * kPi / 3), y, 0.25 * std::sin(k * kPi / 3));
+    }
+    // A pyramid, apex down, its centroid (a quarter of its height above its base) at its
+    // origin and the middle of its height under it: the triangle's back face can win the
+    // SAT while the centroid is still in front.
+    const Shape pyramid = Shape::convex_hull(std::vector<Vec3>{
+        Vec3(0, -0.9, 0), Vec3(-0.5, 0.3, -0.5), Vec3(0.5, 0.3, -0.5), Vec3(-0.5, 0.3, 0.5), Vec3(0.5, 0.3, 0.5)});
+    const Shape shapes[] = {Shape::convex_hull(prism), test::hull_box(Vec3(0.4, 0.4, 0.4)),
+                            Shape::box(Vec3(0.6, 0.3, 0.4)), Shape::capsule(0.8, 0.3), pyramid};
+    const Quat turns[] = {Quat::Identity(), about(Vec3::UnitZ(), -kPi / 2 - 0.1),
+                          about(Vec3(1, 0, 1), std::atan(std::sqrt(2.0))), about(Vec3(1, 0.3, -0.5), 0.6),
+                          about(Vec3(0.2, 1, 0.7), 1.1)};
+    const Shape ground = unit_grid(8);
+    int checked = 0;
+    for (const Shape& shape : shapes) {
+        for (const Quat& q : turns) {
+            for (const Vec3& over : {Vec3(4, 0, 4.1), Vec3(4.3, 0, 3.8), Vec3(4.55, 0, 4.45)}) {
+                const Real lowest = shape.bounds(at(over, q)).min.y();
+                // The centre from just above the plane to nearly as high as the shape reaches
+                // down from it: the shape always lies across the plane, its centre in front.
+                for (const Real share : {0.05, 0.2, 0.4, 0.6, 0.8, 0.95}) {
+                    const Real height = -lowest * share;
+                    const auto m = run(shape, at(over + Vec3(0, height, 0), q), ground, at(Vec3::Zero()));
+                    ASSERT_FALSE(m.empty());
+                    for (const Manifold& manifold : m) {
+                        EXPECT_TRUE(manifold.normal.isApprox(Vec3(0, -1, 0), 1e-9))
+                            << "centre " << height << " up, its lowest point " << lowest + height << " over "
+                            << over.transpose() << ": normal " << manifold.normal.transpose();
+                        // Measured against the front face from the shape's deep side: each
+                        // point midway between the shape's surface under the plane and the
+                        // plane, no deeper than the shape's lowest point.
+                        for (int i = 0; i < manifold.point_count; ++i) {
+                            const ManifoldPoint& p = manifold.points[i];
+                            EXPECT_NEAR(p.separation, 2 * p.point.y(), 1e-9);
+                            EXPECT_GE(p.separation, lowest + height - 1e-9);
+                            EXPECT_LT(p.separation, 0);
+                        }
+                    }
+                    ++checked;
+                }
+            }
+        }
+    }
+    EXPECT_EQ(checked, 5 * 5 * 3 * 6);
+}
+
+// Past the middle, a shape lying across the plane with its centre behind gets no contact
+// from the triangles (pushed on out of their backs it would lever its body about parts
+// still in front); one wholly behind, within reach, is pushed on out of the back.
+TEST(ConvexMesh, ShapeAcrossTheMeshWithItsCentreBehindGetsNothingAndOneWhollyBehindGoesOutTheBack) {
+    const Shape ground = unit_grid(8);
+    const Quat q = about(Vec3(1, 0.3, -0.5), 0.6);
+    for (const Shape& shape : {Shape::box(Vec3(0.6, 0.3, 0.4)), test::hull_box(Vec3(0.4, 0.4, 0.4)),
+                               Shape::capsule(0.8, 0.3), Shape::sphere(0.4)}) {
+        const Vec3 over(4.3, 0, 3.8);
+        const Real highest = shape.bounds(at(over, q)).max.y();
+        for (const Real share : {0.05, 0.5, 0.95})
+            EXPECT_TRUE(run(shape, at(over - Vec3(0, highest * share, 0), q), ground, at(Vec3::Zero())).empty())
+                << to_string(shape.type) << " centre " << highest * share << " under";
+        const auto m = run(shape, at(over - Vec3(0, highest + 0.01, 0), q), ground, at(Vec3::Zero()), 0.05);
+        ASSERT_FALSE(m.empty()) << to_string(shape.type);
+        SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(0, 1, 0), 1e-9);
+        EXPECT_NEAR(deepest(m[0]), 0.01, 1e-9);
+    }
+}
+
 TEST(ConvexMesh, SphereOnARidgeTakesTheEdgeNormal) {
     // Roof ridge along x at y = 1: a sharp (active) edge.
     const std::vector<Vec3> v{Vec3(-2, 1, 0), Vec3(2, 1, 0),  Vec3(-2, 0, -1),
