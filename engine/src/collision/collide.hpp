@@ -41,16 +41,30 @@ struct PartBoxes {
     std::span<const Aabb> a, b;
 };
 
+// The two bodies' motion, for a compound pair with more touching part pairs than room: the
+// manifolds kept are those that would be deepest after a step at these velocities, so that
+// a part coming down fast is not dropped for parts already resting (a long body lying down
+// about its landed end). World frame; centres are the centres of mass.
+struct PairMotion {
+    Vec3 centre_a, v_a, w_a;
+    Vec3 centre_b, v_b, w_b;
+    Real dt = 0;
+
+    // The same motion with a and b swapped.
+    PairMotion swapped() const { return {centre_b, v_b, w_b, centre_a, v_a, w_a, dt}; }
+};
+
 // Writes the manifolds of a (posed by xa) against b (posed by xb) into out[0..capacity)
 // and returns how many. Points are produced while the shapes are closer than
 // `speculative_distance` (speculative contacts have separation > 0). Convex pairs give
 // at most one manifold; a triangle mesh may give several (one per distinct normal, the
 // deepest four), a compound one (or a mesh's several) per touching part pair, in part
-// order, the deepest `capacity` of them when more touch.
+// order, the deepest `capacity` of them when more touch (the deepest a step ahead, when
+// `motion` is given).
 // Any order of shape types is accepted; normals always point from a to b. A compound's
 // walk takes its part boxes from `boxes` where given: the same boxes, not made again.
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-            Manifold* out, int capacity, const PartBoxes& boxes = {});
+            Manifold* out, int capacity, const PartBoxes& boxes = {}, const PairMotion* motion = nullptr);
 
 // What the last whole test of a box or hull pair decided on, kept with the contact (the
 // idea of Box3D's b3SATCache): the feature whose axis separated the two or made their
@@ -102,10 +116,10 @@ using TriangleFeatures = std::vector<TriangleFeature>;
 // rewrites `triangles` (the triangles it met this time, each with its feature); any other
 // pair clears what it does not use. `feature_slop`: how far the separation along a cached
 // touching feature may drift before the whole SAT runs again (the solver's linear slop;
-// 0 never reuses a touching feature). `boxes` as for collide().
+// 0 never reuses a touching feature). `boxes` and `motion` as for collide().
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes = {});
+                   const PartBoxes& boxes = {}, const PairMotion* motion = nullptr);
 
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns

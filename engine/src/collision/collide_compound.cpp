@@ -13,33 +13,56 @@
 namespace spindle::detail {
 namespace {
 
-// Manifolds kept while walking part pairs; past this a deeper one replaces the shallowest.
+// Manifolds kept while walking part pairs; past this one that ranks deeper (rank) replaces
+// the one that ranks shallowest.
 constexpr int kMaxGathered = 64;
 constexpr int kPerPair = 4;               // a mesh may give several manifolds per part
 constexpr std::size_t kInlineParts = 32;  // parts posed on the stack; more go to the heap
 // Far above the relative rounding of a part's bounds computed two ways (about 1e-15).
 constexpr Real kLooseRelative = 1e-9;
 
+// How deep manifold m (normal from the compound pair's a to b) would be after a step at
+// the bodies' velocities: the least over its points of the separation less what the
+// points close along the normal in that time. Without motion, its depth now. A resting
+// part keeps its depth; a part about to land ranks as deep as it would go.
+Real rank(const Manifold& m, const PairMotion* motion) {
+    if (!motion) return deepest(m);
+    Real least = kHuge;
+    for (int i = 0; i < m.point_count; ++i) {
+        const Vec3& p = m.points[i].point;
+        const Vec3 va = motion->v_a + motion->w_a.cross(p - motion->centre_a);
+        const Vec3 vb = motion->v_b + motion->w_b.cross(p - motion->centre_b);
+        least = std::min(least, m.points[i].separation + motion->dt * m.normal.dot(vb - va));
+    }
+    return least;
+}
+
 struct Gathered {
+    explicit Gathered(const PairMotion* m) : motion(m) {}
     ManifoldSlots<kMaxGathered> list;
+    Real ranks[kMaxGathered];  // each manifold's rank, made once
     int count = 0;
+    const PairMotion* motion;
 };
 
 void keep(Gathered& g, const Manifold& m) {
+    const Real r = rank(m, g.motion);
     if (g.count < kMaxGathered) {
+        g.ranks[g.count] = r;
         g.list.fill(static_cast<std::size_t>(g.count++), m);
         return;
     }
-    Manifold* const begin = g.list.data();
-    Manifold* const end = begin + kMaxGathered;
-    Manifold* shallowest = begin;
-    for (Manifold* it = begin; it != end; ++it) {
-        if (deepest(*it) > deepest(*shallowest)) shallowest = it;
+    int shallowest = 0;
+    for (int i = 1; i < kMaxGathered; ++i) {
+        if (g.ranks[i] > g.ranks[shallowest]) shallowest = i;
     }
-    if (deepest(m) >= deepest(*shallowest)) return;
+    if (r >= g.ranks[shallowest]) return;
     // Out of its place, and m at the end: the list stays in the order of the walk.
-    std::move(shallowest + 1, end, shallowest);
-    end[-1] = m;
+    Manifold* const begin = g.list.data();
+    std::move(begin + shallowest + 1, begin + kMaxGathered, begin + shallowest);
+    std::move(g.ranks + shallowest + 1, g.ranks + kMaxGathered, g.ranks + shallowest);
+    begin[kMaxGathered - 1] = m;
+    g.ranks[kMaxGathered - 1] = r;
 }
 
 // Compound b's parts posed in the world, and their bounds: worked out once per pair, not
@@ -141,16 +164,14 @@ void collide_parts(std::uint32_t part_a, const Aabb& a_box, PosedParts& b, std::
     }
 }
 
-// The deepest `capacity` manifolds, in part-pair order (the order of the walk), so the
-// order does not depend on which were kept.
+// The `capacity` manifolds that rank deepest, in part-pair order (the order of the walk),
+// so the order does not depend on which were kept.
 int emit(Gathered& g, Manifold* out, int capacity) {
     const Manifold* begin = g.list.data();
     if (g.count > capacity) {
         std::array<int, kMaxGathered> order;
         for (int i = 0; i < g.count; ++i) order[static_cast<std::size_t>(i)] = i;
-        std::stable_sort(order.begin(), order.begin() + g.count, [&](int x, int y) {
-            return deepest(g.list[static_cast<std::size_t>(x)]) < deepest(g.list[static_cast<std::size_t>(y)]);
-        });
+        std::stable_sort(order.begin(), order.begin() + g.count, [&](int x, int y) { return g.ranks[x] < g.ranks[y]; });
         std::sort(order.begin(), order.begin() + capacity);
         for (int i = 0; i < capacity; ++i)
             out[i] = g.list[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
@@ -161,11 +182,12 @@ int emit(Gathered& g, Manifold* out, int capacity) {
 }
 
 // Shape a against each of compound b's parts near it, through `pair(part, pose, exact bounds,
-// i, found)` (as collide_parts).
+// i, found)` (as collide_parts); with more than `capacity` manifolds, those ranking deepest.
 template <class PairFn>
 int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                        std::span<const Aabb> b_boxes, Real speculative, Manifold* out, int capacity, PairFn&& pair) {
-    Gathered g;
+                        std::span<const Aabb> b_boxes, Real speculative, Manifold* out, int capacity,
+                        const PairMotion* motion, PairFn&& pair) {
+    Gathered g(motion);
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
     PosedParts parts(*b.parts, xb, b_boxes);
     ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
@@ -179,8 +201,8 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
 }  // namespace
 
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                           Manifold* out, int capacity, const PartBoxes& boxes) {
-    return collide_shape_parts(a, xa, b, xb, boxes.b, speculative, out, capacity,
+                           Manifold* out, int capacity, const PartBoxes& boxes, const PairMotion* motion) {
+    return collide_shape_parts(a, xa, b, xb, boxes.b, speculative, out, capacity, motion,
                                [&](const Shape& part, const Transform& x, const Aabb&, std::uint32_t, Manifold* found) {
                                    return collide(a, xa, part, x, speculative, found, kPerPair);
                                });
@@ -188,9 +210,9 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
 
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
-                                 std::span<const Aabb> b_boxes) {
+                                 std::span<const Aabb> b_boxes, const PairMotion* motion) {
     return collide_shape_parts(
-        mesh, xm, b, xb, b_boxes, speculative, out, capacity,
+        mesh, xm, b, xb, b_boxes, speculative, out, capacity, motion,
         [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found) {
             // The mesh's pair function has the part as A: turned round as collide() does.
             // The part's exact box, which the walk's cull has made or was given.
@@ -201,8 +223,9 @@ int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const S
 }
 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes) {
-    Gathered g;
+                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes,
+                              const PairMotion* motion) {
+    Gathered g(motion);
     const Compound& parts = *a.parts;
     const Real margin = std::max(speculative, Real(0));
     PosedParts a_parts(parts, xa, boxes.a), b_parts(*b.parts, xb, boxes.b);

@@ -66,15 +66,17 @@ int collide_convex_mesh_cached(const Shape& a, const Transform& xa, const Shape&
                                TriangleFeatureWalk& walk, const Aabb* a_bounds = nullptr);
 
 // collide_compound.cpp: any shape against a compound (B), and two compounds, part by part,
-// each compound's part boxes taken from `boxes` where given (empty: made by the walk).
+// each compound's part boxes taken from `boxes` where given (empty: made by the walk); with
+// more manifolds than `capacity`, those deepest a step ahead under `motion` (null: now).
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                           Manifold* out, int capacity, const PartBoxes& boxes);
+                           Manifold* out, int capacity, const PartBoxes& boxes, const PairMotion* motion);
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
-                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes);
+                              Real speculative, Manifold* out, int capacity, const PartBoxes& boxes,
+                              const PairMotion* motion);
 // collide_shape_compound for a triangle mesh A, each part's triangles met through `walk`.
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
-                                 std::span<const Aabb> b_boxes);
+                                 std::span<const Aabb> b_boxes, const PairMotion* motion);
 
 // ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and

@@ -14,26 +14,29 @@ namespace detail {
 namespace {
 
 constexpr int kTypeCount = static_cast<int>(ShapeType::Count);
-// A table entry: a pair function, given the compounds' part boxes (only a compound's reads them).
+// A table entry: a pair function, given the compounds' part boxes and the bodies' motion (only a
+// compound's reads them).
 using Entry = int (*)(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
-                      Manifold* out, int capacity, const PartBoxes& boxes);
+                      Manifold* out, int capacity, const PartBoxes& boxes, const PairMotion* motion);
 using Table = std::array<std::array<Entry, kTypeCount>, kTypeCount>;
 
 template <auto Fn>
 int call(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative, Manifold* out,
-         int capacity, const PartBoxes& boxes) {
+         int capacity, const PartBoxes& boxes, const PairMotion* motion) {
     if constexpr (std::is_same_v<decltype(Fn), PairFunction>) {
         return Fn(a, xa, b, xb, speculative, out, capacity);
     } else {
-        return Fn(a, xa, b, xb, speculative, out, capacity, boxes);
+        return Fn(a, xa, b, xb, speculative, out, capacity, boxes, motion);
     }
 }
 
 // Calls Fn with the shapes swapped and turns the normals round, so they point from a to b.
 template <auto Fn>
 int swapped(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative, Manifold* out,
-            int capacity, const PartBoxes& boxes) {
-    const int count = call<Fn>(b, xb, a, xa, speculative, out, capacity, PartBoxes{boxes.b, boxes.a});
+            int capacity, const PartBoxes& boxes, const PairMotion* motion) {
+    const PairMotion turned = motion ? motion->swapped() : PairMotion{};
+    const int count = call<Fn>(b, xb, a, xa, speculative, out, capacity, PartBoxes{boxes.b, boxes.a},
+                               motion ? &turned : nullptr);
     for (int i = 0; i < count; ++i) flip_manifold(out[i]);
     return count;
 }
@@ -77,17 +80,17 @@ const Table& table() {
 }  // namespace detail
 
 int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
-            Manifold* out, int capacity, const PartBoxes& boxes) {
+            Manifold* out, int capacity, const PartBoxes& boxes, const PairMotion* motion) {
     SPINDLE_ASSERT(a.type < ShapeType::Count && b.type < ShapeType::Count, "collide: invalid shape type");
     if (capacity <= 0) return 0;
     const detail::Entry fn = detail::table()[static_cast<int>(a.type)][static_cast<int>(b.type)];
     if (fn == nullptr) return 0;
-    return fn(a, xa, b, xb, speculative_distance, out, capacity, boxes);
+    return fn(a, xa, b, xb, speculative_distance, out, capacity, boxes, motion);
 }
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes) {
+                   const PartBoxes& boxes, const PairMotion* motion) {
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
     const bool mesh_a = a.type == ShapeType::TriangleMesh;
     const bool mesh_b = b.type == ShapeType::TriangleMesh;
@@ -100,11 +103,13 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         detail::TriangleFeatureWalk walk(triangles, feature_slop);
         // The pair functions' normals: from the mesh to a compound, from a convex shape to the mesh.
         const bool from_mesh = shape.type == ShapeType::Compound;
-        const int count = from_mesh
-                              ? detail::collide_mesh_compound_cached(mesh, x_mesh, shape, x_shape, speculative_distance,
-                                                                     out, capacity, walk, mesh_a ? boxes.b : boxes.a)
-                              : detail::collide_convex_mesh_cached(shape, x_shape, mesh, x_mesh, speculative_distance,
-                                                                   out, capacity, 0, walk);
+        const PairMotion mesh_first = motion && !mesh_a ? motion->swapped() : PairMotion{};
+        const PairMotion* const compound_motion = !motion ? nullptr : mesh_a ? motion : &mesh_first;
+        const int count = from_mesh ? detail::collide_mesh_compound_cached(mesh, x_mesh, shape, x_shape,
+                                                                           speculative_distance, out, capacity, walk,
+                                                                           mesh_a ? boxes.b : boxes.a, compound_motion)
+                                    : detail::collide_convex_mesh_cached(shape, x_shape, mesh, x_mesh,
+                                                                         speculative_distance, out, capacity, 0, walk);
         walk.finish();
         if (from_mesh != mesh_a) {
             for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);
@@ -115,7 +120,7 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
     // Box-box has its own 15-axis test; a compound's walk takes its part boxes.
     if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
         cache = FeatureCache();
-        return collide(a, xa, b, xb, speculative_distance, out, capacity, boxes);
+        return collide(a, xa, b, xb, speculative_distance, out, capacity, boxes, motion);
     }
     // The pair functions' order: the lower type is A (box before hull), as in the table.
     const bool swap = b.type < a.type;
