@@ -39,6 +39,8 @@ class QueryScene;        // query/query_scene.hpp
 // awake, but not yet at a position in the list.
 inline constexpr std::int32_t kAwakePending = std::numeric_limits<std::int32_t>::max();
 inline constexpr std::size_t kNoPosition = std::numeric_limits<std::size_t>::max();
+// Bodies::history_place of a slot that never held a body that can move.
+inline constexpr std::uint32_t kNoHistory = std::numeric_limits<std::uint32_t>::max();
 
 // Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
 // data (pose, velocity, mass) sits in its own arrays; the description (shape,
@@ -72,8 +74,13 @@ struct Bodies {
     std::vector<std::uint8_t> layer;
     std::vector<std::uint32_t> group;
 
-    // Interpolation history (the last two recorded steps), origin pose.
-    std::vector<Vec3> history_position[2];
+    // Interpolation history (the last two recorded steps, origin pose) of the bodies that
+    // can move: a static body never blends, so it keeps none (a level's static geometry
+    // would otherwise carry two poses a body). history_place[i] is slot i's entry in the
+    // history arrays, given when the slot first holds a body that can move and kept for the
+    // slot from then on (kNoHistory: none yet).
+    std::vector<std::uint32_t> history_place;
+    std::vector<Vec3> history_position[2];  // by entry
     std::vector<Quat> history_orientation[2];
     std::vector<std::uint8_t> interpolate;  // allow_interpolation
 
@@ -88,10 +95,26 @@ struct Bodies {
         f(b.generation), f(b.alive);
         f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local), f(b.inertia_local);
         f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.awake_index), f(b.sleep_time);
-        f(b.island), f(b.layer), f(b.group), f(b.interpolate);
-        f(b.history_position[0]), f(b.history_position[1]), f(b.history_orientation[0]), f(b.history_orientation[1]);
+        f(b.island), f(b.layer), f(b.group), f(b.interpolate), f(b.history_place);
         f(b.desc);
     }
+    // Slot i's history holds the origin pose p, q in both steps, so an interpolated read
+    // shows the body there instead of sliding to it (a creation, a teleport, sleep). Gives
+    // the slot its entry if it has none: for a body that can move only.
+    void hold_history(std::uint32_t i, const Vec3& p, const Quat& r) {
+        if (history_place[i] == kNoHistory) {
+            history_place[i] = history_count();
+            for (int k = 0; k < 2; ++k) history_position[k].emplace_back(), history_orientation[k].emplace_back();
+        }
+        const std::uint32_t h = history_place[i];
+        for (int k = 0; k < 2; ++k) history_position[k][h] = p, history_orientation[k][h] = r;
+    }
+    // hold_history at the body's pose now, if slot i has a history (a static body has none:
+    // it never blends).
+    void reset_history(std::uint32_t i) {
+        if (history_place[i] != kNoHistory) hold_history(i, origin(i), q[i]);
+    }
+    std::uint32_t history_count() const noexcept { return static_cast<std::uint32_t>(history_position[0].size()); }
     bool is_live(BodyHandle h) const noexcept {
         return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
                h.generation != 0;

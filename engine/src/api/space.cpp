@@ -81,6 +81,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     } else {
         slot = b.capacity();
         Bodies::for_each_slot_array(b, [n = std::size_t{slot} + 1](auto& array) { grow(array, n); });
+        b.history_place[slot] = kNoHistory;
     }
     b.generation[slot] += 1;
     if (b.generation[slot] == 0) b.generation[slot] = 1;  // 2^32 reuses: skip the invalid generation
@@ -109,10 +110,7 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.interpolate[slot] = desc.allow_interpolation ? 1 : 0;
     b.layer[slot] = static_cast<std::uint8_t>(desc.layer);
     b.group[slot] = desc.group;
-    for (int k = 0; k < 2; ++k) {
-        b.history_position[k][slot] = desc.position;
-        b.history_orientation[k][slot] = desc.orientation;
-    }
+    if (desc.type != MotionType::Static) b.hold_history(slot, desc.position, desc.orientation);
     b.desc[slot] = std::move(desc);
     b.bounds[slot] = b.desc[slot].shape.bounds(b.transform(slot));
     if (b.is_fast(slot)) w.fast_bodies += 1;

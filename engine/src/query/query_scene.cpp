@@ -92,7 +92,10 @@ void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpol
     body.group = b.group[i];
     body.current = b.transform(i);
     body.interpolate = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;  // as fill()
-    if (body.interpolate) body.previous = {b.history_position[0][i], b.history_orientation[0][i]};
+    if (body.interpolate) {
+        const std::uint32_t h = b.history_place[i];
+        body.previous = {b.history_position[0][h], b.history_orientation[0][h]};
+    }
     tight = tight_bounds(i);
 }
 
@@ -159,7 +162,10 @@ std::shared_ptr<QueryScene> QueryScene::build(const World& world, const Publishe
         body.group = b.group[i];
         body.current = {buffer.current[i].position, buffer.current[i].orientation};
         body.interpolate = buffer.interpolate[i] != 0;
-        if (body.interpolate) body.previous = {buffer.previous[i].position, buffer.previous[i].orientation};
+        if (body.interpolate) {
+            const PublishedHistory& before = buffer.previous_of(i);
+            body.previous = {before.position, before.orientation};
+        }
         tight.push_back(scene->tight_bounds(i));
         user.push_back(i);
     }

@@ -128,12 +128,13 @@ bool change_motion_type(World& world, std::uint32_t slot, MotionType type) {
     set_awake(world, slot, type != MotionType::Static);
     b.island[slot] = -1;
     if (type == MotionType::Static) {
-        // A static body is never recorded again: both history entries hold its pose, so an
+        // A static body is never recorded again: both history steps hold its pose, so an
         // interpolated read does not stay a step behind.
-        for (int k = 0; k < 2; ++k) {
-            b.history_position[k][slot] = b.origin(slot);
-            b.history_orientation[k][slot] = b.q[slot];
-        }
+        b.reset_history(slot);
+    } else if (before == MotionType::Static) {
+        // Its first history (a static body has none), or the one its slot's last moving
+        // body left.
+        b.hold_history(slot, b.origin(slot), b.q[slot]);
     }
     world.body_set_version += 1;  // the solver's colours depend on which bodies are dynamic
     attach(world, slot);

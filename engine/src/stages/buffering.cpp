@@ -59,16 +59,6 @@ private:
     bool m_took;
 };
 
-// A teleport: the body jumps, so both history entries take the new pose and the
-// interpolation does not slide it there.
-void reset_history(Bodies& b, std::uint32_t i) {
-    const Vec3 origin = b.origin(i);
-    for (int k = 0; k < 2; ++k) {
-        b.history_position[k][i] = origin;
-        b.history_orientation[k][i] = b.q[i];
-    }
-}
-
 }  // namespace
 
 // Each written body once, whatever the number of writes made to it (WriteBuffer
@@ -100,7 +90,7 @@ void apply_writes(World& world) {
             const Vec3 origin = (write.bits & kPendingPosition) != 0 ? write.position : b.origin(i);
             if ((write.bits & kPendingOrientation) != 0) b.q[i] = write.orientation.normalized();
             b.x[i] = origin + b.q[i] * b.local_com[i];
-            reset_history(b, i);
+            b.reset_history(i);  // the body jumps: an interpolated read does not slide it there
         } else if (moves && write.bits != kPendingUserData) {
             wake_body(world, i);  // not for user data alone: a game may tag sleeping bodies every frame
         }
@@ -179,11 +169,18 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
     p.interpolate[i] = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;
     if (p.interpolate[i]) {
         // Bodies without the flag skip this: interpolation costs them nothing.
-        PublishedHistory& before = p.previous[i];
-        before.position = b.history_position[0][i];
-        before.orientation = b.history_orientation[0][i];
+        const std::uint32_t h = b.history_place[i];  // a body that can move has one
+        p.history_place[i] = h;
+        PublishedHistory& before = p.previous[h];
+        before.position = b.history_position[0][h];
+        before.orientation = b.history_orientation[0][h];
         before.center_of_mass = before.position + before.orientation * b.local_com[i];
     }
+}
+
+// Room in a published buffer for every body slot and history entry, before fill().
+static void fit_published(const Bodies& b, PublishedBuffer& p) {
+    if (p.size() < b.capacity() || p.previous.size() < b.history_count()) p.resize(b.capacity(), b.history_count());
 }
 
 // A body's user data, published apart from its state: it lives in the cold description
@@ -211,7 +208,7 @@ void publish_now(World& world, std::uint32_t slot) {
     const PublishingHold guard(manager);
     for (int k = 0; k < 2; ++k) {
         PublishedBuffer& buffer = manager.buffer_locked(k);
-        if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
+        fit_published(world.bodies, buffer);
         fill(world, slot, buffer, interpolating);
         publish_user_data(world, slot, buffer);
     }
@@ -248,7 +245,7 @@ void flip_read_buffers(World& world) {
     Bodies& b = world.bodies;
     MotionStatePublisher manager(world.motion_states);
     PublishedBuffer& back = manager.back();
-    if (back.size() < b.capacity()) back.resize(b.capacity());
+    fit_published(b, back);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
 
     auto publish = [&](std::uint32_t i) {
@@ -336,7 +333,7 @@ void flip_read_buffers(World& world) {
                              world.read_blend};
     world.stats.flip_lock_seconds = manager.flip(time, world.query_scenes[k]);
     // After the swap the new back buffer may be shorter than the body slots.
-    if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
+    fit_published(b, manager.back());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());
     publish_contact_events(world);  // under the events' own lock, not the motion-state lock
     publish_contact_points(world);

@@ -250,11 +250,7 @@ void update_islands(World& world, Real dt) {
         set_awake(world, slot, false);
         b.v[slot] = Vec3::Zero();
         b.w[slot] = Vec3::Zero();
-        // Blend nothing while asleep: both history entries hold the resting pose.
-        for (int k = 0; k < 2; ++k) {
-            b.history_position[k][slot] = b.origin(slot);
-            b.history_orientation[k][slot] = b.q[slot];
-        }
+        b.reset_history(slot);  // blend nothing while asleep: both steps hold the resting pose
         world.changed_now.push_back(slot);
     }
     settle_awake(world);

@@ -2,6 +2,7 @@
 // and impulses at points, kinematic moves, shape and motion type, each buffered (applied
 // at the next update, the last write winning) and each checked (bad values and stale
 // handles rejected with the space unchanged).
+#include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
 
@@ -366,6 +367,27 @@ TEST(Setters, StaticBoxMadeDynamic_Falls) {
     run(space, 60);
     EXPECT_LT(space.internal_position(b).y(), 1);
     EXPECT_EQ(space.internal_desc(b).type, MotionType::Dynamic);
+}
+
+// A static body keeps no interpolation history (world.hpp); made dynamic it gets one at
+// its pose, not the pose the body that last held its slot left there.
+TEST(Setters, StaticBoxMadeDynamicInAReusedSlot_BlendsFromWhereItStands) {
+    SpaceSettings settings = weightless();
+    settings.time_step.use_internal_time_stepping = true;
+    Space space(settings);
+    const Real step = settings.time_step.duration;
+    const BodyHandle gone = space.create_body(box(Vec3(100, 0, 0)));
+    space.update(step);
+    space.destroy_body(gone);
+    BodyDesc d = box(Vec3(0, 5, 0));
+    d.type = MotionType::Static;
+    const BodyHandle b = space.create_body(d);
+    ASSERT_EQ(b.index, gone.index) << "the slot is reused";
+    space.set_motion_type(b, MotionType::Dynamic);
+    space.update(1.5 * step);  // one step and half a step banked: reads blend the last two
+    ASSERT_GT(space.motion_states().alpha(), 0.4);
+    ASSERT_LT(space.motion_states().alpha(), 0.6);
+    EXPECT_LT((space.motion_state(b).position - Vec3(0, 5, 0)).norm(), 1e-9);
 }
 
 // A sleeping box made static must leave its sleeping island: waking the island later (the
