@@ -64,11 +64,12 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     validate(input);
     World& w = *m_world;
     Bodies& b = w.bodies;
-    BodyDesc desc = input;
-    desc.orientation.normalize();
+    const BodyDesc& desc = input;
+    const Quat orientation = desc.orientation.normalized();
+    BodyTraits traits(desc);
 
     // Mass first: it may throw (e.g. a degenerate shape), and nothing has changed yet.
-    const BodyMass mass = body_mass(desc, desc.type, desc.shape, "create_body");
+    const BodyMass mass = body_mass(traits, desc.type, desc.shape, "create_body");
     const Real inv_mass = mass.inv_mass;
     const Mat3& inv_inertia = mass.inv_inertia;
     const Mat3& inertia = mass.inertia;
@@ -88,9 +89,9 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.alive[slot] = 1;
     b.live += 1;
     b.type[slot] = desc.type;
-    b.q[slot] = desc.orientation;
+    b.q[slot] = orientation;
     b.local_com[slot] = local_com;
-    b.x[slot] = desc.position + desc.orientation * local_com;
+    b.x[slot] = desc.position + orientation * local_com;
     const SolverSettings& limits = w.settings.solver;
     b.locks[slot] = desc.type == MotionType::Static ? 0 : lock_bits(desc.locks);
     b.v[slot] = desc.type == MotionType::Static
@@ -110,9 +111,9 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.interpolate[slot] = desc.allow_interpolation ? 1 : 0;
     b.layer[slot] = static_cast<std::uint8_t>(desc.layer);
     b.group[slot] = desc.group;
-    if (desc.type != MotionType::Static) b.hold_history(slot, desc.position, desc.orientation);
-    b.desc[slot] = std::move(desc);
-    b.bounds[slot] = b.desc[slot].shape.bounds(b.transform(slot));
+    if (desc.type != MotionType::Static) b.hold_history(slot, desc.position, orientation);
+    b.traits[slot] = std::move(traits);
+    b.bounds[slot] = b.traits[slot].shape.bounds(b.transform(slot));
     if (b.is_fast(slot)) w.fast_bodies += 1;
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
@@ -163,7 +164,7 @@ void Space::destroy_body(BodyHandle body) {
     if (w.bodies.is_fast(slot)) w.fast_bodies -= 1;
     w.bodies.alive[slot] = 0;
     w.bodies.live -= 1;
-    w.bodies.desc[slot] = BodyDesc{};  // drop the shape's geometry now
+    w.bodies.traits[slot] = BodyTraits{};  // drop the shape's geometry now
     w.bodies.free_slots.push_back(slot);
     w.body_set_version += 1;
     w.body_count.store(w.bodies.live, std::memory_order_release);

@@ -110,10 +110,10 @@ void QueryScene::move(std::uint32_t i, const Aabb& tight, const Vec3& displaceme
 
 void QueryScene::set_shape(const World& world, std::uint32_t i) {
     QueryBody& body = m_bodies[i];
-    const Shape& shape = world.bodies.desc[i].shape;
+    const Shape& shape = world.bodies.traits[i].shape;
     m_shapes[i] = shape;
     body.exact_bounds = shape.static_only();
-    body.sensor = world.bodies.desc[i].sensor;  // set at creation only
+    body.sensor = world.bodies.traits[i].sensor;  // set at creation only
     const Aabb local = shape.bounds({});
     body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
     body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
@@ -129,7 +129,7 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
         return;
     }
     // Shapes change only with the body (creation, a new shape): compared, not copied.
-    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], world.bodies.desc[i].shape)) {
+    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], world.bodies.traits[i].shape)) {
         set_shape(world, i);
     }
     body.generation = world.bodies.generation[i];

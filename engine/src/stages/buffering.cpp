@@ -121,7 +121,7 @@ void apply_writes(World& world) {
             b.w[i] = limit_speed(b.w[i], max_angular);
         }
         if ((write.bits & (kPendingPose | kPendingVelocity)) != 0) {
-            b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            b.bounds[i] = b.traits[i].shape.bounds(b.transform(i));
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
@@ -135,8 +135,8 @@ void apply_writes(World& world) {
         if ((write.bits & kPendingFilter) != 0 && (b.layer[i] != write.layer || b.group[i] != write.group)) {
             b.layer[i] = static_cast<std::uint8_t>(write.layer);
             b.group[i] = write.group;
-            b.desc[i].layer = write.layer;
-            b.desc[i].group = write.group;
+            b.traits[i].layer = write.layer;
+            b.traits[i].group = write.group;
             refiltered.push_back(i);
             world.changed_now.push_back(i);  // the query scenes publish the filter
         }
@@ -186,7 +186,7 @@ static void fit_published(const Bodies& b, PublishedBuffer& p) {
 // A body's user data, published apart from its state: it lives in the cold description
 // and changes only by creation or a write, so only changed bodies are written.
 static void publish_user_data(const World& world, std::uint32_t i, PublishedBuffer& p) {
-    p.user_data[i] = world.bodies.alive[i] ? world.bodies.desc[i].user_data : 0;
+    p.user_data[i] = world.bodies.alive[i] ? world.bodies.traits[i].user_data : 0;
 }
 
 void reserve_published(World& world, std::size_t slots) {
@@ -238,7 +238,7 @@ void publish_now(World& world, std::uint32_t slot) {
 void publish_kind(World& world, std::uint32_t slot) {
     const Bodies& b = world.bodies;
     MotionStatePublisher(world.motion_states)
-        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.desc[slot].shape.static_only());
+        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.traits[slot].shape.static_only());
 }
 
 void flip_read_buffers(World& world) {

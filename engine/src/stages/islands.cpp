@@ -168,7 +168,7 @@ void update_islands(World& world, Real dt) {
     Real longest_rest = 0;
     for (std::uint32_t i : world.awake) {
         const bool driven = b.type[i] == MotionType::Kinematic && (b.v[i] != Vec3::Zero() || b.w[i] != Vec3::Zero());
-        const bool resting = b.desc[i].allow_sleep && !driven && b.v[i].squaredNorm() < lin2 &&
+        const bool resting = b.traits[i].allow_sleep && !driven && b.v[i].squaredNorm() < lin2 &&
                              b.w[i].squaredNorm() < ang2;
         b.sleep_time[i] = resting ? b.sleep_time[i] + dt : 0;
         longest_rest = std::max(longest_rest, b.sleep_time[i]);

@@ -76,7 +76,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
-            const BodyDesc& d = b.desc[i];
+            const BodyTraits& d = b.traits[i];
             sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
             scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
             sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);

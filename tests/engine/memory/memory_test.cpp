@@ -132,14 +132,14 @@ TEST(Memory, BodiesMadeInReservedRoomMoveNoPerBodyArray) {
     const World& world = SpaceInternals::world(space);
     const std::size_t reserved = memory_report(space).bodies;
     const Vec3* positions = world.bodies.x.data();
-    const BodyDesc* descriptions = world.bodies.desc.data();
+    const BodyTraits* descriptions = world.bodies.traits.data();
     const std::uint32_t* awake = world.awake.data();
     const ProxyId* proxies = world.broadphase->proxy.data();
     make_level(space);
     space.update();
     EXPECT_EQ(memory_report(space).bodies, reserved);
     EXPECT_EQ(world.bodies.x.data(), positions);
-    EXPECT_EQ(world.bodies.desc.data(), descriptions);
+    EXPECT_EQ(world.bodies.traits.data(), descriptions);
     EXPECT_EQ(world.awake.data(), awake);
     EXPECT_EQ(world.broadphase->proxy.data(), proxies);
     EXPECT_EQ(space.body_count(), static_cast<std::size_t>(kLevelBodies));
