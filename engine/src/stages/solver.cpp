@@ -355,6 +355,9 @@ void solve(World& world, Real dt) {
         pack_contacts(*world.jobs, scratch);
         world.counters.constraint_colorings += 1;
     }
+    // A world at rest (every body asleep or static) has nothing to move or solve: no
+    // passes at all, not a plan of empty ones each step.
+    if (world.awake.empty() && scratch.wide.empty() && scratch.joints.empty()) return;
     SolverBody* bodies = scratch.bodies.data();
     PushVelocity* push = scratch.push_velocities.data();
     const Real* gravity_scales = scratch.gravity_scales.data();
