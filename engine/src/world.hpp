@@ -43,8 +43,8 @@ inline constexpr std::size_t kNoPosition = std::numeric_limits<std::size_t>::max
 inline constexpr std::uint32_t kNoHistory = std::numeric_limits<std::uint32_t>::max();
 
 // What a body keeps of its description: BodyDesc but for the pose and velocities it was
-// made with (the live arrays hold those; a level's million static boxes would keep 104
-// bytes each of copies never read). Each field means what BodyDesc's does; a field added
+// made with (the live arrays hold those; a level's static geometry would otherwise keep
+// copies no stage reads). Each field means what BodyDesc's does; a field added
 // to BodyDesc is added here, to both conversions and to the test that round-trips them
 // (Setters.InternalDescKeepsEveryFieldItWasMadeWith).
 struct BodyTraits {

@@ -59,12 +59,11 @@ Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make
 
 Space::~Space() = default;
 
-BodyHandle Space::create_body(const BodyDesc& input) {
+BodyHandle Space::create_body(const BodyDesc& desc) {
     const AccessGate::Structure access(m_world->gate, "create_body");
-    validate(input);
+    validate(desc);
     World& w = *m_world;
     Bodies& b = w.bodies;
-    const BodyDesc& desc = input;
     const Quat orientation = desc.orientation.normalized();
     BodyTraits traits(desc);
 
