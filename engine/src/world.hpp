@@ -39,6 +39,61 @@ class QueryScene;        // query/query_scene.hpp
 // awake, but not yet at a position in the list.
 inline constexpr std::int32_t kAwakePending = std::numeric_limits<std::int32_t>::max();
 inline constexpr std::size_t kNoPosition = std::numeric_limits<std::size_t>::max();
+// Bodies::history_place of a slot that never held a body that can move.
+inline constexpr std::uint32_t kNoHistory = std::numeric_limits<std::uint32_t>::max();
+
+// What a body keeps of its description: BodyDesc but for the pose and velocities it was
+// made with (the live arrays hold those; a level's static geometry would otherwise keep
+// copies no stage reads). Each field means what BodyDesc's does; a field added
+// to BodyDesc is added here, to both conversions and to the test that round-trips them
+// (Setters.InternalDescKeepsEveryFieldItWasMadeWith).
+struct BodyTraits {
+    MotionType type = MotionType::Dynamic;
+    Shape shape;  // empty in a free slot: its geometry is let go
+    Real density = 0, mass = 0, friction = 0, restitution = 0, gravity_scale = 0;
+    Real linear_damping = 0, angular_damping = 0;
+    bool gyroscopic = false;
+    MotionLocks locks;
+    bool allow_interpolation = false, allow_sleep = false, fast = false;
+    std::uint32_t layer = 0, group = 0;
+    bool contact_events = false, sensor = false;
+    std::uint64_t user_data = 0;
+
+    BodyTraits() = default;
+    explicit BodyTraits(const BodyDesc& d)
+        : type(d.type),
+          shape(d.shape),
+          density(d.density),
+          mass(d.mass),
+          friction(d.friction),
+          restitution(d.restitution),
+          gravity_scale(d.gravity_scale),
+          linear_damping(d.linear_damping),
+          angular_damping(d.angular_damping),
+          gyroscopic(d.gyroscopic),
+          locks(d.locks),
+          allow_interpolation(d.allow_interpolation),
+          allow_sleep(d.allow_sleep),
+          fast(d.fast),
+          layer(d.layer),
+          group(d.group),
+          contact_events(d.contact_events),
+          sensor(d.sensor),
+          user_data(d.user_data) {}
+    // The description with the given pose and velocities.
+    BodyDesc described(const Vec3& position, const Quat& orientation, const Vec3& linear_velocity,
+                       const Vec3& angular_velocity) const {
+        BodyDesc d;
+        d.type = type, d.shape = shape, d.position = position, d.orientation = orientation;
+        d.linear_velocity = linear_velocity, d.angular_velocity = angular_velocity;
+        d.density = density, d.mass = mass, d.friction = friction, d.restitution = restitution;
+        d.gravity_scale = gravity_scale, d.linear_damping = linear_damping, d.angular_damping = angular_damping;
+        d.gyroscopic = gyroscopic, d.locks = locks, d.allow_interpolation = allow_interpolation;
+        d.allow_sleep = allow_sleep, d.fast = fast, d.layer = layer, d.group = group;
+        d.contact_events = contact_events, d.sensor = sensor, d.user_data = user_data;
+        return d;
+    }
+};
 
 // Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
 // data (pose, velocity, mass) sits in its own arrays; the description (shape,
@@ -72,13 +127,18 @@ struct Bodies {
     std::vector<std::uint8_t> layer;
     std::vector<std::uint32_t> group;
 
-    // Interpolation history (the last two recorded steps), origin pose.
-    std::vector<Vec3> history_position[2];
+    // Interpolation history (the last two recorded steps, origin pose) of the bodies that
+    // can move: a static body never blends, so it keeps none (a level's static geometry
+    // would otherwise carry two poses a body). history_place[i] is slot i's entry in the
+    // history arrays, given when the slot first holds a body that can move and kept for the
+    // slot from then on (kNoHistory: none yet).
+    std::vector<std::uint32_t> history_place;
+    std::vector<Vec3> history_position[2];  // by entry
     std::vector<Quat> history_orientation[2];
     std::vector<std::uint8_t> interpolate;  // allow_interpolation
 
     // Cold.
-    std::vector<BodyDesc> desc;
+    std::vector<BodyTraits> traits;
 
     std::uint32_t capacity() const noexcept { return static_cast<std::uint32_t>(generation.size()); }
     // Calls f on each per-slot array of `b` (all but free_slots), so that growing,
@@ -88,10 +148,26 @@ struct Bodies {
         f(b.generation), f(b.alive);
         f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local), f(b.inertia_local);
         f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.awake_index), f(b.sleep_time);
-        f(b.island), f(b.layer), f(b.group), f(b.interpolate);
-        f(b.history_position[0]), f(b.history_position[1]), f(b.history_orientation[0]), f(b.history_orientation[1]);
-        f(b.desc);
+        f(b.island), f(b.layer), f(b.group), f(b.interpolate), f(b.history_place);
+        f(b.traits);
     }
+    // Slot i's history holds the origin pose p, q in both steps, so an interpolated read
+    // shows the body there instead of sliding to it (a creation, a teleport, sleep). Gives
+    // the slot its entry if it has none: for a body that can move only.
+    void hold_history(std::uint32_t i, const Vec3& p, const Quat& r) {
+        if (history_place[i] == kNoHistory) {
+            history_place[i] = history_count();
+            for (int k = 0; k < 2; ++k) history_position[k].emplace_back(), history_orientation[k].emplace_back();
+        }
+        const std::uint32_t h = history_place[i];
+        for (int k = 0; k < 2; ++k) history_position[k][h] = p, history_orientation[k][h] = r;
+    }
+    // hold_history at the body's pose now, if slot i has a history (a static body has none:
+    // it never blends).
+    void reset_history(std::uint32_t i) {
+        if (history_place[i] != kNoHistory) hold_history(i, origin(i), q[i]);
+    }
+    std::uint32_t history_count() const noexcept { return static_cast<std::uint32_t>(history_position[0].size()); }
     bool is_live(BodyHandle h) const noexcept {
         return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
                h.generation != 0;
@@ -100,7 +176,7 @@ struct Bodies {
     Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
     // Whether the Continuous stage sweeps the body: dynamic and flagged fast (neither
     // changes while the body lives).
-    bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && desc[i].fast; }
+    bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && traits[i].fast; }
     Mat3 inv_inertia_world(std::uint32_t i) const {
         const Mat3 r = q[i].toRotationMatrix();
         if ((locks[i] & kLockRotation) != 0)

@@ -12,7 +12,10 @@
 #include <thread>
 #include <vector>
 
+#include "api/space_internals.hpp"
+#include "api/write_buffer.hpp"
 #include "async_util.hpp"
+#include "world.hpp"
 
 using namespace spindle;
 using namespace spindle::test;
@@ -27,6 +30,22 @@ TEST(WriteBuffer, ManyWritesToOneBodyAreOneEntry) {
     EXPECT_EQ(space.last_update().writes_applied, 20000);
     EXPECT_EQ(space.position(body), Vec3(9999, 0, 0));
     EXPECT_NEAR(space.linear_velocity(body).y(), 100, 1e-9);
+}
+
+// An update with nothing written takes no stripe's lock (it took all 64 each update); one
+// body written, one lock.
+TEST(WriteBuffer, AnUpdateLocksOnlyTheStripesWrittenTo) {
+    Space space(weightless());
+    const BodyHandle body = space.create_body(ball());
+    const WriteBuffer& writes = SpaceInternals::world(space).writes;
+    space.update();
+    const std::uint64_t before = writes.stripes_drained();
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(writes.stripes_drained(), before);
+    space.set_linear_velocity(body, Vec3(1, 0, 0));
+    space.update();
+    EXPECT_EQ(writes.stripes_drained(), before + 1);
+    EXPECT_EQ(space.linear_velocity(body), Vec3(1, 0, 0));
 }
 
 TEST(WriteBuffer, AVelocityWriteReplacesTheImpulsesBeforeItNotAfter) {

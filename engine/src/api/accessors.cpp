@@ -150,7 +150,7 @@ void Space::set_internal_motion_state(BodyHandle body, const MotionState& state)
         b.w[i] = limit_speed(project_angular(state.angular_velocity, b.locks[i]),
                              m_world->settings.solver.max_angular_speed);
     }
-    b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+    b.bounds[i] = b.traits[i].shape.bounds(b.transform(i));
     refresh_proxy(*m_world, i);
     m_world->changed_now.push_back(i);
 }
@@ -162,7 +162,9 @@ bool Space::internal_is_awake(BodyHandle body) const {
 
 BodyDesc Space::internal_desc(BodyHandle body) const {
     const AccessGate::Structure access(m_world->gate, "internal_desc");
-    return m_world->bodies.desc[live_slot(*m_world, body, "internal_desc")];
+    const Bodies& b = m_world->bodies;
+    const std::uint32_t i = live_slot(*m_world, body, "internal_desc");
+    return b.traits[i].described(b.origin(i), b.q[i], b.v[i], b.w[i]);
 }
 
 }  // namespace spindle

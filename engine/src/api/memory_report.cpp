@@ -39,6 +39,10 @@ MemoryReport memory_report(const Space& space) {
     const World& world = SpaceInternals::world(space);
     MemoryReport report;
     report.bodies = body_bytes(world.bodies) + held(world.awake) + held(world.awake_pending);
+    for (int k = 0; k < 2; ++k) {
+        report.histories += held(world.bodies.history_position[k]) + held(world.bodies.history_orientation[k]);
+    }
+    report.published = world.motion_states.buffer_bytes();
     report.contacts = held(world.contacts);
     for (const Contact& contact : world.contacts) {
         if (contact.extra) {

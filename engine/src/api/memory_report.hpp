@@ -9,10 +9,12 @@
 namespace spindle {
 
 // Bytes at capacity (what the containers reserved, not what they use), so that room
-// kept at a high-water mark shows. What it does not itemize (published buffers, write
-// buffer, events, joints, islands) a heap counter sees as the rest.
+// kept at a high-water mark shows. What it does not itemize (write buffer, events,
+// joints, islands) a heap counter sees as the rest.
 struct MemoryReport {
     std::size_t bodies = 0;          // the per-slot body arrays, descriptions included
+    std::size_t histories = 0;       // the interpolation history of the bodies that can move
+    std::size_t published = 0;       // both published buffers (what reads copy)
     std::size_t contacts = 0;        // contact records, with their first manifold
     std::size_t contact_extras = 0;  // further manifolds and triangle features (meshes, compounds)
     std::size_t contact_lookup = 0;  // pair index, keys, summaries, awake list
@@ -23,8 +25,8 @@ struct MemoryReport {
     std::size_t query_scenes = 0;    // both published query scenes
 
     std::size_t total() const noexcept {
-        return bodies + contacts + contact_extras + contact_lookup + wide_contacts + push_rows + solver_other +
-               broadphase + query_scenes;
+        return bodies + histories + published + contacts + contact_extras + contact_lookup + wide_contacts + push_rows +
+               solver_other + broadphase + query_scenes;
     }
 };
 

@@ -89,7 +89,7 @@ namespace {
 // it interpolates (the caller leaves out alpha = 1, where every slot reads as its newest state).
 MotionState blended(const PublishedBuffer& front, std::uint32_t i, const SlerpSeries& blend) {
     if (!front.interpolate[i]) return front.current[i];
-    const PublishedHistory& before = front.previous[i];
+    const PublishedHistory& before = front.previous_of(i);
     MotionState s = front.current[i];
     const Real t = blend.t();
     s.position = before.position + (s.position - before.position) * t;
@@ -129,6 +129,16 @@ std::uint64_t MotionStateManager::read_user_data(BodyHandle body) const {
     const MotionStateLock::Hold guard(m_lock);
     check_locked(body);
     return m_front->user_data[body.index];
+}
+
+std::size_t MotionStateManager::buffer_bytes() const noexcept {
+    const auto held = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    std::size_t bytes = 0;
+    for (const PublishedBuffer& p : m_buffers) {
+        bytes += held(p.generation) + held(p.current) + held(p.interpolate) + held(p.history_place) +
+                 held(p.user_data) + held(p.previous);
+    }
+    return bytes;
 }
 
 // Runs of live slots that need no blending (all of them at alpha 1, else those that do

@@ -59,16 +59,16 @@ Space::Space(const SpaceSettings& settings, JobSystem* jobs) : m_world(std::make
 
 Space::~Space() = default;
 
-BodyHandle Space::create_body(const BodyDesc& input) {
+BodyHandle Space::create_body(const BodyDesc& desc) {
     const AccessGate::Structure access(m_world->gate, "create_body");
-    validate(input);
+    validate(desc);
     World& w = *m_world;
     Bodies& b = w.bodies;
-    BodyDesc desc = input;
-    desc.orientation.normalize();
+    const Quat orientation = desc.orientation.normalized();
+    BodyTraits traits(desc);
 
     // Mass first: it may throw (e.g. a degenerate shape), and nothing has changed yet.
-    const BodyMass mass = body_mass(desc, desc.type, desc.shape, "create_body");
+    const BodyMass mass = body_mass(traits, desc.type, desc.shape, "create_body");
     const Real inv_mass = mass.inv_mass;
     const Mat3& inv_inertia = mass.inv_inertia;
     const Mat3& inertia = mass.inertia;
@@ -81,15 +81,16 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     } else {
         slot = b.capacity();
         Bodies::for_each_slot_array(b, [n = std::size_t{slot} + 1](auto& array) { grow(array, n); });
+        b.history_place[slot] = kNoHistory;
     }
     b.generation[slot] += 1;
     if (b.generation[slot] == 0) b.generation[slot] = 1;  // 2^32 reuses: skip the invalid generation
     b.alive[slot] = 1;
     b.live += 1;
     b.type[slot] = desc.type;
-    b.q[slot] = desc.orientation;
+    b.q[slot] = orientation;
     b.local_com[slot] = local_com;
-    b.x[slot] = desc.position + desc.orientation * local_com;
+    b.x[slot] = desc.position + orientation * local_com;
     const SolverSettings& limits = w.settings.solver;
     b.locks[slot] = desc.type == MotionType::Static ? 0 : lock_bits(desc.locks);
     b.v[slot] = desc.type == MotionType::Static
@@ -109,12 +110,9 @@ BodyHandle Space::create_body(const BodyDesc& input) {
     b.interpolate[slot] = desc.allow_interpolation ? 1 : 0;
     b.layer[slot] = static_cast<std::uint8_t>(desc.layer);
     b.group[slot] = desc.group;
-    for (int k = 0; k < 2; ++k) {
-        b.history_position[k][slot] = desc.position;
-        b.history_orientation[k][slot] = desc.orientation;
-    }
-    b.desc[slot] = std::move(desc);
-    b.bounds[slot] = b.desc[slot].shape.bounds(b.transform(slot));
+    if (desc.type != MotionType::Static) b.hold_history(slot, desc.position, orientation);
+    b.traits[slot] = std::move(traits);
+    b.bounds[slot] = b.traits[slot].shape.bounds(b.transform(slot));
     if (b.is_fast(slot)) w.fast_bodies += 1;
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);
@@ -165,7 +163,7 @@ void Space::destroy_body(BodyHandle body) {
     if (w.bodies.is_fast(slot)) w.fast_bodies -= 1;
     w.bodies.alive[slot] = 0;
     w.bodies.live -= 1;
-    w.bodies.desc[slot] = BodyDesc{};  // drop the shape's geometry now
+    w.bodies.traits[slot] = BodyTraits{};  // drop the shape's geometry now
     w.bodies.free_slots.push_back(slot);
     w.body_set_version += 1;
     w.body_count.store(w.bodies.live, std::memory_order_release);

@@ -118,6 +118,7 @@ void WriteBuffer::push(const BufferedWrite& write) {
     Stripe& stripe = m_stripes[slot % kStripes];
     const std::uint32_t local = slot / kStripes;
     std::scoped_lock guard(stripe.lock);
+    stripe.written.store(true, std::memory_order_release);
     if (stripe.entry_of.size() <= local) stripe.entry_of.resize(local + 1, -1);
     std::int32_t& at = stripe.entry_of[local];
     if (at < 0) {
@@ -143,7 +144,10 @@ void WriteBuffer::drain(std::vector<PendingWrites>& out, std::uint32_t& supersed
     out.clear();
     superseded = 0;
     for (Stripe& stripe : m_stripes) {
+        if (!stripe.written.load(std::memory_order_acquire)) continue;
         std::scoped_lock guard(stripe.lock);
+        stripe.written.store(false, std::memory_order_relaxed);
+        m_stripes_drained += 1;
         for (const PendingWrites& entry : stripe.entries) stripe.entry_of[entry.body.index / kStripes] = -1;
         out.insert(out.end(), stripe.entries.begin(), stripe.entries.end());
         stripe.entries.clear();

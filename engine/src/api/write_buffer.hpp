@@ -9,6 +9,7 @@
 // order is the order the writes were made (the last one wins across threads too).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <vector>
@@ -127,16 +128,24 @@ public:
     // `superseded` gets the writes dropped because their body's slot was reused by a
     // newer body before they were applied.
     void drain(std::vector<PendingWrites>& out, std::uint32_t& superseded);
+    // Stripes whose lock drain took so far: only those written to since the last drain. The
+    // update thread.
+    std::uint64_t stripes_drained() const noexcept { return m_stripes_drained; }
 
 private:
     static constexpr std::uint32_t kStripes = 64;
     struct alignas(cache_line_size) Stripe {
         std::mutex lock;
+        // Set by push under the lock, cleared by drain under it and read by drain before
+        // taking it: an update with nothing written takes no lock at all. A write that
+        // happened before the update is seen; one racing with it may wait for the next.
+        std::atomic<bool> written{false};
         std::vector<std::int32_t> entry_of;  // by slot / kStripes: index into entries, -1 none
         std::vector<PendingWrites> entries;
         std::uint32_t superseded = 0;
     };
     Stripe m_stripes[kStripes];
+    std::uint64_t m_stripes_drained = 0;
 };
 
 }  // namespace spindle

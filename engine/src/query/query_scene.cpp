@@ -92,7 +92,10 @@ void QueryScene::refresh_pose(const World& world, std::uint32_t i, bool interpol
     body.group = b.group[i];
     body.current = b.transform(i);
     body.interpolate = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;  // as fill()
-    if (body.interpolate) body.previous = {b.history_position[0][i], b.history_orientation[0][i]};
+    if (body.interpolate) {
+        const std::uint32_t h = b.history_place[i];
+        body.previous = {b.history_position[0][h], b.history_orientation[0][h]};
+    }
     tight = tight_bounds(i);
 }
 
@@ -107,10 +110,10 @@ void QueryScene::move(std::uint32_t i, const Aabb& tight, const Vec3& displaceme
 
 void QueryScene::set_shape(const World& world, std::uint32_t i) {
     QueryBody& body = m_bodies[i];
-    const Shape& shape = world.bodies.desc[i].shape;
+    const Shape& shape = world.bodies.traits[i].shape;
     m_shapes[i] = shape;
     body.exact_bounds = shape.static_only();
-    body.sensor = world.bodies.desc[i].sensor;  // set at creation only
+    body.sensor = world.bodies.traits[i].sensor;  // set at creation only
     const Aabb local = shape.bounds({});
     body.local_center = body.exact_bounds ? Vec3::Zero() : local.center();
     body.local_extents = body.exact_bounds ? Vec3::Zero() : local.extents();
@@ -126,7 +129,7 @@ void QueryScene::refresh(const World& world, std::uint32_t i, bool interpolating
         return;
     }
     // Shapes change only with the body (creation, a new shape): compared, not copied.
-    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], world.bodies.desc[i].shape)) {
+    if (body.generation != world.bodies.generation[i] || !same_shape(m_shapes[i], world.bodies.traits[i].shape)) {
         set_shape(world, i);
     }
     body.generation = world.bodies.generation[i];
@@ -159,7 +162,10 @@ std::shared_ptr<QueryScene> QueryScene::build(const World& world, const Publishe
         body.group = b.group[i];
         body.current = {buffer.current[i].position, buffer.current[i].orientation};
         body.interpolate = buffer.interpolate[i] != 0;
-        if (body.interpolate) body.previous = {buffer.previous[i].position, buffer.previous[i].orientation};
+        if (body.interpolate) {
+            const PublishedHistory& before = buffer.previous_of(i);
+            body.previous = {before.position, before.orientation};
+        }
         tight.push_back(scene->tight_bounds(i));
         user.push_back(i);
     }

@@ -15,13 +15,13 @@
 
 namespace spindle {
 
-BodyMass body_mass(const BodyDesc& desc, MotionType type, const Shape& shape, const char* who) {
+BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape, const char* who) {
     BodyMass out;
     if (type != MotionType::Dynamic) return out;
-    MassProperties mp = shape.mass_properties(desc.density);
-    if (desc.mass > 0) {
-        mp.inertia *= desc.mass / mp.mass;
-        mp.mass = desc.mass;
+    MassProperties mp = shape.mass_properties(traits.density);
+    if (traits.mass > 0) {
+        mp.inertia *= traits.mass / mp.mass;
+        mp.mass = traits.mass;
     }
     if (!(mp.mass > 0) || !mp.inertia.allFinite()) {
         throw Error(std::string(who) + ": the shape has no volume (mass " + number(mp.mass) + ")");
@@ -44,8 +44,8 @@ void recombine_materials(World& world, std::span<const std::uint32_t> slots) {
         Contact& contact = world.contacts[c];
         if (!changed(contact.body_a) && !changed(contact.body_b)) continue;
         // The mixing rules of create_contacts (contact_list.cpp).
-        const BodyDesc& da = b.desc[contact.body_a];
-        const BodyDesc& db = b.desc[contact.body_b];
+        const BodyTraits& da = b.traits[contact.body_a];
+        const BodyTraits& db = b.traits[contact.body_b];
         contact.friction = std::sqrt(da.friction * db.friction);
         contact.restitution = std::max(da.restitution, db.restitution);
         world.contact_summaries[c] = contact_summary(contact);  // its restitution bit
@@ -92,7 +92,7 @@ void detach(World& world, std::uint32_t slot) {
 // reports as for a created body.
 void attach(World& world, std::uint32_t slot) {
     Bodies& b = world.bodies;
-    b.bounds[slot] = b.desc[slot].shape.bounds(b.transform(slot));
+    b.bounds[slot] = b.traits[slot].shape.bounds(b.transform(slot));
     add_proxy(world, slot);
     world.changed_now.push_back(slot);
     publish_kind(world, slot);
@@ -105,7 +105,7 @@ bool change_motion_type(World& world, std::uint32_t slot, MotionType type) {
     if (b.type[slot] == type) return true;
     BodyMass mass;
     try {
-        mass = body_mass(b.desc[slot], type, b.desc[slot].shape, "set_motion_type");
+        mass = body_mass(b.traits[slot], type, b.traits[slot].shape, "set_motion_type");
     } catch (const Error&) {
         return false;
     }
@@ -113,9 +113,9 @@ bool change_motion_type(World& world, std::uint32_t slot, MotionType type) {
     if (b.is_fast(slot)) world.fast_bodies -= 1;
     const MotionType before = b.type[slot];
     b.type[slot] = type;
-    b.desc[slot].type = type;
+    b.traits[slot].type = type;
     set_mass(world, slot, mass);
-    b.locks[slot] = type == MotionType::Static ? 0 : lock_bits(b.desc[slot].locks);
+    b.locks[slot] = type == MotionType::Static ? 0 : lock_bits(b.traits[slot].locks);
     if (type == MotionType::Static || before == MotionType::Static) {
         // A static body has no velocity; a static body set moving starts at rest.
         b.v[slot] = b.w[slot] = Vec3::Zero();
@@ -128,12 +128,13 @@ bool change_motion_type(World& world, std::uint32_t slot, MotionType type) {
     set_awake(world, slot, type != MotionType::Static);
     b.island[slot] = -1;
     if (type == MotionType::Static) {
-        // A static body is never recorded again: both history entries hold its pose, so an
+        // A static body is never recorded again: both history steps hold its pose, so an
         // interpolated read does not stay a step behind.
-        for (int k = 0; k < 2; ++k) {
-            b.history_position[k][slot] = b.origin(slot);
-            b.history_orientation[k][slot] = b.q[slot];
-        }
+        b.reset_history(slot);
+    } else if (before == MotionType::Static) {
+        // Its first history (a static body has none), or the one its slot's last moving
+        // body left.
+        b.hold_history(slot, b.origin(slot), b.q[slot]);
     }
     world.body_set_version += 1;  // the solver's colours depend on which bodies are dynamic
     attach(world, slot);
@@ -145,14 +146,14 @@ bool change_shape(World& world, std::uint32_t slot, const Shape& shape, bool kee
     BodyMass mass;
     if (!keep_mass) {
         try {
-            mass = body_mass(b.desc[slot], b.type[slot], shape, "set_shape");
+            mass = body_mass(b.traits[slot], b.type[slot], shape, "set_shape");
         } catch (const Error&) {
             return false;
         }
     }
     detach(world, slot);
     if (!keep_mass) set_mass(world, slot, mass);
-    b.desc[slot].shape = shape;
+    b.traits[slot].shape = shape;
     attach(world, slot);
     return true;
 }
@@ -163,7 +164,7 @@ int apply_body_changes(World& world, const PendingWrites& write, std::vector<std
     if ((write.bits & kChanges) == 0) return 0;
     Bodies& b = world.bodies;
     const std::uint32_t i = write.body.index;
-    BodyDesc& desc = b.desc[i];
+    BodyTraits& traits = b.traits[i];
     int rejected = 0;
     if ((write.bits & kPendingMotionType) != 0 && !change_motion_type(world, i, write.motion_type)) rejected += 1;
     if ((write.bits & kPendingShape) != 0) {
@@ -172,20 +173,20 @@ int apply_body_changes(World& world, const PendingWrites& write, std::vector<std
         if (!fits || !change_shape(world, i, write.shape, write.keep_mass)) rejected += 1;
     }
     if ((write.bits & (kPendingFriction | kPendingRestitution)) != 0) {
-        if ((write.bits & kPendingFriction) != 0) desc.friction = write.friction;
-        if ((write.bits & kPendingRestitution) != 0) desc.restitution = write.restitution;
+        if ((write.bits & kPendingFriction) != 0) traits.friction = write.friction;
+        if ((write.bits & kPendingRestitution) != 0) traits.restitution = write.restitution;
         rematerialed.push_back(i);
         // What rests on a static body slides or bounces differently now (a moving body is
         // woken with its island by ApplyWrites).
         if (b.type[i] == MotionType::Static) wake_touching(world, i);
     }
-    if ((write.bits & kPendingGravityScale) != 0) desc.gravity_scale = write.gravity_scale;
+    if ((write.bits & kPendingGravityScale) != 0) traits.gravity_scale = write.gravity_scale;
     if ((write.bits & kPendingDamping) != 0) {
-        desc.linear_damping = write.linear_damping;
-        desc.angular_damping = write.angular_damping;
+        traits.linear_damping = write.linear_damping;
+        traits.angular_damping = write.angular_damping;
     }
     if ((write.bits & kPendingUserData) != 0) {
-        desc.user_data = write.user_data;
+        traits.user_data = write.user_data;
         world.changed_now.push_back(i);  // published at this update's flip, awake or not
     }
     return rejected;

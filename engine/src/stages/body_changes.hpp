@@ -21,7 +21,7 @@ struct BodyMass {
 };
 // Throws spindle::Error ("<who>: the shape has no volume ...") for a shape or mass that
 // gives no finite inverse.
-BodyMass body_mass(const BodyDesc& desc, MotionType type, const Shape& shape, const char* who);
+BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape, const char* who);
 
 // These bodies' friction or restitution changed (descriptions already set; slots
 // ascending): every contact of theirs takes the combined values again. One pass over the

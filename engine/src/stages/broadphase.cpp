@@ -13,7 +13,7 @@ namespace {
 bool can_collide(const Bodies& b, std::uint32_t i, std::uint32_t j) {
     // Two bodies that cannot move each other make no contact; two sensors do not sense each other.
     return (b.type[i] == MotionType::Dynamic || b.type[j] == MotionType::Dynamic) &&
-           !(b.desc[i].sensor && b.desc[j].sensor);
+           !(b.traits[i].sensor && b.traits[j].sensor);
 }
 
 void mark_refit(BroadphaseState& bp, std::uint32_t slot) {
@@ -47,7 +47,7 @@ Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
 }  // namespace
 
 void CompoundPartBoxes::add(const Bodies& bodies, std::uint32_t slot) {
-    if (bodies.desc[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
+    if (bodies.traits[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
     if (m_member_place.size() <= slot) m_member_place.resize(slot + 1, kNone);
     m_member_place[slot] = static_cast<std::uint32_t>(m_members.size());
     m_members.push_back(slot);
@@ -72,7 +72,7 @@ void CompoundPartBoxes::lay_out(const Bodies& bodies) {
     m_first.assign(m_members.size() + 1, 0);
     for (std::uint32_t k = 0; k < m_members.size(); ++k) {
         m_index[m_members[k]] = k;
-        m_first[k + 1] = m_first[k] + bodies.desc[m_members[k]].shape.parts->size();
+        m_first[k + 1] = m_first[k] + bodies.traits[m_members[k]].shape.parts->size();
     }
     m_made.assign(m_members.size(), 0);  // a slot's compound may be another now
     m_boxes.resize(m_first.back());
@@ -227,7 +227,7 @@ void update_broadphase(World& world, Real dt) {
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
-            const Shape& shape = b.desc[i].shape;
+            const Shape& shape = b.traits[i].shape;
             if (shape.type == ShapeType::Compound) {
                 // Kept for the narrowphase's part walks, which would make the same boxes again.
                 b.bounds[i] = shape.parts->bounds(b.transform(i), bp.part_boxes.fill(i, world.steps));

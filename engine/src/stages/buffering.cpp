@@ -59,16 +59,6 @@ private:
     bool m_took;
 };
 
-// A teleport: the body jumps, so both history entries take the new pose and the
-// interpolation does not slide it there.
-void reset_history(Bodies& b, std::uint32_t i) {
-    const Vec3 origin = b.origin(i);
-    for (int k = 0; k < 2; ++k) {
-        b.history_position[k][i] = origin;
-        b.history_orientation[k][i] = b.q[i];
-    }
-}
-
 }  // namespace
 
 // Each written body once, whatever the number of writes made to it (WriteBuffer
@@ -100,7 +90,7 @@ void apply_writes(World& world) {
             const Vec3 origin = (write.bits & kPendingPosition) != 0 ? write.position : b.origin(i);
             if ((write.bits & kPendingOrientation) != 0) b.q[i] = write.orientation.normalized();
             b.x[i] = origin + b.q[i] * b.local_com[i];
-            reset_history(b, i);
+            b.reset_history(i);  // the body jumps: an interpolated read does not slide it there
         } else if (moves && write.bits != kPendingUserData) {
             wake_body(world, i);  // not for user data alone: a game may tag sleeping bodies every frame
         }
@@ -131,7 +121,7 @@ void apply_writes(World& world) {
             b.w[i] = limit_speed(b.w[i], max_angular);
         }
         if ((write.bits & (kPendingPose | kPendingVelocity)) != 0) {
-            b.bounds[i] = b.desc[i].shape.bounds(b.transform(i));
+            b.bounds[i] = b.traits[i].shape.bounds(b.transform(i));
             refresh_proxy(world, i);
             world.changed_now.push_back(i);
         }
@@ -145,8 +135,8 @@ void apply_writes(World& world) {
         if ((write.bits & kPendingFilter) != 0 && (b.layer[i] != write.layer || b.group[i] != write.group)) {
             b.layer[i] = static_cast<std::uint8_t>(write.layer);
             b.group[i] = write.group;
-            b.desc[i].layer = write.layer;
-            b.desc[i].group = write.group;
+            b.traits[i].layer = write.layer;
+            b.traits[i].group = write.group;
             refiltered.push_back(i);
             world.changed_now.push_back(i);  // the query scenes publish the filter
         }
@@ -179,17 +169,24 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
     p.interpolate[i] = interpolating && b.interpolate[i] && b.type[i] != MotionType::Static;
     if (p.interpolate[i]) {
         // Bodies without the flag skip this: interpolation costs them nothing.
-        PublishedHistory& before = p.previous[i];
-        before.position = b.history_position[0][i];
-        before.orientation = b.history_orientation[0][i];
+        const std::uint32_t h = b.history_place[i];  // a body that can move has one
+        p.history_place[i] = h;
+        PublishedHistory& before = p.previous[h];
+        before.position = b.history_position[0][h];
+        before.orientation = b.history_orientation[0][h];
         before.center_of_mass = before.position + before.orientation * b.local_com[i];
     }
+}
+
+// Room in a published buffer for every body slot and history entry, before fill().
+static void fit_published(const Bodies& b, PublishedBuffer& p) {
+    if (p.size() < b.capacity() || p.previous.size() < b.history_count()) p.resize(b.capacity(), b.history_count());
 }
 
 // A body's user data, published apart from its state: it lives in the cold description
 // and changes only by creation or a write, so only changed bodies are written.
 static void publish_user_data(const World& world, std::uint32_t i, PublishedBuffer& p) {
-    p.user_data[i] = world.bodies.alive[i] ? world.bodies.desc[i].user_data : 0;
+    p.user_data[i] = world.bodies.alive[i] ? world.bodies.traits[i].user_data : 0;
 }
 
 void reserve_published(World& world, std::size_t slots) {
@@ -211,7 +208,7 @@ void publish_now(World& world, std::uint32_t slot) {
     const PublishingHold guard(manager);
     for (int k = 0; k < 2; ++k) {
         PublishedBuffer& buffer = manager.buffer_locked(k);
-        if (buffer.size() <= slot) buffer.resize(world.bodies.capacity());
+        fit_published(world.bodies, buffer);
         fill(world, slot, buffer, interpolating);
         publish_user_data(world, slot, buffer);
     }
@@ -241,14 +238,14 @@ void publish_now(World& world, std::uint32_t slot) {
 void publish_kind(World& world, std::uint32_t slot) {
     const Bodies& b = world.bodies;
     MotionStatePublisher(world.motion_states)
-        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.desc[slot].shape.static_only());
+        .set_published_kind(slot, b.type[slot], b.alive[slot] != 0 && b.traits[slot].shape.static_only());
 }
 
 void flip_read_buffers(World& world) {
     Bodies& b = world.bodies;
     MotionStatePublisher manager(world.motion_states);
     PublishedBuffer& back = manager.back();
-    if (back.size() < b.capacity()) back.resize(b.capacity());
+    fit_published(b, back);
     const bool interpolating = world.settings.time_step.use_internal_time_stepping;
 
     auto publish = [&](std::uint32_t i) {
@@ -336,7 +333,7 @@ void flip_read_buffers(World& world) {
                              world.read_blend};
     world.stats.flip_lock_seconds = manager.flip(time, world.query_scenes[k]);
     // After the swap the new back buffer may be shorter than the body slots.
-    if (manager.back().size() < b.capacity()) manager.back().resize(b.capacity());
+    fit_published(b, manager.back());
     world.stats.awake_bodies = static_cast<std::uint32_t>(world.awake.size());
     publish_contact_events(world);  // under the events' own lock, not the motion-state lock
     publish_contact_points(world);

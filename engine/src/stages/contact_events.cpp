@@ -54,8 +54,8 @@ bool contact_touches(const Contact& contact) {
 }
 
 std::uint8_t contact_event_flags(const World& world, std::uint32_t a, std::uint32_t b) {
-    const BodyDesc& da = world.bodies.desc[a];
-    const BodyDesc& db = world.bodies.desc[b];
+    const BodyTraits& da = world.bodies.traits[a];
+    const BodyTraits& db = world.bodies.traits[b];
     const bool sensor = da.sensor || db.sensor;
     return static_cast<std::uint8_t>((da.contact_events || db.contact_events || sensor ? kContactReports : 0) |
                                      (sensor ? kContactSensor : 0));

@@ -27,8 +27,8 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
     contact.body_a = a;
     contact.body_b = b;
     // Mixing rules as most engines: geometric mean friction, largest restitution.
-    contact.friction = std::sqrt(bodies.desc[a].friction * bodies.desc[b].friction);
-    contact.restitution = std::max(bodies.desc[a].restitution, bodies.desc[b].restitution);
+    contact.friction = std::sqrt(bodies.traits[a].friction * bodies.traits[b].friction);
+    contact.restitution = std::max(bodies.traits[a].restitution, bodies.traits[b].restitution);
     contact.events = contact_event_flags(world, a, b);
 }
 

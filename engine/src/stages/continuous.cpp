@@ -71,7 +71,7 @@ void record_fast_starts(World& world) {
     world.fast_starts.clear();
     const Bodies& b = world.bodies;
     for (std::uint32_t i : world.awake) {
-        if (b.is_fast(i) && !b.desc[i].sensor) world.fast_starts.push_back({i, b.x[i], b.q[i]});
+        if (b.is_fast(i) && !b.traits[i].sensor) world.fast_starts.push_back({i, b.x[i], b.q[i]});
     }
     SPINDLE_ASSERT(world.fast_starts.size() <= world.fast_bodies, "continuous: more fast bodies awake than counted");
 }
@@ -84,22 +84,22 @@ void sweep_fast_bodies(World& world) {
     for (const FastStart& start : world.fast_starts) {
         const std::uint32_t i = start.slot;
         const Sweep sweep{start.x0, b.x[i], start.q0, b.q[i], b.local_com[i]};
-        const Shape& shape = b.desc[i].shape;
+        const Shape& shape = b.traits[i].shape;
         const Aabb local = shape.bounds(Transform{});
         const Real reach_radius = std::max((local.min - b.local_com[i]).norm(), (local.max - b.local_com[i]).norm());
         const Aabb swept = shape.bounds(sweep.at(0)).merged(shape.bounds(sweep.at(1))).fattened(reach_radius);
         candidates.clear();
         bp.tree.query(swept, [&](ProxyId id) {
             // A static sensor stops nothing.
-            if (id.is_static() && !b.desc[bp.tree.user(id)].sensor)
+            if (id.is_static() && !b.traits[bp.tree.user(id)].sensor)
                 candidates.push_back(static_cast<std::uint32_t>(bp.tree.user(id)));
             return true;
         });
         std::sort(candidates.begin(), candidates.end());  // the same order whatever the tree's shape
         Real first = 1;
         for (std::uint32_t wall : candidates) {
-            first = std::min(first,
-                             time_of_impact(sweep, shape, reach_radius, b.desc[wall].shape, b.transform(wall), target));
+            first = std::min(first, time_of_impact(sweep, shape, reach_radius, b.traits[wall].shape, b.transform(wall),
+                                                   target));
             world.counters.swept_tests += 1;
         }
         if (first >= 1) continue;

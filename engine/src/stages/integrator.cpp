@@ -77,7 +77,7 @@ void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_
         sb.w = limit_speed(sb.w, max_angular);
         if (sb.damped) {
             // Implicit (Pade) damping: stable for any h.
-            const BodyDesc& d = b.desc[i];
+            const BodyTraits& d = b.traits[i];
             sb.v *= 1 / (1 + h * d.linear_damping);
             sb.w *= 1 / (1 + h * d.angular_damping);
             ++c.damping;

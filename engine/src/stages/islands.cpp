@@ -168,7 +168,7 @@ void update_islands(World& world, Real dt) {
     Real longest_rest = 0;
     for (std::uint32_t i : world.awake) {
         const bool driven = b.type[i] == MotionType::Kinematic && (b.v[i] != Vec3::Zero() || b.w[i] != Vec3::Zero());
-        const bool resting = b.desc[i].allow_sleep && !driven && b.v[i].squaredNorm() < lin2 &&
+        const bool resting = b.traits[i].allow_sleep && !driven && b.v[i].squaredNorm() < lin2 &&
                              b.w[i].squaredNorm() < ang2;
         b.sleep_time[i] = resting ? b.sleep_time[i] + dt : 0;
         longest_rest = std::max(longest_rest, b.sleep_time[i]);
@@ -250,11 +250,7 @@ void update_islands(World& world, Real dt) {
         set_awake(world, slot, false);
         b.v[slot] = Vec3::Zero();
         b.w[slot] = Vec3::Zero();
-        // Blend nothing while asleep: both history entries hold the resting pose.
-        for (int k = 0; k < 2; ++k) {
-            b.history_position[k][slot] = b.origin(slot);
-            b.history_orientation[k][slot] = b.q[slot];
-        }
+        b.reset_history(slot);  // blend nothing while asleep: both steps hold the resting pose
         world.changed_now.push_back(slot);
     }
     settle_awake(world);

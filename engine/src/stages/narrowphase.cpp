@@ -69,7 +69,7 @@ bool out_of_reach(const World& world, std::uint32_t c, Real speculative_distance
     const Real gap = (box_b.min - box_a.max).cwiseMax(box_a.min - box_b.max).maxCoeff();
     if (!(gap > speculative_distance + kReachGuard)) return false;  // cheap before the closing speed
     const Real reach = speculative_distance + (b.v[bb] - b.v[a]).norm() * dt + kReachGuard;
-    return gap > reach && (is_round(b.desc[a].shape) || is_round(b.desc[bb].shape));
+    return gap > reach && (is_round(b.traits[a].shape) || is_round(b.traits[bb].shape));
 }
 
 // How each body has turned since the manifolds were collided.
@@ -243,8 +243,8 @@ void update_narrowphase(World& world) {
             // Speculative contacts reach as far as the bodies can close in one step.
             const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
             const Real speculative = settings.speculative_distance + closing;
-            const Shape& shape_a = b.desc[a].shape;
-            const Shape& shape_b = b.desc[bb].shape;
+            const Shape& shape_a = b.traits[a].shape;
+            const Shape& shape_b = b.traits[bb].shape;
             // A compound's part boxes, where the broadphase made them this step.
             const auto part_boxes = [&](const Shape& shape, std::uint32_t i) {
                 return shape.type == ShapeType::Compound ? world.broadphase->part_boxes.made_in(i, world.steps)

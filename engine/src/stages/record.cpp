@@ -9,10 +9,11 @@ void record(World& world) {
     Bodies& b = world.bodies;
     for (std::uint32_t i : world.awake) {
         if (!b.interpolate[i]) continue;
-        b.history_position[0][i] = b.history_position[1][i];
-        b.history_orientation[0][i] = b.history_orientation[1][i];
-        b.history_position[1][i] = b.origin(i);
-        b.history_orientation[1][i] = b.q[i];
+        const std::uint32_t h = b.history_place[i];  // an awake body can move: it has one
+        b.history_position[0][h] = b.history_position[1][h];
+        b.history_orientation[0][h] = b.history_orientation[1][h];
+        b.history_position[1][h] = b.origin(i);
+        b.history_orientation[1][h] = b.q[i];
     }
 }
 

@@ -76,7 +76,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dq = Quat::Identity();
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
-            const BodyDesc& d = b.desc[i];
+            const BodyTraits& d = b.traits[i];
             sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
             scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
             sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
@@ -355,6 +355,9 @@ void solve(World& world, Real dt) {
         pack_contacts(*world.jobs, scratch);
         world.counters.constraint_colorings += 1;
     }
+    // A world at rest (every body asleep or static) has nothing to move or solve: no
+    // passes at all, not a plan of empty ones each step.
+    if (world.awake.empty() && scratch.wide.empty() && scratch.joints.empty()) return;
     SolverBody* bodies = scratch.bodies.data();
     PushVelocity* push = scratch.push_velocities.data();
     const Real* gravity_scales = scratch.gravity_scales.data();

@@ -1,6 +1,7 @@
 // Islands and sleeping: resting islands sleep as a whole, cost nothing while asleep,
 // and wake together when written to or touched by an awake body.
 #include <spindle/engine/space.hpp>
+#include <spindle/scheduler/single_threaded.hpp>
 
 #include <gtest/gtest.h>
 
@@ -56,6 +57,57 @@ TEST(Islands, RestingIslandSleepsAndCostsNothing) {
     EXPECT_EQ(after.gravity_applied, before.gravity_applied);
     EXPECT_EQ(row.space.last_update().awake_bodies, 0u);
     for (BodyHandle b : row.balls) EXPECT_NEAR(row.space.position(b).y(), 0.5, 0.01);
+}
+
+namespace {
+
+// What steps hand the scheduler: solver plans (run_phases) and parallel ranges with items.
+class CountingJobs final : public JobSystem {
+public:
+    unsigned worker_count() const noexcept override { return 1; }
+    void parallel_for(const char* name, std::uint32_t begin, std::uint32_t end, std::uint32_t grain,
+                      RangeFn fn) override {
+        if (begin < end) ++ranges;
+        m_inner.parallel_for(name, begin, end, grain, fn);
+    }
+    void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override {
+        ++phase_runs;
+        m_inner.run_phases(name, phases, fn);
+    }
+    void run_graph(StageGraph& graph) override { m_inner.run_graph(graph); }
+    void trace_begin(const char* stage) noexcept override { m_inner.trace_begin(stage); }
+    void trace_end() noexcept override { m_inner.trace_end(); }
+    int phase_runs = 0, ranges = 0;
+
+private:
+    SingleThreadedJobSystem m_inner;
+};
+
+}  // namespace
+
+// A world whose bodies all sleep on static ones (large_world's floor of static boxes once
+// its spheres rest): a step hands the scheduler no work at all, however many bodies there are.
+TEST(Islands, AWorldAtRestHandsTheSchedulerNoWork) {
+    CountingJobs jobs;
+    Space space(SpaceSettings{}, &jobs);
+    BodyDesc floor;
+    floor.type = MotionType::Static;
+    floor.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+    for (int i = 0; i < 100; ++i) {
+        floor.position = Vec3(i, -0.5, 0);
+        space.create_body(floor);
+    }
+    BodyDesc ball;
+    ball.shape = Shape::sphere(0.25);
+    ball.position = Vec3(10, 0.25, 0);
+    const BodyHandle resting = space.create_body(ball);
+    for (int i = 0; i < 300 && space.internal_is_awake(resting); ++i) space.update();
+    ASSERT_FALSE(space.internal_is_awake(resting));
+    space.update();  // the flip after the island fell asleep
+    jobs.phase_runs = jobs.ranges = 0;
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(jobs.phase_runs, 0);
+    EXPECT_EQ(jobs.ranges, 0);
 }
 
 TEST(Islands, AWriteWakesTheWholeIsland) {

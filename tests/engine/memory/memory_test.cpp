@@ -132,17 +132,41 @@ TEST(Memory, BodiesMadeInReservedRoomMoveNoPerBodyArray) {
     const World& world = SpaceInternals::world(space);
     const std::size_t reserved = memory_report(space).bodies;
     const Vec3* positions = world.bodies.x.data();
-    const BodyDesc* descriptions = world.bodies.desc.data();
+    const BodyTraits* descriptions = world.bodies.traits.data();
     const std::uint32_t* awake = world.awake.data();
     const ProxyId* proxies = world.broadphase->proxy.data();
     make_level(space);
     space.update();
     EXPECT_EQ(memory_report(space).bodies, reserved);
     EXPECT_EQ(world.bodies.x.data(), positions);
-    EXPECT_EQ(world.bodies.desc.data(), descriptions);
+    EXPECT_EQ(world.bodies.traits.data(), descriptions);
     EXPECT_EQ(world.awake.data(), awake);
     EXPECT_EQ(world.broadphase->proxy.data(), proxies);
     EXPECT_EQ(space.body_count(), static_cast<std::size_t>(kLevelBodies));
+}
+
+// A static body never blends: it keeps no interpolation history, and the published buffers
+// keep no step before the newest for it (a level's static geometry is most of its bodies).
+TEST(Memory, StaticBodiesKeepNoInterpolationHistory) {
+    SpaceSettings settings;
+    settings.time_step.use_internal_time_stepping = true;
+    Space space(settings);
+    space.reserve_bodies(kLevelBodies);
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+    for (int i = 0; i < kLevelBodies; ++i) {
+        d.position = Vec3(2.0 * (i % 40), 0.5, 2.0 * (i / 40));
+        space.create_body(d);
+    }
+    space.update(settings.time_step.duration);
+    const MemoryReport report = memory_report(space);
+    EXPECT_EQ(report.histories, 0u);
+    // A slot of each buffer: generation, newest state, the interpolation flag, the history
+    // entry, user data.
+    const std::size_t slot_bytes = sizeof(std::uint32_t) + sizeof(MotionState) + sizeof(std::uint8_t) +
+                                   sizeof(std::uint32_t) + sizeof(std::uint64_t);
+    EXPECT_LE(report.published, 2 * slot_bytes * kLevelBodies);
 }
 
 TEST(Memory, ReservingMoreBodiesThanAHandleCanIndexThrowsNamingTheCount) {

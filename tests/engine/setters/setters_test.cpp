@@ -2,6 +2,7 @@
 // and impulses at points, kinematic moves, shape and motion type, each buffered (applied
 // at the next update, the last write winning) and each checked (bad values and stale
 // handles rejected with the space unchanged).
+#include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/engine/space.hpp>
 #include <spindle/platform/error.hpp>
 
@@ -366,6 +367,84 @@ TEST(Setters, StaticBoxMadeDynamic_Falls) {
     run(space, 60);
     EXPECT_LT(space.internal_position(b).y(), 1);
     EXPECT_EQ(space.internal_desc(b).type, MotionType::Dynamic);
+}
+
+// The space keeps a description without the pose and velocities (BodyTraits, world.hpp):
+// every other field comes back as made, and those as the body is now.
+TEST(Setters, InternalDescKeepsEveryFieldItWasMadeWith) {
+    Space space(weightless());
+    BodyDesc d = box(Vec3(1, 2, 3));
+    d.shape = Shape::box(Vec3(0.5, 1, 1.5));
+    d.orientation = Quat(Eigen::AngleAxis<Real>(0.5, Vec3(0, 1, 0)));
+    d.linear_velocity = Vec3(1, 0, 0);
+    d.angular_velocity = Vec3(0, 1, 0);
+    d.density = 500;
+    d.mass = 7;
+    d.friction = 0.3;
+    d.restitution = 0.2;
+    d.gravity_scale = 0.5;
+    d.linear_damping = 0.1;
+    d.angular_damping = 0.2;
+    d.gyroscopic = true;
+    d.locks.translation_z = true;
+    d.allow_interpolation = false;
+    d.allow_sleep = false;
+    d.fast = true;
+    d.layer = 3;
+    d.group = 9;
+    d.contact_events = true;
+    d.sensor = true;
+    d.user_data = 42;
+    const BodyHandle b = space.create_body(d);
+    const BodyDesc kept = space.internal_desc(b);
+    EXPECT_EQ(kept.type, d.type);
+    EXPECT_EQ(kept.shape.type, ShapeType::Box);
+    EXPECT_EQ(kept.shape.half_extents, d.shape.half_extents);
+    EXPECT_TRUE(kept.position.isApprox(d.position, 1e-12));
+    EXPECT_TRUE(kept.orientation.isApprox(d.orientation, 1e-12));
+    EXPECT_EQ(kept.linear_velocity, d.linear_velocity);
+    EXPECT_EQ(kept.angular_velocity, d.angular_velocity);
+    EXPECT_EQ(kept.density, d.density);
+    EXPECT_EQ(kept.mass, d.mass);
+    EXPECT_EQ(kept.friction, d.friction);
+    EXPECT_EQ(kept.restitution, d.restitution);
+    EXPECT_EQ(kept.gravity_scale, d.gravity_scale);
+    EXPECT_EQ(kept.linear_damping, d.linear_damping);
+    EXPECT_EQ(kept.angular_damping, d.angular_damping);
+    EXPECT_EQ(kept.gyroscopic, d.gyroscopic);
+    EXPECT_EQ(kept.locks, d.locks);
+    EXPECT_EQ(kept.allow_interpolation, d.allow_interpolation);
+    EXPECT_EQ(kept.allow_sleep, d.allow_sleep);
+    EXPECT_EQ(kept.fast, d.fast);
+    EXPECT_EQ(kept.layer, d.layer);
+    EXPECT_EQ(kept.group, d.group);
+    EXPECT_EQ(kept.contact_events, d.contact_events);
+    EXPECT_EQ(kept.sensor, d.sensor);
+    EXPECT_EQ(kept.user_data, d.user_data);
+    // The pose and velocities as they are now, not as made.
+    space.update();
+    EXPECT_EQ(space.internal_desc(b).position, space.internal_position(b));
+}
+
+// A static body keeps no interpolation history (world.hpp); made dynamic it gets one at
+// its pose, not the pose the body that last held its slot left there.
+TEST(Setters, StaticBoxMadeDynamicInAReusedSlot_BlendsFromWhereItStands) {
+    SpaceSettings settings = weightless();
+    settings.time_step.use_internal_time_stepping = true;
+    Space space(settings);
+    const Real step = settings.time_step.duration;
+    const BodyHandle gone = space.create_body(box(Vec3(100, 0, 0)));
+    space.update(step);
+    space.destroy_body(gone);
+    BodyDesc d = box(Vec3(0, 5, 0));
+    d.type = MotionType::Static;
+    const BodyHandle b = space.create_body(d);
+    ASSERT_EQ(b.index, gone.index) << "the slot is reused";
+    space.set_motion_type(b, MotionType::Dynamic);
+    space.update(1.5 * step);  // one step and half a step banked: reads blend the last two
+    ASSERT_GT(space.motion_states().alpha(), 0.4);
+    ASSERT_LT(space.motion_states().alpha(), 0.6);
+    EXPECT_LT((space.motion_state(b).position - Vec3(0, 5, 0)).norm(), 1e-9);
 }
 
 // A sleeping box made static must leave its sleeping island: waking the island later (the

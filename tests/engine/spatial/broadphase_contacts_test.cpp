@@ -106,7 +106,7 @@ void expect_contacts_are_the_allowed_overlaps(const World& world) {
         for (std::uint32_t j = i + 1; j < b.capacity(); ++j) {
             if (!b.alive[i] || !b.alive[j]) continue;
             if (b.type[i] != MotionType::Dynamic && b.type[j] != MotionType::Dynamic) continue;
-            if (b.desc[i].sensor && b.desc[j].sensor) continue;
+            if (b.traits[i].sensor && b.traits[j].sensor) continue;
             if (filter_blocks_pair(world, i, j) || joint_blocks_pair(world, i, j)) continue;
             if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) continue;
             expected.insert(std::uint64_t{i} << 32 | j);
@@ -155,8 +155,8 @@ TEST(BroadphaseContacts, FirstStep_ContactsInPairOrderWithTheirMaterialsAndFlags
     std::uint32_t reporting = 0;
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         const Contact& contact = world.contacts[c];
-        const BodyDesc& a = world.bodies.desc[contact.body_a];
-        const BodyDesc& b = world.bodies.desc[contact.body_b];
+        const BodyTraits& a = world.bodies.traits[contact.body_a];
+        const BodyTraits& b = world.bodies.traits[contact.body_b];
         ASSERT_EQ(contact.friction, std::sqrt(a.friction * b.friction));
         ASSERT_EQ(contact.restitution, std::max(a.restitution, b.restitution));
         ASSERT_EQ(contact.events, contact_event_flags(world, contact.body_a, contact.body_b));

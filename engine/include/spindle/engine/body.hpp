@@ -73,6 +73,8 @@ struct MotionLocks {
     friend bool operator==(const MotionLocks&, const MotionLocks&) = default;
 };
 
+// A space keeps it as BodyTraits (engine/src/world.hpp) without the pose and velocities: a
+// field added here is added there too.
 struct BodyDesc {
     MotionType type = MotionType::Dynamic;
     Shape shape = Shape::sphere(0.5);

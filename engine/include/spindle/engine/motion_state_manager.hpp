@@ -49,29 +49,35 @@ struct PublishedHistory {
 
 // One published step, by body slot, as arrays: what every read copies (generation,
 // newest state) apart from what only blended reads need, so copying bodies that do not
-// interpolate streams like a memcpy of their states.
+// interpolate streams like a memcpy of their states. The step before is kept only for
+// bodies that can move (a static body never blends), by their history entry.
 struct PublishedBuffer {
     std::vector<std::uint32_t> generation;  // 0: no body in this slot
     std::vector<MotionState> current;
-    std::vector<std::uint8_t> interpolate;   // allow_interpolation and internal time stepping
-    std::vector<PublishedHistory> previous;  // meaningful where interpolate is set
-    std::vector<std::uint64_t> user_data;    // BodyDesc::user_data, as last set (Space::set_user_data)
+    std::vector<std::uint8_t> interpolate;     // allow_interpolation and internal time stepping
+    std::vector<std::uint32_t> history_place;  // where interpolate is set: the slot's entry in previous
+    std::vector<std::uint64_t> user_data;      // BodyDesc::user_data, as last set (Space::set_user_data)
+    std::vector<PublishedHistory> previous;    // by history entry, not by slot
 
     std::size_t size() const noexcept { return generation.size(); }
-    void resize(std::size_t slots) {
+    // Room for `slots` slots and `histories` history entries.
+    void resize(std::size_t slots, std::size_t histories) {
         generation.resize(slots);
         current.resize(slots);
         interpolate.resize(slots);
-        previous.resize(slots);
+        history_place.resize(slots);
         user_data.resize(slots);
+        if (previous.size() < histories) previous.resize(histories);
     }
     void reserve(std::size_t slots) {
         generation.reserve(slots);
         current.reserve(slots);
         interpolate.reserve(slots);
-        previous.reserve(slots);
+        history_place.reserve(slots);
         user_data.reserve(slots);
     }
+    // Slot i's step before the newest; the slot must interpolate.
+    const PublishedHistory& previous_of(std::uint32_t i) const { return previous[history_place[i]]; }
 };
 
 // The motion-state lock: a mutex that knows which thread holds it, so that a thread
@@ -188,6 +194,9 @@ public:
     double alpha_locked() const noexcept { return alpha_locked(m_time.reads); }
     double alpha_locked(BlendClock clock) const noexcept;
     PublishedTime published_time() const;
+    // Heap bytes the two published buffers hold, at capacity (the engine's memory report).
+    // The update thread: it alone changes them.
+    std::size_t buffer_bytes() const noexcept;
 
 private:
     // The physics side (the update thread): only the buffering stages reach it, through

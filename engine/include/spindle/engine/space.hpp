@@ -240,7 +240,9 @@ public:
     void set_internal_motion_state(BodyHandle body, const MotionState& state);
     bool internal_is_awake(BodyHandle body) const;
     // As created (shape, material, flags; a copy), with the changes made since (filter,
-    // material, gravity scale, damping, motion type, shape, user data) as last applied.
+    // material, gravity scale, damping, motion type, shape, user data) as last applied;
+    // position, orientation and velocities as they are now (the space keeps no copy of
+    // those it was made with).
     BodyDesc internal_desc(BodyHandle body) const;
     // How far a joint is from satisfied now, from the live poses.
     JointError internal_joint_error(JointHandle joint) const;
