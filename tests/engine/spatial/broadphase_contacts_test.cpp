@@ -203,7 +203,7 @@ TEST(BroadphaseContacts, PairsFoundAgainAroundAGrownBox_AreNotNewPairs) {
         kept += involves && after.count(key) != 0 ? 1u : 0u;
     }
     ASSERT_GT(kept, 0u);  // pairs a search without the contact index would report again
-    const std::vector<Pair>& pairs = world.broadphase->pairs;
+    const PairList& pairs = world.broadphase->pairs;
     bool found_moved = false;
     for (const Pair& p : pairs) {
         EXPECT_EQ(before.count(p.user_a << 32 | p.user_b), 0u) << "pair " << p.user_a << ", " << p.user_b;
