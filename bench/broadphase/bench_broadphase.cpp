@@ -52,12 +52,12 @@ public:
             b.proxy = m_bp.create_proxy(Aabb::from_center_extents(b.center, b.half), m_next_user++, false);
             m_moving.push_back(b);
         }
-        std::vector<Pair> pairs;
+        PairList pairs;
         m_bp.update_pairs(m_jobs, pairs);  // the initial pairs are not part of a step
     }
 
     // Returns (enlarged proxies, new pairs) of this step.
-    std::pair<std::size_t, std::size_t> step(std::vector<Pair>& pairs) {
+    std::pair<std::size_t, std::size_t> step(PairList& pairs) {
         const double dt = 1.0 / 60.0;
         for (Body& b : m_moving) {
             Vec3 d = b.velocity * dt;
@@ -97,7 +97,7 @@ private:
 
 void bm_step(benchmark::State& state, SceneSpec spec) {
     Scene scene(spec);
-    std::vector<Pair> pairs;
+    PairList pairs;
     double enlarged = 0;
     double found = 0;
     for (auto _ : state) {

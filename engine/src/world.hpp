@@ -26,7 +26,7 @@
 #include "collision/collide.hpp"
 #include "solver/motion_locks.hpp"
 #include "stages/contact_index.hpp"
-#include "stages/huge_page_vector.hpp"
+#include "memory/huge_page_vector.hpp"
 
 namespace spindle {
 

@@ -109,11 +109,11 @@ void ProxyTrees::find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>
     }
 }
 
-void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs) {
+void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs) {
     update_pairs(jobs, new_pairs, [](std::uint64_t, std::uint64_t) { return false; });
 }
 
-void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, KnownPair known) {
+void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair known) {
     new_pairs.clear();
     // The moves since the last call left the trees valid but loose where proxies went:
     // one rebuild of those parts, before the searches walk them.
@@ -137,10 +137,19 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, Kno
 
     m_run_starts.assign(chunks + 1, 0);
     for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
+    // Raw room: each chunk's run is first written by its copy, in jobs where there are
+    // several (a first step's megabytes), here where there is one (a step's few pairs).
     new_pairs.resize(m_run_starts[chunks]);
-    for (std::uint32_t c = 0; c < chunks; ++c) {
-        std::copy(m_chunk_pairs[c].begin(), m_chunk_pairs[c].end(),
-                  new_pairs.begin() + static_cast<std::ptrdiff_t>(m_run_starts[c]));
+    const auto join = [&](std::uint32_t begin, std::uint32_t end, unsigned) {
+        for (std::uint32_t c = begin; c < end; ++c) {
+            std::copy(m_chunk_pairs[c].begin(), m_chunk_pairs[c].end(),
+                      new_pairs.begin() + static_cast<std::ptrdiff_t>(m_run_starts[c]));
+        }
+    };
+    if (chunks == 1) {
+        join(0, 1, 0);
+    } else {
+        jobs.parallel_for("broadphase.join_pairs", 0, chunks, 1, join);
     }
     // The chunk order already fixes the result for a given enlarged list; sorting also
     // frees it from the marking order, so the engine sees pairs in a canonical order.
@@ -153,7 +162,7 @@ void ProxyTrees::update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, Kno
 // Merges the sorted runs [m_run_starts[r], m_run_starts[r + 1]) of `pairs` into one sorted
 // list, neighbouring runs two at a time in parallel rounds. No two pairs are equal, so the
 // sorted order is unique: the result does not depend on how the rounds ran.
-void ProxyTrees::merge_runs(JobSystem& jobs, std::vector<Pair>& pairs) {
+void ProxyTrees::merge_runs(JobSystem& jobs, PairList& pairs) {
     std::vector<std::size_t>& starts = m_run_starts;
     m_merged_pairs.resize(pairs.size());
     for (auto runs = static_cast<std::uint32_t>(starts.size() - 1); runs > 1;) {

@@ -11,6 +11,7 @@
 #include <spindle/scheduler/function_ref.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
+#include "memory/huge_page_vector.hpp"
 #include "spatial/aabb_tree.hpp"
 
 namespace spindle {
@@ -44,6 +45,12 @@ struct Pair {
     std::uint64_t user_a = 0;
     std::uint64_t user_b = 0;
 };
+
+// update_pairs' result, and the merge's scratch it is swapped with. A first step finds
+// every pair at once, megabytes of them: their lists' room is left as it is by a resize
+// and first written by the jobs that copy and merge the pairs into it, instead of zeroed
+// first by the thread that resizes.
+using PairList = RawRoomVector<Pair>;
 
 struct BroadphaseSettings {
     // Fat box margin of moving proxies (metres). Static proxies get none: they rarely move.
@@ -102,9 +109,9 @@ public:
     // enlarged (DynamicAabbTree::rebuild_enlarged). Who may call: the thread that owns the broadphase; it
     // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
     // meanwhile). Safe from inside a job: parallel_for may nest.
-    void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs, KnownPair known);
+    void update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair known);
     // As above, every pair reported.
-    void update_pairs(JobSystem& jobs, std::vector<Pair>& new_pairs);
+    void update_pairs(JobSystem& jobs, PairList& new_pairs);
 
     // Whether the fat boxes of a and b overlap (the engine drops a contact when not).
     bool test_overlap(ProxyId a, ProxyId b) const { return fat_aabb(a).overlaps(fat_aabb(b)); }
@@ -144,7 +151,7 @@ private:
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
     void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;
-    void merge_runs(JobSystem& jobs, std::vector<Pair>& pairs);
+    void merge_runs(JobSystem& jobs, PairList& pairs);
     void validate_enlarged() const;
     // The trees validate themselves after each change; this adds the enlarged list.
     void validate_if_enabled() const {
@@ -164,7 +171,7 @@ private:
     // Scratch for putting the chunks' sorted lists together: where each run starts, and
     // the merged list (swapped with the caller's at each round).
     std::vector<std::size_t> m_run_starts;
-    std::vector<Pair> m_merged_pairs;
+    PairList m_merged_pairs;
 };
 
 template <typename Callback>

@@ -62,7 +62,7 @@ private:
 struct BroadphaseState {
     ProxyTrees tree;             // moving and static AABB trees; proxy user value = body slot
     std::vector<ProxyId> proxy;  // per body slot
-    std::vector<Pair> pairs;     // scratch: pairs found this step (kept: no allocation per step)
+    PairList pairs;              // scratch: pairs found this step (kept: no allocation per step)
     // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;

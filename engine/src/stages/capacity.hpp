@@ -12,7 +12,7 @@
 
 #include <spindle/scheduler/job_system.hpp>
 
-#include "stages/huge_page_vector.hpp"
+#include "memory/huge_page_vector.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>

@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "stages/huge_page_vector.hpp"
+#include "memory/huge_page_vector.hpp"
 
 namespace spindle {
 

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <numeric>
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
@@ -110,8 +111,16 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     world.events->reporting += reporting.load(std::memory_order_relaxed);
     // New contacts are awake, and come after every other: a list that is up to date gets
     // their positions at its end instead of a rebuild that reads every contact's record.
+    // Where every contact is new (a first step), the list is all of them, whatever it was.
+    std::vector<std::uint32_t>& awake = world.awake_contact_list;
+    if (first == 0) {
+        awake.clear();
+        world.awake_contacts_dirty = false;
+    }
     if (!world.awake_contacts_dirty) {
-        for (std::uint32_t c = static_cast<std::uint32_t>(first); c < end; ++c) world.awake_contact_list.push_back(c);
+        const std::size_t before = awake.size();
+        awake.resize(before + (end - first));
+        std::iota(awake.begin() + static_cast<std::ptrdiff_t>(before), awake.end(), static_cast<std::uint32_t>(first));
     }
 }
 

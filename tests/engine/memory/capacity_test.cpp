@@ -1,5 +1,5 @@
 // map_room (stages/capacity.hpp): the room of a growing array mapped in jobs before its
-// elements are made there; the array's block (stages/huge_page_vector.hpp) whole huge
+// elements are made there; the array's block (memory/huge_page_vector.hpp) whole huge
 // pages where the system gives them on request. Mapping is a hint: the elements and
 // their count stay as they were. A smaller block of a few pages has its pages mapped by
 // the allocation.
@@ -16,9 +16,9 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "memory/huge_page_vector.hpp"
 #include "stages/capacity.hpp"
 #include "stages/contact_index.hpp"
-#include "stages/huge_page_vector.hpp"
 
 using namespace spindle;
 

@@ -1,4 +1,4 @@
-// RawRoomVector (stages/huge_page_vector.hpp): a resize leaves the new elements' bytes as
+// RawRoomVector (memory/huge_page_vector.hpp): a resize leaves the new elements' bytes as
 // they were, so the solver's per-step arrays on it must be written whole before they are
 // read in any step that grows them. Checked by growing them into room filled with bytes
 // that read as NaN or as indices far out of range: a step must not see them.
@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "api/space_internals.hpp"
+#include "memory/huge_page_vector.hpp"
 #include "solver/constraints.hpp"
-#include "stages/huge_page_vector.hpp"
 
 using namespace spindle;
 

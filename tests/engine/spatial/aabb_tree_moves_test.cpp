@@ -386,7 +386,7 @@ TEST(AabbTreeMoves, ProxyTrees_UpdatePairsRebuildsWhatMoved) {
         ids.push_back(
             trees.create_proxy(Aabb::from_center_extents(rng.vec(-20, 20), Vec3::Constant(0.5)), i, i % 10 == 0));
     }
-    std::vector<Pair> pairs;
+    PairList pairs;
     SingleThreadedJobSystem jobs;
     trees.update_pairs(jobs, pairs);
     for (const ProxyId id : ids) {

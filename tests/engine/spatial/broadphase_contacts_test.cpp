@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <set>
 #include <vector>
 
@@ -203,7 +204,7 @@ TEST(BroadphaseContacts, PairsFoundAgainAroundAGrownBox_AreNotNewPairs) {
         kept += involves && after.count(key) != 0 ? 1u : 0u;
     }
     ASSERT_GT(kept, 0u);  // pairs a search without the contact index would report again
-    const std::vector<Pair>& pairs = world.broadphase->pairs;
+    const PairList& pairs = world.broadphase->pairs;
     bool found_moved = false;
     for (const Pair& p : pairs) {
         EXPECT_EQ(before.count(p.user_a << 32 | p.user_b), 0u) << "pair " << p.user_a << ", " << p.user_b;
@@ -256,6 +257,29 @@ TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
     EXPECT_GT(kept, 100);  // the list was up to date after most steps
     EXPECT_GT(made, 5);
     EXPECT_GT(lost, 5);
+}
+
+// Contacts made where there were none are the whole awake list, in order, whatever the
+// list held: a first step does not rebuild it from tens of thousands of records. Here the
+// list is left stale (dirty, with positions in it) when the block's contacts are removed
+// and made again.
+TEST(BroadphaseContacts, ContactsMadeFromNone_AreTheAwakeListInOrder) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    block.space.update();
+    const std::vector<std::uint64_t> keys = world.contact_keys;
+    ASSERT_GT(keys.size(), 2000u);
+    std::vector<std::uint32_t> all(keys.size());
+    std::iota(all.begin(), all.end(), 0u);
+    remove_contacts(world, all);
+    ASSERT_TRUE(world.contacts.empty());
+    world.awake_contact_list = {7, 3, 7};
+    world.awake_contacts_dirty = true;
+    create_contacts(world, keys);
+    ASSERT_EQ(world.contacts.size(), keys.size());
+    EXPECT_FALSE(world.awake_contacts_dirty);
+    EXPECT_EQ(world.awake_contact_list, all);
 }
 
 // A removal fills the removed places with the kept contacts past the new end, so each

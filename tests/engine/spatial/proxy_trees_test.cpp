@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 #include <utility>
@@ -20,13 +21,13 @@ using UserPair = std::pair<std::uint64_t, std::uint64_t>;
 
 Aabb cube(const Vec3& c, Real half) { return Aabb::from_center_extents(c, Vec3::Constant(half)); }
 
-std::vector<UserPair> user_pairs(const std::vector<Pair>& pairs) {
+std::vector<UserPair> user_pairs(const PairList& pairs) {
     std::vector<UserPair> out;
     for (const Pair& p : pairs) out.emplace_back(p.user_a, p.user_b);
     return out;
 }
 
-bool is_canonical_and_unique(const std::vector<Pair>& pairs) {
+bool is_canonical_and_unique(const PairList& pairs) {
     for (std::size_t i = 0; i < pairs.size(); ++i) {
         if (pairs[i].user_a > pairs[i].user_b) return false;
         if (i > 0 &&
@@ -45,7 +46,7 @@ TEST(ProxyTrees, NewProxies_ReportEachOverlapOnceAndNeverStaticWithStatic) {
     bp.create_proxy(cube(Vec3(0, 1.5, 0), 1), 3, false);  // overlaps 10, 11 and moving 4
     bp.create_proxy(cube(Vec3(0, 3, 0), 1), 4, false);
     bp.create_proxy(cube(Vec3(50, 0, 0), 1), 5, false);  // alone
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{3, 4}, {3, 10}, {3, 11}}));
     for (const Pair& p : pairs) {
@@ -68,7 +69,7 @@ TEST(ProxyTrees, KnownPairs_LeftOutAndTheRestInOrder) {
     build(all);
     build(some);
     SingleThreadedJobSystem jobs;
-    std::vector<Pair> every, rest;
+    PairList every, rest;
     all.update_pairs(jobs, every);
     std::vector<UserPair> asked;
     const auto known = [&asked](std::uint64_t a, std::uint64_t b) {
@@ -92,7 +93,7 @@ TEST(ProxyTrees, MoveInsideFatBox_ReportsNothing_MoveOutside_ReportsAgain) {
     SingleThreadedJobSystem jobs;
     const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
     bp.create_proxy(cube(Vec3(2.3, 0, 0), 1), 2, false);
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{1, 2}}));  // fat boxes overlap: 1.2 + 1.2 > 2.3
 
@@ -112,7 +113,7 @@ TEST(ProxyTrees, TwoEnlargedProxies_PairReportedOnce) {
     SingleThreadedJobSystem jobs;
     const ProxyId a = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, false);
     const ProxyId b = bp.create_proxy(cube(Vec3(10, 0, 0), 1), 2, false);
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_TRUE(pairs.empty());
     EXPECT_TRUE(bp.move_proxy(a, cube(Vec3(4, 0, 0), 1), Vec3(4, 0, 0)));
@@ -129,7 +130,7 @@ TEST(ProxyTrees, MovedStaticProxy_FindsMovingButNotStatic) {
     const ProxyId s = bp.create_proxy(cube(Vec3(0, 0, 0), 1), 1, true);
     bp.create_proxy(cube(Vec3(10, 0, 0), 1), 2, true);
     bp.create_proxy(cube(Vec3(10, 2, 0), 1), 3, false);
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{2, 3}}));
     EXPECT_TRUE(bp.move_proxy(s, cube(Vec3(10, 1, 0), 1), Vec3::Zero()));  // teleported onto both
@@ -145,7 +146,7 @@ TEST(ProxyTrees, DestroyedEnlargedProxy_IsNotReported) {
     bp.create_proxy(cube(Vec3(0, 1, 0), 1), 3, false);
     bp.destroy_proxy(a);
     bp.validate();
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_EQ(user_pairs(pairs), (std::vector<UserPair>{{2, 3}}));
     bp.destroy_proxy(b);
@@ -165,7 +166,7 @@ TEST(ProxyTrees, TestOverlap_UsesFatBoxes) {
 TEST(ProxyTrees, NothingEnlarged_RunsNoJobs) {
     ProxyTrees bp;
     test::CountingJobSystem jobs;
-    std::vector<Pair> pairs{Pair{}};
+    PairList pairs{Pair{}};
     bp.update_pairs(jobs, pairs);
     EXPECT_TRUE(pairs.empty());
     EXPECT_EQ(jobs.chunks, 0);
@@ -300,7 +301,7 @@ TEST_P(BroadphaseScenes, UpdatePairs_MatchesBruteForce) {
     std::set<UserPair> contacts;
     std::set<UserPair> overlapping;
     std::vector<UserPair> expected_new;
-    std::vector<Pair> pairs;
+    PairList pairs;
     for (int step = 0; step < c.steps; ++step) {
         if (step > 0) scene.step();
         scene.brute_force(overlapping, expected_new);
@@ -349,8 +350,8 @@ TEST(ProxyTrees, UpdatePairs_SameResultForAnyJobSystemAndGrain) {
     Scene threaded(bodies, 7, BroadphaseSettings{.grain = 3});
     SingleThreadedJobSystem jobs_single;
     test::ReverseThreadedJobSystem jobs_threaded(4);
-    std::vector<Pair> a;
-    std::vector<Pair> b;
+    PairList a;
+    PairList b;
     std::size_t total = 0;
     for (int step = 0; step < steps; ++step) {
         single.step();
@@ -369,13 +370,49 @@ TEST(ProxyTrees, UpdatePairs_SameResultForAnyJobSystemAndGrain) {
     EXPECT_GT(total, 0u);
 }
 
+// The pair lists are raw room (PairList): a resize leaves the new pairs' bytes as they
+// were. Before each update the caller's list is cleared and its room filled with 0xff
+// bytes (proxies and users out of range) in one broadphase, with zeros in its twin; the
+// lists alternate with the merge's scratch, so both grow into filled room. Every pair
+// must be written before it is read or returned: the lists come out the same.
+TEST(ProxyTrees, UpdatePairs_ListsGrownIntoFilledRoomAsIntoZeros) {
+    constexpr int kBodies = 1000;
+    constexpr int kSteps = 20;
+    constexpr std::size_t kFew = 64;
+    const auto fill_room = [](PairList& pairs, unsigned char byte) {
+        pairs.reserve(2 * pairs.size() + kFew);
+        pairs.clear();
+        std::memset(static_cast<void*>(pairs.data()), byte, pairs.capacity() * sizeof(Pair));
+    };
+    Scene clean(kBodies, 11, BroadphaseSettings{.grain = 3});
+    Scene filled(kBodies, 11, BroadphaseSettings{.grain = 3});
+    test::ReverseThreadedJobSystem jobs(3);
+    PairList a;
+    PairList b;
+    std::size_t total = 0;
+    for (int step = 0; step < kSteps; ++step) {
+        if (step > 0) {
+            clean.step();
+            filled.step();
+        }
+        fill_room(a, 0x00);
+        fill_room(b, 0xff);
+        clean.broadphase().update_pairs(jobs, a);
+        filled.broadphase().update_pairs(jobs, b);
+        ASSERT_EQ(a.size(), b.size()) << "step " << step;
+        ASSERT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(Pair)), 0) << "step " << step;
+        total += a.size();
+    }
+    EXPECT_GT(total, 0u);
+}
+
 TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
     ProxyTrees bp;
     SingleThreadedJobSystem jobs;
     std::vector<ProxyId> statics;
     for (int i = 0; i < 200; ++i)
         statics.push_back(bp.create_proxy(cube(Vec3(i * 1.5, 0, 0), 1), std::uint64_t(i), true));
-    std::vector<Pair> pairs;
+    PairList pairs;
     bp.update_pairs(jobs, pairs);
     EXPECT_TRUE(pairs.empty());
     bp.rebuild_static_tree();

@@ -123,9 +123,10 @@ using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
 // HugePageAllocator whose resize leaves the new elements' bytes as they are: for arrays
 // that the code after each resize writes whole, element by element, before anything
-// reads them (the solver's per-step arrays). A first step's megabytes are then first
-// written by the jobs that fill them, split over the workers, instead of zeroed by the
-// resizing thread first. Copies and moves construct as usual.
+// reads them (the solver's per-step arrays, the broadphase's pair lists). A first
+// step's megabytes are then first written by the jobs that fill them, split over the
+// workers, instead of zeroed by the resizing thread first. Copies and moves construct
+// as usual.
 template <typename T>
 struct RawRoomAllocator : HugePageAllocator<T> {
     RawRoomAllocator() = default;
