@@ -24,9 +24,9 @@
 #include "api/joint_targets.hpp"
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
+#include "memory/huge_page_vector.hpp"
 #include "solver/motion_locks.hpp"
 #include "stages/contact_index.hpp"
-#include "memory/huge_page_vector.hpp"
 
 namespace spindle {
 
