@@ -59,15 +59,20 @@ struct PoleLanding {
     Real final_height = 0;   // of the centre of mass
 };
 
-// The pole lies along x, its centre 4 m above `floor_shape` and its +x end kPoleTilt
-// lower (0.86 m up), spinning about z so that end swings down.
-PoleLanding throw_pole_onto(const Shape& floor_shape) {
-    Space space;
+// Landing gravity, and `floor_shape` as a static body at the origin.
+void add_floor(Space& space, const Shape& floor_shape) {
     space.set_gravity(Vec3(0, -kLandingGravity, 0));
     BodyDesc floor;
     floor.type = MotionType::Static;
     floor.shape = floor_shape;
     space.create_body(floor);
+}
+
+// The pole lies along x, its centre 4 m above `floor_shape` and its +x end kPoleTilt
+// lower (0.86 m up), spinning about z so that end swings down.
+PoleLanding throw_pole_onto(const Shape& floor_shape) {
+    Space space;
+    add_floor(space, floor_shape);
     BodyDesc pole;
     pole.shape = segmented_pole();
     const Real length = kPoleParts * kPartLength;
@@ -129,11 +134,7 @@ struct BarLanding {
 
 BarLanding drop_bar_onto(const Shape& floor_shape) {
     Space space;
-    space.set_gravity(Vec3(0, -kLandingGravity, 0));
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = floor_shape;
-    space.create_body(floor);
+    add_floor(space, floor_shape);
     std::vector<CompoundPart> parts;
     for (int i = 0; i < kBarParts; ++i) {
         const Real x = (2 * i + 1 - kBarParts) * kBarPartHalf;
