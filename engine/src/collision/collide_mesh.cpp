@@ -60,20 +60,17 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
 }
 
 // Replaces an edge or vertex normal by the face normal, on the side of the triangle's
-// plane the shape reaches into (the front unless it lies wholly behind: one lying across
-// the plane has its centre in front, collide_triangles drops the others), and measures the
+// plane the shape reaches into (`front`: its centre is in front; collide_triangles has
+// dropped a shape lying across the plane with its centre behind), and measures the
 // contact again against that face: a sphere or capsule from its deepest core point(s)
 // along the new normal, a polyhedron as its SAT would have had the face chosen (its
 // incident face clipped over the triangle, else its vertex deepest along the normal).
 // The SAT's own points do not serve: for shapes apart, its axis may be one beside the
 // triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
 // be measured from its far side. False when nothing is within reach.
-bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                     const ShapeSpan& span, const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
+bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron, bool front,
+                     const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
     const Vec3& n = tri.normal();
-    Real lo, hi;
-    span.along(n, lo, hi);
-    const bool front = hi > n.dot(on_plane);
     if (polyhedron) {
         const Transform identity;
         return face_of_b_manifold(*polyhedron, xa, tri.view(), identity, front ? 0 : 1, speculative, m);
@@ -166,7 +163,8 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const Real facing = m.normal.dot(poly.normal());  // the normal points from the shape to the triangle
         const bool through = centre_in_front && facing > 0;
         const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
-        if ((through || off_face) && !use_face_normal(m, a, a_in_mesh, polyhedron, span, poly, v[0], speculative))
+        if ((through || off_face) &&
+            !use_face_normal(m, a, a_in_mesh, polyhedron, centre_in_front, poly, v[0], speculative))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
