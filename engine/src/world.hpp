@@ -42,11 +42,28 @@ inline constexpr std::size_t kNoPosition = std::numeric_limits<std::size_t>::max
 // Bodies::history_place of a slot that never held a body that can move.
 inline constexpr std::uint32_t kNoHistory = std::numeric_limits<std::uint32_t>::max();
 
+// The number of fields of an aggregate: the most initialisers T{...} accepts.
+namespace detail {
+struct AnyField {
+    template <typename T>
+    operator T() const;  // declared only: named in unevaluated contexts
+};
+template <typename T, typename... Fields>
+consteval std::size_t field_count() {
+    if constexpr (requires { T{Fields{}..., AnyField{}}; }) {
+        return field_count<T, Fields..., AnyField>();
+    } else {
+        return sizeof...(Fields);
+    }
+}
+}  // namespace detail
+
 // What a body keeps of its description: BodyDesc but for the pose and velocities it was
 // made with (the live arrays hold those; a level's static geometry would otherwise keep
 // copies no stage reads). Each field means what BodyDesc's does; a field added
 // to BodyDesc is added here, to both conversions and to the test that round-trips them
-// (Setters.InternalDescKeepsEveryFieldItWasMadeWith).
+// (Setters.InternalDescKeepsEveryFieldItWasMadeWith); the assertion below the struct fails
+// the build until it is.
 struct BodyTraits {
     MotionType type = MotionType::Dynamic;
     Shape shape;  // empty in a free slot: its geometry is let go
@@ -94,6 +111,11 @@ struct BodyTraits {
         return d;
     }
 };
+// BodyTraits' 19 fields and the pose and velocities (4): a field added to BodyDesc and not
+// here would be lost by every body made (the round-trip test only sets the fields it knows).
+static_assert(detail::field_count<BodyDesc>() == 19 + 4,
+              "BodyDesc's fields changed: carry the new one in BodyTraits (both conversions, the round-trip test), "
+              "then count it here");
 
 // Bodies, indexed by handle slot (holes where bodies were destroyed). Hot per-step
 // data (pose, velocity, mass) sits in its own arrays; the description (shape,
