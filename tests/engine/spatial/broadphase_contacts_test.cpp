@@ -353,3 +353,62 @@ TEST(BroadphaseContacts, RemovedContacts_TheLastContactsFillTheirPlaces) {
 
 }  // namespace
 }  // namespace spindle
+
+namespace spindle {
+namespace {
+
+// A block of touching spheres big enough that the index claims and erases in jobs (tens of
+// thousands of contacts; thousands lost at once when every other sphere of the top layers is
+// teleported away). The keys after the first step and after the loss, and the index's
+// positions, as one thread makes them.
+std::vector<std::vector<std::uint64_t>> run_sphere_block(JobSystem& jobs) {
+    SpaceSettings settings;
+    settings.gravity = Vec3::Zero();
+    settings.sleep.enabled = false;
+    Space space(settings, &jobs);
+    std::vector<BodyHandle> top;
+    for (int y = 0; y < 4; ++y) {
+        for (int i = 0; i < 40; ++i) {
+            for (int k = 0; k < 40; ++k) {
+                BodyDesc d;
+                d.shape = Shape::sphere(0.5);
+                d.position = {Real(i), Real(y), Real(k)};
+                const BodyHandle body = space.create_body(d);
+                if (y >= 2 && (i + k) % 2 == 0) top.push_back(body);
+            }
+        }
+    }
+    World& world = SpaceInternals::world(space);
+    std::vector<std::vector<std::uint64_t>> lists;
+    const auto check_index = [&] {
+        ContactIndex index = world.contact_index;
+        EXPECT_EQ(index.size(), world.contact_keys.size());
+        for (std::uint32_t c = 0; c < world.contact_keys.size(); ++c) {
+            const std::uint32_t* position = index.find(world.contact_keys[c]);
+            ASSERT_NE(position, nullptr);
+            ASSERT_EQ(*position, c);
+        }
+    };
+    space.update();
+    check_index();
+    lists.push_back(world.contact_keys);
+    for (std::size_t k = 0; k < top.size(); ++k) space.set_position(top[k], Vec3(0, 100 + 3 * Real(k), 0));
+    space.update();
+    check_index();
+    lists.push_back(world.contact_keys);
+    return lists;
+}
+
+TEST(BroadphaseContacts, ManyContactsMadeAndLostOnThreads_AreTheListsOfOneThread) {
+    SingleThreadedJobSystem single;
+    const std::vector<std::vector<std::uint64_t>> reference = run_sphere_block(single);
+    ASSERT_GT(reference[0].size(), 20000u);                      // the index has 65,536 slots or more
+    ASSERT_GT(reference[0].size(), reference[1].size() + 2000);  // thousands lost at once
+    test::ReverseThreadedJobSystem reverse(3);
+    const std::vector<std::vector<std::uint64_t>> lists = run_sphere_block(reverse);
+    ASSERT_EQ(lists.size(), reference.size());
+    for (std::size_t k = 0; k < lists.size(); ++k) EXPECT_TRUE(lists[k] == reference[k]) << "after step " << k + 1;
+}
+
+}  // namespace
+}  // namespace spindle
