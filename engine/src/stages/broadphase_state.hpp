@@ -68,6 +68,7 @@ struct BroadphaseState {
     std::vector<std::uint8_t> refit;
     std::vector<std::uint32_t> refit_slots;    // the slots marked in refit, to clear just them
     std::vector<std::uint8_t> moving;          // scratch, per awake body: its proxy must move this step
+    RawRoomVector<Aabb> moved_boxes;           // scratch, per awake body: its new fat box where it moves
     std::vector<std::uint64_t> new_keys;       // scratch: keys of the new pairs that may make contacts
     std::vector<std::uint32_t> range_counts;   // scratch: values kept per job range (broadphase.cpp, create_contacts)
     std::vector<std::uint32_t> claimed_slots;  // scratch: per new key, the index slot it claimed (create_contacts)

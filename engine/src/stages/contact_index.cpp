@@ -57,7 +57,8 @@ void ContactIndex::rehash(std::size_t slots, JobSystem* jobs) {
         return;
     }
     jobs->parallel_for("IndexFill", 0, static_cast<std::uint32_t>(slots), kIndexSlotGrain, fill);
-    if (m_size > 0) jobs->parallel_for("IndexMove", 0, static_cast<std::uint32_t>(keys.size()), kIndexSlotGrain, move_keys);
+    if (m_size > 0)
+        jobs->parallel_for("IndexMove", 0, static_cast<std::uint32_t>(keys.size()), kIndexSlotGrain, move_keys);
 }
 
 void ContactIndex::erase_at(JobSystem& jobs, std::span<const std::uint32_t> positions,
