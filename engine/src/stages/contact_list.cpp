@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <new>
 #include <numeric>
 #include <utility>
 
@@ -120,17 +121,17 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     reserve_for(world.contacts, end);
     reserve_for(world.contact_summaries, end);
     map_room(*world.jobs, world.contacts, end);
-    world.contacts.resize(end);  // in place, all at once: the record is large
+    world.contacts.resize(end);  // in place, all at once, constructed by the jobs below: the record is large
     world.contact_summaries.resize(end);
 
-    // The records read the bodies' descriptions (cold: a first step reads tens of
-    // thousands) in parallel; each job writes only its own contacts.
+    // The records are constructed and filled from the bodies' descriptions (cold: a first
+    // step reads tens of thousands) in parallel; each job writes only its own contacts.
     std::atomic<std::uint32_t> reporting{0};
     world.jobs->parallel_for("NewContacts", static_cast<std::uint32_t>(first), end, kNewContactGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
                                  std::uint32_t reports = 0;
                                  for (std::uint32_t c = lo; c < hi; ++c) {
-                                     Contact& contact = world.contacts[c];
+                                     Contact& contact = *::new (&world.contacts[c]) Contact();
                                      init_contact(world, made[c], contact);
                                      reports += contact.events != 0 ? 1u : 0u;
                                      world.contact_summaries[c] = contact_summary(contact);  // a sensor's has no points

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <set>
 #include <vector>
@@ -263,23 +264,58 @@ TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
 // list held: a first step does not rebuild it from tens of thousands of records. Here the
 // list is left stale (dirty, with positions in it) when the block's contacts are removed
 // and made again.
+// The block's first step, then every contact removed: the keys it had.
+std::vector<std::uint64_t> make_and_remove_every_contact(Block& block) {
+    World& world = SpaceInternals::world(block.space);
+    block.space.update();
+    const std::vector<std::uint64_t> keys = world.contact_keys;
+    std::vector<std::uint32_t> all(keys.size());
+    std::iota(all.begin(), all.end(), 0u);
+    remove_contacts(world, all);
+    return keys;
+}
+
 TEST(BroadphaseContacts, ContactsMadeFromNone_AreTheAwakeListInOrder) {
     SingleThreadedJobSystem jobs;
     Block block(jobs);
     World& world = SpaceInternals::world(block.space);
-    block.space.update();
-    const std::vector<std::uint64_t> keys = world.contact_keys;
+    const std::vector<std::uint64_t> keys = make_and_remove_every_contact(block);
     ASSERT_GT(keys.size(), 2000u);
+    ASSERT_TRUE(world.contacts.empty());
     std::vector<std::uint32_t> all(keys.size());
     std::iota(all.begin(), all.end(), 0u);
-    remove_contacts(world, all);
-    ASSERT_TRUE(world.contacts.empty());
     world.awake_contact_list = {7, 3, 7};
     world.awake_contacts_dirty = true;
     create_contacts(world, keys);
     ASSERT_EQ(world.contacts.size(), keys.size());
     EXPECT_FALSE(world.awake_contacts_dirty);
     EXPECT_EQ(world.awake_contact_list, all);
+}
+
+// The contact array's growth leaves the new records to create_contacts' jobs, which
+// construct each in place: records made into room full of 0xff bytes (a removed pile's
+// leftovers) are new records, no manifold, no extra, not asleep, with their pair's materials.
+TEST(BroadphaseContacts, ContactsMadeIntoDirtyRoom_AreNewRecords) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    const std::vector<std::uint64_t> keys = make_and_remove_every_contact(block);
+    ASSERT_GE(world.contacts.capacity(), keys.size());
+    std::memset(static_cast<void*>(world.contacts.data()), 0xff, keys.size() * sizeof(Contact));
+    create_contacts(world, keys);
+    ASSERT_EQ(world.contact_keys, keys);
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const Contact& contact = world.contacts[c];
+        ASSERT_EQ(contact.manifold_count, 0) << "contact " << c;
+        ASSERT_TRUE(contact.extra == nullptr);
+        ASSERT_FALSE(contact.sleeping);
+        ASSERT_FALSE(contact.cached);
+        ASSERT_FALSE(contact.touch_reported);
+        ASSERT_EQ(contact.friction, std::sqrt(world.bodies.traits[contact.body_a].friction *
+                                              world.bodies.traits[contact.body_b].friction));
+    }
+    block.space.update();  // and a step runs on them
+    expect_contacts_are_the_allowed_overlaps(world);
 }
 
 // A removal fills the removed places with the kept contacts past the new end, so each
