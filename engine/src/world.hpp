@@ -376,7 +376,8 @@ struct World {
     // Collision: contacts in a deterministic order (creation order from canonical pair
     // lists; removed places taken by the last contacts, remove_contacts).
     std::unique_ptr<BroadphaseState> broadphase;
-    HugePageVector<Contact> contacts;
+    // Grown only by create_contacts, whose jobs construct the new records in place.
+    std::vector<Contact, PlacedByCallerAllocator<Contact>> contacts;
     ContactIndex contact_index;  // key -> position in contacts
     std::vector<std::uint64_t>
         contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact

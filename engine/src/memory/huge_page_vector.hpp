@@ -121,25 +121,41 @@ struct HugePageAllocator {
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
+// HugePageAllocator whose resize leaves the new elements unconstructed: the code after
+// each growing resize must construct every new element in place (placement new) before
+// anything else touches the array, so that jobs construct a first step's records instead
+// of the resizing thread (World::contacts, create_contacts). Copies, moves and shrinking
+// resizes are as usual.
+template <typename T>
+struct PlacedByCallerAllocator : HugePageAllocator<T> {
+    PlacedByCallerAllocator() = default;
+    template <typename U>
+    PlacedByCallerAllocator(const PlacedByCallerAllocator<U>&) noexcept {}
+
+    template <typename U>
+    void construct(U*) noexcept {}
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
 // HugePageAllocator whose resize leaves the new elements' bytes as they are: for arrays
 // that the code after each resize writes whole, element by element, before anything
 // reads them (the solver's per-step arrays, the broadphase's pair lists). A first
 // step's megabytes are then first written by the jobs that fill them, split over the
-// workers, instead of zeroed by the resizing thread first. Copies and moves construct
-// as usual.
+// workers, instead of zeroed by the resizing thread first. Only for types with nothing
+// to destroy, so that an element never written is harmless.
 template <typename T>
-struct RawRoomAllocator : HugePageAllocator<T> {
+struct RawRoomAllocator : PlacedByCallerAllocator<T> {
     RawRoomAllocator() = default;
     template <typename U>
     RawRoomAllocator(const RawRoomAllocator<U>&) noexcept {}
 
+    using PlacedByCallerAllocator<T>::construct;
     template <typename U>
     void construct(U*) noexcept {
         static_assert(std::is_trivially_destructible_v<U>, "raw room holds no object that needs destroying");
-    }
-    template <typename U, typename... Args>
-    void construct(U* p, Args&&... args) {
-        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
     }
 };
 

@@ -220,9 +220,11 @@ void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
-    // Bounds, and whether each proxy must move, in parallel; the tree is single-writer,
-    // so the few proxies that left their fat boxes are moved after, in awake order.
+    // Bounds, and whether each proxy must move and to which fat box, in parallel; the tree
+    // is single-writer, so the few proxies that left their fat boxes are moved after, in
+    // awake order.
     bp.moving.resize(n);
+    bp.moved_boxes.resize(n);
     bp.part_boxes.lay_out(b);
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t k = lo; k < hi; ++k) {
@@ -235,7 +237,10 @@ void update_broadphase(World& world, Real dt) {
                 b.bounds[i] = shape.bounds(b.transform(i));
             }
             const Vec3 d = b.v[i] * dt;
-            bp.moving[k] = bp.tree.needs_move(bp.proxy[i], swept_bounds(b, i, d), d) ? 1 : 0;
+            const Aabb swept = swept_bounds(b, i, d);
+            const bool moves = bp.tree.needs_move(bp.proxy[i], swept, d);
+            bp.moving[k] = moves ? 1 : 0;
+            if (moves) bp.moved_boxes[k] = bp.tree.fat_box(bp.proxy[i], swept, d);
         }
     });
     // The moved leaves' ancestors are only flagged: update_pairs rebuilds them before its
@@ -243,10 +248,8 @@ void update_broadphase(World& world, Real dt) {
     for (std::uint32_t k = 0; k < n; ++k) {
         if (!bp.moving[k]) continue;
         const std::uint32_t i = world.awake[k];
-        const Vec3 d = b.v[i] * dt;
-        const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept_bounds(b, i, d), d);
-        note_fat_change(bp, i, bp.tree.fat_aabb(bp.proxy[i]), fat);
-        bp.tree.set_fat_box(bp.proxy[i], fat);
+        note_fat_change(bp, i, bp.tree.fat_aabb(bp.proxy[i]), bp.moved_boxes[k]);
+        bp.tree.set_fat_box(bp.proxy[i], bp.moved_boxes[k]);
     }
 
     // A pair found again (one of its proxies grew) has its contact: left out by the pair

@@ -66,10 +66,12 @@ struct BroadphaseState {
     // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;
-    std::vector<std::uint32_t> refit_slots;   // the slots marked in refit, to clear just them
-    std::vector<std::uint8_t> moving;         // scratch, per awake body: its proxy must move this step
-    std::vector<std::uint64_t> new_keys;      // scratch: keys of the new pairs that may make contacts
-    std::vector<std::uint32_t> range_counts;  // scratch: values kept per job range (broadphase.cpp)
+    std::vector<std::uint32_t> refit_slots;    // the slots marked in refit, to clear just them
+    std::vector<std::uint8_t> moving;          // scratch, per awake body: its proxy must move this step
+    RawRoomVector<Aabb> moved_boxes;           // scratch, per awake body: its new fat box where it moves
+    std::vector<std::uint64_t> new_keys;       // scratch: keys of the new pairs that may make contacts
+    std::vector<std::uint32_t> range_counts;   // scratch: values kept per job range (broadphase.cpp, create_contacts)
+    std::vector<std::uint32_t> claimed_slots;  // scratch: per new key, the index slot it claimed (create_contacts)
     CompoundPartBoxes part_boxes;
 };
 
@@ -99,7 +101,7 @@ void remove_proxy(World& world, std::uint32_t slot);
 void refresh_proxy(World& world, std::uint32_t slot);
 // Removes every contact of a body (destroy_body).
 void remove_contacts_of(World& world, std::uint32_t slot);
-// Creates a contact for each pair key (min slot << 32 | max slot) that has none, at the
+// Creates a contact for each pair key (min slot << 32 | max slot; the keys distinct) that has none, at the
 // end of World::contacts in the keys' order, the records filled in parallel jobs. Room is
 // made once for all of them: a first step makes tens of thousands, and growing by
 // push_back would move every contact again and again.

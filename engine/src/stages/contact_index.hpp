@@ -3,14 +3,22 @@
 // contacts: a node-based map allocated one node per contact and took twice the memory.
 // Never iterated, so its order cannot reach results. Its arrays are on the huge-page
 // allocator: a first step's rehashes fill megabytes of fresh memory from one thread.
+// Besides one key at a time, it takes many distinct keys from jobs: claims by
+// compare-and-swap (a linear-probing table holds the same keys whatever the order of
+// their inserts) and erases split by the runs of full slots (an erase shifts keys only
+// inside its key's run). Which slot a key lands in may then depend on the jobs' timing,
+// which nothing reads.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "memory/huge_page_vector.hpp"
 
 namespace spindle {
+
+class JobSystem;
 
 class ContactIndex {
 public:
@@ -41,29 +49,30 @@ public:
     // tombstones: lookups stay as short as the load allows).
     void erase(std::uint64_t key) noexcept {
         if (m_keys.empty()) return;
-        std::size_t hole = home(key);
-        for (; m_keys[hole] != key; hole = next(hole)) {
-            if (m_keys[hole] == kEmpty) return;
-        }
-        for (std::size_t i = next(hole); m_keys[i] != kEmpty; i = next(i)) {
-            // The key at i may fill the hole unless its home lies cyclically in (hole, i].
-            const std::size_t h = home(m_keys[i]);
-            const bool stays = hole < i ? (hole < h && h <= i) : (hole < h || h <= i);
-            if (stays) continue;
-            m_keys[hole] = m_keys[i];
-            m_positions[hole] = m_positions[i];
-            hole = i;
-        }
-        m_keys[hole] = kEmpty;
-        --m_size;
+        if (erase_in_run(key)) --m_size;
     }
 
-    // Room for `count` keys without growing (at most half the slots full).
-    void reserve(std::size_t count) {
+    // Room for `count` keys without growing (at most half the slots full). With `jobs`, a
+    // rehash fills the new slots and moves the keys in jobs.
+    void reserve(std::size_t count, JobSystem* jobs = nullptr) {
         std::size_t slots = m_keys.empty() ? kMinSlots : m_keys.size();
         while (slots < 2 * count) slots *= 2;
-        if (slots > m_keys.size()) rehash(slots);
+        if (slots > m_keys.size()) rehash(slots, jobs);
     }
+
+    // Many distinct keys from jobs: reserve() room for them first; then claim() each, from
+    // any number of jobs at once (nothing else may touch the index meanwhile): the key's
+    // slot, or kNotClaimed when the key is there already. Then, after those jobs, on one
+    // thread, add_claimed(how many were claimed); and give each claimed slot its position
+    // (set_position_at, from jobs: one slot each) before the next find().
+    static constexpr std::uint32_t kNotClaimed = ~std::uint32_t{0};
+    std::uint32_t claim(std::uint64_t key) noexcept;
+    void add_claimed(std::size_t count) noexcept { m_size += count; }
+    void set_position_at(std::uint32_t slot, std::uint32_t position) noexcept { m_positions[slot] = position; }
+
+    // Erases keys[p] for each p in positions (the keys distinct, each in the index), in jobs:
+    // the slots are cut at empty slots into ranges, each range's keys erased by one job.
+    void erase_at(JobSystem& jobs, std::span<const std::uint32_t> positions, std::span<const std::uint64_t> keys);
 
     std::size_t size() const noexcept { return m_size; }
     std::size_t heap_bytes() const noexcept {
@@ -81,21 +90,32 @@ private:
     }
     std::size_t next(std::size_t i) const noexcept { return (i + 1) & (m_keys.size() - 1); }
 
-    void rehash(std::size_t slots) {
-        HugePageVector<std::uint64_t> keys(slots, kEmpty);
-        HugePageVector<std::uint32_t> positions(slots);
-        keys.swap(m_keys);
-        positions.swap(m_positions);
-        m_shift = 64;
-        for (std::size_t s = slots; s > 1; s /= 2) --m_shift;
-        m_size = 0;
-        for (std::size_t i = 0; i < keys.size(); ++i) {
-            if (keys[i] != kEmpty) insert(keys[i], positions[i]);
+    // Erases key, if there, without counting: reads and writes only the run of full slots
+    // holding the key's home, so erases in different runs may run at once.
+    bool erase_in_run(std::uint64_t key) noexcept {
+        std::size_t hole = home(key);
+        for (; m_keys[hole] != key; hole = next(hole)) {
+            if (m_keys[hole] == kEmpty) return false;
         }
+        for (std::size_t i = next(hole); m_keys[i] != kEmpty; i = next(i)) {
+            // The key at i may fill the hole unless its home lies cyclically in (hole, i].
+            const std::size_t h = home(m_keys[i]);
+            const bool stays = hole < i ? (hole < h && h <= i) : (hole < h || h <= i);
+            if (stays) continue;
+            m_keys[hole] = m_keys[i];
+            m_positions[hole] = m_positions[i];
+            hole = i;
+        }
+        m_keys[hole] = kEmpty;
+        return true;
     }
 
-    HugePageVector<std::uint64_t> m_keys;  // kEmpty where free; a power of two long
-    HugePageVector<std::uint32_t> m_positions;
+    // Raw room: the keys are filled with kEmpty here (in jobs when given), and a position
+    // is read only where a key is.
+    void rehash(std::size_t slots, JobSystem* jobs = nullptr);
+
+    RawRoomVector<std::uint64_t> m_keys;  // kEmpty where free; a power of two long
+    RawRoomVector<std::uint32_t> m_positions;
     std::size_t m_size = 0;
     int m_shift = 64;
 };

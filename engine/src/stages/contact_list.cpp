@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <new>
 #include <numeric>
+#include <utility>
 
 #include "collision/collide.hpp"
 #include "stages/broadphase_state.hpp"
@@ -17,8 +19,10 @@ namespace {
 
 // New contacts per job: each reads two bodies' descriptions and writes one record.
 constexpr std::uint32_t kNewContactGrain = 256;
-// Moved contacts per job when their index entries are updated (one lookup each).
-constexpr std::uint32_t kMovedContactGrain = 1024;
+// Moved contacts per job: a record moved and its index entry updated (one lookup) each.
+constexpr std::uint32_t kMovedContactGrain = 256;
+// New pair keys per job when the index claims their slots (one probe each).
+constexpr std::uint32_t kClaimGrain = 1024;
 
 // A new contact's record, from its bodies' descriptions (reads only: many jobs at once).
 void init_contact(const World& world, std::uint64_t key, Contact& contact) {
@@ -76,32 +80,58 @@ void fit_contacts(World& world) {
 
 void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     if (keys.empty()) return;
-    // Positions in list order, one index lookup per key; a key the index holds already is
-    // a pair found again (one of its proxies grew). Room is made for the new ones only: a
-    // step that finds many pairs again must not grow the arrays only to give them back.
+    // Positions in list order; a key the index holds already is a pair found again (one of
+    // its proxies grew). The index claims the keys' slots in jobs, then each range places
+    // its new keys from its first position on, so the order is the keys' order on any
+    // worker count. Room is made for the new ones only: a step that finds many pairs again
+    // must not grow the arrays only to give them back.
     const std::size_t first = world.contacts.size();
-    world.contact_index.reserve(first + keys.size());
+    ContactIndex& index = world.contact_index;
+    index.reserve(first + keys.size(), world.jobs);
+    BroadphaseState& bp = *world.broadphase;
+    const auto n = static_cast<std::uint32_t>(keys.size());
+    std::vector<std::uint32_t>& claimed = bp.claimed_slots;
+    std::vector<std::uint32_t>& offsets = bp.range_counts;
+    claimed.resize(n);
+    offsets.assign((n + kClaimGrain - 1) / kClaimGrain, 0);
+    world.jobs->parallel_for("ClaimKeys", 0, n, kClaimGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        std::uint32_t count = 0;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            claimed[k] = index.claim(keys[k]);
+            count += claimed[k] != ContactIndex::kNotClaimed ? 1u : 0u;
+        }
+        offsets[lo / kClaimGrain] = count;
+    });
+    std::uint32_t made_count = 0;
+    for (std::uint32_t& offset : offsets) made_count += std::exchange(offset, made_count);
+    if (made_count == 0) return;
+    index.add_claimed(made_count);
     std::vector<std::uint64_t>& made = world.contact_keys;
     reserve_for(made, first + keys.size());  // 8 bytes a key: the pairs found again are not worth a second pass
-    for (const std::uint64_t key : keys) {
-        if (world.contact_index.insert(key, static_cast<std::uint32_t>(made.size()))) made.push_back(key);
-    }
+    made.resize(first + made_count);
+    world.jobs->parallel_for("PlaceKeys", 0, n, kClaimGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        auto position = static_cast<std::uint32_t>(first + offsets[lo / kClaimGrain]);
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            if (claimed[k] == ContactIndex::kNotClaimed) continue;
+            made[position] = keys[k];
+            index.set_position_at(claimed[k], position++);
+        }
+    });
     const auto end = static_cast<std::uint32_t>(made.size());
-    if (end == first) return;
     reserve_for(world.contacts, end);
     reserve_for(world.contact_summaries, end);
     map_room(*world.jobs, world.contacts, end);
-    world.contacts.resize(end);  // in place, all at once: the record is large
+    world.contacts.resize(end);  // in place, all at once, constructed by the jobs below: the record is large
     world.contact_summaries.resize(end);
 
-    // The records read the bodies' descriptions (cold: a first step reads tens of
-    // thousands) in parallel; each job writes only its own contacts.
+    // The records are constructed and filled from the bodies' descriptions (cold: a first
+    // step reads tens of thousands) in parallel; each job writes only its own contacts.
     std::atomic<std::uint32_t> reporting{0};
     world.jobs->parallel_for("NewContacts", static_cast<std::uint32_t>(first), end, kNewContactGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
                                  std::uint32_t reports = 0;
                                  for (std::uint32_t c = lo; c < hi; ++c) {
-                                     Contact& contact = world.contacts[c];
+                                     Contact& contact = *::new (&world.contacts[c]) Contact();
                                      init_contact(world, made[c], contact);
                                      reports += contact.events != 0 ? 1u : 0u;
                                      world.contact_summaries[c] = contact_summary(contact);  // a sensor's has no points
@@ -137,10 +167,11 @@ const std::vector<std::uint32_t>& awake_contacts(World& world) {
 
 void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
     if (positions.empty()) return;
-    for (std::uint32_t p : positions) {
-        note_contact_removed(world, world.contacts[p]);  // a touching one ends its touch
-        world.contact_index.erase(world.contact_keys[p]);
+    // Only a reporting contact has a touch to end: while none reports, no record is read.
+    if (world.events->reporting != 0) {
+        for (std::uint32_t p : positions) note_contact_removed(world, world.contacts[p]);
     }
+    world.contact_index.erase_at(*world.jobs, positions, world.contact_keys);
     // The kept contacts past the new end fill the removed places below it, both taken in
     // ascending order (Box3D swaps the last contact into a removed one's place): each
     // record moves at most once and no more move than are removed, where keeping the
@@ -154,18 +185,25 @@ void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) 
     std::uint32_t from = size;
     for (std::size_t h = 0; h < holes; ++h, ++from) {
         for (; tail_removed < positions.size() && positions[tail_removed] == from; ++tail_removed) ++from;
-        const std::uint32_t to = positions[h];
-        world.contacts[to] = std::move(world.contacts[from]);
-        world.contact_keys[to] = world.contact_keys[from];
-        world.contact_summaries[to] = world.contact_summaries[from];
-        moves.push_back({from, to});
+        moves.push_back({from, positions[h]});
     }
-    // The index learns the moved contacts' positions: one lookup each, in parallel (each
-    // writes only its own key's entry; no key is added or removed meanwhile).
-    world.jobs->parallel_for("MovedContacts", 0, static_cast<std::uint32_t>(moves.size()), kMovedContactGrain,
+    // The records move in jobs (no two moves share a place), each telling the index its
+    // key's new position (no key is added or removed meanwhile). The removed records past
+    // the new end drop their extras there too, so the resize below only reads them.
+    const auto moved = static_cast<std::uint32_t>(moves.size());
+    const auto dropped = static_cast<std::uint32_t>(positions.size() - holes);
+    world.jobs->parallel_for("MovedContacts", 0, moved + dropped, kMovedContactGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
                                  for (std::uint32_t k = lo; k < hi; ++k) {
-                                     *world.contact_index.find(world.contact_keys[moves[k].to]) = moves[k].to;
+                                     if (k >= moved) {
+                                         world.contacts[positions[holes + (k - moved)]].extra.reset();
+                                         continue;
+                                     }
+                                     const auto [source, to] = moves[k];
+                                     world.contacts[to] = std::move(world.contacts[source]);
+                                     world.contact_keys[to] = world.contact_keys[source];
+                                     world.contact_summaries[to] = world.contact_summaries[source];
+                                     *world.contact_index.find(world.contact_keys[to]) = to;
                                  }
                              });
     world.contacts.resize(size);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <set>
 #include <vector>
@@ -263,23 +264,58 @@ TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
 // list held: a first step does not rebuild it from tens of thousands of records. Here the
 // list is left stale (dirty, with positions in it) when the block's contacts are removed
 // and made again.
+// The block's first step, then every contact removed: the keys it had.
+std::vector<std::uint64_t> make_and_remove_every_contact(Block& block) {
+    World& world = SpaceInternals::world(block.space);
+    block.space.update();
+    const std::vector<std::uint64_t> keys = world.contact_keys;
+    std::vector<std::uint32_t> all(keys.size());
+    std::iota(all.begin(), all.end(), 0u);
+    remove_contacts(world, all);
+    return keys;
+}
+
 TEST(BroadphaseContacts, ContactsMadeFromNone_AreTheAwakeListInOrder) {
     SingleThreadedJobSystem jobs;
     Block block(jobs);
     World& world = SpaceInternals::world(block.space);
-    block.space.update();
-    const std::vector<std::uint64_t> keys = world.contact_keys;
+    const std::vector<std::uint64_t> keys = make_and_remove_every_contact(block);
     ASSERT_GT(keys.size(), 2000u);
+    ASSERT_TRUE(world.contacts.empty());
     std::vector<std::uint32_t> all(keys.size());
     std::iota(all.begin(), all.end(), 0u);
-    remove_contacts(world, all);
-    ASSERT_TRUE(world.contacts.empty());
     world.awake_contact_list = {7, 3, 7};
     world.awake_contacts_dirty = true;
     create_contacts(world, keys);
     ASSERT_EQ(world.contacts.size(), keys.size());
     EXPECT_FALSE(world.awake_contacts_dirty);
     EXPECT_EQ(world.awake_contact_list, all);
+}
+
+// The contact array's growth leaves the new records to create_contacts' jobs, which
+// construct each in place: records made into room full of 0xff bytes (a removed pile's
+// leftovers) are new records, no manifold, no extra, not asleep, with their pair's materials.
+TEST(BroadphaseContacts, ContactsMadeIntoDirtyRoom_AreNewRecords) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    const std::vector<std::uint64_t> keys = make_and_remove_every_contact(block);
+    ASSERT_GE(world.contacts.capacity(), keys.size());
+    std::memset(static_cast<void*>(world.contacts.data()), 0xff, keys.size() * sizeof(Contact));
+    create_contacts(world, keys);
+    ASSERT_EQ(world.contact_keys, keys);
+    for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
+        const Contact& contact = world.contacts[c];
+        ASSERT_EQ(contact.manifold_count, 0) << "contact " << c;
+        ASSERT_TRUE(contact.extra == nullptr);
+        ASSERT_FALSE(contact.sleeping);
+        ASSERT_FALSE(contact.cached);
+        ASSERT_FALSE(contact.touch_reported);
+        ASSERT_EQ(contact.friction, std::sqrt(world.bodies.traits[contact.body_a].friction *
+                                              world.bodies.traits[contact.body_b].friction));
+    }
+    block.space.update();  // and a step runs on them
+    expect_contacts_are_the_allowed_overlaps(world);
 }
 
 // A removal fills the removed places with the kept contacts past the new end, so each
@@ -349,6 +385,65 @@ TEST(BroadphaseContacts, RemovedContacts_TheLastContactsFillTheirPlaces) {
     EXPECT_EQ(still_sleeping, sleeping);
     ASSERT_FALSE(world.awake_contacts_dirty);
     EXPECT_EQ(world.awake_contact_list, rebuilt);
+}
+
+}  // namespace
+}  // namespace spindle
+
+namespace spindle {
+namespace {
+
+// A block of touching spheres big enough that the index claims and erases in jobs (tens of
+// thousands of contacts; thousands lost at once when every other sphere of the top layers is
+// teleported away). The keys after the first step and after the loss, and the index's
+// positions, as one thread makes them.
+std::vector<std::vector<std::uint64_t>> run_sphere_block(JobSystem& jobs) {
+    SpaceSettings settings;
+    settings.gravity = Vec3::Zero();
+    settings.sleep.enabled = false;
+    Space space(settings, &jobs);
+    std::vector<BodyHandle> top;
+    for (int y = 0; y < 4; ++y) {
+        for (int i = 0; i < 40; ++i) {
+            for (int k = 0; k < 40; ++k) {
+                BodyDesc d;
+                d.shape = Shape::sphere(0.5);
+                d.position = {Real(i), Real(y), Real(k)};
+                const BodyHandle body = space.create_body(d);
+                if (y >= 2 && (i + k) % 2 == 0) top.push_back(body);
+            }
+        }
+    }
+    World& world = SpaceInternals::world(space);
+    std::vector<std::vector<std::uint64_t>> lists;
+    const auto check_index = [&] {
+        ContactIndex index = world.contact_index;
+        EXPECT_EQ(index.size(), world.contact_keys.size());
+        for (std::uint32_t c = 0; c < world.contact_keys.size(); ++c) {
+            const std::uint32_t* position = index.find(world.contact_keys[c]);
+            ASSERT_NE(position, nullptr);
+            ASSERT_EQ(*position, c);
+        }
+    };
+    space.update();
+    check_index();
+    lists.push_back(world.contact_keys);
+    for (std::size_t k = 0; k < top.size(); ++k) space.set_position(top[k], Vec3(0, 100 + 3 * Real(k), 0));
+    space.update();
+    check_index();
+    lists.push_back(world.contact_keys);
+    return lists;
+}
+
+TEST(BroadphaseContacts, ManyContactsMadeAndLostOnThreads_AreTheListsOfOneThread) {
+    SingleThreadedJobSystem single;
+    const std::vector<std::vector<std::uint64_t>> reference = run_sphere_block(single);
+    ASSERT_GT(reference[0].size(), 20000u);                      // the index has 65,536 slots or more
+    ASSERT_GT(reference[0].size(), reference[1].size() + 2000);  // thousands lost at once
+    test::ReverseThreadedJobSystem reverse(3);
+    const std::vector<std::vector<std::uint64_t>> lists = run_sphere_block(reverse);
+    ASSERT_EQ(lists.size(), reference.size());
+    for (std::size_t k = 0; k < lists.size(); ++k) EXPECT_TRUE(lists[k] == reference[k]) << "after step " << k + 1;
 }
 
 }  // namespace
