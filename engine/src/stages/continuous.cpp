@@ -112,9 +112,9 @@ Real height_above(const ConvexCore& core, const Vec3& n, const Vec3& v) {
 // the part's swept box: those whose plane has the part's centre behind it at the start
 // are left out (Box3D's b3CollideTriangleAndHull culls so, and collide_mesh.cpp gives a
 // shape with its centre behind no contact from a triangle it lies across), and so are
-// those whose plane it cannot reach within the step. At each pose the triangle whose plane
-// is nearest is measured first; a triangle whose plane is no nearer than the best gap
-// found is not measured at all.
+// those whose plane it cannot reach within the step. At each pose the triangle nearest by
+// a cheap bound (its plane's distance, or its box's from the part's) is measured first; a
+// triangle whose bound is no nearer than the best gap found is not measured at all.
 Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const TriangleMesh& mesh, const Transform& xw,
                         Real target, Real before, SweepScratch& scratch) {
     const Transform to_mesh = xw.inverse();
@@ -138,9 +138,16 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
     heights.resize(triangles.size());
     return time_of_impact(path, part, target, before, [&](const Transform& pose, Real touching) {
         pose_core(part.core, to_mesh * pose, posed);
+        Aabb core_box;
+        for (int i = 0; i < posed.count; ++i) core_box = core_box.merged({posed.points[i], posed.points[i]});
+        core_box = core_box.fattened(posed.radius);
         std::size_t nearest = 0;
         for (std::size_t k = 0; k < triangles.size(); ++k) {
-            heights[k] = height_above(posed, triangles[k][3], triangles[k][0]);
+            const std::array<Vec3, 4>& tri = triangles[k];
+            // The gap between the boxes bounds the triangle's too.
+            const Vec3 lo = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), hi = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
+            const Vec3 apart = (lo - core_box.max).cwiseMax(core_box.min - hi).cwiseMax(Vec3::Zero());
+            heights[k] = std::max(height_above(posed, tri[3], tri[0]), apart.norm());
             if (heights[k] < heights[nearest]) nearest = k;
         }
         Gap best = core_gap(posed, triangles[nearest].data(), 3, 0);
