@@ -16,6 +16,7 @@
 #include "collision/gjk.hpp"
 #include "collision/triangle_mesh.hpp"
 #include "stages/broadphase_state.hpp"
+#include "stages/continuous.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -28,8 +29,11 @@ struct BodyPath {
     Vec3 x0, x1;  // centre of mass
     Quat q0, q1;
     Vec3 local_com;
-    Vec3 moved;   // x1 - x0
-    Real turned;  // the angle from q0 to q1
+    Vec3 moved;  // x1 - x0
+    // The turn from q0 to q1 as an angle times its axis, in the body's frame, each
+    // coordinate's size: a point at r in that frame moves at most |turn x r| as the body
+    // turns about that fixed axis, bounded per axis by modified_cross(turn, |r|).
+    Vec3 turn;
     Transform at(Real t) const {
         const Quat q = q0.slerp(t, q1);
         return {x0 + t * moved - q * local_com, q};
@@ -41,21 +45,26 @@ struct SweptPart {
     ConvexCore core;
     Vec3 centre = Vec3::Zero();
     Real half_size = 0;  // the farthest core point from the centre, plus the radius
-    Real lever = 0;      // the farthest core point from the centre of mass, plus the radius
     Real thinnest = 0;
+    // The most any point of the part moves as the body turns through the whole step: from
+    // the centre of mass (swing), and about the part's own centre (twist).
+    Real swing = 0, twist = 0;
 };
 
-void make_part(const Shape& shape, const Transform& pose, const Vec3& local_com, SweptPart& part) {
+// Part `shape` posed by `pose` in the body's frame, swept along `path`.
+void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, SweptPart& part) {
     make_core(shape, pose, part.core);
     part.centre = pose.apply(shape.type == ShapeType::ConvexHull ? shape.hull->centroid() : Vec3::Zero());
-    Real half = 0, lever = 0;
+    Vec3 from_com = Vec3::Zero(), from_centre = Vec3::Zero();
     for (int i = 0; i < part.core.count; ++i) {
-        half = std::max(half, (part.core.points[i] - part.centre).squaredNorm());
-        lever = std::max(lever, (part.core.points[i] - local_com).squaredNorm());
+        from_com = from_com.cwiseMax((part.core.points[i] - path.local_com).cwiseAbs());
+        from_centre = from_centre.cwiseMax((part.core.points[i] - part.centre).cwiseAbs());
     }
-    part.half_size = std::sqrt(half) + part.core.radius;
-    part.lever = std::sqrt(lever) + part.core.radius;
+    const Vec3 radius = Vec3::Constant(part.core.radius);
+    part.half_size = from_centre.norm() + part.core.radius;
     part.thinnest = thinnest_half_size(shape);
+    part.swing = modified_cross(path.turn, from_com + radius).norm();
+    part.twist = modified_cross(path.turn, from_centre + radius).norm();
 }
 
 void pose_core(const ConvexCore& local, const Transform& x, ConvexCore& out) {
@@ -78,16 +87,19 @@ Gap core_gap(const ConvexCore& a, const Vec3* b, int b_count, Real b_radius) {
 }
 
 // First time of impact in [0, before) of the swept part against one static target whose
-// gap to the part at a pose of the body gap_at(pose, target) gives (it may return any gap
-// under `target` as soon as it finds one: that ends the sweep); `before` when none. A part
-// touching it at the start is left to the contacts.
+// gap to the part at a pose of the body gap_at(pose, target, reach) gives (it may return
+// any gap under `target` as soon as it finds one: that ends the sweep; and it may forget
+// for good what lies farther than `reach`, more than any point of the part can move in
+// the rest of the sweep); `before` when none. A part touching it at the start is left to
+// the contacts.
 template <typename GapAt>
 Real time_of_impact(const BodyPath& path, const SweptPart& part, Real target, Real before, GapAt&& gap_at) {
     Real t = 0;
     for (int iter = 0; iter < kMaxIterations; ++iter) {
-        const Gap gap = gap_at(path.at(t), target);
+        const Real reach = (before - t) * (path.moved.norm() + part.swing) + target;
+        const Gap gap = gap_at(path.at(t), target, reach);
         if (gap.distance < target) return iter == 0 ? before : t;  // touching at the start: contacts handle it
-        const Real bound = std::max(Real(0), path.moved.dot(gap.normal)) + path.turned * part.lever;
+        const Real bound = std::max(Real(0), path.moved.dot(gap.normal)) + part.swing;
         if (bound < 1e-12) return before;            // not closing in
         t += (gap.distance - 0.5 * target) / bound;  // the surfaces cannot meet before this
         if (t >= before) return before;
@@ -108,6 +120,21 @@ Real height_above(const ConvexCore& core, const Vec3& n, const Vec3& v) {
     return lowest - core.radius - n.dot(v);
 }
 
+Aabb box_of(const ConvexCore& core) {
+    Aabb box;
+    for (int i = 0; i < core.count; ++i) box = box.merged({core.points[i], core.points[i]});
+    return box.fattened(core.radius);
+}
+
+// A lower bound on the gap between the core (its box: core_box) and a mesh triangle (its
+// corners, then its normal): the height of the core above the triangle's plane, or the gap
+// between their boxes.
+Real gap_bound(const ConvexCore& core, const Aabb& core_box, const std::array<Vec3, 4>& tri) {
+    const Vec3 lo = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), hi = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
+    const Vec3 apart = (lo - core_box.max).cwiseMax(core_box.min - hi).cwiseMax(Vec3::Zero());
+    return std::max(height_above(core, tri[3], tri[0]), apart.norm());
+}
+
 // The part against a triangle mesh posed by xw. The triangles are gathered once, under
 // the part's swept box: those whose plane has the part's centre behind it at the start
 // are left out (Box3D's b3CollideTriangleAndHull culls so, and collide_mesh.cpp gives a
@@ -120,36 +147,38 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
     const Transform to_mesh = xw.inverse();
     ConvexCore posed;
     pose_core(part.core, to_mesh * path.at(0), posed);
+    Aabb core_box = box_of(posed);
     const Vec3 c0 = to_mesh.apply(path.at(0).apply(part.centre));
     const Vec3 c1 = to_mesh.apply(path.at(1).apply(part.centre));
-    const Real travel = path.moved.norm() + path.turned * part.lever + target;
+    const Real travel = path.moved.norm() + part.swing + target;
     const Aabb box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
     std::vector<std::array<Vec3, 4>>& triangles = scratch.triangles;
     triangles.clear();
     mesh.query(box, [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
-        const Vec3& v0 = mesh.vertices()[tri.v[0]];
-        const Vec3 n = mesh.normal(t);
-        if (n.dot(c0 - v0) < 0 || height_above(posed, n, v0) > travel) return;
-        triangles.push_back({v0, mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]], n});
+        const std::array<Vec3, 4> corners{mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]],
+                                          mesh.vertices()[tri.v[2]], mesh.normal(t)};
+        if (corners[3].dot(c0 - corners[0]) < 0 || gap_bound(posed, core_box, corners) > travel) return;
+        triangles.push_back(corners);
     });
     if (triangles.empty()) return before;
     std::vector<Real>& heights = scratch.heights;
     heights.resize(triangles.size());
-    return time_of_impact(path, part, target, before, [&](const Transform& pose, Real touching) {
+    return time_of_impact(path, part, target, before, [&](const Transform& pose, Real touching, Real reach) {
         pose_core(part.core, to_mesh * pose, posed);
-        Aabb core_box;
-        for (int i = 0; i < posed.count; ++i) core_box = core_box.merged({posed.points[i], posed.points[i]});
-        core_box = core_box.fattened(posed.radius);
-        std::size_t nearest = 0;
+        core_box = box_of(posed);
+        // Triangles out of reach for the rest of the sweep are dropped, the others kept in order.
+        std::size_t kept = 0;
         for (std::size_t k = 0; k < triangles.size(); ++k) {
-            const std::array<Vec3, 4>& tri = triangles[k];
-            // The gap between the boxes bounds the triangle's too.
-            const Vec3 lo = tri[0].cwiseMin(tri[1]).cwiseMin(tri[2]), hi = tri[0].cwiseMax(tri[1]).cwiseMax(tri[2]);
-            const Vec3 apart = (lo - core_box.max).cwiseMax(core_box.min - hi).cwiseMax(Vec3::Zero());
-            heights[k] = std::max(height_above(posed, tri[3], tri[0]), apart.norm());
-            if (heights[k] < heights[nearest]) nearest = k;
+            const Real h = gap_bound(posed, core_box, triangles[k]);
+            if (h > reach) continue;
+            triangles[kept] = triangles[k];
+            heights[kept++] = h;
         }
+        triangles.resize(kept);
+        if (kept == 0) return Gap{};
+        const auto nearest =
+            static_cast<std::size_t>(std::min_element(heights.begin(), heights.begin() + kept) - heights.begin());
         Gap best = core_gap(posed, triangles[nearest].data(), 3, 0);
         for (std::size_t k = 0; k < triangles.size() && best.distance >= touching; ++k) {
             if (k == nearest || heights[k] >= best.distance) continue;
@@ -170,7 +199,7 @@ Real sweep_against(const BodyPath& path, const SweptPart& part, const Shape& wal
         case ShapeType::Plane: {
             const Vec3 n = xw.rotate(wall.normal);
             const Real offset = wall.offset + n.dot(xw.p);
-            return time_of_impact(path, part, target, before, [&](const Transform& pose, Real) {
+            return time_of_impact(path, part, target, before, [&](const Transform& pose, Real, Real) {
                 Real lowest = kHuge;
                 for (int i = 0; i < part.core.count; ++i)
                     lowest = std::min(lowest, n.dot(pose.apply(part.core.points[i])));
@@ -188,7 +217,7 @@ Real sweep_against(const BodyPath& path, const SweptPart& part, const Shape& wal
         default: {
             ConvexCore other;
             make_core(wall, xw, other);
-            return time_of_impact(path, part, target, before, [&](const Transform& pose, Real) {
+            return time_of_impact(path, part, target, before, [&](const Transform& pose, Real, Real) {
                 pose_core(part.core, pose, posed);
                 return core_gap(posed, other.points.data(), other.count, other.radius);
             });
@@ -199,14 +228,16 @@ Real sweep_against(const BodyPath& path, const SweptPart& part, const Shape& wal
 // The first time of impact in [0, 1) of the listed body against static geometry, or 1.
 // A compound is swept part by part (Box3D sweeps each shape): one part resting on the
 // ground, touching at the start, must not hide another coming down. A part whose own
-// centre moved, plus its turn times its half-size, less than half its thinnest half-size
-// cannot pass through anything (a pole's end pivoting on the ground) and is not swept.
+// centre moved, plus the most the turn moves its points about it, less than half its
+// thinnest half-size cannot pass through anything (a pole's end pivoting on the ground, a
+// tree's part spinning about the tree's long axis) and is not swept.
 Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     Bodies& b = world.bodies;
     const std::uint32_t i = start.slot;
     const Real target = world.settings.solver.linear_slop;
-    BodyPath path{start.x0, b.x[i], start.q0, b.q[i], b.local_com[i], b.x[i] - start.x0, 0};
-    path.turned = start.q0.angularDistance(b.q[i]);
+    BodyPath path{start.x0, b.x[i], start.q0, b.q[i], b.local_com[i], b.x[i] - start.x0, Vec3::Zero()};
+    const Eigen::AngleAxis<Real> turn(start.q0.conjugate() * b.q[i]);  // the shortest way round
+    path.turn = (turn.angle() * turn.axis()).cwiseAbs();
     // The static bodies near the centre of mass's path, within its farthest reach: no
     // shape bounds, no slerp, for a body with no static body near.
     const Aabb swept =
@@ -229,14 +260,14 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     SweptPart part;
     for (std::uint32_t p = 0; p < part_count; ++p) {
         if (compound) {
-            make_part(shape.parts->shape(p), shape.parts->pose(p), path.local_com, part);
+            make_part(shape.parts->shape(p), shape.parts->pose(p), path, part);
         } else {
-            make_part(shape, Transform{}, path.local_com, part);
+            make_part(shape, Transform{}, path, part);
         }
         const Vec3 c0 = path.at(0).apply(part.centre);
         const Vec3 c1 = path.at(1).apply(part.centre);
-        if (compound && (c1 - c0).norm() + path.turned * part.half_size < Real(0.5) * part.thinnest) continue;
-        const Real travel = path.moved.norm() + path.turned * part.lever + target;
+        if (compound && (c1 - c0).norm() + part.twist < Real(0.5) * part.thinnest) continue;
+        const Real travel = path.moved.norm() + part.swing + target;
         const Aabb part_box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
         for (const std::uint32_t wall : statics) {
             if (!part_box.overlaps(b.bounds[wall])) continue;
