@@ -34,6 +34,7 @@ struct BodyPath {
     // coordinate's size: a point at r in that frame moves at most |turn x r| as the body
     // turns about that fixed axis, bounded per axis by modified_cross(turn, |r|).
     Vec3 turn;
+    Transform start, end;  // at(0), at(1)
     Transform at(Real t) const {
         const Quat q = q0.slerp(t, q1);
         return {x0 + t * moved - q * local_com, q};
@@ -46,25 +47,22 @@ struct SweptPart {
     Vec3 centre = Vec3::Zero();
     Real half_size = 0;  // the farthest core point from the centre, plus the radius
     Real thinnest = 0;
-    // The most any point of the part moves as the body turns through the whole step: from
-    // the centre of mass (swing), and about the part's own centre (twist).
-    Real swing = 0, twist = 0;
+    Real swing = 0;  // the most any point of the part moves as the body turns about its centre of mass
 };
 
 // Part `shape` posed by `pose` in the body's frame, swept along `path`.
 void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, SweptPart& part) {
     make_core(shape, pose, part.core);
     part.centre = pose.apply(shape.type == ShapeType::ConvexHull ? shape.hull->centroid() : Vec3::Zero());
-    Vec3 from_com = Vec3::Zero(), from_centre = Vec3::Zero();
+    Vec3 from_com = Vec3::Zero();
+    Real half = 0;
     for (int i = 0; i < part.core.count; ++i) {
         from_com = from_com.cwiseMax((part.core.points[i] - path.local_com).cwiseAbs());
-        from_centre = from_centre.cwiseMax((part.core.points[i] - part.centre).cwiseAbs());
+        half = std::max(half, (part.core.points[i] - part.centre).squaredNorm());
     }
-    const Vec3 radius = Vec3::Constant(part.core.radius);
-    part.half_size = from_centre.norm() + part.core.radius;
+    part.half_size = std::sqrt(half) + part.core.radius;
     part.thinnest = thinnest_half_size(shape);
-    part.swing = modified_cross(path.turn, from_com + radius).norm();
-    part.twist = modified_cross(path.turn, from_centre + radius).norm();
+    part.swing = modified_cross(path.turn, from_com + Vec3::Constant(part.core.radius)).norm();
 }
 
 void pose_core(const ConvexCore& local, const Transform& x, ConvexCore& out) {
@@ -146,10 +144,10 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
                         Real target, Real before, SweepScratch& scratch) {
     const Transform to_mesh = xw.inverse();
     ConvexCore posed;
-    pose_core(part.core, to_mesh * path.at(0), posed);
+    pose_core(part.core, to_mesh * path.start, posed);
     Aabb core_box = box_of(posed);
-    const Vec3 c0 = to_mesh.apply(path.at(0).apply(part.centre));
-    const Vec3 c1 = to_mesh.apply(path.at(1).apply(part.centre));
+    const Vec3 c0 = to_mesh.apply(path.start.apply(part.centre));
+    const Vec3 c1 = to_mesh.apply(path.end.apply(part.centre));
     const Real travel = path.moved.norm() + part.swing + target;
     const Aabb box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
     std::vector<std::array<Vec3, 4>>& triangles = scratch.triangles;
@@ -235,9 +233,17 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     Bodies& b = world.bodies;
     const std::uint32_t i = start.slot;
     const Real target = world.settings.solver.linear_slop;
-    BodyPath path{start.x0, b.x[i], start.q0, b.q[i], b.local_com[i], b.x[i] - start.x0, Vec3::Zero()};
     const Eigen::AngleAxis<Real> turn(start.q0.conjugate() * b.q[i]);  // the shortest way round
-    path.turn = (turn.angle() * turn.axis()).cwiseAbs();
+    const Vec3& com = b.local_com[i];
+    const BodyPath path{start.x0,
+                        b.x[i],
+                        start.q0,
+                        b.q[i],
+                        com,
+                        b.x[i] - start.x0,
+                        (turn.angle() * turn.axis()).cwiseAbs(),
+                        {start.x0 - start.q0 * com, start.q0},
+                        {b.x[i] - b.q[i] * com, b.q[i]}};
     // The static bodies near the centre of mass's path, within its farthest reach: no
     // shape bounds, no slerp, for a body with no static body near.
     const Aabb swept =
@@ -260,13 +266,17 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     SweptPart part;
     for (std::uint32_t p = 0; p < part_count; ++p) {
         if (compound) {
+            // Every point of the part lies within its box's half-extents of the box's centre.
+            const Aabb& local = shape.parts->part_bounds(p);
+            const Real moved = (path.end.apply(local.center()) - path.start.apply(local.center())).norm();
+            const Real twist = modified_cross(path.turn, local.extents()).norm();
+            if (moved + twist < Real(0.5) * thinnest_half_size(shape.parts->shape(p))) continue;
             make_part(shape.parts->shape(p), shape.parts->pose(p), path, part);
         } else {
             make_part(shape, Transform{}, path, part);
         }
-        const Vec3 c0 = path.at(0).apply(part.centre);
-        const Vec3 c1 = path.at(1).apply(part.centre);
-        if (compound && (c1 - c0).norm() + part.twist < Real(0.5) * part.thinnest) continue;
+        const Vec3 c0 = path.start.apply(part.centre);
+        const Vec3 c1 = path.end.apply(part.centre);
         const Real travel = path.moved.norm() + part.swing + target;
         const Aabb part_box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
         for (const std::uint32_t wall : statics) {
