@@ -233,6 +233,20 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     Bodies& b = world.bodies;
     const std::uint32_t i = start.slot;
     const Real target = world.settings.solver.linear_slop;
+    // The static bodies near the centre of mass's path, within its farthest reach: no
+    // shape bounds, no slerp, for a body with no static body near.
+    const Aabb swept =
+        Aabb{start.x0.cwiseMin(b.x[i]), start.x0.cwiseMax(b.x[i])}.fattened(b.extents[i].reach.norm() + target);
+    std::vector<std::uint32_t>& statics = scratch.statics;
+    statics.clear();
+    const BroadphaseState& bp = *world.broadphase;
+    bp.tree.static_tree().query(swept, [&](std::int32_t id) {
+        const auto wall = static_cast<std::uint32_t>(bp.tree.static_tree().user(id));
+        if (!passes_through(world, i, wall)) statics.push_back(wall);
+        return true;
+    });
+    if (statics.empty()) return 1;
+    std::sort(statics.begin(), statics.end());                         // the same order whatever the tree's shape
     const Eigen::AngleAxis<Real> turn(start.q0.conjugate() * b.q[i]);  // the shortest way round
     const Vec3& com = b.local_com[i];
     const BodyPath path{start.x0,
@@ -244,20 +258,6 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
                         (turn.angle() * turn.axis()).cwiseAbs(),
                         {start.x0 - start.q0 * com, start.q0},
                         {b.x[i] - b.q[i] * com, b.q[i]}};
-    // The static bodies near the centre of mass's path, within its farthest reach: no
-    // shape bounds, no slerp, for a body with no static body near.
-    const Aabb swept =
-        Aabb{path.x0.cwiseMin(path.x1), path.x0.cwiseMax(path.x1)}.fattened(b.extents[i].reach.norm() + target);
-    std::vector<std::uint32_t>& statics = scratch.statics;
-    statics.clear();
-    const BroadphaseState& bp = *world.broadphase;
-    bp.tree.static_tree().query(swept, [&](std::int32_t id) {
-        const auto wall = static_cast<std::uint32_t>(bp.tree.static_tree().user(id));
-        if (!passes_through(world, i, wall)) statics.push_back(wall);
-        return true;
-    });
-    if (statics.empty()) return 1;
-    std::sort(statics.begin(), statics.end());  // the same order whatever the tree's shape
 
     const Shape& shape = b.traits[i].shape;
     const bool compound = shape.type == ShapeType::Compound;
