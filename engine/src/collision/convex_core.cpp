@@ -73,6 +73,10 @@ SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com) {
     if (shape.type == ShapeType::Compound) {
         const Compound& parts = *shape.parts;
         for (std::uint32_t i = 0; i < parts.size(); ++i) add_part(parts.shape(i), parts.pose(i), local_com, extent);
+    } else if (shape.type == ShapeType::Box) {
+        // The farthest corner along each axis, without making the corners: a box is most bodies.
+        extent.reach = local_com.cwiseAbs() + shape.half_extents;
+        extent.thinnest = shape.half_extents.minCoeff();
     } else if (is_convex(shape)) {
         add_part(shape, Transform{}, local_com, extent);
     } else {
