@@ -268,9 +268,16 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
         if (compound) {
             // Every point of the part lies within its box's half-extents of the box's centre.
             const Aabb& local = shape.parts->part_bounds(p);
-            const Real moved = (path.end.apply(local.center()) - path.start.apply(local.center())).norm();
+            const Vec3 b0 = path.start.apply(local.center()), b1 = path.end.apply(local.center());
             const Real twist = modified_cross(path.turn, local.extents()).norm();
-            if (moved + twist < Real(0.5) * thinnest_half_size(shape.parts->shape(p))) continue;
+            if ((b1 - b0).norm() + twist < Real(0.5) * thinnest_half_size(shape.parts->shape(p))) continue;
+            // Nor is its core made when its swept box meets no static body.
+            const Vec3 lever = (local.center() - path.local_com).cwiseAbs() + local.extents();
+            const Real reach = local.extents().norm() + path.moved.norm() + modified_cross(path.turn, lever).norm();
+            const Aabb box = Aabb{b0.cwiseMin(b1), b0.cwiseMax(b1)}.fattened(reach + target);
+            if (std::none_of(statics.begin(), statics.end(),
+                             [&](std::uint32_t wall) { return box.overlaps(b.bounds[wall]); }))
+                continue;
             make_part(shape.parts->shape(p), shape.parts->pose(p), path, part);
         } else {
             make_part(shape, Transform{}, path, part);
