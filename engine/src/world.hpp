@@ -24,6 +24,7 @@
 #include "api/joint_targets.hpp"
 #include "api/write_buffer.hpp"
 #include "collision/collide.hpp"
+#include "collision/convex_core.hpp"
 #include "memory/huge_page_vector.hpp"
 #include "solver/motion_locks.hpp"
 #include "stages/contact_index.hpp"
@@ -140,7 +141,11 @@ struct Bodies {
     std::vector<std::uint8_t> locks;      // BodyDesc::locks as bits (solver/motion_locks.hpp)
     std::vector<Vec3> force;              // accumulated, consumed by the next step
     std::vector<Vec3> torque;
-    std::vector<Aabb> bounds;               // tight, world
+    std::vector<Aabb> bounds;  // tight, world
+    // How far the shape reaches along the body's axes and its thinnest half-size, for the
+    // solver's check of whether a step moved the body far enough to be swept (made at
+    // creation and by attach(), so a new shape or motion type remakes it).
+    std::vector<SweepExtent> extents;
     std::vector<std::int32_t> awake_index;  // position in World::awake, kAwakePending, or -1 if static or asleep
     std::vector<Real> sleep_time;
     std::vector<std::int32_t> island;  // sleeping island id, -1 when awake
@@ -169,7 +174,8 @@ struct Bodies {
     static void for_each_slot_array(Self& b, F&& f) {
         f(b.generation), f(b.alive);
         f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local), f(b.inertia_local);
-        f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.awake_index), f(b.sleep_time);
+        f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.extents), f(b.awake_index);
+        f(b.sleep_time);
         f(b.island), f(b.layer), f(b.group), f(b.interpolate), f(b.history_place);
         f(b.traits);
     }
@@ -196,8 +202,13 @@ struct Bodies {
     }
     Vec3 origin(std::uint32_t i) const { return x[i] - q[i] * local_com[i]; }
     Transform transform(std::uint32_t i) const { return {origin(i), q[i]}; }
-    // Whether the Continuous stage sweeps the body: dynamic and flagged fast (neither
-    // changes while the body lives).
+    // extents[i] for the body's shape, motion type and centre of mass as they are now: a
+    // static body is never swept.
+    void remake_extent(std::uint32_t i) {
+        extents[i] = type[i] == MotionType::Static ? SweepExtent{} : sweep_extent(traits[i].shape, local_com[i]);
+    }
+    // Whether the Continuous stage sweeps the body every step: dynamic and flagged fast
+    // (others are swept in the steps that move them far for their size).
     bool is_fast(std::uint32_t i) const { return type[i] == MotionType::Dynamic && traits[i].fast; }
     Mat3 inv_inertia_world(std::uint32_t i) const {
         const Mat3 r = q[i].toRotationMatrix();
@@ -346,11 +357,21 @@ struct SleepingIsland {
     std::vector<JointHandle> joints;  // handles: a joint destroyed while asleep is skipped on waking
 };
 
-// A fast body's pose when the step began, for the swept test after the solver.
+// A body to sweep: its pose when the step began, for the swept test after the solver.
 struct FastStart {
     std::uint32_t slot = 0;
     Vec3 x0 = Vec3::Zero();
     Quat q0 = Quat::Identity();
+};
+
+// One worker's room in the Continuous stage: the static bodies and mesh triangles a sweep
+// meets (kept from its first distance query for the later ones), and the swept tests it
+// counted. A cache line apart from the next worker's.
+struct alignas(64) SweepScratch {
+    std::vector<std::uint32_t> statics;
+    std::vector<std::array<Vec3, 4>> triangles;  // a mesh's, in its frame: the corners, then the unit normal
+    std::vector<Real> heights;                   // a part's height above each triangle's plane
+    std::uint64_t tests = 0;
 };
 
 // A kinematic body's target pose (Space::move_kinematic), for the next step to reach.
@@ -451,11 +472,15 @@ struct World {
     std::vector<std::uint32_t> scratch_lost;
     std::vector<ContactMove> scratch_contact_moves;  // remove_contacts (contact_list.cpp)
     std::vector<std::uint32_t> scratch_moved_awake;  // the same: the moved contacts that are awake
-    std::vector<FastStart> fast_starts;              // continuous.cpp
-    // Live bodies that are fast (create_body, destroy_body): without any, a step skips
-    // the Continuous stage instead of walking the awake bodies to find none.
+    // Bodies to sweep, listed by the solver's FinalizeBodies jobs, one list per worker
+    // (a sweep reads only static bodies and writes only its own, so the lists' order
+    // changes nothing); the Continuous stage runs only when one is not empty.
+    std::vector<std::vector<FastStart>> fast_lists;
+    std::vector<FastStart> fast_starts;  // the lists joined (continuous.cpp)
+    // Live bodies flagged fast (create_body, destroy_body): while there are any, the
+    // narrowphase collides their pairs every step instead of recycling manifolds.
     std::uint32_t fast_bodies = 0;
-    std::vector<std::uint32_t> scratch_candidates;
+    std::vector<SweepScratch> sweep_scratch;     // per worker
     std::vector<KinematicMove> kinematic_moves;  // taken by the next step (stages/body_changes.cpp)
 
     // Islands.

@@ -113,6 +113,7 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     if (desc.type != MotionType::Static) b.hold_history(slot, desc.position, orientation);
     b.traits[slot] = std::move(traits);
     b.bounds[slot] = b.traits[slot].shape.bounds(b.transform(slot));
+    b.remake_extent(slot);
     if (b.is_fast(slot)) w.fast_bodies += 1;
     add_proxy(w, slot);
     if (b.type[slot] != MotionType::Static) set_awake(w, slot, true);

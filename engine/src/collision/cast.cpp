@@ -13,6 +13,7 @@
 
 #include "collision/collide.hpp"
 #include "collision/compound.hpp"
+#include "collision/convex_core.hpp"
 #include "collision/convex_hull.hpp"
 #include "collision/gjk.hpp"
 #include "collision/polyhedron.hpp"
@@ -22,7 +23,6 @@ namespace spindle {
 namespace {
 
 constexpr int kMeshStack = 128;            // the mesh tree's depth bound, as in TriangleMesh::query
-constexpr int kMaxCorePoints = 256;        // ConvexHull keeps at most this many vertices
 constexpr int kMaxSweepSteps = 64;         // conservative advancement steps before giving up
 constexpr Real kRelativeTolerance = 1e-4;  // of the translation's length
 constexpr Real kMaxTolerance = 1e-5;       // m
@@ -242,44 +242,9 @@ bool ray_local(const Shape& shape, const Segment& s, LocalHit& hit) {
 
 // ---- Convex cores --------------------------------------------------------------------
 
-struct Core {
-    std::array<Vec3, kMaxCorePoints> points;
-    int count = 0;
-    Real radius = 0;
-};
-
-bool is_convex(const Shape& shape) {
-    return shape.type == ShapeType::Sphere || shape.type == ShapeType::Capsule || shape.type == ShapeType::Box ||
-           shape.type == ShapeType::ConvexHull;
-}
+using Core = ConvexCore;
 
 bool pose_is_finite(const Transform& x) { return is_finite(x.p) && is_finite(x.q); }
-
-// The core of a convex shape posed by x in the query's frame.
-void make_core(const Shape& shape, const Transform& x, Core& core) {
-    core.radius = round_radius(shape);
-    core.count = 0;
-    switch (shape.type) {
-        case ShapeType::Sphere: core.points[core.count++] = x.p; break;
-        case ShapeType::Capsule:
-            core.points[core.count++] = x.apply(Vec3(0, -shape.half_height, 0));
-            core.points[core.count++] = x.apply(Vec3(0, shape.half_height, 0));
-            break;
-        case ShapeType::Box: {
-            const Vec3& h = shape.half_extents;
-            for (int i = 0; i < 8; ++i) {
-                core.points[core.count++] =
-                    x.apply(Vec3(i & 1 ? h.x() : -h.x(), i & 2 ? h.y() : -h.y(), i & 4 ? h.z() : -h.z()));
-            }
-            break;
-        }
-        case ShapeType::ConvexHull:
-            SPINDLE_ASSERT(shape.hull->vertices().size() <= kMaxCorePoints, "hull has more vertices than a core holds");
-            for (const Vec3& v : shape.hull->vertices()) core.points[core.count++] = x.apply(v);
-            break;
-        default: SPINDLE_ASSERT(false, "make_core: not a convex shape");
-    }
-}
 
 void make_triangle_core(const TriangleMesh& mesh, std::uint32_t t, Core& core) {
     const MeshTriangle& tri = mesh.triangles()[t];
@@ -312,7 +277,7 @@ Real sweep_tolerance(const Vec3& translation) {
 // short of that plane cannot pass through b. The hit's point is on b's surface.
 Sweep sweep_cores(const Core& a, const Vec3& translation, const Core& b, Real tolerance, Real max_fraction,
                   CastHit& hit) {
-    std::array<Vec3, kMaxCorePoints> moved;
+    std::array<Vec3, ConvexCore::kMaxPoints> moved;
     Real t = 0;
     for (int step = 0; step < kMaxSweepSteps; ++step) {
         for (int i = 0; i < a.count; ++i) moved[i] = a.points[i] + t * translation;

@@ -29,6 +29,7 @@ struct alignas(64) SolverBody {
     // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
     // and no rotation lock. Kept here so integrate_positions reads no body description.
     bool gyroscopic = false;
+    std::uint8_t sweep = 0;           // kSweepNever, kSweepWhenFast or kSweepAlways (stages/continuous.hpp)
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
 };
 static_assert(sizeof(SolverBody) == 192 && offsetof(SolverBody, gyroscopic) < 128,

@@ -89,10 +89,11 @@ void detach(World& world, std::uint32_t slot) {
 }
 
 // After: a new proxy (in the tree of its motion type), whose pairs the next broadphase
-// reports as for a created body.
+// reports as for a created body, and the extents the solver's sweep check reads.
 void attach(World& world, std::uint32_t slot) {
     Bodies& b = world.bodies;
     b.bounds[slot] = b.traits[slot].shape.bounds(b.transform(slot));
+    b.remake_extent(slot);  // a new shape, centre of mass or motion type
     add_proxy(world, slot);
     world.changed_now.push_back(slot);
     publish_kind(world, slot);

@@ -19,6 +19,7 @@
 
 #include "solver/speed_limit.hpp"
 #include "stages/capacity.hpp"
+#include "stages/continuous.hpp"
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -78,6 +79,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.locks = b.locks[i];
             const BodyTraits& d = b.traits[i];
             sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
+            sb.sweep = !sb.dynamic || d.sensor ? kSweepNever : d.fast ? kSweepAlways : kSweepWhenFast;
             scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
             sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
             sb.inv_mass = b.inv_mass[i];
@@ -318,14 +320,18 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     plan_body_pass(scratch, Pass::FinalizeBodies, "FinalizeBodies", n);
 }
 
-// The step's motion into the bodies, awake bodies [lo, hi).
-void finalize_bodies(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
+// The step's motion into the bodies, awake bodies [lo, hi); those it moved far for their
+// size (or flagged fast) are listed, with their poses before it, for the Continuous stage.
+void finalize_bodies(World& world, const SolverScratch& scratch, Real dt, std::uint32_t lo, std::uint32_t hi,
+                     std::vector<FastStart>& to_sweep) {
     Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
     for (std::uint32_t k = lo; k < hi; ++k) {
         const std::uint32_t i = world.awake[k];
         const SolverBody& sb = scratch.bodies[k];
+        if (sb.sweep == kSweepAlways || (sb.sweep == kSweepWhenFast && moves_fast(sb, b.extents[i], b.q[i], dt)))
+            to_sweep.push_back({i, b.x[i], b.q[i]});
         b.x[i] += sb.dp;
         b.q[i] = (sb.dq * b.q[i]).normalized();
         // Constraints may push a body past the limits its integration kept: the stored
@@ -345,6 +351,8 @@ void solve(World& world, Real dt) {
     const int substeps = settings.substeps;
     const Real h = dt / substeps;
 
+    world.fast_lists.resize(world.jobs->worker_count());
+    for (std::vector<FastStart>& list : world.fast_lists) list.clear();
     prepare_bodies(world, scratch);
     const bool restitution = list_manifolds(world, scratch);
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
@@ -401,7 +409,7 @@ void solve(World& world, Real dt) {
                 case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
                 case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
                 case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
-                case Pass::FinalizeBodies: finalize_bodies(world, scratch, lo, hi); break;
+                case Pass::FinalizeBodies: finalize_bodies(world, scratch, dt, lo, hi, world.fast_lists[worker]); break;
                 case Pass::IntegrateVelocities:
                     integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
                     break;

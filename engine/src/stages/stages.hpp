@@ -19,9 +19,9 @@ void update_narrowphase(World& world);
 void update_islands(World& world, Real dt);
 // solver.cpp: substeps of integrate velocities, warm start, solve, integrate positions, relax.
 void solve(World& world, Real dt);
-// continuous.cpp: fast bodies swept against static geometry (poses recorded before the
-// solver; step() runs neither while World::fast_bodies is zero).
-void record_fast_starts(World& world);
+// continuous.cpp: the bodies the solver listed in World::fast_lists swept against static
+// geometry (step() runs the stage only when bodies_to_sweep()).
+bool bodies_to_sweep(const World& world);
 void sweep_fast_bodies(World& world);
 // integrator.cpp (called by the solver once per substep, in blocks of the awake
 // bodies [lo, hi); effects used are counted into `counts`).

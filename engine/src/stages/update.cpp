@@ -138,11 +138,11 @@ void step(World& w, Real dt) {
     run_stage(w, Stage::Broadphase, [&] { update_broadphase(w, dt); });
     run_stage(w, Stage::Narrowphase, [&] { update_narrowphase(w); });
     run_stage(w, Stage::Islands, [&] { update_islands(w, dt); });
-    // Fast bodies' poses before the solver moves them; no stage at all in a scene without any.
-    if (w.fast_bodies > 0) run_stage(w, Stage::Continuous, [&] { record_fast_starts(w); });
     run_stage(w, Stage::Solver, [&] { solve(w, dt); });  // substeps integrate velocities and positions
     note_hits(w);  // from the impulses just solved; nothing to do unless a pair reports events
-    if (!w.fast_starts.empty()) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
+    // The bodies the solver found moving far for their size, or flagged fast; no stage at
+    // all in a step without any.
+    if (bodies_to_sweep(w)) run_stage(w, Stage::Continuous, [&] { sweep_fast_bodies(w); });
     if (!w.kinematic_moves.empty()) finish_kinematic_moves(w);  // exactly on target, then at rest
     run_stage(w, Stage::Record, [&] { record(w); });
     w.steps += 1;

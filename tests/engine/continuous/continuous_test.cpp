@@ -1,7 +1,9 @@
-// Continuous collision: a fast-spinning bar flagged `fast` does not sweep through a
-// thin static wall (speculative contacts see only the linear closing speed, so
-// without the swept test it does), and bodies not flagged pay nothing for it: a scene
-// without fast bodies has no Continuous stage at all.
+// Continuous collision: a fast-spinning bar does not sweep through a thin static wall
+// (speculative contacts see only the linear closing speed, so without the swept test it
+// does), flagged `fast` or not: a body is swept in the steps that move some point of it
+// farther than half its thinnest half-size (Box3D's choice), a flagged one in every step.
+// Slow and kinematic bodies pay nothing for it: a step without a body to sweep has no
+// Continuous stage at all.
 #include <spindle/engine/space.hpp>
 #include <spindle/scheduler/work_stealing.hpp>
 
@@ -22,7 +24,7 @@ struct BarRun {
 // A 4 m bar spinning at 60 rad/s about its centre 1 m from a 4 cm wall: within one
 // step its tip turns from x = 0.07 to x = 1.0, through the wall at x = 0.48..0.52.
 // Added to `space` (gravity turned off) after whatever it holds; returns the bar.
-BodyHandle add_bar_and_wall(Space& space, bool fast) {
+BodyDesc bar_at_wall(Space& space) {
     space.set_gravity(Vec3::Zero());
     BodyDesc wall;
     wall.type = MotionType::Static;
@@ -34,8 +36,21 @@ BodyHandle add_bar_and_wall(Space& space, bool fast) {
     bar.position = Vec3(-1, 0, 0);
     bar.orientation = Quat(Eigen::AngleAxisd(2.0, Vec3::UnitZ()));
     bar.angular_velocity = Vec3(0, 0, -60);
+    return bar;
+}
+
+BodyHandle add_bar_and_wall(Space& space, bool fast) {
+    BodyDesc bar = bar_at_wall(space);
     bar.fast = fast;
     return space.create_body(bar);
+}
+
+// One worker, the caller: no threads.
+WorkStealingJobSystem::Options one_worker() {
+    WorkStealingJobSystem::Options options;
+    options.worker_pus = {0};
+    options.pin = false;
+    return options;
 }
 
 // 30 steps of the bar: how far its tips reached, and the sweeps paid for.
@@ -80,10 +95,61 @@ TEST(Continuous, FastSpinningBarStopsAtAThinWall) {
     EXPECT_GT(run.swept_tests, 0u);
 }
 
-TEST(Continuous, WithoutTheFlagTheBarSweepsThroughAndNoSweepIsPaidFor) {
+// Its tip moves 1.0 m a step, twenty times its half-thickness: swept without the flag.
+TEST(Continuous, WithoutTheFlagTheBarIsSweptWhileItSpinsFast) {
     const BarRun run = spin_bar_at_wall(false);
-    EXPECT_GT(run.max_tip_x, 0.52);  // the case the swept test exists for
+    EXPECT_LT(run.max_tip_x, 0.48 + 0.01);
+    EXPECT_GT(run.swept_tests, 0u);
+}
+
+// The same bar kinematic: it is driven, not stopped by what it meets, so never swept.
+TEST(Continuous, AKinematicBarIsNeverSwept) {
+    Space space;
+    const BodyHandle bar = add_bar_and_wall(space, false);
+    space.set_motion_type(bar, MotionType::Kinematic);
+    space.set_angular_velocity(bar, Vec3(0, 0, -60));
+    const BarRun run = spin(space, bar);
+    EXPECT_GT(run.max_tip_x, 0.52);  // through the wall, as a kinematic body may go
     EXPECT_EQ(run.swept_tests, 0u);
+}
+
+// The extents the check reads are remade with the shape (attach()): the bar made as a ball
+// of radius 1, which turning at 10 rad/s moves its points 0.24 m a step, under half its
+// radius (not swept), then given the bar's shape, whose tip moves 0.33 m a step, more than
+// the wall and the bar's thickness together: it would pass through without a sweep.
+TEST(Continuous, TheSweepMeasuresTheShapeSetLast) {
+    Space space;
+    BodyDesc ball = bar_at_wall(space);
+    ball.shape = Shape::sphere(1);
+    ball.angular_velocity = Vec3(0, 0, -10);
+    const BodyHandle bar = space.create_body(ball);
+    space.set_shape(bar, Shape::box(Vec3(2, 0.05, 0.05)));
+    const BarRun run = spin(space, bar);
+    EXPECT_LT(run.max_tip_x, 0.48 + 0.01);
+    EXPECT_GT(run.swept_tests, 0u);
+}
+
+// Boxes stacked on the ground and balls dropped onto it from 2 m (at most 6.3 m/s, 0.1 m
+// a step, under half their half-size): no step sweeps anything.
+TEST(Continuous, SlowBodiesAreNeverSwept) {
+    WorkStealingJobSystem jobs(one_worker());
+    jobs.enable_trace(true);
+    Space space(SpaceSettings{}, &jobs);
+    BodyDesc ground;
+    ground.type = MotionType::Static;
+    ground.shape = Shape::box(Vec3(20, 0.5, 20));
+    ground.position = Vec3(0, -0.5, 0);
+    space.create_body(ground);
+    for (int i = 0; i < 5; ++i) {
+        BodyDesc box;
+        box.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        box.position = Vec3(0, 0.5 + i, 0);
+        space.create_body(box);
+        add_ball(space, Vec3(3.0 + 1.5 * i, 2.5, 0), false);
+    }
+    for (int i = 0; i < 120; ++i) space.update();
+    EXPECT_EQ(space.counters().swept_tests, 0u);
+    EXPECT_EQ(continuous_stages(jobs), 0);
 }
 
 // The stage runs only while fast bodies live (World::fast_bodies): these check that
@@ -113,10 +179,7 @@ TEST(Continuous, AFastBarIsStillSweptAfterOtherBodiesComeAndGo) {
 }
 
 TEST(Continuous, WithoutFastBodiesTheStageDoesNotRun) {
-    WorkStealingJobSystem::Options options;
-    options.worker_pus = {0};  // one worker, the caller: no threads
-    options.pin = false;
-    WorkStealingJobSystem jobs(options);
+    WorkStealingJobSystem jobs(one_worker());
     jobs.enable_trace(true);
     Space space(SpaceSettings{}, &jobs);
     add_ball(space, Vec3(0, 10, 0), false);
@@ -124,8 +187,8 @@ TEST(Continuous, WithoutFastBodiesTheStageDoesNotRun) {
     EXPECT_EQ(continuous_stages(jobs), 0);
     const BodyHandle fast = add_ball(space, Vec3(5, 10, 0), true);
     space.update();
-    EXPECT_EQ(continuous_stages(jobs), 2);  // its pose before the solver, its sweep after
+    EXPECT_EQ(continuous_stages(jobs), 1);  // a flagged body is swept every step
     space.destroy_body(fast);
     for (int i = 0; i < 5; ++i) space.update();
-    EXPECT_EQ(continuous_stages(jobs), 2);
+    EXPECT_EQ(continuous_stages(jobs), 1);
 }
