@@ -77,8 +77,9 @@ TEST(Tipping, ThinPoleFallsInItsPivotTimeWithoutSpinningAboutItsAxis) {
         }
         if (tilt >= lying) down_at = step * dt;
     }
-    std::printf("pole lies down at %.3f s (rod: %.3f s); largest spin about its axis before 75 degrees of tilt: %.3f rad/s\n",
-                down_at, expected, largest_axial);
+    std::printf(
+        "pole lies down at %.3f s (rod: %.3f s); largest spin about its axis before 75 degrees of tilt: %.3f rad/s\n",
+        down_at, expected, largest_axial);
     ASSERT_GT(down_at, 0) << "the pole never came down";
     EXPECT_NEAR(down_at, expected, 0.1 * expected);
     // Until it has tipped 75 degrees, no faster about its axis than the rod's own rate
