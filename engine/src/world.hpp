@@ -137,6 +137,7 @@ struct Bodies {
     std::vector<Real> inv_mass;
     std::vector<Mat3> inv_inertia_local;  // about the centre of mass, body frame
     std::vector<Mat3> inertia_local;      // the same, not inverted (gyroscopic bodies read it)
+    std::vector<std::uint8_t> elongated;  // turns keeping its momentum whatever it asks (BodyMass::elongated)
     std::vector<Vec3> local_com;          // centre of mass in the shape's frame
     std::vector<std::uint8_t> locks;      // BodyDesc::locks as bits (solver/motion_locks.hpp)
     std::vector<Vec3> force;              // accumulated, consumed by the next step
@@ -174,6 +175,7 @@ struct Bodies {
     static void for_each_slot_array(Self& b, F&& f) {
         f(b.generation), f(b.alive);
         f(b.type), f(b.x), f(b.q), f(b.v), f(b.w), f(b.inv_mass), f(b.inv_inertia_local), f(b.inertia_local);
+        f(b.elongated);
         f(b.local_com), f(b.locks), f(b.force), f(b.torque), f(b.bounds), f(b.extents), f(b.awake_index);
         f(b.sleep_time);
         f(b.island), f(b.layer), f(b.group), f(b.interpolate), f(b.history_place);

@@ -102,6 +102,7 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     b.inv_mass[slot] = inv_mass;
     b.inv_inertia_local[slot] = inv_inertia;
     b.inertia_local[slot] = inertia;
+    b.elongated[slot] = mass.elongated ? 1 : 0;
     b.force[slot] = Vec3::Zero();
     b.torque[slot] = Vec3::Zero();
     b.awake_index[slot] = -1;

@@ -26,8 +26,9 @@ struct alignas(64) SolverBody {
     bool dynamic = false;        // only dynamic bodies are written by constraints
     std::uint8_t locks = 0;      // motion lock bits (motion_locks.hpp)
     bool damped = false;         // damps: integrate_velocities reads the description only then
-    // Turns keeping its angular momentum (integrator.cpp): dynamic, BodyDesc::gyroscopic
-    // and no rotation lock. Kept here so integrate_positions reads no body description.
+    // Turns keeping its angular momentum (integrate_velocities): dynamic, BodyDesc::gyroscopic
+    // or elongated (Bodies::elongated), and no rotation lock. Kept here so the integrator
+    // reads no body description.
     bool gyroscopic = false;
     std::uint8_t sweep = 0;           // kSweepNever, kSweepWhenFast or kSweepAlways (stages/continuous.hpp)
     Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes

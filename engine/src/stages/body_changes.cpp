@@ -5,6 +5,8 @@
 
 #include <spindle/platform/error.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +36,9 @@ BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape
     }
     out.inertia = mp.inertia;
     out.local_com = mp.center_of_mass;
+    // Principal inertias, ascending: a compound's inertia need not be diagonal.
+    const Vec3 principal = Eigen::SelfAdjointEigenSolver<Mat3>(mp.inertia, Eigen::EigenvaluesOnly).eigenvalues();
+    out.elongated = principal.z() > kElongatedInertiaRatio * principal.x();
     return out;
 }
 
@@ -76,6 +81,7 @@ void set_mass(World& world, std::uint32_t slot, const BodyMass& mass) {
     b.inv_mass[slot] = mass.inv_mass;
     b.inv_inertia_local[slot] = mass.inv_inertia;
     b.inertia_local[slot] = mass.inertia;
+    b.elongated[slot] = mass.elongated ? 1 : 0;
     b.local_com[slot] = mass.local_com;
     b.x[slot] = origin + b.q[slot] * mass.local_com;
 }

@@ -11,6 +11,14 @@
 
 namespace spindle {
 
+// A dynamic body whose largest principal inertia is more than this many times its
+// smallest is elongated: it always turns keeping its angular momentum (integrator.cpp),
+// as if it set BodyDesc::gyroscopic. Without that, a pole or tree pivoting on its end
+// turns any spin out of its tipping plane into a spin about its long axis that grows
+// without bound, and it falls late (docs/benchmarks.md, h45, session 19). Box3D applies
+// its gyroscopic step to every body; a body this far from a sphere is where it matters.
+inline constexpr Real kElongatedInertiaRatio = 10;
+
 // A body's mass, inertia and centre of mass as create_body computes them: from the
 // shape and the description's density or mass for a dynamic body, none otherwise.
 struct BodyMass {
@@ -18,6 +26,7 @@ struct BodyMass {
     Mat3 inv_inertia = Mat3::Zero();
     Mat3 inertia = Mat3::Zero();
     Vec3 local_com = Vec3::Zero();  // in the shape's frame
+    bool elongated = false;         // kElongatedInertiaRatio
 };
 // Throws spindle::Error ("<who>: the shape has no volume ...") for a shape or mass that
 // gives no finite inverse.

@@ -12,10 +12,12 @@
 namespace spindle {
 namespace {
 
-// A body's world inverse inertia at orientation q.
-Mat3 inverse_inertia_at(const Quat& q, const Mat3& inv_inertia_local) {
+// The spin of angular momentum L at orientation q: L into the body's frame, through the
+// inverse inertia and back (three matrix-vector products, not the world inverse inertia's
+// two matrix products).
+Vec3 spin_at(const Quat& q, const Mat3& inv_inertia_local, const Vec3& momentum) {
     const Mat3 r = q.toRotationMatrix();
-    return r * inv_inertia_local * r.transpose();
+    return r * (inv_inertia_local * (r.transpose() * momentum));
 }
 
 // Gyroscopic motion that keeps angular momentum. Without torque, a body's world angular
@@ -37,7 +39,7 @@ void keep_momentum(SolverBody& sb, const Quat& start, const Mat3& inertia_local,
     const Vec3 momentum = r * (inertia_local * (r.transpose() * sb.w));
     Vec3 mid_spin = sb.w;
     for (int pass = 0; pass < 2; ++pass) {
-        mid_spin = inverse_inertia_at(integrate_rotation(q0, mid_spin, h / 2), inv_inertia_local) * momentum;
+        mid_spin = spin_at(integrate_rotation(q0, mid_spin, h / 2), inv_inertia_local, momentum);
     }
     sb.w = mid_spin;
 }

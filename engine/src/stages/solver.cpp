@@ -78,7 +78,7 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
             sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
             const BodyTraits& d = b.traits[i];
-            sb.gyroscopic = sb.dynamic && d.gyroscopic && (sb.locks & kLockRotation) == 0;
+            sb.gyroscopic = sb.dynamic && (d.gyroscopic || b.elongated[i] != 0) && (sb.locks & kLockRotation) == 0;
             sb.sweep = !sb.dynamic || d.sensor ? kSweepNever : d.fast ? kSweepAlways : kSweepWhenFast;
             scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
             sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);

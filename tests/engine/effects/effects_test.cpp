@@ -45,13 +45,23 @@ SpaceSettings awake() {
 
 }  // namespace
 
-TEST(Effects, GyroscopicTorqueOnlyForBodiesThatAsk) {
+TEST(Effects, GyroscopicTorqueOnlyForBodiesThatAskOrAreElongated) {
     Space space(awake());
     space.set_gravity(Vec3::Zero());
     BodyDesc d;
-    d.shape = Shape::box(Vec3(0.5, 0.2, 0.1));
+    d.shape = Shape::box(Vec3(0.5, 0.2, 0.1));  // principal inertias 0.05 : 0.26 : 0.29
     d.angular_velocity = Vec3(0.1, 5, 0.1);
     space.create_body(d);
+    // Elongated (inertias 0.005 : 1.0025 : 1.0025), but not free to turn, or not dynamic.
+    BodyDesc pole = d;
+    pole.shape = Shape::box(Vec3(1, 0.05, 0.05));
+    pole.position = Vec3(0, 5, 0);
+    pole.locks.rotation_x = true;
+    space.create_body(pole);
+    pole.locks = MotionLocks{};
+    pole.position = Vec3(0, -5, 0);
+    pole.type = MotionType::Kinematic;
+    space.create_body(pole);
     for (int i = 0; i < 10; ++i) space.update();
     EXPECT_EQ(space.counters().gyroscopic_applied, 0u);
     d.position = Vec3(5, 0, 0);
@@ -59,6 +69,12 @@ TEST(Effects, GyroscopicTorqueOnlyForBodiesThatAsk) {
     space.create_body(d);
     for (int i = 0; i < 10; ++i) space.update();
     EXPECT_EQ(space.counters().gyroscopic_applied, 10u * 4u);  // one body, 4 substeps
+    // A dynamic elongated body turns keeping its momentum without asking.
+    pole.type = MotionType::Dynamic;
+    pole.position = Vec3(-5, 0, 0);
+    space.create_body(pole);
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(space.counters().gyroscopic_applied, 10u * 4u + 10u * 4u * 2u);  // and now two bodies
 }
 
 TEST(Effects, GravityScaleZeroSkipsGravity) {

@@ -91,6 +91,10 @@ struct BodyDesc {
     Real angular_damping = 0;  // 1/s; 0 costs nothing
     // Gyroscopic motion: a spinning asymmetric body precesses and flips, keeping its
     // angular momentum (not for a body with a rotation lock: it turns as any other).
+    // An elongated dynamic body (its largest principal inertia over 10 times its
+    // smallest: a pole, a tree, a thin limb) always moves so, whatever this says: without
+    // it, such a body tipping over on its end turns into a fast, growing spin about its
+    // long axis and falls late. For others it costs some time a body each substep.
     bool gyroscopic = false;
     MotionLocks locks;  // nothing locked by default; for dynamic and kinematic bodies
     bool allow_interpolation = true;
