@@ -41,6 +41,12 @@ struct BodyPath {
     }
 };
 
+// The box of the segment from a to b, fattened by margin: what a point within margin of
+// something moving from a to b can touch.
+Aabb segment_box(const Vec3& a, const Vec3& b, Real margin) {
+    return Aabb{a.cwiseMin(b), a.cwiseMax(b)}.fattened(margin);
+}
+
 // A convex part of the body (or its whole convex shape) as a core in the body's shape frame.
 struct SweptPart {
     ConvexCore core;
@@ -149,7 +155,7 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
     const Vec3 c0 = to_mesh.apply(path.start.apply(part.centre));
     const Vec3 c1 = to_mesh.apply(path.end.apply(part.centre));
     const Real travel = path.moved.norm() + part.swing + target;
-    const Aabb box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
+    const Aabb box = segment_box(c0, c1, part.half_size + travel);
     std::vector<std::array<Vec3, 4>>& triangles = scratch.triangles;
     triangles.clear();
     mesh.query(box, [&](std::uint32_t t) {
@@ -235,8 +241,7 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     const Real target = world.settings.solver.linear_slop;
     // The static bodies near the centre of mass's path, within its farthest reach: no
     // shape bounds, no slerp, for a body with no static body near.
-    const Aabb swept =
-        Aabb{start.x0.cwiseMin(b.x[i]), start.x0.cwiseMax(b.x[i])}.fattened(b.extents[i].reach.norm() + target);
+    const Aabb swept = segment_box(start.x0, b.x[i], b.extents[i].reach.norm() + target);
     std::vector<std::uint32_t>& statics = scratch.statics;
     statics.clear();
     const BroadphaseState& bp = *world.broadphase;
@@ -274,7 +279,7 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
             // Nor is its core made when its swept box meets no static body.
             const Vec3 lever = (local.center() - path.local_com).cwiseAbs() + local.extents();
             const Real reach = local.extents().norm() + path.moved.norm() + modified_cross(path.turn, lever).norm();
-            const Aabb box = Aabb{b0.cwiseMin(b1), b0.cwiseMax(b1)}.fattened(reach + target);
+            const Aabb box = segment_box(b0, b1, reach + target);
             if (std::none_of(statics.begin(), statics.end(),
                              [&](std::uint32_t wall) { return box.overlaps(b.bounds[wall]); }))
                 continue;
@@ -285,7 +290,7 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
         const Vec3 c0 = path.start.apply(part.centre);
         const Vec3 c1 = path.end.apply(part.centre);
         const Real travel = path.moved.norm() + part.swing + target;
-        const Aabb part_box = Aabb{c0.cwiseMin(c1), c0.cwiseMax(c1)}.fattened(part.half_size + travel);
+        const Aabb part_box = segment_box(c0, c1, part.half_size + travel);
         for (const std::uint32_t wall : statics) {
             if (!part_box.overlaps(b.bounds[wall])) continue;
             first = sweep_against(path, part, b.traits[wall].shape, b.transform(wall), target, first, scratch);
