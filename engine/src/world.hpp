@@ -3,8 +3,10 @@
 // only the update thread touches it, and stages split work through the JobSystem.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -68,7 +70,7 @@ consteval std::size_t field_count() {
 struct BodyTraits {
     MotionType type = MotionType::Dynamic;
     Shape shape;  // empty in a free slot: its geometry is let go
-    Real density = 0, mass = 0, friction = 0, restitution = 0, gravity_scale = 0;
+    Real density = 0, mass = 0, friction = 0, restitution = 0, rolling_resistance = 0, gravity_scale = 0;
     Real linear_damping = 0, angular_damping = 0;
     bool gyroscopic = false;
     MotionLocks locks;
@@ -85,6 +87,7 @@ struct BodyTraits {
           mass(d.mass),
           friction(d.friction),
           restitution(d.restitution),
+          rolling_resistance(d.rolling_resistance),
           gravity_scale(d.gravity_scale),
           linear_damping(d.linear_damping),
           angular_damping(d.angular_damping),
@@ -105,6 +108,7 @@ struct BodyTraits {
         d.type = type, d.shape = shape, d.position = position, d.orientation = orientation;
         d.linear_velocity = linear_velocity, d.angular_velocity = angular_velocity;
         d.density = density, d.mass = mass, d.friction = friction, d.restitution = restitution;
+        d.rolling_resistance = rolling_resistance;
         d.gravity_scale = gravity_scale, d.linear_damping = linear_damping, d.angular_damping = angular_damping;
         d.gyroscopic = gyroscopic, d.locks = locks, d.allow_interpolation = allow_interpolation;
         d.allow_sleep = allow_sleep, d.fast = fast, d.layer = layer, d.group = group;
@@ -112,9 +116,9 @@ struct BodyTraits {
         return d;
     }
 };
-// BodyTraits' 19 fields and the pose and velocities (4): a field added to BodyDesc and not
+// BodyTraits' 20 fields and the pose and velocities (4): a field added to BodyDesc and not
 // here would be lost by every body made (the round-trip test only sets the fields it knows).
-static_assert(detail::field_count<BodyDesc>() == 19 + 4,
+static_assert(detail::field_count<BodyDesc>() == 20 + 4,
               "BodyDesc's fields changed: carry the new one in BodyTraits (both conversions, the round-trip test), "
               "then count it here");
 
@@ -247,6 +251,9 @@ struct ContactManifold {
     // central friction): the twist impulse about the normal, and (below) the tangential
     // impulse there (world, in the contact plane), kept for warm starting.
     float twist_impulse = 0;
+    // Rolling resistance's angular impulse (world), kept for warm starting; zero unless the
+    // contact has rolling resistance.
+    float rolling_impulse[3] = {};
     // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
     // when collided, so that recycling and the solver stay off the cold descriptions.
     Real radius_a = 0, radius_b = 0;
@@ -284,6 +291,9 @@ struct Contact {
     // rotations and centres of mass): while the bodies stay close to them the manifolds
     // are recycled, not collided again (narrowphase.cpp).
     bool cached : 1 = false;
+    // The larger of the bodies' BodyDesc::rolling_resistance (0: the solver adds no rolling
+    // row); in the record's padding before the quaternions, so it costs no bytes.
+    float rolling_resistance = 0;
     Quat cached_qa = Quat::Identity(), cached_qb = Quat::Identity();
     // A point's anchors (Box3D's) are its offsets from the centres of mass, world axes: they
     // stay attached to their bodies while the manifolds are recycled, and the solver pushes
@@ -309,6 +319,15 @@ struct Contact {
         return *extra;
     }
 };
+
+// A contact's material from its bodies' (when made, and when a body's changes): geometric
+// mean friction and the larger restitution, as most engines; the larger rolling
+// resistance, as Box3D.
+inline void mix_materials(const BodyTraits& a, const BodyTraits& b, Contact& contact) {
+    contact.friction = std::sqrt(a.friction * b.friction);
+    contact.restitution = std::max(a.restitution, b.restitution);
+    contact.rolling_resistance = static_cast<float>(std::max(a.rolling_resistance, b.rolling_resistance));
+}
 
 // A contact moved to a removed one's place (remove_contacts).
 struct ContactMove {
@@ -342,6 +361,7 @@ struct alignas(64) EffectCounts {
     std::uint64_t gravity = 0, damping = 0, gyro = 0;  // body-substeps (integrator.cpp)
     std::uint64_t contact_points = 0;                  // point-passes of the normal rows
     std::uint64_t friction = 0;                        // manifold-passes of the central friction rows
+    std::uint64_t rolling = 0;                         // manifold-passes of the rolling resistance rows
     std::uint64_t restitution = 0;                     // points checked for a bounce
     std::uint64_t joints = 0;                          // joint-passes
 };

@@ -173,6 +173,7 @@ const std::vector<std::string_view>& body_property_keys() {
                                                        "mass",
                                                        "friction",
                                                        "restitution",
+                                                       "rolling_resistance",
                                                        "gravity_scale",
                                                        "linear_damping",
                                                        "angular_damping",
@@ -214,6 +215,8 @@ bool apply_body_key(const TomlReader& r, std::string_view key, const toml::node&
     } else if (key == "restitution") {
         d.restitution = r.non_negative(value, what);
         if (d.restitution > 1) r.fail(value, what + ": expected a number in [0, 1], got " + show(d.restitution));
+    } else if (key == "rolling_resistance") {
+        d.rolling_resistance = r.non_negative(value, what);
     } else if (key == "gravity_scale") {
         d.gravity_scale = r.number(value, what);
     } else if (key == "linear_damping") {

@@ -40,14 +40,15 @@ def main():
     print(f"""# Box3D's benchmark "trees100" (shared/benchmarks.c, CreateTrees with scale 1; Box3D 30c67b5):
 # {TREES} trees, each one dynamic body of {SEGMENTS} stacked six-sided cylinder hulls (b3CreateCylinder, radius
 # 0.75 shrinking by 0.95 a segment, each 1.5 m plus two radii tall; Box3D's float32 points), standing
-# at (0, 1, z) for z = -70, -67, ..., 77, density 1, friction 0.9, each spun about z at
-# (0.5 + 0.5 i / {TREES}) x 0.5 rad/s, alternating in sign (starting with -), its centre of mass moving
+# at (0, 1, z) for z = -70, -67, ..., 77, density 1, friction 0.9, rolling resistance 0.05 (Box3D's
+# material), each spun about z at (0.5 + 0.5 i / {TREES}) x 0.5 rad/s, alternating in sign (starting with -), its centre of mass moving
 # at omega x (centre - origin) as Box3D sets it; on a static wave mesh of {X_CELLS} x {Z_CELLS} cells of
 # {CELL:g} m, heights {AMPLITUDE:g} sin(2 pi {COLUMN_HZ:g} ix) sin(2 pi {ROW_HZ:g} iz) at vertex (ix, iz) counted from the
 # (-75, -100) corner, that is {-AMPLITUDE:g} sin(2 pi x / {1 / COLUMN_HZ:g}) sin(2 pi z / {1 / ROW_HZ:g}) about the centre; gravity -10 (Box3D's);
 # sleeping on (Box3D's default) with the trees' sleep threshold of 0.2 m/s.
 # Differs in: Box3D's tree is a body with 22 hull shapes; here one compound body of 22 hull
-# parts. Box3D gives the trees rolling resistance 0.05: Spindle has none. Box3D's sleep
+# parts, so each manifold (a part against the mesh) takes its part's rolling radius, as each of
+# Box3D's hull shapes has its own contact. Box3D's sleep
 # threshold is per body; here it is the space's (only the trees are dynamic). The terrain is a
 # generated heightfield: its heights use libm's sine where Box3D's use its float32
 # approximation (b3ComputeCosSin), and each cell is split along the other diagonal (Box3D's
@@ -66,7 +67,7 @@ friction = 0.6  # Box3D's default: only the trees have 0.9
 shape = {{ heightfield = {{ size = [{X_CELLS * CELL:g}, {Z_CELLS * CELL:g}], cells = [{X_CELLS}, {Z_CELLS}], amplitude = {-AMPLITUDE:g}, wavelength = [{1 / COLUMN_HZ:g}, {1 / ROW_HZ:g}] }} }}
 """)
     compound = "{ compound = [\n" + "".join(f"  {{ shape = {b.hull(p)} }},\n" for p, _, _ in parts) + "] }"
-    print(f"[defaults]\ndensity = 1\nfriction = 0.9\nshape = {compound}\n")
+    print(f"[defaults]\ndensity = 1\nfriction = 0.9\nrolling_resistance = 0.05\nshape = {compound}\n")
     z = -70.0
     omega = -0.5
     for i in range(TREES):

@@ -60,6 +60,11 @@ void Space::set_restitution(BodyHandle body, Real restitution) {
     push_scalar(*m_world, body, WriteKind::Restitution, restitution, "set_restitution");
 }
 
+void Space::set_rolling_resistance(BodyHandle body, Real rolling_resistance) {
+    check_non_negative(rolling_resistance, "set_rolling_resistance", "rolling_resistance");
+    push_scalar(*m_world, body, WriteKind::RollingResistance, rolling_resistance, "set_rolling_resistance");
+}
+
 void Space::set_gravity_scale(BodyHandle body, Real scale) {
     check_finite(scale, "set_gravity_scale", "gravity_scale");
     push_scalar(*m_world, body, WriteKind::GravityScale, scale, "set_gravity_scale");

@@ -177,6 +177,7 @@ void validate(const BodyDesc& d) {
     }
     check_non_negative(d.friction, who, "friction");
     check_non_negative(d.restitution, who, "restitution");
+    check_non_negative(d.rolling_resistance, who, "rolling_resistance");
     check_finite(d.gravity_scale, who, "gravity_scale");
     check_non_negative(d.linear_damping, who, "linear_damping");
     check_non_negative(d.angular_damping, who, "angular_damping");

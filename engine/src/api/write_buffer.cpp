@@ -72,6 +72,10 @@ void merge(PendingWrites& entry, const BufferedWrite& write) {
             entry.restitution = write.scalar;
             entry.bits |= kPendingRestitution;
             break;
+        case WriteKind::RollingResistance:
+            entry.rolling_resistance = write.scalar;
+            entry.bits |= kPendingRollingResistance;
+            break;
         case WriteKind::GravityScale:
             entry.gravity_scale = write.scalar;
             entry.bits |= kPendingGravityScale;

@@ -34,6 +34,7 @@ enum class WriteKind : std::uint8_t {
     // Changes after creation (api/body_setters.cpp): each replaces the last of its kind.
     Friction,
     Restitution,
+    RollingResistance,
     GravityScale,
     Damping,  // linear and angular
     MotionType,
@@ -53,7 +54,8 @@ struct BufferedWrite {
     Quat rotation = Quat::Identity();    // orientation
     MotionState state;                   // motion state
     std::uint32_t layer = 0, group = 0;  // collision filter
-    Real scalar = 0, scalar2 = 0;        // friction, restitution, gravity scale, damping (linear, angular)
+    Real scalar = 0,
+         scalar2 = 0;  // friction, restitution, rolling resistance, gravity scale, damping (linear, angular)
     std::uint64_t user_data = 0;
     spindle::MotionType motion_type = spindle::MotionType::Dynamic;
     bool keep_mass = false;
@@ -82,6 +84,7 @@ enum PendingBits : std::uint32_t {
     kPendingKinematicMove = 1U << 17U,
     kPendingForceAt = 1U << 18U,
     kPendingImpulseAt = 1U << 19U,
+    kPendingRollingResistance = 1U << 20U,
     kPendingPose = kPendingPosition | kPendingOrientation,
     kPendingVelocity = kPendingLinearVelocity | kPendingAngularVelocity,
 };
@@ -104,7 +107,7 @@ struct PendingWrites {
     Vec3 angular_impulse = Vec3::Zero();
     std::uint32_t layer = 0, group = 0;  // valid where kPendingFilter is set
     // Changes after creation, each valid where its bit is set.
-    Real friction = 0, restitution = 0, gravity_scale = 1;
+    Real friction = 0, restitution = 0, rolling_resistance = 0, gravity_scale = 1;
     Real linear_damping = 0, angular_damping = 0;
     spindle::MotionType motion_type = spindle::MotionType::Dynamic;
     bool keep_mass = false;

@@ -60,6 +60,17 @@ struct WidePoint {
     Wide normal_impulse{};
 };
 
+// Rolling resistance of a WideContact's lanes (Box3D's): an angular impulse against the
+// bodies' relative spin, within the cap x the manifold's normal impulse. Kept apart from the
+// wide contacts (one per wide contact, SolverScratch::rolling) and written only for those
+// whose `rolls` is set: the passes of a scene without it stream none of these bytes.
+struct WideRolling {
+    Wide cap{};                             // per unit normal impulse: the mixed coefficient x the rolling radius
+    WideSym3 mass;                          // (Ia^-1 + Ib^-1)^-1, world
+    WideSym3 inv_inertia_a, inv_inertia_b;  // world, fixed for the step
+    Wide3 impulse;                          // accumulated; B gets it, A its opposite
+};
+
 // An awake joint as listed for the step: what its colour and packing depend on.
 struct JointRef {
     std::uint32_t joint = 0;     // slot in world.joints
@@ -88,6 +99,10 @@ struct WideContact {
     // A lane bounces (restitution) or reports hits (kContactReports): the passes keep
     // the points' largest pushes and approach speeds (below). Else nothing reads them.
     bool tracks_push = false;
+    // A lane's contact has rolling resistance: its rows are in `rolling` (set with it by
+    // prepare_wide), which no pass reads otherwise.
+    bool rolls = false;
+    WideRolling* rolling = nullptr;  // this wide contact's in SolverScratch::rolling, where it rolls
     Wide3 normal, tangent[2];
     Wide inv_mass_a{}, inv_mass_b{};
     Wide friction{};
@@ -289,6 +304,7 @@ struct SolverScratch {
     // writes their lanes, prepare_wide every other field).
     RawRoomVector<WideContact> wide;
     RawRoomVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (push_out, before read)
+    RawRoomVector<WideRolling> rolling;  // one per wide contact: written by prepare_wide where it rolls, else unread
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed

@@ -16,8 +16,11 @@
 #include <cstddef>
 #include <type_traits>
 
+#include "collision/compound.hpp"
+#include "collision/convex_hull.hpp"
 #include "solver/body_lanes.hpp"
 #include "solver/constraints.hpp"
+#include "solver/joint_rows.hpp"
 #include "stages/capacity.hpp"
 #include "stages/stages.hpp"
 
@@ -187,6 +190,41 @@ void prepare_friction(const SolverBody& A, const SolverBody& B, const Contact& c
     wc.twist_impulse[l] = m.twist_impulse;
 }
 
+// The reach of a shape's rolling resistance (Box3D's): a sphere's or capsule's radius, a
+// quarter of a box's or hull's inner radius (the flat faces already resist rolling); none
+// for a plane or mesh, which only the other shape rolls on.
+Real rolling_radius(const Shape& shape) {
+    switch (shape.type) {
+        case ShapeType::Sphere:
+        case ShapeType::Capsule: return shape.radius;
+        case ShapeType::Box: return Real(0.25) * shape.half_extents.minCoeff();
+        case ShapeType::ConvexHull: return Real(0.25) * shape.hull->inner_radius();
+        default: return 0;
+    }
+}
+
+// Lane l's rolling row, where its contact has rolling resistance (Box3D's, per shape pair:
+// here per manifold, so a compound's parts each brake with their own radius and normal
+// impulse). The first rolling lane clears `rolling`, the wide contact's, and points it there.
+void prepare_rolling(const World& world, const Contact& contact, const ContactManifold& m, const SolverBody& A,
+                     const SolverBody& B, WideContact& wc, WideRolling& rolling, int l) {
+    const Bodies& b = world.bodies;
+    const Real radius = std::max(rolling_radius(part_shape(b.traits[contact.body_a].shape, m.part_a)),
+                                 rolling_radius(part_shape(b.traits[contact.body_b].shape, m.part_b)));
+    const Real cap = contact.rolling_resistance * radius;
+    if (!(cap > 0)) return;
+    if (!wc.rolls) {
+        rolling = WideRolling{};
+        wc.rolling = &rolling;
+        wc.rolls = true;
+    }
+    rolling.cap[l] = static_cast<float>(cap);
+    rolling.mass.set_lane(l, inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B)));
+    rolling.inv_inertia_a.set_lane(l, A.inv_inertia);
+    rolling.inv_inertia_b.set_lane(l, B.inv_inertia);
+    rolling.impulse.set_lane(l, Vec3(m.rolling_impulse[0], m.rolling_impulse[1], m.rolling_impulse[2]));
+}
+
 // The body, or (scale != 1) a copy of it in `copy` with its inverse mass and inertia scaled.
 const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
     if (scale == 1) return body;
@@ -198,7 +236,9 @@ const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
 
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
-void prepare_wide(const World& world, const SolverScratch& scratch, const ContactSolveParams& params, WideContact& wc) {
+// `rolling`: the wide contact's rolling rows, written only where a lane rolls.
+void prepare_wide(const World& world, const SolverScratch& scratch, const ContactSolveParams& params, WideContact& wc,
+                  WideRolling& rolling) {
     const Bodies& b = world.bodies;
     const Vec3 g = world.settings.gravity;
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
@@ -212,6 +252,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.locked = false;
     wc.tracks_push = false;
+    wc.rolls = false;
     wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
     wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
@@ -261,6 +302,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             ++wc.slot_points[j];
         }
         prepare_friction(A, B, contact, m, tangent, friction_distance, wc, l);
+        if (contact.rolling_resistance > 0) prepare_rolling(world, contact, m, A, B, wc, rolling, l);
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());
@@ -320,6 +362,10 @@ void pack_contacts(JobSystem& jobs, SolverScratch& scratch) {
     map_room(jobs, scratch.push_anchors, std::size_t{count} * kLanes);
     scratch.push_anchors.resize(std::size_t{count} * kLanes);
     if (far_above_use(scratch.push_anchors.capacity(), std::size_t{count} * kLanes)) fit_capacity(scratch.push_anchors);
+    // Not mapped ahead: most scenes never write it, and its pages stay untouched.
+    reserve_for(scratch.rolling, count);
+    scratch.rolling.resize(count);
+    if (far_above_use(scratch.rolling.capacity(), count)) fit_capacity(scratch.rolling);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     jobs.parallel_for("PackContacts", 0, count, kPackGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         int c = 0;
@@ -381,6 +427,21 @@ void push_out(WideContact& wc, PushAnchors& anchors, int lane, SolverBody* bodie
     apply_row(Am, Bm, push, normal, row, Real(total) - Real(impulse));
     impulse = total;
     store_push(A, B, push_a, push_b, push);
+}
+
+// Rolling resistance (Box3D's): the angular impulse that stops the relative spin, kept
+// within the cap x the manifold's normal impulse. A lane without it has a zero cap, so
+// its impulse stays zero.
+inline void solve_rolling(WideRolling& r, WideVelocities& s, Wide pressed) {
+    const Wide3 old = r.impulse;
+    const Wide3 wanted = old - r.mass * (s.wb - s.wa);
+    const Wide limit = r.cap * pressed;
+    const Wide length_sq = dot(wanted, wanted);
+    const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), splat(1));
+    r.impulse = scale * wanted;
+    const Wide3 delta = r.impulse - old;
+    s.wa -= r.inv_inertia_a * delta;
+    s.wb += r.inv_inertia_b * delta;
 }
 
 template <bool kBias, bool kLocked>
@@ -460,8 +521,10 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     // pushed against, and a 100 kg box on a 1 kg cube rocked for ever instead of resting.
     // Its cones scale with the normal impulses of the touching points only: a speculative
     // point far from the body (a fast sphere's, metres ahead) would spin it up through
-    // the lever arm.
-    if (!kBias && any(wc.friction > zero)) {
+    // the lever arm. Rolling resistance (where a lane has it) goes first, as Box3D's, within
+    // the same touching impulse.
+    const bool rubs = any(wc.friction > zero);
+    if (!kBias && (rubs || wc.rolls)) {
         const Wide slop = splat(params.slop);
         Wide pressed = zero, twist_reach = zero;
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
@@ -469,33 +532,39 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             pressed += touching_impulse;
             twist_reach += wc.points[j].lever_arm * touching_impulse;
         }
-        counts.friction += static_cast<std::uint64_t>(wc.lanes);
-        // Twist about the normal, within friction x the normal impulses' moments.
-        {
-            const Wide speed = dot(wc.normal, s.wb - s.wa);
-            const Wide limit = wc.friction * twist_reach;
-            const Wide old = wc.twist_impulse;
-            const Wide total = wide_min(wide_max(old - wc.twist_mass * speed, -limit), limit);
-            wc.twist_impulse = total;
-            apply_angular_row(s, wc.twist_row, total - old);
+        if (wc.rolls) {
+            counts.rolling += static_cast<std::uint64_t>(wc.lanes);
+            solve_rolling(*wc.rolling, s, pressed);
         }
-        // The two tangent rows at the centre, solved together by their 2x2 mass, within
-        // Coulomb's cone of friction x the total normal impulse.
-        const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
-        const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
-        const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
-        const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
-        Wide new0 = old0 - (m00 * v0 + m01 * v1);
-        Wide new1 = old1 - (m01 * v0 + m11 * v1);
-        const Wide limit = wc.friction * pressed;
-        const Wide length_sq = new0 * new0 + new1 * new1;
-        const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), one);
-        new0 *= scale;
-        new1 *= scale;
-        wc.friction_impulse[0] = new0;
-        wc.friction_impulse[1] = new1;
-        apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], new0 - old0);
-        apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], new1 - old1);
+        if (rubs) {
+            counts.friction += static_cast<std::uint64_t>(wc.lanes);
+            // Twist about the normal, within friction x the normal impulses' moments.
+            {
+                const Wide speed = dot(wc.normal, s.wb - s.wa);
+                const Wide limit = wc.friction * twist_reach;
+                const Wide old = wc.twist_impulse;
+                const Wide total = wide_min(wide_max(old - wc.twist_mass * speed, -limit), limit);
+                wc.twist_impulse = total;
+                apply_angular_row(s, wc.twist_row, total - old);
+            }
+            // The two tangent rows at the centre, solved together by their 2x2 mass, within
+            // Coulomb's cone of friction x the total normal impulse.
+            const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
+            const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
+            const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
+            const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
+            Wide new0 = old0 - (m00 * v0 + m01 * v1);
+            Wide new1 = old1 - (m01 * v0 + m11 * v1);
+            const Wide limit = wc.friction * pressed;
+            const Wide length_sq = new0 * new0 + new1 * new1;
+            const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), one);
+            new0 *= scale;
+            new1 *= scale;
+            wc.friction_impulse[0] = new0;
+            wc.friction_impulse[1] = new1;
+            apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], new0 - old0);
+            apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], new1 - old1);
+        }
     }
     scatter(wc, bodies, s);
     if constexpr (kBias) {
@@ -520,6 +589,11 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
         apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], wc.friction_impulse[0]);
         apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], wc.friction_impulse[1]);
         apply_angular_row(s, wc.twist_row, wc.twist_impulse);
+    }
+    if (wc.rolls) {
+        const WideRolling& r = *wc.rolling;
+        s.wa -= r.inv_inertia_a * r.impulse;
+        s.wb += r.inv_inertia_b * r.impulse;
     }
     scatter(wc, bodies, s);
     for (int l = 0; l < kLanes; ++l) {
@@ -575,7 +649,7 @@ void prepare_contacts(const World& world, SolverScratch& scratch, const ContactS
                       std::uint32_t hi) {
     for (std::uint32_t k = lo; k < hi; ++k) {
         if (k + 1 < hi) prefetch_contacts(world, scratch, scratch.wide[k + 1]);
-        prepare_wide(world, scratch, params, scratch.wide[k]);
+        prepare_wide(world, scratch, params, scratch.wide[k], scratch.rolling[k]);
     }
 }
 
@@ -628,6 +702,14 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
                     m.pushed_speed = approach;
                 }
             }
+        }
+        if (!wc.rolls) continue;
+        for (int l = 0; l < wc.lanes; ++l) {
+            const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
+            ContactManifold& m = world.contacts[ref.contact].manifold_at(static_cast<int>(ref.manifold));
+            m.rolling_impulse[0] = wc.rolling->impulse.x[l];
+            m.rolling_impulse[1] = wc.rolling->impulse.y[l];
+            m.rolling_impulse[2] = wc.rolling->impulse.z[l];
         }
     }
 }

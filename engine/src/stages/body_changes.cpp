@@ -48,11 +48,7 @@ void recombine_materials(World& world, std::span<const std::uint32_t> slots) {
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         Contact& contact = world.contacts[c];
         if (!changed(contact.body_a) && !changed(contact.body_b)) continue;
-        // The mixing rules of create_contacts (contact_list.cpp).
-        const BodyTraits& da = b.traits[contact.body_a];
-        const BodyTraits& db = b.traits[contact.body_b];
-        contact.friction = std::sqrt(da.friction * db.friction);
-        contact.restitution = std::max(da.restitution, db.restitution);
+        mix_materials(b.traits[contact.body_a], b.traits[contact.body_b], contact);
         world.contact_summaries[c] = contact_summary(contact);  // its restitution bit
     }
 }
@@ -166,8 +162,9 @@ bool change_shape(World& world, std::uint32_t slot, const Shape& shape, bool kee
 }
 
 int apply_body_changes(World& world, const PendingWrites& write, std::vector<std::uint32_t>& rematerialed) {
-    constexpr std::uint32_t kChanges = kPendingMotionType | kPendingShape | kPendingFriction | kPendingRestitution |
-                                       kPendingGravityScale | kPendingDamping | kPendingUserData;
+    constexpr std::uint32_t kMaterial = kPendingFriction | kPendingRestitution | kPendingRollingResistance;
+    constexpr std::uint32_t kChanges = kPendingMotionType | kPendingShape | kMaterial | kPendingGravityScale |
+                                       kPendingDamping | kPendingUserData;
     if ((write.bits & kChanges) == 0) return 0;
     Bodies& b = world.bodies;
     const std::uint32_t i = write.body.index;
@@ -179,9 +176,10 @@ int apply_body_changes(World& world, const PendingWrites& write, std::vector<std
         const bool fits = !write.shape.static_only() || b.type[i] == MotionType::Static;
         if (!fits || !change_shape(world, i, write.shape, write.keep_mass)) rejected += 1;
     }
-    if ((write.bits & (kPendingFriction | kPendingRestitution)) != 0) {
+    if ((write.bits & kMaterial) != 0) {
         if ((write.bits & kPendingFriction) != 0) traits.friction = write.friction;
         if ((write.bits & kPendingRestitution) != 0) traits.restitution = write.restitution;
+        if ((write.bits & kPendingRollingResistance) != 0) traits.rolling_resistance = write.rolling_resistance;
         rematerialed.push_back(i);
         // What rests on a static body slides or bounces differently now (a moving body is
         // woken with its island by ApplyWrites).

@@ -32,7 +32,7 @@ struct BodyMass {
 // gives no finite inverse.
 BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape, const char* who);
 
-// These bodies' friction or restitution changed (descriptions already set; slots
+// These bodies' friction, restitution or rolling resistance changed (descriptions already set; slots
 // ascending): every contact of theirs takes the combined values again. One pass over the
 // contacts for all of them.
 void recombine_materials(World& world, std::span<const std::uint32_t> slots);
@@ -46,7 +46,7 @@ bool change_shape(World& world, std::uint32_t slot, const Shape& shape, bool kee
 
 // The changes after creation in one body's pending writes (motion type, then shape,
 // material, gravity scale, damping, user data), before its pose and velocities are
-// applied. Bodies whose friction or restitution changed are added to `rematerialed`, for
+// applied. Bodies whose material (friction, restitution, rolling resistance) changed are added to `rematerialed`, for
 // recombine_materials once all are applied. Returns the writes rejected (a motion type or
 // shape whose mass would not be finite; a kinematic move of a body not kinematic).
 int apply_body_changes(World& world, const PendingWrites& write, std::vector<std::uint32_t>& rematerialed);

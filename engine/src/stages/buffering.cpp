@@ -72,7 +72,7 @@ void apply_writes(World& world) {
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
     std::vector<std::uint32_t> refiltered;    // bodies whose filter changed (rare: no allocation otherwise)
-    std::vector<std::uint32_t> rematerialed;  // bodies whose friction or restitution changed (as rare)
+    std::vector<std::uint32_t> rematerialed;  // bodies whose material changed (as rare)
     for (const PendingWrites& write : world.drained) {
         if (!b.is_live(write.body)) {
             world.stats.writes_rejected += static_cast<int>(write.writes);  // destroyed after the writes were made

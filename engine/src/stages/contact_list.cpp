@@ -31,9 +31,7 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
     const Bodies& bodies = world.bodies;
     contact.body_a = a;
     contact.body_b = b;
-    // Mixing rules as most engines: geometric mean friction, largest restitution.
-    contact.friction = std::sqrt(bodies.traits[a].friction * bodies.traits[b].friction);
-    contact.restitution = std::max(bodies.traits[a].restitution, bodies.traits[b].restitution);
+    mix_materials(bodies.traits[a], bodies.traits[b], contact);
     contact.events = contact_event_flags(world, a, b);
 }
 

@@ -8,6 +8,7 @@
 // shifts); with recycled ones it stands, as it does in Box3D.
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "collision/compound.hpp"
 #include "stages/broadphase_state.hpp"
@@ -155,6 +156,9 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     if (facing) {
         fresh.friction_impulse = facing->friction_impulse - facing->friction_impulse.dot(fresh.normal) * fresh.normal;
         fresh.twist_impulse = facing->twist_impulse;
+        if (old_contact.rolling_resistance > 0) {
+            std::copy(std::begin(facing->rolling_impulse), std::end(facing->rolling_impulse), fresh.rolling_impulse);
+        }
     }
     for (int j = 0; j < fresh.point_count; ++j) {
         ContactPoint& p = fresh.points[j];

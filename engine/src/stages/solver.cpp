@@ -452,6 +452,7 @@ void solve(World& world, Real dt) {
         world.counters.gyroscopic_applied += c.gyro;
         world.counters.contact_points_solved += c.contact_points;
         world.counters.friction_applied += c.friction;
+        world.counters.rolling_applied += c.rolling;
         world.counters.restitution_applied += c.restitution;
         world.counters.joints_solved += c.joints;
     }

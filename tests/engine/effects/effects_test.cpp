@@ -126,6 +126,30 @@ TEST(Effects, FrictionCountsExactlyTheFrictionalManifolds) {
     EXPECT_EQ(boxes.counters().friction_applied, 30u * relax_passes(boxes));
 }
 
+// Rolling resistance is one row per manifold in the relax passes, and only where a contact
+// has it: a ball and a box resting without it solve none; a ball with it on a plane without
+// it (the pair mixes the larger) solves one a relax pass.
+TEST(Effects, RollingResistanceOnlyWhereContactsHaveIt) {
+    Space space(awake());
+    add_ground(space);
+    space.create_body(ball(Vec3(0, 0.5, 0)));
+    BodyDesc box;
+    box.shape = Shape::box(Vec3::Constant(0.5));
+    box.position = Vec3(3, 0.5, 0);
+    space.create_body(box);
+    for (int i = 0; i < 30; ++i) space.update();
+    EXPECT_EQ(space.counters().rolling_applied, 0u);
+
+    Space rolling(awake());
+    add_ground(rolling);
+    BodyDesc d = ball(Vec3(0, 0.5, 0));
+    d.rolling_resistance = 0.05;
+    rolling.create_body(d);
+    for (int i = 0; i < 30; ++i) rolling.update();
+    EXPECT_EQ(rolling.counters().rolling_applied, 30u * relax_passes(rolling));
+    EXPECT_EQ(rolling.counters().friction_applied, 30u * relax_passes(rolling));
+}
+
 // Restitution is one pass after the substeps: each point of a bouncy contact is
 // checked once per step.
 TEST(Effects, RestitutionChecksEachBouncyPointOncePerStep) {

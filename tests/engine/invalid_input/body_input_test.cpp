@@ -84,6 +84,7 @@ TEST(InvalidBody, RealFieldsFollowTheirRules) {
             {"mass", &BodyDesc::mass, Rule::NonNegative},
             {"friction", &BodyDesc::friction, Rule::NonNegative},
             {"restitution", &BodyDesc::restitution, Rule::NonNegative},
+            {"rolling_resistance", &BodyDesc::rolling_resistance, Rule::NonNegative},
             {"gravity_scale", &BodyDesc::gravity_scale, Rule::Finite},
             {"linear_damping", &BodyDesc::linear_damping, Rule::NonNegative},
             {"angular_damping", &BodyDesc::angular_damping, Rule::NonNegative},

@@ -138,6 +138,8 @@ TEST(InvalidWrite, RealSettersFollowTheirRules) {
     const std::vector<RealWrite> writes{
         {"friction", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_friction(b, v); }},
         {"restitution", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_restitution(b, v); }},
+        {"rolling_resistance", Rule::NonNegative,
+         [](Space& s, BodyHandle b, Real v) { s.set_rolling_resistance(b, v); }},
         {"gravity_scale", Rule::Finite, [](Space& s, BodyHandle b, Real v) { s.set_gravity_scale(b, v); }},
         {"linear_damping", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_damping(b, v, 0); }},
         {"angular_damping", Rule::NonNegative, [](Space& s, BodyHandle b, Real v) { s.set_damping(b, 0, v); }},

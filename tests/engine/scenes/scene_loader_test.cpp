@@ -182,6 +182,7 @@ TEST(SceneFiles, Box3DBenchmarkScenes_HaveBox3DsDynamicBodies) {
         ASSERT_EQ(trees.shapes[b.shape].parts.size(), 22u);
         ASSERT_EQ(b.desc.density, 1.0);
         ASSERT_EQ(b.desc.friction, 0.9);
+        ASSERT_EQ(b.desc.rolling_resistance, 0.05);  // Box3D's tree material
     }
 
     const SceneDesc large_world = load("large_world");
@@ -355,10 +356,12 @@ TEST(SceneParse, BodyProperties_DefaultsThenEntryKeys) {
 shape = { sphere = 0.5 }
 friction = 0.1
 restitution = 0.5
+rolling_resistance = 0.02
 allow_sleep = false
 
 [[body]]
 friction = 0.9
+rolling_resistance = 0.3
 type = "kinematic"
 orientation = { axis = [0, 0, 2], degrees = 90 }
 velocity = [1, 2, 3]
@@ -385,6 +388,7 @@ orientation = [2, 0, 0, 0]
     EXPECT_EQ(a.type, MotionType::Kinematic);
     EXPECT_EQ(a.friction, 0.9);
     EXPECT_EQ(a.restitution, 0.5);
+    EXPECT_EQ(a.rolling_resistance, 0.3);
     EXPECT_FALSE(a.allow_sleep);
     EXPECT_TRUE(a.orientation.isApprox(Quat(Eigen::AngleAxis<Real>(kPi / 2, Vec3::UnitZ())), 1e-12));
     EXPECT_EQ(a.linear_velocity, Vec3(1, 2, 3));
@@ -401,6 +405,7 @@ orientation = [2, 0, 0, 0]
 
     const BodyDesc& b = scene.bodies[1].desc;
     EXPECT_EQ(b.friction, 0.1);
+    EXPECT_EQ(b.rolling_resistance, 0.02);
     EXPECT_EQ(b.mass, 7);
     EXPECT_EQ(b.type, MotionType::Dynamic);
     EXPECT_TRUE(b.orientation.isApprox(Quat::Identity()));  // normalised
@@ -525,6 +530,10 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\ntype = \"wobbly\"\n", "3:8",
                     "expected \"dynamic\", \"static\" or \"kinematic\"");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nrestitution = 2\n", "3:15", "expected a number in [0, 1]");
+    EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nrolling_resistance = -0.05\n", "3:22",
+                    "body.rolling_resistance: expected a number >= 0, got -0.05");
+    EXPECT_REJECTED("[defaults]\nrolling_resistance = nan\n", "2:22",
+                    "defaults.rolling_resistance: expected a finite number, got nan");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\norientation = [0, 0, 0, 0]\n", "3:15", "non-zero quaternion");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\norientation = { axis = [0, 1, 0], degrees = 1, radians = 1 }\n",
                     "3:15", "exactly one of degrees or radians");

@@ -382,6 +382,7 @@ TEST(Setters, InternalDescKeepsEveryFieldItWasMadeWith) {
     d.mass = 7;
     d.friction = 0.3;
     d.restitution = 0.2;
+    d.rolling_resistance = 0.05;
     d.gravity_scale = 0.5;
     d.linear_damping = 0.1;
     d.angular_damping = 0.2;
@@ -408,6 +409,7 @@ TEST(Setters, InternalDescKeepsEveryFieldItWasMadeWith) {
     EXPECT_EQ(kept.mass, d.mass);
     EXPECT_EQ(kept.friction, d.friction);
     EXPECT_EQ(kept.restitution, d.restitution);
+    EXPECT_EQ(kept.rolling_resistance, d.rolling_resistance);
     EXPECT_EQ(kept.gravity_scale, d.gravity_scale);
     EXPECT_EQ(kept.linear_damping, d.linear_damping);
     EXPECT_EQ(kept.angular_damping, d.angular_damping);
@@ -613,6 +615,10 @@ TEST(Setters, BadValuesAndStaleHandles_ThrowNamingThemAndChangeNothing) {
         {"set_friction: friction must be finite and >= 0, got nan", [&] { space.set_friction(b, nan); }},
         {"set_friction: friction must be finite and >= 0, got -1", [&] { space.set_friction(b, -1); }},
         {"set_restitution: restitution must be finite and >= 0, got -0.5", [&] { space.set_restitution(b, -0.5); }},
+        {"set_rolling_resistance: rolling_resistance must be finite and >= 0, got -0.05",
+         [&] { space.set_rolling_resistance(b, -0.05); }},
+        {"set_rolling_resistance: rolling_resistance must be finite and >= 0, got inf",
+         [&] { space.set_rolling_resistance(b, inf); }},
         {"set_gravity_scale: gravity_scale must be finite, got inf", [&] { space.set_gravity_scale(b, inf); }},
         {"set_damping: linear_damping must be finite and >= 0, got -1", [&] { space.set_damping(b, -1, 0); }},
         {"set_damping: angular_damping must be finite and >= 0, got nan", [&] { space.set_damping(b, 0, nan); }},
@@ -627,6 +633,8 @@ TEST(Setters, BadValuesAndStaleHandles_ThrowNamingThemAndChangeNothing) {
          [&] { space.move_kinematic(b, Vec3(1, 0, 0), Quat::Identity()); }},
         {"set_friction: body 1 (generation 1) is not a live body", [&] { space.set_friction(gone, 0.5); }},
         {"set_restitution: body 1 (generation 1) is not a live body", [&] { space.set_restitution(gone, 0.5); }},
+        {"set_rolling_resistance: body 1 (generation 1) is not a live body",
+         [&] { space.set_rolling_resistance(gone, 0.5); }},
         {"set_gravity_scale: body 1 (generation 1) is not a live body", [&] { space.set_gravity_scale(gone, 1); }},
         {"set_damping: body 1 (generation 1) is not a live body", [&] { space.set_damping(gone, 1, 1); }},
         {"set_motion_type: body 1 (generation 1) is not a live body",

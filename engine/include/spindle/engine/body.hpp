@@ -86,6 +86,14 @@ struct BodyDesc {
     Real mass = 0;        // kg; > 0 overrides density (inertia scaled to match)
     Real friction = 0.6;
     Real restitution = 0;
+    // Rolling resistance (Box3D's): a ball, a barrel or a log rolling or rocking on
+    // something slows and stops instead of rolling for ever. Dimensionless, >= 0 (0: none,
+    // and no cost). A touching part pair brakes the bodies' relative spin with a torque of
+    // at most this x the pair's rolling radius x its normal force: the radius of a
+    // sphere or capsule, a quarter of a box's or hull's inner radius (the larger of the two
+    // parts'). Two bodies mix as the larger of their coefficients. Box3D's benchmark trees
+    // carry 0.05.
+    Real rolling_resistance = 0;
     Real gravity_scale = 1;
     Real linear_damping = 0;   // 1/s; 0 costs nothing
     Real angular_damping = 0;  // 1/s; 0 costs nothing

@@ -130,11 +130,13 @@ public:
     // and value: "set_friction: friction must be finite and >= 0, got nan"), then the
     // handle, lock-free (a stale one is named); a rejected call changes nothing. None takes
     // the motion-state lock, so none can deadlock with a flip.
-    // The body's contacts mix the new friction or restitution from the next step on.
-    void set_friction(BodyHandle body, Real friction);             // >= 0
-    void set_restitution(BodyHandle body, Real restitution);       // >= 0
-    void set_gravity_scale(BodyHandle body, Real scale);           // finite
-    void set_damping(BodyHandle body, Real linear, Real angular);  // 1/s, >= 0 each
+    // The body's contacts mix the new friction, restitution or rolling resistance from the
+    // next step on.
+    void set_friction(BodyHandle body, Real friction);                      // >= 0
+    void set_restitution(BodyHandle body, Real restitution);                // >= 0
+    void set_rolling_resistance(BodyHandle body, Real rolling_resistance);  // >= 0 (BodyDesc's)
+    void set_gravity_scale(BodyHandle body, Real scale);                    // finite
+    void set_damping(BodyHandle body, Real linear, Real angular);           // 1/s, >= 0 each
     // Static, kinematic or dynamic. Wakes the body and what it touches, removes its
     // contacts (found again at the next step, none between two bodies that are not
     // dynamic) and rebuilds its mass (none unless dynamic). A static body made moving

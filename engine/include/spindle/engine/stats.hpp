@@ -55,6 +55,7 @@ struct WorkCounters {
     std::uint64_t contact_points_solved = 0;  // point-iterations of the normal rows (solve and relax)
     std::uint64_t restitution_applied = 0;    // points checked for a bounce by the restitution pass
     std::uint64_t friction_applied = 0;       // manifold-iterations of the (central) friction rows
+    std::uint64_t rolling_applied = 0;        // manifold-iterations of the rolling resistance rows
     std::uint64_t joints_solved = 0;          // joint-iterations (solve and relax)
     std::uint64_t constraint_colorings = 0;   // steps that coloured their constraints (the rest reused the last step's)
     std::uint64_t swept_tests = 0;            // continuous-collision sweeps
