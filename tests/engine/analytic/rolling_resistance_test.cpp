@@ -228,3 +228,39 @@ TEST(RollingResistance, SetAfterCreationBrakesFromTheNextUpdate) {
     std::printf("[ measure  ] set after creation: deceleration %.4f m/s^2 (analytic %.4f)\n", measured, a);
     EXPECT_NEAR(measured, a, 0.03 * a);
 }
+
+// On a slope the row holds a ball whose coefficient is at least the slope's tangent (the
+// friction force m g sin(t) at the contact needs a torque m g sin(t) R, at most c R m g cos(t)):
+// a ball of 0.1 rests on a slope of 0.05 without creeping; on a slope of 0.2 it rolls down at
+// 5/7 g (sin(t) - c cos(t)).
+TEST(RollingResistance, BallHeldOnASlopeGentlerThanItsCoefficient_RollsDownASteeperOne) {
+    constexpr double kC = 0.1, kR = 0.5;
+    for (const double slope : {0.05, 0.2}) {
+        auto space = make_space();
+        const double angle = std::atan(slope);
+        const Quat tilt(Eigen::AngleAxisd(angle, Vec3::UnitZ()));  // downhill is -x
+        add_static_box(*space, Vec3(20, 0.5, 3), Vec3::Zero(), tilt, 0.9);
+        BodyDesc d;
+        d.shape = Shape::sphere(kR);
+        d.position = tilt * Vec3(0, 0.5 + kR, 0);
+        d.friction = 0.9;
+        d.rolling_resistance = kC;
+        const BodyHandle ball = space->create_body(d);
+        const Vec3 downhill = tilt * -Vec3::UnitX();
+        for (int step = 0; step < 30; ++step) space->update();  // settled into the soft contact
+        const Vec3 start = space->internal_position(ball);
+        for (int step = 0; step < 120; ++step) space->update();
+        const double moved = (space->internal_position(ball) - start).dot(downhill);
+        const double speed = space->internal_linear_velocity(ball).dot(downhill);
+        const double a = 5.0 / 7.0 * kGravity * (std::sin(angle) - kC * std::cos(angle));
+        std::printf("[ measure  ] slope %.2f, c %.2f: moved %.3g m over the last 2 s, speed %.4f m/s at 2.5 s (%s)\n",
+                    slope, kC, moved, speed, a > 0 ? "rolls" : "held");
+        if (a <= 0) {
+            EXPECT_LT(std::abs(moved), 1e-3) << "slope " << slope;
+            EXPECT_LT(std::abs(speed), 1e-3) << "slope " << slope;
+        } else {
+            // Rolling from rest at creation: speed a t after the 150 steps.
+            EXPECT_NEAR(speed, a * (150 * kStep), 0.05 * a * (150 * kStep)) << "slope " << slope;
+        }
+    }
+}
