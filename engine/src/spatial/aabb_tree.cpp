@@ -4,6 +4,7 @@
 #include "spatial/aabb_tree.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <tuple>
 
@@ -185,6 +186,34 @@ void DynamicAabbTree::flag_ancestors(std::int32_t leaf) {
         flag = 1;
         ++m_enlarged_nodes;
     }
+}
+
+std::int32_t DynamicAabbTree::set_fat_box_shared(std::int32_t id, const Aabb& fat) {
+    check_proxy(id);
+    SPINDLE_ASSERT(is_finite_box(fat), "DynamicAabbTree::set_fat_box_shared: box must be finite with min <= max");
+    m_nodes[static_cast<std::size_t>(id)].box = fat;
+    return flag_ancestors_shared(id);
+}
+
+void DynamicAabbTree::end_shared_fat_boxes(std::int32_t flagged, std::int32_t boxes_set) {
+    m_enlarged_nodes += flagged;
+    // As set_fat_box: only a lone leaf (the root) has no ancestor to go stale.
+    if (boxes_set > 0 && m_nodes[static_cast<std::size_t>(m_root)].height > 0) m_stale_boxes = true;
+    validate_if_enabled();
+}
+
+// flag_ancestors for many leaves on many threads: a node is flagged by the one walk whose
+// exchange found it clear; a walk that finds it flagged stops, as the walk that flagged it
+// goes on to the root.
+std::int32_t DynamicAabbTree::flag_ancestors_shared(std::int32_t leaf) {
+    std::int32_t flagged = 0;
+    for (std::int32_t id = m_nodes[static_cast<std::size_t>(leaf)].parent_or_next; id != kNull;
+         id = m_nodes[static_cast<std::size_t>(id)].parent_or_next) {
+        std::atomic_ref<std::uint8_t> flag(m_enlarged[static_cast<std::size_t>(id)]);
+        if (flag.load(std::memory_order_relaxed) != 0 || flag.exchange(1, std::memory_order_relaxed) != 0) break;
+        ++flagged;
+    }
+    return flagged;
 }
 
 // Box2D v3's answer to many moving proxies (b2DynamicTree_EnlargeProxy): a remove and an

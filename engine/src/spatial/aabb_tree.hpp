@@ -64,6 +64,14 @@ public:
     // would be wasted. Until that rebuild the ancestors' boxes are stale: query() and
     // ray_cast() must not run (they could miss the moved proxies).
     void set_fat_box(std::int32_t id, const Aabb& fat);
+    // set_fat_box for many proxies from jobs at once: gives one proxy its box and flags its
+    // ancestors, each flag taken by an atomic exchange, so a path shared with calls on other
+    // threads is flagged once and the walk stops at a flagged node as set_fat_box's does.
+    // Returns the number of nodes this call flagged. The ids must be distinct; nothing
+    // else may touch the tree until end_shared_fat_boxes(sum of the returns, calls made)
+    // counts the flags (the flags set are the same whatever the order of the calls).
+    std::int32_t set_fat_box_shared(std::int32_t id, const Aabb& fat);
+    void end_shared_fat_boxes(std::int32_t flagged, std::int32_t boxes_set);
 
     // Calls callback(id) -> bool for every proxy whose fat box overlaps `box`; false stops.
     template <typename Callback>
@@ -163,6 +171,7 @@ private:
     bool rotate(std::int32_t id);  // true when it swapped
     void enlarge_ancestors(std::int32_t leaf);
     void flag_ancestors(std::int32_t leaf);
+    std::int32_t flag_ancestors_shared(std::int32_t leaf);
     void validate_if_enabled() const {
         if (m_settings.validate_each_operation) validate();
     }

@@ -66,6 +66,57 @@ void ProxyTrees::set_fat_box(ProxyId id, const Aabb& fat) {
     if (grew) mark_enlarged(id);
 }
 
+void ProxyTrees::set_fat_boxes(JobSystem& jobs, std::span<const ProxyId> ids, std::span<const Aabb> boxes) {
+    SPINDLE_ASSERT(boxes.size() >= ids.size(), "ProxyTrees::set_fat_boxes: a box for every id");
+    const auto n = static_cast<std::uint32_t>(ids.size());
+    // Ids per job: each set walks up its leaf's path until a flagged node.
+    constexpr std::uint32_t kGrain = 256;
+    m_fat_ranges.assign((n + kGrain - 1) / kGrain, FatBoxRange{});
+    m_grown.resize(n);
+    // The boxes and flags, and which proxies join the enlarged list. The list and its slots
+    // are only read here (is_enlarged), so each range can tell its own.
+    jobs.parallel_for("broadphase.fat_boxes", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        FatBoxRange range;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            m_grown[k] = 0;
+            const ProxyId id = ids[k];
+            if (!id.valid()) continue;
+            DynamicAabbTree& tree = tree_of(id);
+            const int t = id.is_static() ? 1 : 0;
+            const bool grew = !tree.fat_aabb(id.tree_id()).contains(boxes[k]);
+            range.flagged[t] += tree.set_fat_box_shared(id.tree_id(), boxes[k]);
+            range.set[t] += 1;
+            if (grew && !is_enlarged(id)) {
+                m_grown[k] = 1;
+                range.grown += 1;
+            }
+        }
+        m_fat_ranges[lo / kGrain] = range;
+    });
+    auto end = static_cast<std::uint32_t>(m_enlarged.size());
+    std::int32_t set[2] = {0, 0}, flagged[2] = {0, 0};
+    for (FatBoxRange& range : m_fat_ranges) {
+        range.first = end;
+        end += range.grown;
+        for (int t = 0; t < 2; ++t) set[t] += range.set[t], flagged[t] += range.flagged[t];
+    }
+    for (int t = 0; t < 2; ++t) m_trees[t].end_shared_fat_boxes(flagged[t], set[t]);
+    if (end == m_enlarged.size()) return;
+    // Each range places its grown proxies from its own first place on: the list's order is
+    // the ids' order, on any worker count.
+    m_enlarged.resize(end);
+    jobs.parallel_for("broadphase.mark_enlarged", 0, n, kGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        std::uint32_t place = m_fat_ranges[lo / kGrain].first;
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            if (!m_grown[k]) continue;
+            m_enlarged[place] = ids[k];
+            slots_of(ids[k])[static_cast<std::size_t>(ids[k].tree_id())] = static_cast<std::int32_t>(place);
+            ++place;
+        }
+    });
+    validate_if_enabled();
+}
+
 bool ProxyTrees::is_enlarged(ProxyId id) const {
     const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
     const auto i = static_cast<std::size_t>(id.tree_id());
@@ -191,7 +242,8 @@ std::size_t ProxyTrees::heap_bytes() const noexcept {
     std::size_t bytes = m_trees[0].heap_bytes() + m_trees[1].heap_bytes() + m_enlarged.capacity() * sizeof(ProxyId) +
                         (m_enlarged_slot[0].capacity() + m_enlarged_slot[1].capacity()) * sizeof(std::int32_t) +
                         m_chunk_pairs.capacity() * sizeof(std::vector<Pair>) +
-                        m_run_starts.capacity() * sizeof(std::size_t) + m_merged_pairs.capacity() * sizeof(Pair);
+                        m_run_starts.capacity() * sizeof(std::size_t) + m_merged_pairs.capacity() * sizeof(Pair) +
+                        m_fat_ranges.capacity() * sizeof(FatBoxRange) + m_grown.capacity();
     for (const std::vector<Pair>& pairs : m_chunk_pairs) bytes += pairs.capacity() * sizeof(Pair);
     return bytes;
 }

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include <spindle/engine/math.hpp>
@@ -93,6 +94,11 @@ public:
     // broadphase, which moves many proxies and then calls update_pairs. Nothing may query
     // the trees in between (DynamicAabbTree::set_fat_box).
     void set_fat_box(ProxyId id, const Aabb& fat);
+    // set_fat_box(ids[k], boxes[k]) for every k whose id is valid, in jobs on `jobs`: the
+    // same boxes, the same flagged nodes and the same enlarged list, in the order of k, as
+    // those calls one by one in that order. The valid ids must be distinct. Who may call:
+    // the thread that owns the broadphase, as for set_fat_box; it waits for the jobs.
+    void set_fat_boxes(JobSystem& jobs, std::span<const ProxyId> ids, std::span<const Aabb> boxes);
 
     // Whether the caller already has the pair of these user values (user_a <= user_b).
     // Called from the pair jobs, many at once: it may only read.
@@ -129,6 +135,8 @@ public:
     bool is_enlarged(ProxyId id) const;
     std::int32_t proxy_count() const noexcept { return m_trees[0].proxy_count() + m_trees[1].proxy_count(); }
     std::size_t enlarged_count() const noexcept { return m_enlarged.size(); }
+    // The proxies enlarged since the last update_pairs, in marking order (for checks).
+    std::span<const ProxyId> enlarged() const noexcept { return m_enlarged; }
     const DynamicAabbTree& moving_tree() const noexcept { return m_trees[0]; }
     const DynamicAabbTree& static_tree() const noexcept { return m_trees[1]; }
     const BroadphaseSettings& settings() const noexcept { return m_settings; }
@@ -172,6 +180,17 @@ private:
     // the merged list (swapped with the caller's at each round).
     std::vector<std::size_t> m_run_starts;
     PairList m_merged_pairs;
+    // Scratch for set_fat_boxes: per range of ids, the boxes set and nodes flagged in each
+    // tree, the proxies that grew and were not enlarged yet, and where in the enlarged list
+    // the range's first goes; per id, whether it is one of those.
+    struct FatBoxRange {
+        std::int32_t set[2] = {0, 0};
+        std::int32_t flagged[2] = {0, 0};
+        std::uint32_t grown = 0;
+        std::uint32_t first = 0;
+    };
+    std::vector<FatBoxRange> m_fat_ranges;
+    std::vector<std::uint8_t> m_grown;
 };
 
 template <typename Callback>

@@ -220,13 +220,15 @@ void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
-    // Bounds, and whether each proxy must move and to which fat box, in parallel; the tree
-    // is single-writer, so the few proxies that left their fat boxes are moved after, in
-    // awake order.
-    bp.moving.resize(n);
+    // Bounds, and whether each proxy must move and to which fat box, in parallel; the
+    // proxies that left their fat boxes then get them in jobs too (set_fat_boxes).
+    bp.refit_marked.resize(n);
+    bp.moved_ids.resize(n);
     bp.moved_boxes.resize(n);
     bp.part_boxes.lay_out(b);
+    std::atomic<std::uint32_t> marked{0};
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        std::uint32_t range_marked = 0;
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             const Shape& shape = b.traits[i].shape;
@@ -238,19 +240,25 @@ void update_broadphase(World& world, Real dt) {
             }
             const Vec3 d = b.v[i] * dt;
             const Aabb swept = swept_bounds(b, i, d);
-            const bool moves = bp.tree.needs_move(bp.proxy[i], swept, d);
-            bp.moving[k] = moves ? 1 : 0;
-            if (moves) bp.moved_boxes[k] = bp.tree.fat_box(bp.proxy[i], swept, d);
+            bp.refit_marked[k] = 0;
+            bp.moved_ids[k] = ProxyId{};
+            if (!bp.tree.needs_move(bp.proxy[i], swept, d)) continue;
+            const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, d);
+            bp.moved_ids[k] = bp.proxy[i];
+            bp.moved_boxes[k] = fat;
+            // note_fat_change, for this job's own bodies (a slot is marked by one job).
+            const Aabb& before = bp.tree.fat_aabb(bp.proxy[i]);
+            if ((fat.min != before.min || fat.max != before.max) && !bp.refit[i]) {
+                bp.refit[i] = 1;
+                bp.refit_marked[k] = 1;
+                ++range_marked;
+            }
         }
+        if (range_marked != 0) marked.fetch_add(range_marked, std::memory_order_relaxed);
     });
     // The moved leaves' ancestors are only flagged: update_pairs rebuilds them before its
     // searches, which are the next to read the tree.
-    for (std::uint32_t k = 0; k < n; ++k) {
-        if (!bp.moving[k]) continue;
-        const std::uint32_t i = world.awake[k];
-        note_fat_change(bp, i, bp.tree.fat_aabb(bp.proxy[i]), bp.moved_boxes[k]);
-        bp.tree.set_fat_box(bp.proxy[i], bp.moved_boxes[k]);
-    }
+    bp.tree.set_fat_boxes(*world.jobs, bp.moved_ids, bp.moved_boxes);
 
     // A pair found again (one of its proxies grew) has its contact: left out by the pair
     // jobs, which only read the index meanwhile.
@@ -264,12 +272,21 @@ void update_broadphase(World& world, Real dt) {
     // can have stopped overlapping.
     std::vector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
-    if (!bp.refit_slots.empty()) find_lost_contacts(world, bp, lost);
+    const bool moves_marked = marked.load(std::memory_order_relaxed) != 0;
+    if (!bp.refit_slots.empty() || moves_marked) find_lost_contacts(world, bp, lost);
     remove_contacts(world, lost);
     fit_contacts(world);
     // Only the marked slots are cleared: a sleeping pile's slots are not touched.
     for (std::uint32_t slot : bp.refit_slots) bp.refit[slot] = 0;
     bp.refit_slots.clear();
+    if (moves_marked) {
+        SPINDLE_ASSERT(world.awake.size() == n, "broadphase: the awake list changed within the stage");
+        world.jobs->parallel_for("ClearRefit", 0, n, 1024, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+            for (std::uint32_t k = lo; k < hi; ++k) {
+                if (bp.refit_marked[k]) bp.refit[world.awake[k]] = 0;
+            }
+        });
+    }
 }
 
 }  // namespace spindle

@@ -66,8 +66,11 @@ struct BroadphaseState {
     // Per body slot: 1 when its fat box changed since the last broadphase stage. A contact
     // can only lose its overlap when one of its bodies' fat boxes changed.
     std::vector<std::uint8_t> refit;
-    std::vector<std::uint32_t> refit_slots;    // the slots marked in refit, to clear just them
-    std::vector<std::uint8_t> moving;          // scratch, per awake body: its proxy must move this step
+    std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
+    // Scratch, per awake body: 1 when this step's move set its refit mark (those marks are
+    // not in refit_slots: the stage clears them through this).
+    std::vector<std::uint8_t> refit_marked;
+    std::vector<ProxyId> moved_ids;            // scratch, per awake body: its proxy where it moves, else invalid
     RawRoomVector<Aabb> moved_boxes;           // scratch, per awake body: its new fat box where it moves
     std::vector<std::uint64_t> new_keys;       // scratch: keys of the new pairs that may make contacts
     std::vector<std::uint32_t> range_counts;   // scratch: values kept per job range (broadphase.cpp, create_contacts)

@@ -370,6 +370,72 @@ TEST(ProxyTrees, UpdatePairs_SameResultForAnyJobSystemAndGrain) {
     EXPECT_GT(total, 0u);
 }
 
+// The broadphase's moves in one batch: set_fat_boxes in jobs (three threads taking the
+// ranges last to first, a small grain's worth of ids each) leaves the trees as set_fat_box
+// on each id in turn does: the same fat boxes, the same flagged nodes, the same enlarged
+// list in the same order (grown proxies only, each once: some were enlarged already), and
+// then the same pairs. Static proxies and boxes that shrank are among the moves.
+TEST(ProxyTrees, FatBoxesSetInJobs_AreTheTreesOfOneByOne) {
+#ifdef NDEBUG
+    constexpr int kProxies = 4000;
+#else
+    constexpr int kProxies = 800;
+#endif
+    std::mt19937_64 rng(23);
+    const auto uniform = [&](Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(rng); };
+    const auto vec = [&](Real lo, Real hi) { return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); };
+    ProxyTrees one_by_one;
+    std::vector<ProxyId> ids;
+    for (int i = 0; i < kProxies; ++i) {
+        ids.push_back(one_by_one.create_proxy(cube(vec(-40, 40), 0.4), static_cast<std::uint64_t>(i), i % 16 == 0));
+    }
+    SingleThreadedJobSystem jobs_single;
+    test::ReverseThreadedJobSystem jobs_threaded(3);
+    PairList pairs_single;
+    PairList pairs_threaded;
+    one_by_one.update_pairs(jobs_single, pairs_single);
+    ProxyTrees batch = one_by_one;
+    std::vector<ProxyId> moved(ids.size());
+    std::vector<Aabb> boxes(ids.size());
+    for (int round = 0; round < 6; ++round) {
+        for (std::size_t k = 0; k < ids.size(); ++k) {
+            moved[k] = ProxyId{};
+            if (uniform(0, 1) < 0.4) continue;
+            moved[k] = ids[k];
+            const Aabb& fat = one_by_one.fat_aabb(ids[k]);
+            // A third shrink inside their fat box (no new pairs), the rest move.
+            boxes[k] = uniform(0, 1) < 0.33 ? Aabb{fat.min.array() + 0.05, fat.max.array() - 0.05}
+                                            : Aabb::from_center_extents(fat.center() + vec(-0.6, 0.6),
+                                                                        Vec3::Constant(uniform(0.3, 0.6)));
+        }
+        for (std::size_t k = 0; k < ids.size(); k += 7) {  // enlarged before the moves: not listed twice
+            one_by_one.touch(ids[k]);
+            batch.touch(ids[k]);
+        }
+        for (std::size_t k = 0; k < ids.size(); ++k) {
+            if (moved[k].valid()) one_by_one.set_fat_box(moved[k], boxes[k]);
+        }
+        batch.set_fat_boxes(jobs_threaded, moved, boxes);
+        batch.validate();
+        const std::span<const ProxyId> expected = one_by_one.enlarged();
+        const std::span<const ProxyId> got = batch.enlarged();
+        ASSERT_EQ(got.size(), expected.size()) << "round " << round;
+        ASSERT_TRUE(std::equal(got.begin(), got.end(), expected.begin())) << "round " << round;
+        ASSERT_GT(batch.moving_tree().enlarged_node_count(), 0);
+        ASSERT_EQ(batch.moving_tree().enlarged_node_count(), one_by_one.moving_tree().enlarged_node_count());
+        ASSERT_EQ(batch.static_tree().enlarged_node_count(), one_by_one.static_tree().enlarged_node_count());
+        for (const ProxyId id : ids) {
+            ASSERT_TRUE(batch.fat_aabb(id).min == one_by_one.fat_aabb(id).min &&
+                        batch.fat_aabb(id).max == one_by_one.fat_aabb(id).max);
+        }
+        one_by_one.update_pairs(jobs_single, pairs_single);
+        batch.update_pairs(jobs_threaded, pairs_threaded);
+        batch.validate();
+        ASSERT_GT(pairs_single.size(), 0u);
+        ASSERT_EQ(user_pairs(pairs_threaded), user_pairs(pairs_single)) << "round " << round;
+    }
+}
+
 // The pair lists are raw room (PairList): a resize leaves the new pairs' bytes as they
 // were. Before each update the caller's list is cleared and its room filled with 0xff
 // bytes (proxies and users out of range) in one broadphase, with zeros in its twin; the
