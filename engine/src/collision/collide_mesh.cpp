@@ -23,6 +23,9 @@ constexpr int kMaxMeshOutput = 4;       // the deepest of them a shape keeps aga
 constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
 constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
+// How far a kept mesh query reaches past the query box it was made for (Box3D's
+// B3_MAX_AABB_MARGIN, in metres): a part rocking or creeping where it lies stays inside.
+constexpr Real kQueryMargin = 0.1;
 
 // Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
 // prepared once for all the triangles of the query, and with the triangle's cache when
@@ -138,7 +141,7 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
 
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
-    mesh.query(query, [&](std::uint32_t t) {
+    const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
         if (span.clear_of_plane(v, speculative)) return;
@@ -169,7 +172,9 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
         gather(found, found_count, m);
-    });
+    };
+    if (walk) walk->query(part, mesh, query, visit);
+    else mesh.query(query, visit);
 
     std::sort(found.data(), found.data() + found_count,
               [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
@@ -196,9 +201,57 @@ FeatureCache* TriangleFeatureWalk::next(std::uint32_t part, std::uint32_t triang
     return &m_features.back().feature;
 }
 
+void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, const Aabb& box,
+                                FunctionRef<void(std::uint32_t)> visit) {
+    if (!m_queries) {
+        mesh.query(box, visit);
+        return;
+    }
+    MeshQueries& q = *m_queries;
+    SPINDLE_ASSERT(q.parts.size() == m_last_parts || q.parts.back().part < part,
+                   "TriangleFeatureWalk: parts out of order");
+    if (q.mesh != &mesh) {
+        m_part_cursor = m_last_parts;  // made on another mesh: none is kept
+        q.mesh = &mesh;
+    }
+    while (m_part_cursor < m_last_parts && q.parts[m_part_cursor].part < part) ++m_part_cursor;
+    const bool kept = m_part_cursor < m_last_parts && q.parts[m_part_cursor].part == part &&
+                      q.parts[m_part_cursor].box.contains(box);
+    MeshQuery now;
+    now.part = part;
+    now.first = static_cast<std::uint32_t>(q.triangles.size());
+    if (kept) {
+        const MeshQuery was = q.parts[m_part_cursor];
+        now.box = was.box;
+        for (std::uint32_t k = 0; k < was.count; ++k) {
+            const std::uint32_t t = q.triangles[was.first + k];
+            q.triangles.push_back(t);
+        }
+    } else {
+        now.box = box.fattened(kQueryMargin);
+        mesh.query(now.box, [&](std::uint32_t t) { q.triangles.push_back(t); });
+    }
+    now.count = static_cast<std::uint32_t>(q.triangles.size()) - now.first;
+    q.parts.push_back(now);
+    // The kept box holds `box`, so every triangle overlapping `box` is among its triangles:
+    // the same test as the mesh's leaves the same triangles in the same order.
+    const std::span<const Vec3> vertices = mesh.vertices();
+    const std::span<const MeshTriangle> triangles = mesh.triangles();
+    for (std::uint32_t k = now.first; k < now.first + now.count; ++k) {
+        const std::uint32_t t = q.triangles[k];
+        if (triangle_bounds(vertices, triangles[t]).overlaps(box)) visit(t);
+    }
+}
+
 void TriangleFeatureWalk::finish() {
     m_features.erase(m_features.begin(), m_features.begin() + static_cast<std::ptrdiff_t>(m_last));
     m_last = m_cursor = 0;
+    if (!m_queries) return;
+    MeshQueries& q = *m_queries;
+    q.parts.erase(q.parts.begin(), q.parts.begin() + static_cast<std::ptrdiff_t>(m_last_parts));
+    q.triangles.erase(q.triangles.begin(), q.triangles.begin() + static_cast<std::ptrdiff_t>(m_last_triangles));
+    for (MeshQuery& p : q.parts) p.first -= static_cast<std::uint32_t>(m_last_triangles);
+    m_last_parts = m_last_triangles = m_part_cursor = 0;
 }
 
 namespace {
