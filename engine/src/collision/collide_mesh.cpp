@@ -28,10 +28,11 @@ constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a poin
 constexpr Real kQueryMargin = 0.1;
 
 // Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
-// prepared once for all the triangles of the query, and with the triangle's cache when
-// the contact keeps them (null: the whole SAT).
+// prepared once for all the triangles of the query, with the mesh's pose in its frame
+// (mesh_in_a), and with the triangle's cache when the contact keeps them (null: the whole SAT).
 bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                      const TrianglePoly& tri, Real speculative, FeatureCache* cache, Real feature_slop, Manifold& m) {
+                      const RelativePose& mesh_in_a, const TrianglePoly& tri, Real speculative, FeatureCache* cache,
+                      Real feature_slop, Manifold& m) {
     const Transform identity;
     switch (a.type) {
         case ShapeType::Sphere:
@@ -42,7 +43,7 @@ bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhed
         }
         case ShapeType::Box:
         case ShapeType::ConvexHull:
-            return collide_polyhedra(*polyhedron, xa, tri.view(), identity, speculative, m, cache, feature_slop);
+            return collide_polyhedra(*polyhedron, xa, tri.view(), mesh_in_a, speculative, m, cache, feature_slop);
         default: return false;
     }
 }
@@ -71,13 +72,11 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
 // The SAT's own points do not serve: for shapes apart, its axis may be one beside the
 // triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
 // be measured from its far side. False when nothing is within reach.
-bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron, bool front,
-                     const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
+bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
+                     const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3& on_plane,
+                     Real speculative) {
     const Vec3& n = tri.normal();
-    if (polyhedron) {
-        const Transform identity;
-        return face_of_b_manifold(*polyhedron, xa, tri.view(), identity, front ? 0 : 1, speculative, m);
-    }
+    if (polyhedron) return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m);
     const Vec3 face = front ? Vec3(-n) : n;
     Vec3 core[2];
     rounded_core(a, core[0], core[1]);
@@ -138,14 +137,17 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
     const ShapeSpan span(a, a_in_mesh);
     // A sphere's or capsule's core, a box's centre, a hull's centroid.
     const Vec3 centre = polyhedron ? a_in_mesh.apply(polyhedron->view().inner_centre) : a_in_mesh.p;
+    // The mesh's frame in a's, made once for all the triangles (a polyhedron's SAT works there).
+    const RelativePose mesh_in_a(a_in_mesh, Transform());
 
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
     const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
-        if (span.clear_of_plane(v, speculative)) return;
-        const TrianglePoly poly(v[0], v[1], v[2]);
+        const Vec3 normal = triangle_normal(v[0], v[1], v[2]);  // made once for the cull and the polyhedron
+        if (span.clear_of_plane(v, normal, speculative)) return;
+        const TrianglePoly poly(v[0], v[1], v[2], normal);
         // Triangles are one-sided for a shape lying across their plane (Box3D culls by the
         // shape's centre too). With its centre behind, it has passed the middle and gets no
         // contact here: pushed on out of the back while its body's other parts are pushed out
@@ -159,7 +161,9 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         }
         Manifold m;
         FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
-        if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, cache, walk ? walk->slop() : 0, m)) return;
+        if (!collide_triangle(a, a_in_mesh, polyhedron, mesh_in_a, poly, speculative, cache, walk ? walk->slop() : 0,
+                              m))
+            return;
         // With its centre in front, a normal that would push it on through the back (the back
         // face, or an edge axis leaning that way, can win the SAT once it is deep) is measured
         // again against the front face, from its deep side.
@@ -167,7 +171,7 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const bool through = centre_in_front && facing > 0;
         const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
         if ((through || off_face) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, centre_in_front, poly, v[0], speculative))
+            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;

@@ -107,12 +107,25 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
 class PreparedPolyhedron;
 bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
                        Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr, Real feature_slop = 0);
+// B's pose in A's frame as the SAT works with it, a rotation matrix and an offset: made
+// once for many b posed alike (each triangle of a mesh against one hull), the same to the
+// bit as the pair function makes it from xa and xb each time.
+struct RelativePose {
+    RelativePose(const Transform& xa, const Transform& xb)
+        : r((xa.q.conjugate() * xb.q).toRotationMatrix()), t(xa.apply_inverse(xb.p)) {}
+    Mat3 r;
+    Vec3 t;
+};
+bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
+                       Real speculative_distance, Manifold& out, FeatureCache* cache, Real feature_slop);
 
 // The manifold collide_polyhedra makes when its SAT picks face `face_b` of b as the
 // reference, whatever the SAT would pick: a's incident face clipped against that face, or
 // a's vertex deepest along it when nothing clipped is within reach. False when even that
 // vertex is farther than the speculative distance from the face's plane.
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                        std::uint32_t face_b, Real speculative_distance, Manifold& out);
+bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out);
 
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
