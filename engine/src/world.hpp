@@ -268,6 +268,8 @@ struct ContactExtra {
     // A box, hull or compound against a triangle mesh: each triangle's feature, as
     // Contact::feature is for a convex pair (collide_cached).
     TriangleFeatures triangle_features;
+    // The same pairs' mesh queries, each part's kept while it stays near where it was.
+    MeshQueries mesh_queries;
 };
 
 // Contact::events: the pair reports events (a body asked, or is a sensor); a body is a

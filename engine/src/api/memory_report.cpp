@@ -47,7 +47,8 @@ MemoryReport memory_report(const Space& space) {
     for (const Contact& contact : world.contacts) {
         if (contact.extra) {
             report.contact_extras += sizeof(ContactExtra) + held(contact.extra->manifolds) +
-                                     held(contact.extra->triangle_features);
+                                     held(contact.extra->triangle_features) + held(contact.extra->mesh_queries.parts) +
+                                     held(contact.extra->mesh_queries.triangles);
         }
     }
     report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +

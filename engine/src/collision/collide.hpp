@@ -111,15 +111,36 @@ struct TriangleFeature {
 // A contact's triangle features from its last collide, sorted by part, then triangle.
 using TriangleFeatures = std::vector<TriangleFeature>;
 
+// A shape's (or compound part's) mesh query kept across steps, as Box3D keeps its mesh
+// contact's query bounds (b3RefreshCache): `box` is the query box it was made for, in the
+// mesh's frame, enlarged so that a part resting or rocking in place stays inside it; the
+// triangles whose bounds overlap it are MeshQueries::triangles[first, first + count), in
+// increasing index. While a later query box lies inside `box`, its triangles are these,
+// filtered by the same overlap test: the mesh is not queried again.
+struct MeshQuery {
+    std::uint32_t part = 0;
+    std::uint32_t first = 0, count = 0;
+    Aabb box;
+};
+// A contact's mesh queries from its last collide, sorted by part, and the mesh they were
+// made on (a contact's mesh stays its own, but a query on another would be wrong).
+struct MeshQueries {
+    const void* mesh = nullptr;
+    std::vector<MeshQuery> parts;
+    std::vector<std::uint32_t> triangles;
+};
+
 // collide() with the pair's caches, for the narrowphase: box-hull and hull-hull pairs
 // read and write `cache`; a box, hull or compound against a triangle mesh reads and
 // rewrites `triangles` (the triangles it met this time, each with its feature); any other
 // pair clears what it does not use. `feature_slop`: how far the separation along a cached
 // touching feature may drift before the whole SAT runs again (the solver's linear slop;
-// 0 never reuses a touching feature). `boxes` and `motion` as for collide().
+// 0 never reuses a touching feature). `boxes` and `motion` as for collide(). `queries`,
+// when given, keeps a mesh pair's mesh queries across calls (the same manifolds as
+// without); null queries the mesh every call.
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes = {}, const PairMotion* motion = nullptr);
+                   const PartBoxes& boxes = {}, const PairMotion* motion = nullptr, MeshQueries* queries = nullptr);
 
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns

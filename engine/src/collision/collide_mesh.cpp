@@ -23,12 +23,16 @@ constexpr int kMaxMeshOutput = 4;       // the deepest of them a shape keeps aga
 constexpr Real kSameNormal = 0.999;     // manifolds closer than this merge
 constexpr Real kFaceNormal = 1 - 1e-6;  // a contact this aligned with the face is a face contact
 constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a point is on an edge
+// How far a kept mesh query reaches past the query box it was made for (Box3D's
+// B3_MAX_AABB_MARGIN, in metres): a part rocking or creeping where it lies stays inside.
+constexpr Real kQueryMargin = 0.1;
 
 // Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
-// prepared once for all the triangles of the query, and with the triangle's cache when
-// the contact keeps them (null: the whole SAT).
+// prepared once for all the triangles of the query, with the mesh's pose in its frame
+// (mesh_in_a), and with the triangle's cache when the contact keeps them (null: the whole SAT).
 bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                      const TrianglePoly& tri, Real speculative, FeatureCache* cache, Real feature_slop, Manifold& m) {
+                      const RelativePose& mesh_in_a, const TrianglePoly& tri, Real speculative, FeatureCache* cache,
+                      Real feature_slop, Manifold& m) {
     const Transform identity;
     switch (a.type) {
         case ShapeType::Sphere:
@@ -39,7 +43,7 @@ bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhed
         }
         case ShapeType::Box:
         case ShapeType::ConvexHull:
-            return collide_polyhedra(*polyhedron, xa, tri.view(), identity, speculative, m, cache, feature_slop);
+            return collide_polyhedra(*polyhedron, xa, tri.view(), mesh_in_a, speculative, m, cache, feature_slop);
         default: return false;
     }
 }
@@ -68,13 +72,11 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
 // The SAT's own points do not serve: for shapes apart, its axis may be one beside the
 // triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
 // be measured from its far side. False when nothing is within reach.
-bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron, bool front,
-                     const TrianglePoly& tri, const Vec3& on_plane, Real speculative) {
+bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
+                     const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3& on_plane,
+                     Real speculative) {
     const Vec3& n = tri.normal();
-    if (polyhedron) {
-        const Transform identity;
-        return face_of_b_manifold(*polyhedron, xa, tri.view(), identity, front ? 0 : 1, speculative, m);
-    }
+    if (polyhedron) return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m);
     const Vec3 face = front ? Vec3(-n) : n;
     Vec3 core[2];
     rounded_core(a, core[0], core[1]);
@@ -135,14 +137,17 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
     const ShapeSpan span(a, a_in_mesh);
     // A sphere's or capsule's core, a box's centre, a hull's centroid.
     const Vec3 centre = polyhedron ? a_in_mesh.apply(polyhedron->view().inner_centre) : a_in_mesh.p;
+    // The mesh's frame in a's, made once for all the triangles (a polyhedron's SAT works there).
+    const RelativePose mesh_in_a(a_in_mesh, Transform());
 
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
-    mesh.query(query, [&](std::uint32_t t) {
+    const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
-        if (span.clear_of_plane(v, speculative)) return;
-        const TrianglePoly poly(v[0], v[1], v[2]);
+        const Vec3 normal = triangle_normal(v[0], v[1], v[2]);  // made once for the cull and the polyhedron
+        if (span.clear_of_plane(v, normal, speculative)) return;
+        const TrianglePoly poly(v[0], v[1], v[2], normal);
         // Triangles are one-sided for a shape lying across their plane (Box3D culls by the
         // shape's centre too). With its centre behind, it has passed the middle and gets no
         // contact here: pushed on out of the back while its body's other parts are pushed out
@@ -156,7 +161,9 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         }
         Manifold m;
         FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
-        if (!collide_triangle(a, a_in_mesh, polyhedron, poly, speculative, cache, walk ? walk->slop() : 0, m)) return;
+        if (!collide_triangle(a, a_in_mesh, polyhedron, mesh_in_a, poly, speculative, cache, walk ? walk->slop() : 0,
+                              m))
+            return;
         // With its centre in front, a normal that would push it on through the back (the back
         // face, or an edge axis leaning that way, can win the SAT once it is deep) is measured
         // again against the front face, from its deep side.
@@ -164,12 +171,14 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const bool through = centre_in_front && facing > 0;
         const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
         if ((through || off_face) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, centre_in_front, poly, v[0], speculative))
+            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
         gather(found, found_count, m);
-    });
+    };
+    if (walk) walk->query(part, mesh, query, visit);
+    else mesh.query(query, visit);
 
     std::sort(found.data(), found.data() + found_count,
               [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
@@ -196,9 +205,57 @@ FeatureCache* TriangleFeatureWalk::next(std::uint32_t part, std::uint32_t triang
     return &m_features.back().feature;
 }
 
+void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, const Aabb& box,
+                                FunctionRef<void(std::uint32_t)> visit) {
+    if (!m_queries) {
+        mesh.query(box, visit);
+        return;
+    }
+    MeshQueries& q = *m_queries;
+    SPINDLE_ASSERT(q.parts.size() == m_last_parts || q.parts.back().part < part,
+                   "TriangleFeatureWalk: parts out of order");
+    if (q.mesh != &mesh) {
+        m_part_cursor = m_last_parts;  // made on another mesh: none is kept
+        q.mesh = &mesh;
+    }
+    while (m_part_cursor < m_last_parts && q.parts[m_part_cursor].part < part) ++m_part_cursor;
+    const bool kept = m_part_cursor < m_last_parts && q.parts[m_part_cursor].part == part &&
+                      q.parts[m_part_cursor].box.contains(box);
+    MeshQuery now;
+    now.part = part;
+    now.first = static_cast<std::uint32_t>(q.triangles.size());
+    if (kept) {
+        const MeshQuery was = q.parts[m_part_cursor];
+        now.box = was.box;
+        for (std::uint32_t k = 0; k < was.count; ++k) {
+            const std::uint32_t t = q.triangles[was.first + k];
+            q.triangles.push_back(t);
+        }
+    } else {
+        now.box = box.fattened(kQueryMargin);
+        mesh.query(now.box, [&](std::uint32_t t) { q.triangles.push_back(t); });
+    }
+    now.count = static_cast<std::uint32_t>(q.triangles.size()) - now.first;
+    q.parts.push_back(now);
+    // The kept box holds `box`, so every triangle overlapping `box` is among its triangles:
+    // the same test as the mesh's leaves the same triangles in the same order.
+    const std::span<const Vec3> vertices = mesh.vertices();
+    const std::span<const MeshTriangle> triangles = mesh.triangles();
+    for (std::uint32_t k = now.first; k < now.first + now.count; ++k) {
+        const std::uint32_t t = q.triangles[k];
+        if (triangle_bounds(vertices, triangles[t]).overlaps(box)) visit(t);
+    }
+}
+
 void TriangleFeatureWalk::finish() {
     m_features.erase(m_features.begin(), m_features.begin() + static_cast<std::ptrdiff_t>(m_last));
     m_last = m_cursor = 0;
+    if (!m_queries) return;
+    MeshQueries& q = *m_queries;
+    q.parts.erase(q.parts.begin(), q.parts.begin() + static_cast<std::ptrdiff_t>(m_last_parts));
+    q.triangles.erase(q.triangles.begin(), q.triangles.begin() + static_cast<std::ptrdiff_t>(m_last_triangles));
+    for (MeshQuery& p : q.parts) p.first -= static_cast<std::uint32_t>(m_last_triangles);
+    m_last_parts = m_last_triangles = m_part_cursor = 0;
 }
 
 namespace {

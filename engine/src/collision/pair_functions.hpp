@@ -4,6 +4,8 @@
 // Convex pairs write at most one manifold; all take capacity >= 1.
 #pragma once
 
+#include <spindle/scheduler/function_ref.hpp>
+
 #include "collision/collide.hpp"
 #include "collision/polyhedron.hpp"
 
@@ -37,12 +39,23 @@ int collide_convex_plane(const Shape&, const Transform&, const Shape&, const Tra
 // them), and finish() leaves only the new ones.
 class TriangleFeatureWalk {
 public:
-    TriangleFeatureWalk(TriangleFeatures& features, Real slop)
-        : m_features(features), m_last(features.size()), m_slop(slop) {}
+    // With `queries`, each part's mesh query is kept for the next collide the same way.
+    TriangleFeatureWalk(TriangleFeatures& features, Real slop, MeshQueries* queries = nullptr)
+        : m_features(features),
+          m_last(features.size()),
+          m_slop(slop),
+          m_queries(queries),
+          m_last_parts(queries ? queries->parts.size() : 0),
+          m_last_triangles(queries ? queries->triangles.size() : 0) {}
     // The cache of (part, triangle) for this collide's SAT, holding the feature it had
     // last time (none if it was not met then); valid until the next call. Calls come in
     // increasing (part, triangle).
     FeatureCache* next(std::uint32_t part, std::uint32_t triangle);
+    // Calls visit(t) for each triangle of `mesh` whose bounds overlap `box` (mesh frame),
+    // in increasing t, as mesh.query does: from the triangles kept for `part` when `box`
+    // lies inside their enlarged box, else from a query of a new enlarged box, kept for
+    // the next collide. Calls come in increasing part.
+    void query(std::uint32_t part, const TriangleMesh& mesh, const Aabb& box, FunctionRef<void(std::uint32_t)> visit);
     Real slop() const { return m_slop; }
     void finish();
 
@@ -54,6 +67,10 @@ private:
     std::size_t m_last;        // m_features[0, m_last) are the last collide's
     std::size_t m_cursor = 0;  // where the last collide's are merged up to
     Real m_slop;
+    MeshQueries* m_queries;         // null: every query goes to the mesh
+    std::size_t m_last_parts;       // m_queries->parts[0, m_last_parts) are the last collide's
+    std::size_t m_last_triangles;   // and the triangles they hold, m_queries->triangles[0, m_last_triangles)
+    std::size_t m_part_cursor = 0;  // where the last collide's parts are merged up to
 };
 
 // collide_mesh.cpp: every convex shape against a triangle mesh (B).
@@ -90,12 +107,25 @@ bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b
 class PreparedPolyhedron;
 bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
                        Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr, Real feature_slop = 0);
+// B's pose in A's frame as the SAT works with it, a rotation matrix and an offset: made
+// once for many b posed alike (each triangle of a mesh against one hull), the same to the
+// bit as the pair function makes it from xa and xb each time.
+struct RelativePose {
+    RelativePose(const Transform& xa, const Transform& xb)
+        : r((xa.q.conjugate() * xb.q).toRotationMatrix()), t(xa.apply_inverse(xb.p)) {}
+    Mat3 r;
+    Vec3 t;
+};
+bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
+                       Real speculative_distance, Manifold& out, FeatureCache* cache, Real feature_slop);
 
 // The manifold collide_polyhedra makes when its SAT picks face `face_b` of b as the
 // reference, whatever the SAT would pick: a's incident face clipped against that face, or
 // a's vertex deepest along it when nothing clipped is within reach. False when even that
 // vertex is farther than the speculative distance from the face's plane.
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
+                        std::uint32_t face_b, Real speculative_distance, Manifold& out);
+bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out);
 
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by

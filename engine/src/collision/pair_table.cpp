@@ -90,7 +90,7 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes, const PairMotion* motion) {
+                   const PartBoxes& boxes, const PairMotion* motion, MeshQueries* queries) {
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
     const bool mesh_a = a.type == ShapeType::TriangleMesh;
     const bool mesh_b = b.type == ShapeType::TriangleMesh;
@@ -100,7 +100,7 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         const Shape& mesh = mesh_a ? a : b;
         const Transform& x_mesh = mesh_a ? xa : xb;
         const Transform& x_shape = mesh_a ? xb : xa;
-        detail::TriangleFeatureWalk walk(triangles, feature_slop);
+        detail::TriangleFeatureWalk walk(triangles, feature_slop, queries);
         // The pair functions' normals: from the mesh to a compound, from a convex shape to the mesh.
         const bool from_mesh = shape.type == ShapeType::Compound;
         const PairMotion mesh_first = motion && !mesh_a ? motion->swapped() : PairMotion{};
@@ -117,6 +117,7 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         return count;
     }
     triangles.clear();
+    if (queries) *queries = MeshQueries();
     // Box-box has its own 15-axis test; a compound's walk takes its part boxes.
     if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
         cache = FeatureCache();

@@ -84,8 +84,7 @@ PolyView BoxPoly::view() const {
     return make_view(m_vertices, m_faces, kBoxLoops, box_topology().edges, Vec3::Zero(), half_extents.minCoeff());
 }
 
-TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : m_vertices{a, b, c} {
-    const Vec3 n = (b - a).cross(c - a).normalized();
+TrianglePoly::TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) : m_vertices{a, b, c} {
     m_faces[0] = {n, n.dot(a), 0, 3};
     m_faces[1] = {-n, -n.dot(a), 3, 3};
 }

@@ -55,9 +55,14 @@ private:
 };
 
 // A triangle as a polyhedron: face 0 is the front (counter-clockwise) side, face 1 the back.
+// The unit normal of triangle (a, b, c), counter-clockwise seen from its front.
+inline Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a).normalized(); }
+
 class TrianglePoly {
 public:
-    TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c);
+    TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c) : TrianglePoly(a, b, c, triangle_normal(a, b, c)) {}
+    // With its normal made by triangle_normal(a, b, c) already.
+    TrianglePoly(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& normal);
     PolyView view() const;
     const Vec3& normal() const { return m_faces[0].normal; }
 

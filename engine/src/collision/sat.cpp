@@ -440,11 +440,11 @@ namespace {
 // stack) and returns with(pa, pb). Inlined: collide_polyhedra is the narrowphase's
 // hottest call.
 template <typename With>
-[[gnu::always_inline]] inline bool with_posed_pair(const PreparedPolyhedron& prepared, const Transform& xa,
-                                                   const PolyView& b, const Transform& xb, With&& with) {
+[[gnu::always_inline]] inline bool with_posed_pair(const PreparedPolyhedron& prepared, const PolyView& b,
+                                                   const RelativePose& b_in_a, With&& with) {
     const PolyView& a = prepared.view();
-    const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
-    const Vec3 t = xa.apply_inverse(xb.p);
+    const Mat3& r = b_in_a.r;
+    const Vec3& t = b_in_a.t;
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
     ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
@@ -458,7 +458,13 @@ template <typename With>
 
 bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
                        Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop) {
-    return with_posed_pair(prepared, xa, b, xb, [&](const Posed& pa, const Posed& pb) {
+    return collide_polyhedra(prepared, xa, b, RelativePose(xa, xb), speculative, m, cache, feature_slop);
+}
+
+bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
+                       const RelativePose& b_in_a, Real speculative, Manifold& m, FeatureCache* cache,
+                       Real feature_slop) {
+    return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
         using Kind = FeatureCache::Kind;
         if (cache && cache->kind() != Kind::None) {
             const CachedAxis axis = cached_axis(*cache, pa, pb);
@@ -508,7 +514,12 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
 
 bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b, const Transform& xb,
                         std::uint32_t face_b, Real speculative, Manifold& m) {
-    return with_posed_pair(prepared, xa, b, xb, [&](const Posed& pa, const Posed& pb) {
+    return face_of_b_manifold(prepared, xa, b, RelativePose(xa, xb), face_b, speculative, m);
+}
+
+bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
+                        const RelativePose& b_in_a, std::uint32_t face_b, Real speculative, Manifold& m) {
+    return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
         if (!face_manifold(pa, pb, face_b, true, speculative, false, m)) return false;
         manifold_to_world(m, xa);
         return true;

@@ -8,6 +8,7 @@
 
 #include "collision/convex_hull.hpp"
 #include "collision/lanes.hpp"
+#include "collision/polyhedron.hpp"
 
 namespace spindle::detail {
 namespace {
@@ -72,7 +73,10 @@ void ShapeSpan::along(const Vec3& n, Real& lo, Real& hi) const {
 }
 
 bool ShapeSpan::clear_of_plane(const Vec3 (&v)[3], Real speculative) const {
-    const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+    return clear_of_plane(v, triangle_normal(v[0], v[1], v[2]), speculative);
+}
+
+bool ShapeSpan::clear_of_plane(const Vec3 (&v)[3], const Vec3& n, Real speculative) const {
     const Real offset = n.dot(v[0]);
     Real lo, hi;
     along(n, lo, hi);

@@ -19,6 +19,8 @@ public:
     // True when the shape lies farther than `speculative` from the plane of triangle v on
     // either side, by more than rounding: the pair test would find no contact with it.
     bool clear_of_plane(const Vec3 (&v)[3], Real speculative) const;
+    // The same with the triangle's normal made by triangle_normal already.
+    bool clear_of_plane(const Vec3 (&v)[3], const Vec3& n, Real speculative) const;
 
 private:
     ShapeType m_type;

@@ -258,13 +258,14 @@ void update_narrowphase(World& world) {
             // Only a mesh pair keeps triangle features; the others' record has no room for them.
             const bool mesh = shape_a.type == ShapeType::TriangleMesh || shape_b.type == ShapeType::TriangleMesh;
             TriangleFeatures& triangles = mesh ? contact.made_extra().triangle_features : no_triangles;
+            MeshQueries* const queries = mesh ? &contact.made_extra().mesh_queries : nullptr;
             // A compound pair with more part manifolds than room keeps those deepest a step
             // ahead, not the deepest now: the parts about to land before those resting.
             const bool compound = shape_a.type == ShapeType::Compound || shape_b.type == ShapeType::Compound;
             PairMotion motion;
             if (compound) motion = {b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         triangles, settings.linear_slop, boxes, compound ? &motion : nullptr);
+                                         triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries);
             for (int m = 0; m < n; ++m) {
                 fresh[m] = ContactManifold{};
                 fresh[m].normal = found[m].normal;

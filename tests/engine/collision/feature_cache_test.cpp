@@ -12,6 +12,7 @@
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/space.hpp>
 
+#include "collision/triangle_mesh.hpp"
 #include "collision_test_util.hpp"
 
 namespace spindle {
@@ -353,6 +354,80 @@ TEST(FeatureCache, MeshTrianglesFeaturesGoStaleWhenTheCompoundTurnsOrMoves) {
         EXPECT_GT(np, 0) << "step " << step;
         expect_same(cached, nc, plain, np, step);
     }
+}
+
+// The compound creeping on the mesh (1 mm and 0.002 rad a call), jumping 1.5 m halfway:
+// while its parts' query boxes stay inside the boxes kept with their triangles the mesh is
+// not queried again, after the jump it must be, and every collide gives what the same
+// collide without kept queries gives, bit for bit (the features kept the same way).
+TEST(MeshQueries, KeptWhileThePartsStayNearAndMadeAgainWhenTheyLeave) {
+    const Shape mesh = flat_mesh();
+    const Shape tree = three_parts();
+    const Transform xm = at(Vec3::Zero());
+    FeatureCache cache, plain_cache;
+    TriangleFeatures triangles, plain_triangles;
+    MeshQueries queries;
+    int kept = 0, made = 0;
+    constexpr int kSteps = 60;
+    for (int step = 0; step < kSteps; ++step) {
+        const Real x = -2 + 0.001 * step + (step >= kSteps / 2 ? 1.5 : 0);
+        const Transform xt = sunk(tree, x, 0.3, about(Vec3::UnitY(), 0.002 * step), 0.002);
+        const std::vector<MeshQuery> before = queries.parts;
+        Manifold with[8], without[8];
+        const int nw = collide_cached(tree, xt, mesh, xm, 0.1, with, 8, cache, triangles, 0.005, {}, nullptr, &queries);
+        const int nn = collide_cached(tree, xt, mesh, xm, 0.1, without, 8, plain_cache, plain_triangles, 0.005);
+        EXPECT_GT(nn, 0) << "step " << step;
+        expect_same(with, nw, without, nn, step);
+        ASSERT_EQ(queries.parts.size(), 2u) << "step " << step;  // the boxes: the round hull is above the mesh's box
+        bool same_boxes = before.size() == queries.parts.size();
+        for (std::size_t i = 0; same_boxes && i < before.size(); ++i) {
+            same_boxes = before[i].box.min == queries.parts[i].box.min && before[i].box.max == queries.parts[i].box.max;
+        }
+        if (step == kSteps / 2) {
+            EXPECT_FALSE(same_boxes) << "the parts left their boxes: the mesh is queried again";
+        }
+        (same_boxes ? kept : made) += 1;
+    }
+    // Made at the start and after the jump; a 0.1 m margin holds some 30 mm of creep and turn.
+    EXPECT_GT(kept, kSteps - 10);
+    EXPECT_GE(made, 2);
+}
+
+// The compound resting on the flat mesh with its queries kept, then the same queries met
+// with a mesh whose triangles are others (a bump raised under a part, the tree's order
+// new): the bump must be found as the whole SAT finds it, not the last mesh's triangles.
+TEST(MeshQueries, ATriangleRaisedUnderARestingPartIsFoundOnANewMesh) {
+    const Shape flat = flat_mesh();
+    std::vector<Vec3> v;
+    std::vector<std::uint32_t> idx;
+    for (const Vec3& p : flat.mesh->vertices()) v.push_back(p);
+    for (const MeshTriangle& t : flat.mesh->triangles()) idx.insert(idx.end(), {t.v[0], t.v[1], t.v[2]});
+    // A small steep tent under the first box part (about x = -1.8 when the compound is at -1).
+    const auto first = static_cast<std::uint32_t>(v.size());
+    v.insert(v.end(), {Vec3(-2.0, -0.05, 0.2), Vec3(-1.7, -0.05, 0.6), Vec3(-1.6, 0.05, 0.3)});
+    idx.insert(idx.end(), {first, first + 1, first + 2});
+    const Shape bumped = Shape::triangle_mesh(v, idx);
+    const Shape tree = three_parts();
+    const Transform xm = at(Vec3::Zero());
+    const Transform xt = sunk(tree, -1, 0.3, Quat::Identity(), 0.002);
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    MeshQueries queries;
+    Manifold out[8], plain[8];
+    for (int step = 0; step < 5; ++step)
+        collide_cached(tree, xt, flat, xm, 0.1, out, 8, cache, triangles, 0.005, {}, nullptr, &queries);
+    const int n = collide_cached(tree, xt, bumped, xm, 0.1, out, 8, cache, triangles, 0.005, {}, nullptr, &queries);
+    const int np = collide(tree, xt, bumped, xm, 0.1, plain, 8);
+    Real flat_deepest = kHuge, deepest_with = kHuge, deepest_plain = kHuge;
+    Manifold flat_out[8];
+    const int nf = collide(tree, xt, flat, xm, 0.1, flat_out, 8);
+    for (int m = 0; m < nf; ++m) flat_deepest = std::min(flat_deepest, deepest(flat_out[m]));
+    for (int m = 0; m < n; ++m) deepest_with = std::min(deepest_with, deepest(out[m]));
+    for (int m = 0; m < np; ++m) deepest_plain = std::min(deepest_plain, deepest(plain[m]));
+    EXPECT_LT(deepest_plain, flat_deepest - 0.02) << "the bump reaches into the part";
+    EXPECT_EQ(deepest_with, deepest_plain);
+    ASSERT_EQ(n, np);
+    for (int m = 0; m < n; ++m) EXPECT_EQ(out[m].normal, plain[m].normal) << "manifold " << m;
 }
 
 TEST(FeatureCache, OtherPairsClearIt) {
