@@ -384,10 +384,13 @@ TEST(ProxyTrees, FatBoxesSetInJobs_AreTheTreesOfOneByOne) {
     std::mt19937_64 rng(23);
     const auto uniform = [&](Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(rng); };
     const auto vec = [&](Real lo, Real hi) { return Vec3(uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)); };
+    // The same crowding for either count: a debug build's fewer proxies in a smaller room
+    // (4,000 in 80 m across; 800 in 80 m across found no pair in some round).
+    const Real half = 40 * std::cbrt(Real(kProxies) / 4000);
     ProxyTrees one_by_one;
     std::vector<ProxyId> ids;
     for (int i = 0; i < kProxies; ++i) {
-        ids.push_back(one_by_one.create_proxy(cube(vec(-40, 40), 0.4), static_cast<std::uint64_t>(i), i % 16 == 0));
+        ids.push_back(one_by_one.create_proxy(cube(vec(-half, half), 0.4), static_cast<std::uint64_t>(i), i % 16 == 0));
     }
     SingleThreadedJobSystem jobs_single;
     test::ReverseThreadedJobSystem jobs_threaded(3);
