@@ -1,5 +1,6 @@
-// A flat triangle mesh for tests: a square grid on y = 0 about the origin, two triangles
-// a cell, their fronts up. Suites that need one add this folder to their include path.
+// Triangle meshes for tests: a square grid about the origin, flat on y = 0 or at given
+// heights, two triangles a cell, their fronts up. Suites that need one add this folder to
+// their include path.
 #pragma once
 
 #include <cstdint>
@@ -9,12 +10,17 @@
 
 namespace spindle::test {
 
-// cells x cells squares of side `cell`, centred on the origin.
-inline Shape flat_grid_mesh(int cells, Real cell) {
+// cells x cells squares of side `cell`, centred on the origin, each vertex at the height
+// height(x, z) gives.
+template <class Height>
+Shape height_grid_mesh(int cells, Real cell, Height height) {
     std::vector<Vec3> vertices;
     std::vector<std::uint32_t> indices;
     for (int i = 0; i <= cells; ++i) {
-        for (int k = 0; k <= cells; ++k) vertices.emplace_back((i - cells / 2) * cell, 0, (k - cells / 2) * cell);
+        for (int k = 0; k <= cells; ++k) {
+            const Real x = (i - cells / 2) * cell, z = (k - cells / 2) * cell;
+            vertices.emplace_back(x, height(x, z), z);
+        }
     }
     auto at = [cells](int i, int k) { return static_cast<std::uint32_t>(i * (cells + 1) + k); };
     for (int i = 0; i < cells; ++i) {
@@ -25,6 +31,11 @@ inline Shape flat_grid_mesh(int cells, Real cell) {
         }
     }
     return Shape::triangle_mesh(vertices, indices);
+}
+
+// cells x cells squares of side `cell` on y = 0, centred on the origin.
+inline Shape flat_grid_mesh(int cells, Real cell) {
+    return height_grid_mesh(cells, cell, [](Real, Real) { return Real(0); });
 }
 
 }  // namespace spindle::test

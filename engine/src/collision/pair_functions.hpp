@@ -119,10 +119,12 @@ struct RelativePose {
 bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
                        Real speculative_distance, Manifold& out, FeatureCache* cache, Real feature_slop);
 
-// The manifold collide_polyhedra makes when its SAT picks face `face_b` of b as the
-// reference, whatever the SAT would pick: a's incident face clipped against that face, or
-// a's vertex deepest along it when nothing clipped is within reach. False when even that
-// vertex is farther than the speculative distance from the face's plane.
+// The manifold of face `face_b` of b as the reference, whatever the SAT would pick, measured
+// over that face only (a mesh triangle's face, for a shape whose SAT axis the triangle does
+// not admit): a's incident face clipped against it; when nothing clipped is within reach, a's
+// vertex deepest along the normal if it lies over the face, else a's faces that face against
+// the normal, each clipped against it. False when nothing of a over the face is within the
+// speculative distance of its plane.
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out);
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,

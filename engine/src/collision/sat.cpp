@@ -306,14 +306,12 @@ std::uint32_t incident_face(const Posed& inc, const Vec3& n) {
     return incident;
 }
 
-// Clips the incident face of `inc` against reference face `face` of `ref` and returns the
-// points within reach. A vertex that clipping drops lies beside the reference face,
-// outside `ref`, and is not kept.
-int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative, Vec3& n,
-                 ContactCandidate* out) {
-    n = ref.normal(face);
+// Clips face `incident` of `inc` against reference face `face` of `ref` (normal n) and
+// returns the points within reach. A vertex that clipping drops lies beside the reference
+// face, outside `ref`, and is not kept.
+int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const Posed& inc, std::uint32_t incident,
+                    bool reference_is_b, Real speculative, ContactCandidate* out) {
     const Real d = ref.offset(face, n);
-    const std::uint32_t incident = incident_face(inc, n);
     const HullFace& ref_face = ref.view.faces[face];
     const HullFace& inc_face = inc.view.faces[incident];
     const std::size_t capacity = inc_face.count + ref_face.count + 1;
@@ -339,6 +337,14 @@ int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool re
         out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
     }
     return n_out;
+}
+
+// The incident face of `inc` (the one facing most against the reference face's normal)
+// clipped against reference face `face` of `ref`; its normal in n.
+int face_contact(const Posed& ref, std::uint32_t face, const Posed& inc, bool reference_is_b, Real speculative, Vec3& n,
+                 ContactCandidate* out) {
+    n = ref.normal(face);
+    return clipped_contact(ref, face, n, inc, incident_face(inc, n), reference_is_b, speculative, out);
 }
 
 // When nothing over the reference face is within reach, yet the face axis says the shapes
@@ -374,6 +380,53 @@ bool face_manifold(const Posed& pa, const Posed& pb, std::uint32_t face, bool re
     m.normal = reference_is_b ? Vec3(-n) : n;
     reduce_to_manifold(candidates.data(), count, m);
     return true;
+}
+
+// True when p lies over reference face `face` of `ref` (normal n): inside each of the side
+// planes its clipping uses.
+bool over_face(const Posed& ref, std::uint32_t face, const Vec3& n, const Vec3& p) {
+    const HullFace& f = ref.view.faces[face];
+    for (std::uint32_t k = 0; k < f.count; ++k) {
+        const Vec3& v0 = ref.vertices[ref.view.face_vertices[f.first + k]];
+        const Vec3& v1 = ref.vertices[ref.view.face_vertices[f.first + (k + 1) % f.count]];
+        if ((v1 - v0).cross(n).dot(p - v0) > 0) return false;
+    }
+    return true;
+}
+
+// The manifold (in A's frame) of B's face `face` measured over that face alone: A's incident
+// face clipped against it; when nothing clipped is within reach, A's vertex deepest along the
+// normal if it lies over the face (it is then A's deepest point there), else every face of A
+// that faces against the normal clipped against the face (A's surface over the face, which
+// holds its deepest point there). The face's plane carried on past its edges says nothing of
+// A beyond them: a long hull across a sloping triangle of a mesh lies far under that plane
+// there, over other triangles. False when nothing over the face is within reach.
+bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real speculative, Manifold& m) {
+    const Vec3 n = pb.normal(face);
+    ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
+    int count = clipped_contact(pb, face, n, pa, incident_face(pa, n), true, speculative, candidates.data());
+    m.normal = -n;
+    if (count > 0) {
+        reduce_to_manifold(candidates.data(), count, m);
+        return true;
+    }
+    if (over_face(pb, face, n, pa.vertices[pa.support(-n)])) {
+        count = deepest_vertex_contact(pb, face, pa, true, speculative, candidates.data());
+        reduce_to_manifold(candidates.data(), count, m);
+        return count > 0;
+    }
+    // Each face of A clipped leaves at most its own vertices and one more per side of B's face.
+    std::size_t room = 0;
+    for (std::uint32_t f = 0; f < pa.view.face_count; ++f) room += pa.view.faces[f].count + pb.view.faces[face].count;
+    ScratchBuffer<ContactCandidate, 2 * kInlineVertices> surface(room);
+    count = 0;
+    for (std::uint32_t f = 0; f < pa.view.face_count; ++f) {
+        if (pa.normal(f).dot(n) < 0)
+            count += clipped_contact(pb, face, n, pa, f, true, speculative, surface.data() + count);
+    }
+    // Neighbouring faces share the points clipped on their common edge: pruned.
+    reduce_to_manifold(surface.data(), count, m, true);
+    return m.point_count > 0;
 }
 
 // The one point (in A's frame) between edge edge_a of A and edge_b of B, along `axis`.
@@ -520,7 +573,7 @@ bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa,
 bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
                         const RelativePose& b_in_a, std::uint32_t face_b, Real speculative, Manifold& m) {
     return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
-        if (!face_manifold(pa, pb, face_b, true, speculative, false, m)) return false;
+        if (!face_of_b_over(pa, pb, face_b, speculative, m)) return false;
         manifold_to_world(m, xa);
         return true;
     });
