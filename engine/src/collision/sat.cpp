@@ -410,7 +410,10 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
         reduce_to_manifold(candidates.data(), count, m);
         return true;
     }
-    if (over_face(pb, face, n, pa.vertices[pa.support(-n)])) {
+    const Vec3& deepest = pa.vertices[pa.support(-n)];
+    const Real d = pb.offset(face, n);
+    if (n.dot(deepest) - d > speculative) return false;  // no point of A is within reach
+    if (over_face(pb, face, n, deepest)) {
         count = deepest_vertex_contact(pb, face, pa, true, speculative, candidates.data());
         reduce_to_manifold(candidates.data(), count, m);
         return count > 0;
@@ -421,8 +424,13 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     ScratchBuffer<ContactCandidate, 2 * kInlineVertices> surface(room);
     count = 0;
     for (std::uint32_t f = 0; f < pa.view.face_count; ++f) {
-        if (pa.normal(f).dot(n) < 0)
-            count += clipped_contact(pb, face, n, pa, f, true, speculative, surface.data() + count);
+        if (pa.normal(f).dot(n) >= 0) continue;
+        // What clipping leaves of a face lies between its vertices: none within reach, none left.
+        const HullFace& af = pa.view.faces[f];
+        bool reaches = false;
+        for (std::uint32_t k = 0; k < af.count && !reaches; ++k)
+            reaches = n.dot(pa.vertices[pa.view.face_vertices[af.first + k]]) - d <= speculative;
+        if (reaches) count += clipped_contact(pb, face, n, pa, f, true, speculative, surface.data() + count);
     }
     // Neighbouring faces share the points clipped on their common edge: pruned.
     reduce_to_manifold(surface.data(), count, m, true);
