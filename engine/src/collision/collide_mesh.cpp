@@ -63,52 +63,35 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
     return false;
 }
 
-// Clips segment p0-p1 to the part over triangle v (normal n): false when none of it is.
-bool clip_over_triangle(const Vec3 (&v)[3], const Vec3& n, Vec3& p0, Vec3& p1) {
-    for (int k = 0; k < 3; ++k) {
-        const Vec3 side = (v[(k + 1) % 3] - v[k]).cross(n);  // outward
-        const Real d0 = side.dot(p0 - v[k]), d1 = side.dot(p1 - v[k]);
-        if (d0 > 0 && d1 > 0) return false;
-        if (d0 > 0) p0 += (d0 / (d0 - d1)) * (p1 - p0);
-        else if (d1 > 0) p1 += (d1 / (d1 - d0)) * (p0 - p1);
-    }
-    return true;
-}
-
 // Replaces an edge or vertex normal by the face normal, on the side of the triangle's
 // plane the shape reaches into (`front`: its centre is in front; collide_triangles has
 // dropped a shape lying across the plane with its centre behind), and measures the
-// contact again against that face, over the triangle only: a sphere or capsule from its
-// core's deepest points over the triangle along the new normal, a polyhedron as its SAT
-// would have had the face chosen, over the triangle (face_of_b_manifold). The SAT's own
-// points do not serve: for shapes apart, its axis may be one beside the triangle, whose
-// points lie off both shapes; for a shape deep in the triangle, they may be measured from
-// its far side. Nor does the triangle's plane carried on past its edges: what lies beyond
-// them lies over the neighbouring triangles, which measure it themselves (on a crest the
-// plane runs above them, and a shape met there would be lifted out of ground it is not
-// in). False when nothing over the triangle is within reach.
+// contact again against that face: a sphere or capsule from its deepest core point(s)
+// along the new normal, a polyhedron as its SAT would have had the face chosen, over the
+// triangle only (face_of_b_manifold: the triangle's plane carried on past its edges says
+// nothing of what lies beyond them, over the neighbouring triangles).
+// The SAT's own points do not serve: for shapes apart, its axis may be one beside the
+// triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
+// be measured from its far side. False when nothing is within reach.
 bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                     const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3 (&v)[3],
+                     const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3& on_plane,
                      Real speculative) {
     const Vec3& n = tri.normal();
     if (polyhedron) return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m);
     const Vec3 face = front ? Vec3(-n) : n;
     Vec3 core[2];
     rounded_core(a, core[0], core[1]);
-    core[0] = xa.apply(core[0]);
-    core[1] = a.type == ShapeType::Sphere ? core[0] : xa.apply(core[1]);
+    const int ends = a.type == ShapeType::Sphere ? 1 : 2;
     const std::uint32_t id = m.points[0].id;
     m.point_count = 0;
-    m.normal = face;
-    if (!clip_over_triangle(v, n, core[0], core[1])) return false;
-    const int ends = a.type == ShapeType::Sphere ? 1 : 2;
     for (int i = 0; i < ends; ++i) {
-        const Vec3 on_a = core[i] + face * a.radius;
-        const Real separation = face.dot(v[0] - on_a);
+        const Vec3 on_a = xa.apply(core[i]) + face * a.radius;
+        const Real separation = face.dot(on_plane - on_a);
         if (separation > speculative) continue;
         m.points[m.point_count++] = {on_a + face * (Real(0.5) * separation), separation,
                                      id + static_cast<std::uint32_t>(i)};
     }
+    m.normal = face;
     return m.point_count > 0;
 }
 
@@ -189,7 +172,7 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const bool through = centre_in_front && facing > 0;
         const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
         if ((through || off_face) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v, speculative))
+            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
