@@ -41,7 +41,7 @@ struct BenchOptions {
 constexpr double kSerialPartShown = 0.02;
 
 // The quieter half of the steps' profiles (serial_fraction.hpp), and the fraction of all of them.
-void print_serial(const std::vector<SerialProfile>& steps) {
+void print_serial(const std::vector<SerialProfile>& steps, double phases, double barriers) {
     const SerialProfile p = quieter_half(steps);
     const auto used = static_cast<double>((steps.size() + 1) / 2);
     const SerialProfile all = sum_profiles(steps);
@@ -50,6 +50,16 @@ void print_serial(const std::vector<SerialProfile>& steps) {
                 p.serial_fraction(), p.serial_work_fraction(), amdahl_speedup(p.serial_work_fraction(), 4),
                 amdahl_speedup(p.serial_work_fraction(), 8), amdahl_speedup(p.serial_work_fraction(), 16), steps.size(),
                 all.serial_fraction(), all.serial_code_fraction());
+    // The serial time by kind (serial_fraction.hpp), as shares of the step: what a phase's
+    // start, its tail and the barrier after it cost, beside the stages' own code.
+    const double step = p.step_seconds > 0 ? p.step_seconds : 1;
+    std::printf("serial_kinds phase_start=%.4f phase_tail=%.4f barrier=%.4f stage_code=%.4f lone_jobs=%.4f\n",
+                p.phase_start_seconds / step, p.phase_tail_seconds / step, p.barrier_seconds / step,
+                p.stage_code_seconds() / step, p.lone_job_seconds / step);
+    // What the kinds' time is spent on: the solver's phases per step and the barriers they
+    // met (consecutive one-block phases share one).
+    const auto traced = static_cast<double>(steps.size());
+    std::printf("phases_per_step=%.1f barriers_per_step=%.1f\n", phases / traced, barriers / traced);
     for (const SerialPart& part : p.parts) {
         const double share = p.step_seconds > 0 ? part.seconds / p.step_seconds : 0;
         if (share < kSerialPartShown) break;
@@ -120,12 +130,17 @@ int bench(const BenchOptions& o) {
 
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};
     std::vector<SerialProfile> serial_steps;
-    double analysis_seconds = 0;  // --serial's, left out of the run's time
+    double analysis_seconds = 0;                           // --serial's, left out of the run's time
+    std::uint64_t phases_before = 0, barriers_before = 0;  // run_phases' counts before the traced steps
     const Stopwatch watch;
     double first_step_seconds = 0;
     for (std::int64_t i = 0; i < o.steps; ++i) {
         // The first step makes every contact: timed apart, and left out of --serial's trace.
-        if (i == 1 && o.serial) traced->enable_trace(true);
+        if (i == 1 && o.serial) {
+            traced->enable_trace(true);
+            phases_before = traced->phases_run();
+            barriers_before = traced->phase_barriers();
+        }
         space.update();
         if (i == 0) first_step_seconds = watch.elapsed_seconds();
         const UpdateStats& stats = space.last_update();
@@ -164,7 +179,10 @@ int bench(const BenchOptions& o) {
         std::printf("\n");
     }
     if (o.joint_errors) print_joint_errors(space, joints);
-    if (o.serial) print_serial(serial_steps);
+    if (o.serial) {
+        print_serial(serial_steps, static_cast<double>(traced->phases_run() - phases_before),
+                     static_cast<double>(traced->phase_barriers() - barriers_before));
+    }
     return 0;
 }
 
@@ -201,10 +219,12 @@ Command add_bench_command(CLI::App& program) {
     cli->add_flag("--serial", o->serial,
                   "trace each step after the first and print the serial fraction of a step (time with\n"
                   "at most one worker working) over the quieter half of the steps, Amdahl's bound on 4,\n"
-                  "8 and 16 workers, and a line per serial part over 2% of a step; needs --threads 2 or\n"
-                  "more, e.g.\n"
+                  "8 and 16 workers, that time by kind (a solver phase's start, its tail, the barrier\n"
+                  "after it, the stages' own code, lone jobs) and a line per serial part over 2% of a\n"
+                  "step; needs --threads 2 or more, e.g.\n"
                   "serial_fraction=0.08 serial_work_fraction=0.04 amdahl_4=3.55 amdahl_8=6.2 amdahl_16=9.9\n"
                   "  traced_steps=299 all_steps_serial_fraction=0.09 serial_code_fraction=0.02\n"
+                  "serial_kinds phase_start=0.02 phase_tail=0.02 barrier=0.01 stage_code=0.02 lone_jobs=0.01\n"
                   "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")

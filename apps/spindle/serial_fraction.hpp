@@ -26,6 +26,18 @@ struct SerialProfile {
     double outside_jobs_seconds = 0;  // of serial_seconds, with no job running: the stages' own code
     std::vector<SerialPart> parts;    // serial_seconds by name, longest first
 
+    // serial_seconds by kind. Inside a run_phases call (a participant's span open, holding
+    // its phase spans), one worker alone in a phase before any other began it (the others
+    // still coming out of the barrier, or given no block), one alone after the others
+    // finished it (its last blocks: the tail), no worker in a phase (all at the barrier);
+    // outside it, a lone job, or the stages' own code (outside_jobs_seconds less the
+    // barrier time).
+    double phase_start_seconds = 0;
+    double phase_tail_seconds = 0;
+    double barrier_seconds = 0;
+    double lone_job_seconds = 0;
+    double stage_code_seconds() const { return outside_jobs_seconds - barrier_seconds; }
+
     // Of the step as it ran: the share of its time with at most one worker working.
     double serial_fraction() const { return step_seconds > 0 ? serial_seconds / step_seconds : 0; }
     // Of the work, as one worker would do it: Amdahl's serial fraction.

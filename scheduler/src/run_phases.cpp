@@ -1,5 +1,6 @@
 // WorkStealingJobSystem::run_phases: one participant per worker runs every phase, each
-// phase's items in shares and blocks, with a spinning barrier between phases.
+// phase's items in shares and blocks, with a spinning barrier between phases (one after a
+// run of phases that fit in one block each).
 #include "worker.hpp"
 
 #include <spindle/platform/clock.hpp>
@@ -41,11 +42,18 @@ void share_block(std::uint32_t items, std::uint32_t grain, std::uint32_t b, std:
     hi = lo + block_size(left, grain);
 }
 
+// A phase whose items fit in one block. Consecutive ones run as one round: the participant
+// that claims the first runs them all back to back, in order, and everyone meets at one
+// barrier after the last. Split, they would leave all but one participant idle anyway, and
+// each barrier between them costs a round trip between cores.
+bool one_block(const Phase& phase) { return phase.count <= std::max<std::uint32_t>(phase.grain, 1); }
+
 // One run_phases call, on the caller's stack. Each phase is cut into one share per
 // participant and each share into blocks. claimed[j] counts the blocks taken from share
 // j over every phase so far, done the blocks finished: a phase is over when done
 // reaches the blocks of all phases up to it. No counter is reset between phases, so
-// a participant that starts late just walks past the phases that are over.
+// a participant that starts late just walks past the phases that are over. A round of
+// one-block phases is one block of share 0.
 struct PhaseRun {
     std::span<const Phase> phases;
     PhaseFn fn;
@@ -53,46 +61,85 @@ struct PhaseRun {
     unsigned participants;
     CacheLinePadded<std::atomic<std::uint32_t>> claimed[WorkStealingJobSystem::kMaxPhaseWorkers];
     CacheLinePadded<std::atomic<std::uint64_t>> done;
+    std::uint64_t phases_run = 0;  // phases with items and rounds, counted by participant 0,
+    std::uint64_t barriers = 0;    // which walks every round
 };
 
-// Participant `me`: for each phase, its own share first, then what is left of the
-// others'; then the barrier.
+// Participant `me`'s part of a round of one-block phases [p, end): the whole round if it
+// claims it. Returns the blocks it ran (0 or 1).
+std::uint64_t run_one_block_round(PhaseRun& run, std::uint32_t p, std::uint32_t end, std::uint32_t share_end,
+                                  unsigned worker, Worker& self) noexcept {
+    std::atomic<std::uint32_t>& claimed = run.claimed[0].value;
+    std::uint32_t seen = claimed.load(std::memory_order_relaxed);
+    while (seen < share_end) {
+        if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
+        const bool tracing = self.system->trace_enabled();
+        for (std::uint32_t q = p; q < end; ++q) {
+            const Phase& phase = run.phases[q];
+            if (phase.count == 0) continue;
+            const std::int64_t traced_from = tracing ? now_nanoseconds() : 0;
+            run.fn(q, 0, phase.count, worker);
+            if (tracing) self.record(phase.name, run.name, traced_from, now_nanoseconds());
+        }
+        return 1;
+    }
+    return 0;
+}
+
+// Participant `me`: for each round (a phase, or consecutive one-block phases), its own
+// share first, then what is left of the others'; then the barrier.
 void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexcept {
     const unsigned n = run.participants;
     std::uint32_t taken_before[WorkStealingJobSystem::kMaxPhaseWorkers] = {};  // claimed[j] when the phase began
     std::uint64_t done_target = 0;
     const bool tracing = self.system->trace_enabled();
-    for (std::uint32_t p = 0; p < run.phases.size(); ++p) {
+    const auto phase_count = static_cast<std::uint32_t>(run.phases.size());
+    for (std::uint32_t p = 0, end = 0; p < phase_count; p = end) {
         const Phase& phase = run.phases[p];
+        end = p + 1;
         if (phase.count == 0) continue;
-        const std::uint32_t grain = std::max<std::uint32_t>(phase.grain, 1);
-        std::uint64_t ran = 0;
-        std::int64_t traced_from = 0;  // when this participant claimed its first block of the phase
-        for (unsigned step = 0; step < n; ++step) {
-            const unsigned j = (me + step) % n;
-            const auto first = static_cast<std::uint32_t>(std::uint64_t{phase.count} * j / n);
-            const auto items = static_cast<std::uint32_t>(std::uint64_t{phase.count} * (j + 1) / n) - first;
-            const std::uint32_t blocks = share_blocks(items, grain);
-            done_target += blocks;
-            const std::uint32_t share_end = taken_before[j] + blocks;
-            std::atomic<std::uint32_t>& claimed = run.claimed[j].value;
-            std::uint32_t seen = claimed.load(std::memory_order_relaxed);
-            while (seen < share_end) {
-                if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
-                std::uint32_t lo = 0, hi = 0;
-                share_block(items, grain, seen - taken_before[j], lo, hi);
-                if (tracing && ran == 0) traced_from = now_nanoseconds();
-                run.fn(p, first + lo, first + hi, worker);
-                ++ran;
-                ++seen;
-            }
-            taken_before[j] = share_end;
+        if (me == 0) {
+            ++run.phases_run;
+            ++run.barriers;
         }
-        // One span per participant and phase, from its first block to the end of its last:
-        // between its blocks it claims the next one, which is its own work, not a wait, so
-        // only the barrier below is left out of it (and a block costs no clock reads).
-        if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
-        // Publish this phase's blocks at once (one shared write per phase, not per block).
+        std::uint64_t ran = 0;
+        if (one_block(phase)) {
+            while (end < phase_count && one_block(run.phases[end])) {
+                if (me == 0 && run.phases[end].count > 0) ++run.phases_run;
+                ++end;
+            }
+            done_target += 1;
+            taken_before[0] += 1;
+            ran = run_one_block_round(run, p, end, taken_before[0], worker, self);
+        } else {
+            const std::uint32_t grain = std::max<std::uint32_t>(phase.grain, 1);
+            std::int64_t traced_from = 0;  // when this participant claimed its first block of the phase
+            for (unsigned step = 0; step < n; ++step) {
+                const unsigned j = (me + step) % n;
+                const auto first = static_cast<std::uint32_t>(std::uint64_t{phase.count} * j / n);
+                const auto items = static_cast<std::uint32_t>(std::uint64_t{phase.count} * (j + 1) / n) - first;
+                const std::uint32_t blocks = share_blocks(items, grain);
+                done_target += blocks;
+                const std::uint32_t share_end = taken_before[j] + blocks;
+                std::atomic<std::uint32_t>& claimed = run.claimed[j].value;
+                std::uint32_t seen = claimed.load(std::memory_order_relaxed);
+                while (seen < share_end) {
+                    if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
+                    std::uint32_t lo = 0, hi = 0;
+                    share_block(items, grain, seen - taken_before[j], lo, hi);
+                    if (tracing && ran == 0) traced_from = now_nanoseconds();
+                    run.fn(p, first + lo, first + hi, worker);
+                    ++ran;
+                    ++seen;
+                }
+                taken_before[j] = share_end;
+            }
+            // One span per participant and phase, from its first block to the end of its last:
+            // between its blocks it claims the next one, which is its own work, not a wait, so
+            // only the barrier below is left out of it (and a block costs no clock reads).
+            if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
+        }
+        // Publish this round's blocks at once (one shared write per round, not per block).
         if (ran > 0) run.done.value.fetch_add(ran, std::memory_order_release);
         for (int spins = 0; run.done.value.load(std::memory_order_acquire) < done_target; ++spins) {
             if (spins < kSpinsBeforeYield) {
@@ -114,6 +161,8 @@ void WorkStealingJobSystem::run_phases(const char* name, std::span<const Phase> 
     parallel_for(name, 0, run.participants, 1, [&run, this](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         for (std::uint32_t me = lo; me < hi; ++me) take_part(run, me, worker, *m_workers[worker]);
     });
+    m_phases_run.fetch_add(run.phases_run, std::memory_order_relaxed);
+    m_phase_barriers.fetch_add(run.barriers, std::memory_order_relaxed);
 }
 
 }  // namespace spindle

@@ -57,6 +57,47 @@ TEST(SerialFraction, HandMadeStep_HasTheSerialTimeItWasMadeWith) {
     EXPECT_NEAR(p.parts[3].seconds, 5e-6, 1e-12);
 }
 
+// The hand-made step's serial time by kind: [60, 70) and [90, 100) worker 0 alone after worker
+// 1 finished its blocks of the phase (tails), [70, 75) both at the barrier, [0, 10) a lone
+// parallel_for chunk, [40, 50) the Broadphase's own code.
+TEST(SerialFraction, HandMadeStep_SerialTimeByKind) {
+    const SerialProfile p = serial_profile(two_worker_step());
+    EXPECT_NEAR(p.phase_tail_seconds, 20e-6, 1e-12);
+    EXPECT_EQ(p.phase_start_seconds, 0.0);
+    EXPECT_NEAR(p.barrier_seconds, 5e-6, 1e-12);
+    EXPECT_NEAR(p.lone_job_seconds, 10e-6, 1e-12);
+    EXPECT_NEAR(p.stage_code_seconds(), 10e-6, 1e-12);
+}
+
+// Three phases on two workers, each participant's span holding its phase spans:
+//   phase 1: worker 0 [0, 10), worker 1 [3, 8): worker 1 late by 3 (start), worker 0 alone [8, 10) (tail);
+//   barrier [10, 12);
+//   phase 2: worker 1 only [12, 20) (worker 0 got no block): a start, however long;
+//   barrier [20, 21);
+//   phase 3: worker 0 [21, 30), worker 1 [21, 25): tail [25, 30).
+// And after the run_phases call, still in the stage, a job alone on worker 1 [30, 34).
+TEST(SerialFraction, PhasesStartAndTail_AreToldApart) {
+    const std::vector<TraceEvent> events = {
+        span("stage", "Solver", 0, 34, 0),        span("parallel_for", "Solver", 0, 30, 0),
+        span("parallel_for", "Solver", 0, 30, 1), span("Solver", "Solve", 0, 10, 0),
+        span("Solver", "Solve", 3, 8, 1),         span("Solver", "Relax", 12, 20, 1),
+        span("Solver", "Relax", 21, 30, 0),       span("Solver", "Relax", 21, 25, 1),
+        span("job", "Last", 30, 34, 1),
+    };
+    const SerialProfile p = serial_profile(events);
+    EXPECT_NEAR(p.serial_seconds, 25e-6, 1e-12);
+    EXPECT_NEAR(p.phase_start_seconds, 11e-6, 1e-12);  // [0, 3) and [12, 20)
+    EXPECT_NEAR(p.phase_tail_seconds, 7e-6, 1e-12);    // [8, 10) and [25, 30)
+    EXPECT_NEAR(p.barrier_seconds, 3e-6, 1e-12);       // [10, 12) and [20, 21)
+    EXPECT_NEAR(p.lone_job_seconds, 4e-6, 1e-12);
+    EXPECT_EQ(p.stage_code_seconds(), 0.0);
+    const SerialProfile twice = sum_profiles(std::vector<SerialProfile>{p, p});
+    EXPECT_NEAR(twice.phase_start_seconds, 22e-6, 1e-12);
+    EXPECT_NEAR(twice.phase_tail_seconds, 14e-6, 1e-12);
+    EXPECT_NEAR(twice.barrier_seconds, 6e-6, 1e-12);
+    EXPECT_NEAR(twice.lone_job_seconds, 8e-6, 1e-12);
+}
+
 TEST(SerialFraction, SpansInAnyOrder_GiveTheSameProfile) {
     std::vector<TraceEvent> events = two_worker_step();
     std::reverse(events.begin(), events.end());

@@ -417,6 +417,47 @@ TEST(WorkStealing, PhasesFinishWhenAWorkerNeverJoins) {
     EXPECT_EQ(chain.values, expected.values);
 }
 
+// Phases that fit in one block each (count <= grain), one after another, are one round: the
+// worker that claims the first runs them all, in order, and the others meet it at one barrier
+// after the last; a phase with more blocks, or one after it, is not in the round.
+TEST(WorkStealing, ConsecutiveOneBlockPhases_RunBackToBackWithOneBarrier) {
+    const Phase phases[] = {
+        {"split", 100, 1}, {"tail", 1, 1},   {"tail", 3, 4}, {"empty", 0, 1},
+        {"tail", 2, 2},    {"split", 50, 1}, {"tail", 1, 1}, {"split", 9, 1},
+    };
+    const std::vector<std::uint32_t> round = {1, 2, 4};  // the round of one-block phases
+    for (unsigned workers : {2u, 3u}) {
+        auto jobs = make(workers);
+        for (int repeat = 0; repeat < 20; ++repeat) {
+            std::vector<unsigned> ran_on(std::size(phases), ~0u);
+            std::vector<int> order(std::size(phases), -1);
+            std::atomic<int> next{0};
+            std::atomic<int> blocks_split{0};
+            const std::uint64_t before = jobs->phase_barriers();
+            const std::uint64_t phases_before = jobs->phases_run();
+            jobs->run_phases("tails", phases,
+                             [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+                                 if (std::strcmp(phases[p].name, "split") == 0) {
+                                     blocks_split.fetch_add(1);
+                                     return;
+                                 }
+                                 EXPECT_EQ(lo, 0u);
+                                 EXPECT_EQ(hi, phases[p].count);
+                                 ran_on[p] = worker;
+                                 order[p] = next.fetch_add(1);
+                             });
+            EXPECT_EQ(jobs->phase_barriers() - before, 5u) << workers << " workers: split, round, split, tail, split";
+            EXPECT_EQ(jobs->phases_run() - phases_before, 7u);
+            for (std::uint32_t p : round) EXPECT_EQ(ran_on[p], ran_on[round[0]]) << "phase " << p;
+            EXPECT_LT(order[1], order[2]);
+            EXPECT_LT(order[2], order[4]);
+            EXPECT_EQ(order[3], -1);  // the empty phase runs nothing
+            EXPECT_EQ(order[6], 3);
+            EXPECT_GT(blocks_split.load(), 3);
+        }
+    }
+}
+
 // A participant's blocks of a phase are one span (its claims between them are its own
 // work; the barrier after them is left out), named after the phase.
 TEST(WorkStealing, PhasesAreTracedOnceByEachParticipantThatRanBlocks) {

@@ -43,6 +43,10 @@ constexpr std::uint32_t kBodyGrain = 128;  // PrepareBodies, a parallel_for
 constexpr std::uint32_t kBodyPassGrain = 32;
 // Joints or wide contacts (kLanes manifolds each) per block of a colour.
 constexpr std::uint32_t kConstraintGrain = 1;
+// A colour with at most this many is one block (Box3D's smallest block of wide contacts):
+// run_phases runs consecutive one-block phases back to back on one worker with one barrier
+// after them, so a pass's tail colours cost one barrier, not one each.
+constexpr std::uint32_t kOneBlockColor = 4;
 // Wide contacts per block when preparing them (the longest per item) and storing their
 // impulses.
 constexpr std::uint32_t kWideGrain = 1;
@@ -263,7 +267,7 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
                                         : 0u;
         const std::uint32_t count = joints + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
         if (count == 0) continue;
-        scratch.phases.push_back(Phase{name, count, kConstraintGrain});
+        scratch.phases.push_back(Phase{name, count, count <= kOneBlockColor ? count : kConstraintGrain});
         scratch.plan.push_back(SolverPhase{pass, c});
     }
     const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||

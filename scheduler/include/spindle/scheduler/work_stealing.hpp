@@ -97,8 +97,16 @@ public:
     // job too (it keeps running other jobs, never idles while work is queued).
     void wait(JobGroup& group);
     // See JobSystem: one job per worker (at most kMaxPhaseWorkers) runs every phase.
+    // Consecutive phases that fit in one block each (count <= grain) are one round: the
+    // worker that claims the first runs them all back to back, in order, with one
+    // barrier after the last (a split would leave the others idle at each barrier).
     void run_phases(const char* name, std::span<const Phase> phases, PhaseFn fn) override;
     static constexpr unsigned kMaxPhaseWorkers = 16;
+    // Phases with items that run_phases calls have run so far, and the barriers they met:
+    // one per such phase, except that consecutive phases of one block each share one.
+    // Any thread.
+    std::uint64_t phases_run() const noexcept { return m_phases_run.load(std::memory_order_relaxed); }
+    std::uint64_t phase_barriers() const noexcept { return m_phase_barriers.load(std::memory_order_relaxed); }
     // Runs a stage graph to completion (nodes in dependency order, in parallel where
     // allowed); rethrows the first exception after every runnable node finished.
     void run_graph(StageGraph& graph) override;
@@ -172,6 +180,8 @@ private:
     // job reads m_trace_on; on one line each lock would take the line from the workers.
     alignas(cache_line_size) std::mutex m_external;  // one external thread acts as worker 0 at a time
     alignas(cache_line_size) std::atomic<bool> m_trace_on{false};
+    std::atomic<std::uint64_t> m_phases_run{0};  // both added to once per run_phases call
+    std::atomic<std::uint64_t> m_phase_barriers{0};
     mutable std::mutex m_stage_lock;  // stage spans (a few per step) from the owner thread
     std::vector<TraceEvent> m_stage_events;
     std::vector<std::pair<const char*, std::int64_t>> m_open_stages;
