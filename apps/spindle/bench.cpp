@@ -35,10 +35,26 @@ struct BenchOptions {
     bool stages = false;
     bool joint_errors = false;
     bool serial = false;
+    bool serial_first = false;
 };
 
 // Parts of the step shorter than this share of it are left out of --serial's list.
 constexpr double kSerialPartShown = 0.02;
+
+// Parts of the first step at least this long are listed by --serial-first: the first step
+// is one profile (no quieter half), and a part worth splitting is a millisecond or more.
+constexpr double kFirstStepPartShown = 1e-3;
+
+// The first step's profile: its serial time, and its serial parts of a millisecond or more.
+void print_first_step_serial(const SerialProfile& p) {
+    std::printf("first_step_traced_ms=%.3f first_step_serial_ms=%.3f first_step_serial_fraction=%.4f "
+                "first_step_serial_code_ms=%.3f\n",
+                1e3 * p.step_seconds, 1e3 * p.serial_seconds, p.serial_fraction(), 1e3 * p.outside_jobs_seconds);
+    for (const SerialPart& part : p.parts) {
+        if (part.seconds < kFirstStepPartShown) break;
+        std::printf("first_step_part ms=%.3f name=\"%s\"\n", 1e3 * part.seconds, part.name.c_str());
+    }
+}
 
 // The quieter half of the steps' profiles (serial_fraction.hpp), and the fraction of all of them.
 void print_serial(const std::vector<SerialProfile>& steps, double phases, double barriers) {
@@ -109,6 +125,10 @@ int bench(const BenchOptions& o) {
                      "--steps 2 or more (the first step is not traced)\n";
         return 2;
     }
+    if (o.serial_first && (!traced || threads < 2)) {
+        std::cerr << "spindle bench: --serial-first needs --threads 2 or more (one worker has no parallel part)\n";
+        return 2;
+    }
     if (jobs->worker_count() != threads) {
         std::cerr << "spindle bench: note: " << threads << " threads asked for, the scheduler runs "
                   << jobs->worker_count() << '\n';
@@ -134,8 +154,11 @@ int bench(const BenchOptions& o) {
     std::uint64_t phases_before = 0, barriers_before = 0;  // run_phases' counts before the traced steps
     const Stopwatch watch;
     double first_step_seconds = 0;
+    std::optional<SerialProfile> first_step_serial;
     for (std::int64_t i = 0; i < o.steps; ++i) {
-        // The first step makes every contact: timed apart, and left out of --serial's trace.
+        // The first step makes every contact: timed apart, and left out of --serial's trace
+        // (--serial-first traces it alone).
+        if (i == 0 && o.serial_first) traced->enable_trace(true);
         if (i == 1 && o.serial) {
             traced->enable_trace(true);
             phases_before = traced->phases_run();
@@ -143,6 +166,13 @@ int bench(const BenchOptions& o) {
         }
         space.update();
         if (i == 0) first_step_seconds = watch.elapsed_seconds();
+        if (i == 0 && o.serial_first) {
+            const Stopwatch analysis;
+            traced->enable_trace(false);
+            first_step_serial = serial_profile(traced->trace_events());
+            traced->clear_trace();
+            analysis_seconds += analysis.elapsed_seconds();
+        }
         const UpdateStats& stats = space.last_update();
         for (std::size_t k = 0; k < stage_seconds.size(); ++k) stage_seconds[k] += stats.stage_seconds[k];
         if (i >= 1 && o.serial) {
@@ -179,6 +209,7 @@ int bench(const BenchOptions& o) {
         std::printf("\n");
     }
     if (o.joint_errors) print_joint_errors(space, joints);
+    if (first_step_serial) print_first_step_serial(*first_step_serial);
     if (o.serial) {
         print_serial(serial_steps, static_cast<double>(traced->phases_run() - phases_before),
                      static_cast<double>(traced->phase_barriers() - barriers_before));
@@ -226,6 +257,14 @@ Command add_bench_command(CLI::App& program) {
                   "  traced_steps=299 all_steps_serial_fraction=0.09 serial_code_fraction=0.02\n"
                   "serial_kinds phase_start=0.02 phase_tail=0.02 barrier=0.01 stage_code=0.02 lone_jobs=0.01\n"
                   "serial_part share=0.031 ms_per_step=0.29 name=\"Islands outside jobs\"")
+        ->check(no_value());
+    cli->add_flag("--serial-first", o->serial_first,
+                  "trace the first step alone (it makes every contact) and print its traced and serial\n"
+                  "time and a line per serial part of 1 ms or more, longest first; needs --threads 2 or\n"
+                  "more, e.g.\n"
+                  "first_step_traced_ms=31.2 first_step_serial_ms=9.8 first_step_serial_fraction=0.3141\n"
+                  "  first_step_serial_code_ms=4.1\n"
+                  "first_step_part ms=2.310 name=\"Broadphase outside jobs\"")
         ->check(no_value());
     cli->add_option("SCENE", o->scene, "a built-in scene (see `spindle scenes`) or a .toml scene file")
         ->required()

@@ -424,11 +424,13 @@ struct World {
     // Grown only by create_contacts, whose jobs construct the new records in place.
     std::vector<Contact, PlacedByCallerAllocator<Contact>> contacts;
     ContactIndex contact_index;  // key -> position in contacts
-    std::vector<std::uint64_t>
-        contact_keys;  // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact
+    // contacts[i]'s pair key (body_a << 32 | body_b), packed: a scan reads 8 bytes per contact.
+    // Raw room, as the next: create_contacts' jobs write every new element (a first step's
+    // were value-initialised by one thread, into fresh pages faulted one by one).
+    RawRoomVector<std::uint64_t> contact_keys;
     // contacts[i]'s manifolds in 4 bytes (contact_summary()): what the solver's list of
     // manifolds needs, without reading the contact (the narrowphase writes it).
-    std::vector<std::uint32_t> contact_summaries;
+    RawRoomVector<std::uint32_t> contact_summaries;
     // Positions of the contacts that are not asleep, ascending; rebuilt only after a
     // contact is made, removed, or changes sleep, so sleeping contacts cost nothing per step.
     std::vector<std::uint32_t> awake_contact_list;
@@ -493,9 +495,9 @@ struct World {
     std::vector<EffectCounts> scratch_counts;                    // per worker
     std::vector<ContactCounts> contact_counts;                   // per worker (narrowphase.cpp)
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
-    std::vector<std::uint32_t> scratch_lost;
-    std::vector<ContactMove> scratch_contact_moves;  // remove_contacts (contact_list.cpp)
-    std::vector<std::uint32_t> scratch_moved_awake;  // the same: the moved contacts that are awake
+    RawRoomVector<std::uint32_t> scratch_lost;                   // raw room: a first step's search writes what it keeps
+    std::vector<ContactMove> scratch_contact_moves;              // remove_contacts (contact_list.cpp)
+    std::vector<std::uint32_t> scratch_moved_awake;              // the same: the moved contacts that are awake
     // Bodies to sweep, listed by the solver's FinalizeBodies jobs, one list per worker
     // (a sweep reads only static bodies and writes only its own, so the lists' order
     // changes nothing); the Continuous stage runs only when one is not empty.

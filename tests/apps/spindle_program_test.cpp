@@ -276,14 +276,44 @@ TEST(SpindleProgram, BenchLine_HasTheStepTimeAndTheFirstStepApart) {
     EXPECT_GT(field(words(one.output), "first_step_ms"), 0.0) << one.output;
 }
 
+// The output's lines, each cut into words.
+std::vector<std::vector<std::string>> word_lines(const std::string& output) {
+    std::vector<std::vector<std::string>> lines;
+    std::istringstream in(output);
+    for (std::string line; std::getline(in, line);) lines.push_back(words(line));
+    return lines;
+}
+
+// The serial part lines after bench's two lines: each `tag key=X ... name="..."`, X at
+// least `least` and no more than the line before; their sum.
+double serial_parts(const std::vector<std::vector<std::string>>& lines, const std::string& tag, const std::string& key,
+                    double least, const std::string& output) {
+    double previous = 1e300, sum = 0;
+    for (std::size_t i = 2; i < lines.size(); ++i) {
+        const std::vector<std::string>& part = lines[i];
+        if (part.empty()) {
+            ADD_FAILURE() << "an empty line: " << output;
+            continue;
+        }
+        EXPECT_EQ(part.front(), tag) << output;
+        const double x = field(part, key);
+        EXPECT_GE(x, least) << output;
+        EXPECT_LE(x, previous) << output;
+        previous = x;
+        sum += x;
+        const bool named = std::any_of(part.begin(), part.end(),
+                                       [](const std::string& w) { return w.rfind("name=\"", 0) == 0; });
+        EXPECT_TRUE(named) << output;
+    }
+    return sum;
+}
+
 // --serial: the share of the quieter half of the traced steps with at most one worker
 // working, Amdahl's bounds from it, and the serial parts over 2 % of a step, longest first.
 TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const Result r = spindle("bench pyramid --threads 2 --steps 20 --serial", true);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    std::vector<std::vector<std::string>> lines;
-    std::istringstream in(r.output);
-    for (std::string line; std::getline(in, line);) lines.push_back(words(line));
+    const std::vector<std::vector<std::string>> lines = word_lines(r.output);
     ASSERT_GE(lines.size(), 2u) << r.output;
     const std::vector<std::string>& summary = lines[1];
     ASSERT_EQ(summary.size(), 8u) << r.output;
@@ -303,19 +333,7 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const double code = field(summary, "serial_code_fraction");
     EXPECT_GT(code, 0.0);  // the stages' own code between jobs
     EXPECT_LE(code, field(summary, "all_steps_serial_fraction"));
-    double previous = 1, sum = 0;
-    for (std::size_t i = 2; i < lines.size(); ++i) {
-        const std::vector<std::string>& part = lines[i];
-        ASSERT_GE(part.size(), 4u) << r.output;
-        EXPECT_EQ(part[0], "serial_part");
-        const double share = field(part, "share");
-        EXPECT_GE(share, 0.02) << r.output;
-        EXPECT_LE(share, previous) << r.output;
-        previous = share;
-        sum += share;
-        EXPECT_EQ(part[3].rfind("name=\"", 0), 0u) << r.output;
-    }
-    EXPECT_LE(sum, serial + 1e-3) << r.output;
+    EXPECT_LE(serial_parts(lines, "serial_part", "share", 0.02, r.output), serial + 1e-3) << r.output;
 
     const Result one = spindle("bench pyramid --threads 1 --serial");
     EXPECT_EQ(one.exit_code, 2) << one.output;
@@ -323,6 +341,37 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const Result untraced = spindle("bench pyramid --threads 2 --steps 1 --serial");  // the first step is not traced
     EXPECT_EQ(untraced.exit_code, 2) << untraced.output;
     expect_contains(untraced.output, "--steps 2 or more");
+}
+
+// --serial-first: the first step traced alone (it makes every contact), its serial time and
+// the serial parts of a millisecond or more, longest first; no trace of the steps after it.
+TEST(SpindleProgram, BenchSerialFirst_PrintsTheFirstStepsSerialTimeAndParts) {
+    const Result r = spindle("bench pyramid --threads 2 --steps 3 --serial-first", true);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::vector<std::vector<std::string>> lines = word_lines(r.output);
+    ASSERT_GE(lines.size(), 2u) << r.output;
+    const std::vector<std::string>& summary = lines[1];
+    ASSERT_EQ(summary.size(), 4u) << r.output;
+    const double traced = field(summary, "first_step_traced_ms");
+    const double serial = field(summary, "first_step_serial_ms");
+    const double code = field(summary, "first_step_serial_code_ms");
+    EXPECT_GT(traced, 0.0);
+    EXPECT_LE(traced, field(lines[0], "first_step_ms") + 1e-3);  // the stages lie inside the timed step
+    EXPECT_GT(serial, 0.0);                                      // at least the stages' own code between jobs
+    EXPECT_LE(serial, traced + 1e-3);
+    EXPECT_NEAR(field(summary, "first_step_serial_fraction"), serial / traced, 1e-3);
+    EXPECT_GT(code, 0.0);
+    EXPECT_LE(code, serial + 1e-3);
+    EXPECT_LE(serial_parts(lines, "first_step_part", "ms", 1.0, r.output), serial + 1e-2) << r.output;
+
+    const Result one = spindle("bench pyramid --threads 1 --serial-first");
+    EXPECT_EQ(one.exit_code, 2) << one.output;
+    expect_contains(one.output, "--serial-first needs --threads 2 or more");
+    // With --serial too, the steps after the first are traced and reported as before.
+    const Result both = spindle("bench pyramid --threads 2 --steps 4 --serial-first --serial", true);
+    ASSERT_EQ(both.exit_code, 0) << both.output;
+    expect_contains(both.output, "first_step_serial_ms=");
+    expect_contains(both.output, "traced_steps=3 ");
 }
 
 TEST(SpindleProgram, BenchStages_PrintsMillisecondsPerStage) {

@@ -281,7 +281,10 @@ void block_pair(World& world, const Joint& j, int delta) {
     if (delta > 0) {
         pairs[key] += 1;
         // A contact made before the joint would otherwise live until the bounds separate.
-        if (const std::uint32_t* position = world.contact_index.find(key)) remove_contacts(world, {*position});
+        if (const std::uint32_t* found = world.contact_index.find(key)) {
+            const std::uint32_t position = *found;  // a copy: the removal moves the index's slots
+            remove_contacts(world, {&position, 1});
+        }
     } else if (auto it = pairs.find(key); it != pairs.end() && --it->second == 0) {
         pairs.erase(it);
     }

@@ -111,7 +111,7 @@ namespace {
 // `involves` accepts, waking both bodies of each first: what rested on the other may fall.
 template <typename Involves>
 void remove_filtered_contacts(World& world, Involves&& involves) {
-    std::vector<std::uint32_t>& filtered = world.scratch_lost;
+    RawRoomVector<std::uint32_t>& filtered = world.scratch_lost;
     filtered.clear();
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         const std::uint64_t key = world.contact_keys[c];
@@ -155,10 +155,10 @@ constexpr std::uint32_t kContactGrain = 1024;
 // Runs keep(k, out) -> bool over [0, n) in parallel ranges of `grain`, each range writing
 // what it keeps to out from its own first index on; then closes the ranges up, in range
 // order. `out` holds the kept values in index order, the same for any number of workers.
-template <typename T, typename Keep>
+template <typename T, typename Allocator, typename Keep>
 void select_in_order(JobSystem& jobs, const char* name, std::uint32_t n, std::uint32_t grain,
-                     std::vector<std::uint32_t>& counts, std::vector<T>& out, Keep&& keep) {
-    out.resize(n);
+                     std::vector<std::uint32_t>& counts, std::vector<T, Allocator>& out, Keep&& keep) {
+    out.resize(n);  // on raw room (RawRoomVector) left as it is: only kept values are read
     counts.assign((n + grain - 1) / grain, 0);
     jobs.parallel_for(name, 0, n, grain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         std::uint32_t kept = 0;
@@ -200,7 +200,7 @@ void make_contacts(World& world, BroadphaseState& bp) {
 
 // The awake contacts (positions ascending) whose fat boxes stopped overlapping; only a
 // refitted box can have.
-void find_lost_contacts(World& world, BroadphaseState& bp, std::vector<std::uint32_t>& lost) {
+void find_lost_contacts(World& world, BroadphaseState& bp, RawRoomVector<std::uint32_t>& lost) {
     const std::vector<std::uint32_t>& awake = awake_contacts(world);
     select_in_order(*world.jobs, "LostPairs", static_cast<std::uint32_t>(awake.size()), kContactGrain, bp.range_counts,
                     lost, [&](std::uint32_t k, std::uint32_t& position) {
@@ -270,7 +270,7 @@ void update_broadphase(World& world, Real dt) {
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
     // can have stopped overlapping.
-    std::vector<std::uint32_t>& lost = world.scratch_lost;
+    RawRoomVector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
     const bool moves_marked = marked.load(std::memory_order_relaxed) != 0;
     if (!bp.refit_slots.empty() || moves_marked) find_lost_contacts(world, bp, lost);

@@ -70,11 +70,13 @@ struct BroadphaseState {
     // Scratch, per awake body: 1 when this step's move set its refit mark (those marks are
     // not in refit_slots: the stage clears them through this).
     std::vector<std::uint8_t> refit_marked;
-    std::vector<ProxyId> moved_ids;            // scratch, per awake body: its proxy where it moves, else invalid
-    RawRoomVector<Aabb> moved_boxes;           // scratch, per awake body: its new fat box where it moves
-    std::vector<std::uint64_t> new_keys;       // scratch: keys of the new pairs that may make contacts
-    std::vector<std::uint32_t> range_counts;   // scratch: values kept per job range (broadphase.cpp, create_contacts)
-    std::vector<std::uint32_t> claimed_slots;  // scratch: per new key, the index slot it claimed (create_contacts)
+    std::vector<ProxyId> moved_ids;   // scratch, per awake body: its proxy where it moves, else invalid
+    RawRoomVector<Aabb> moved_boxes;  // scratch, per awake body: its new fat box where it moves
+    // Scratch on raw room: the jobs after each growing resize write what is read (a first
+    // step's tens of thousands, not value-initialised by the resizing thread first).
+    RawRoomVector<std::uint64_t> new_keys;       // keys of the new pairs that may make contacts
+    std::vector<std::uint32_t> range_counts;     // values kept per job range (broadphase.cpp, create_contacts)
+    RawRoomVector<std::uint32_t> claimed_slots;  // per new key, the index slot it claimed (create_contacts)
     CompoundPartBoxes part_boxes;
 };
 
@@ -113,6 +115,6 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys);
 void fit_contacts(World& world);
 // Removes contacts by their positions in world.contacts (ascending); the kept contacts
 // past the new end take the removed places below it, in order (the rest stay in place).
-void remove_contacts(World& world, const std::vector<std::uint32_t>& positions);
+void remove_contacts(World& world, std::span<const std::uint32_t> positions);
 
 }  // namespace spindle

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <new>
 #include <numeric>
+#include <span>
 #include <utility>
 
 #include "collision/collide.hpp"
@@ -40,7 +41,7 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
 // without reading the records. Every position at or past `size` (the new count) was either
 // removed or moved; the moves are in ascending order of both ends, so the awake ones among
 // them are gathered in order of their new places and merged in.
-void drop_from_awake_list(std::vector<std::uint32_t>& awake, const std::vector<std::uint32_t>& removed,
+void drop_from_awake_list(std::vector<std::uint32_t>& awake, std::span<const std::uint32_t> removed,
                           const std::vector<ContactMove>& moves, std::uint32_t size,
                           std::vector<std::uint32_t>& moved_awake) {
     moved_awake.clear();
@@ -88,7 +89,7 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     index.reserve(first + keys.size(), world.jobs);
     BroadphaseState& bp = *world.broadphase;
     const auto n = static_cast<std::uint32_t>(keys.size());
-    std::vector<std::uint32_t>& claimed = bp.claimed_slots;
+    RawRoomVector<std::uint32_t>& claimed = bp.claimed_slots;  // raw room: every key's claim is written below
     std::vector<std::uint32_t>& offsets = bp.range_counts;
     claimed.resize(n);
     offsets.assign((n + kClaimGrain - 1) / kClaimGrain, 0);
@@ -104,9 +105,9 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     for (std::uint32_t& offset : offsets) made_count += std::exchange(offset, made_count);
     if (made_count == 0) return;
     index.add_claimed(made_count);
-    std::vector<std::uint64_t>& made = world.contact_keys;
+    RawRoomVector<std::uint64_t>& made = world.contact_keys;
     reserve_for(made, first + keys.size());  // 8 bytes a key: the pairs found again are not worth a second pass
-    made.resize(first + made_count);
+    made.resize(first + made_count);         // raw room: each new key is written by PlaceKeys
     world.jobs->parallel_for("PlaceKeys", 0, n, kClaimGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         auto position = static_cast<std::uint32_t>(first + offsets[lo / kClaimGrain]);
         for (std::uint32_t k = lo; k < hi; ++k) {
@@ -119,8 +120,8 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
     reserve_for(world.contacts, end);
     reserve_for(world.contact_summaries, end);
     map_room(*world.jobs, world.contacts, end);
-    world.contacts.resize(end);  // in place, all at once, constructed by the jobs below: the record is large
-    world.contact_summaries.resize(end);
+    world.contacts.resize(end);           // in place, all at once, constructed by the jobs below: the record is large
+    world.contact_summaries.resize(end);  // raw room, as the records: written by the jobs below
 
     // The records are constructed and filled from the bodies' descriptions (cold: a first
     // step reads tens of thousands) in parallel; each job writes only its own contacts.
@@ -163,7 +164,7 @@ const std::vector<std::uint32_t>& awake_contacts(World& world) {
     return world.awake_contact_list;
 }
 
-void remove_contacts(World& world, const std::vector<std::uint32_t>& positions) {
+void remove_contacts(World& world, std::span<const std::uint32_t> positions) {
     if (positions.empty()) return;
     // Only a reporting contact has a touch to end: while none reports, no record is read.
     if (world.events->reporting != 0) {

@@ -36,10 +36,16 @@ struct ContactList {
     bool operator==(const ContactList&) const = default;
 };
 
+// A raw-room array's values, as a plain vector to compare.
+template <typename T, typename A>
+std::vector<T> values(const std::vector<T, A>& v) {
+    return std::vector<T>(v.begin(), v.end());
+}
+
 ContactList contact_list(const World& world) {
     ContactList list;
-    list.keys = world.contact_keys;
-    list.summaries = world.contact_summaries;
+    list.keys = values(world.contact_keys);
+    list.summaries = values(world.contact_summaries);
     for (const Contact& c : world.contacts) {
         list.friction.push_back(c.friction);
         list.restitution.push_back(c.restitution);
@@ -268,7 +274,7 @@ TEST(BroadphaseContacts, AwakeListKeptUpToDate_EqualsARebuild) {
 std::vector<std::uint64_t> make_and_remove_every_contact(Block& block) {
     World& world = SpaceInternals::world(block.space);
     block.space.update();
-    const std::vector<std::uint64_t> keys = world.contact_keys;
+    const std::vector<std::uint64_t> keys = values(world.contact_keys);
     std::vector<std::uint32_t> all(keys.size());
     std::iota(all.begin(), all.end(), 0u);
     remove_contacts(world, all);
@@ -292,9 +298,20 @@ TEST(BroadphaseContacts, ContactsMadeFromNone_AreTheAwakeListInOrder) {
     EXPECT_EQ(world.awake_contact_list, all);
 }
 
+// Fills the room of a raw-room array (grown to hold n, then shrunk to none, its bytes left)
+// with `byte`: what a growing resize then leaves unwritten keeps it.
+template <typename T>
+void fill_room(RawRoomVector<T>& v, std::size_t n, unsigned char byte) {
+    v.resize(n);
+    std::memset(static_cast<void*>(v.data()), byte, n * sizeof(T));
+    v.clear();
+}
+
 // The contact array's growth leaves the new records to create_contacts' jobs, which
 // construct each in place: records made into room full of 0xff bytes (a removed pile's
 // leftovers) are new records, no manifold, no extra, not asleep, with their pair's materials.
+// The keys, the summaries and the claimed index slots are raw room too, grown into 0xff and
+// 0x5a bytes here: each new key and summary is written, none read before.
 TEST(BroadphaseContacts, ContactsMadeIntoDirtyRoom_AreNewRecords) {
     SingleThreadedJobSystem jobs;
     Block block(jobs);
@@ -302,10 +319,15 @@ TEST(BroadphaseContacts, ContactsMadeIntoDirtyRoom_AreNewRecords) {
     const std::vector<std::uint64_t> keys = make_and_remove_every_contact(block);
     ASSERT_GE(world.contacts.capacity(), keys.size());
     std::memset(static_cast<void*>(world.contacts.data()), 0xff, keys.size() * sizeof(Contact));
+    fill_room(world.contact_keys, keys.size(), 0xff);
+    fill_room(world.contact_summaries, keys.size(), 0x5a);
+    fill_room(world.broadphase->claimed_slots, keys.size(), 0x5a);
     create_contacts(world, keys);
-    ASSERT_EQ(world.contact_keys, keys);
+    ASSERT_EQ(values(world.contact_keys), keys);
+    ASSERT_EQ(world.contact_summaries.size(), keys.size());
     for (std::uint32_t c = 0; c < world.contacts.size(); ++c) {
         const Contact& contact = world.contacts[c];
+        ASSERT_EQ(world.contact_summaries[c], contact_summary(contact)) << "contact " << c;
         ASSERT_EQ(contact.manifold_count, 0) << "contact " << c;
         ASSERT_TRUE(contact.extra == nullptr);
         ASSERT_FALSE(contact.sleeping);
@@ -346,7 +368,7 @@ TEST(BroadphaseContacts, RemovedContacts_TheLastContactsFillTheirPlaces) {
     for (std::uint32_t c = 7; c + 2 < count; c += 5) removed.push_back(c);
     removed.push_back(count - 2);
     removed.push_back(count - 1);
-    std::vector<std::uint64_t> expected = world.contact_keys, removed_keys;
+    std::vector<std::uint64_t> expected = values(world.contact_keys), removed_keys;
     for (std::uint32_t p : removed) removed_keys.push_back(expected[p]);
     std::set<std::uint64_t> sleeping;
     for (std::uint32_t c = 0; c < count; ++c) {
@@ -364,7 +386,7 @@ TEST(BroadphaseContacts, RemovedContacts_TheLastContactsFillTheirPlaces) {
     expected.resize(size);
     remove_contacts(world, removed);
 
-    ASSERT_EQ(world.contact_keys, expected);
+    ASSERT_EQ(values(world.contact_keys), expected);
     ASSERT_EQ(world.contacts.size(), expected.size());
     ContactIndex index = world.contact_index;
     std::set<std::uint64_t> still_sleeping;
@@ -427,11 +449,11 @@ std::vector<std::vector<std::uint64_t>> run_sphere_block(JobSystem& jobs) {
     };
     space.update();
     check_index();
-    lists.push_back(world.contact_keys);
+    lists.push_back(values(world.contact_keys));
     for (std::size_t k = 0; k < top.size(); ++k) space.set_position(top[k], Vec3(0, 100 + 3 * Real(k), 0));
     space.update();
     check_index();
-    lists.push_back(world.contact_keys);
+    lists.push_back(values(world.contact_keys));
     return lists;
 }
 
