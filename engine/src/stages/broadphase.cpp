@@ -36,10 +36,16 @@ Aabb reach_box(const BroadphaseState& bp, const Aabb& bounds, bool is_static) {
     return is_static ? bounds : bounds.fattened(bp.rule.speculative);
 }
 
+// The displacement a proxy's fat box stretches along (FatBoxRule::stretched).
+Vec3 stretch_of(const BroadphaseState& bp, ProxyId proxy, const Vec3& displacement) {
+    return bp.rule.stretched(displacement, bp.tree.margin(proxy));
+}
+
 // Moves a body's proxy (its ancestors grown at once).
 void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
     const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
-    bp.tree.move_proxy(bp.proxy[slot], reach_box(bp, box, bp.proxy[slot].is_static()), displacement);
+    bp.tree.move_proxy(bp.proxy[slot], reach_box(bp, box, bp.proxy[slot].is_static()),
+                       stretch_of(bp, bp.proxy[slot], displacement));
     note_fat_change(bp, slot, before, bp.tree.fat_aabb(bp.proxy[slot]));
 }
 
@@ -87,11 +93,12 @@ void FatBoxRule::check() const {
     require(speculative, "speculative");
     require(max_margin, "max_margin");
     require(margin_fraction, "margin_fraction");
+    require(stretch, "stretch");
 }
 
-// Box3D's rule has no stretch along the motion (see FatBoxRule).
+// The trees stretch the displacements they are given; the stage gives a slow body's as none.
 BroadphaseState::BroadphaseState(const FatBoxRule& fat_rule)
-    : rule((fat_rule.check(), fat_rule)), tree(BroadphaseSettings{.displacement_multiplier = 0}) {}
+    : rule((fat_rule.check(), fat_rule)), tree(BroadphaseSettings{.displacement_multiplier = fat_rule.stretch}) {}
 
 void CompoundPartBoxes::add(const Bodies& bodies, std::uint32_t slot) {
     if (bodies.traits[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
@@ -291,8 +298,9 @@ void update_broadphase(World& world, Real dt) {
             const Aabb swept = reach_box(bp, swept_bounds(b, i, d), bp.proxy[i].is_static());
             bp.refit_marked[k] = 0;
             bp.moved_ids[k] = ProxyId{};
-            if (!bp.tree.needs_move(bp.proxy[i], swept, d)) continue;
-            const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, d);
+            const Vec3 stretch = stretch_of(bp, bp.proxy[i], d);
+            if (!bp.tree.needs_move(bp.proxy[i], swept, stretch)) continue;
+            const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, stretch);
             bp.moved_ids[k] = bp.proxy[i];
             bp.moved_boxes[k] = fat;
             // note_fat_change, for this job's own bodies (a slot is marked by one job).

@@ -1,8 +1,8 @@
 // The broadphase's fat box rule (Box3D's; stages/broadphase_state.hpp FatBoxRule): a moving
 // body's fat box is its bounds grown by the speculative distance and its shape's own margin
 // (an eighth of its radius, at most 5 cm), a static body's is its bounds; a bad rule is
-// refused naming the field; and a fast body closing on another still gets its contact
-// before they meet, though no box reaches ahead of it.
+// refused naming the field; a slow body's box is not stretched along its motion, a fast
+// one's is; and a fast body closing on another still gets its contact before they meet.
 #include <spindle/engine/space.hpp>
 
 #include <gtest/gtest.h>
@@ -85,13 +85,61 @@ TEST(FatBoxRule, BadRule_IsRefusedNamingTheField) {
     refused(FatBoxRule{.max_margin = -1}, "max_margin");
     refused(FatBoxRule{.max_margin = std::numeric_limits<Real>::infinity()}, "max_margin");
     refused(FatBoxRule{.margin_fraction = -0.125}, "margin_fraction");
-    EXPECT_NO_THROW(BroadphaseState(FatBoxRule{.speculative = 0, .max_margin = 0, .margin_fraction = 0}));
+    refused(FatBoxRule{.stretch = -2}, "stretch");
+    refused(FatBoxRule{.stretch = std::numeric_limits<Real>::infinity()}, "stretch");
+    EXPECT_NO_THROW(BroadphaseState(FatBoxRule{.speculative = 0, .max_margin = 0, .margin_fraction = 0, .stretch = 0}));
+}
+
+// Two 1 m cubes (margin 5 cm) gliding along x without gravity: one at 1 m/s (1.7 cm a step,
+// under its margin), one at 12 m/s (20 cm a step). Each time a box is made again it is the
+// bounds swept over the step and grown by the speculative distance and the margin; the slow
+// cube's is not stretched (a tight box), the fast cube's reaches two displacements further
+// ahead, so it is made again every few steps, not every step.
+TEST(FatBoxRule, SlowBodysBoxIsTight_FastBodysIsStretchedAndLastsSteps) {
+    Space space;
+    space.set_gravity(Vec3::Zero());
+    const Real speeds[] = {1, 12};
+    for (int k = 0; k < 2; ++k) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3::Constant(0.5));
+        d.position = Vec3(0, 0, 4.0 * k);
+        d.linear_velocity = Vec3(speeds[k], 0, 0);
+        space.create_body(d);
+    }
+    const World& world = SpaceInternals::world(space);
+    const BroadphaseState& bp = *world.broadphase;
+    const Real dt = TimeStepSettings{}.duration;
+    const int steps = 60;
+    for (int k = 0; k < 2; ++k) {
+        const auto slot = static_cast<std::size_t>(k);
+        const Real ahead = k == 0 ? 0 : 2 * speeds[k] * dt;  // the stretch along the motion
+        int made = 0;
+        Aabb fat = bp.tree.fat_aabb(bp.proxy[slot]);
+        for (int step = 0; step < steps; ++step) {
+            space.update();
+            if (same_box(bp.tree.fat_aabb(bp.proxy[slot]), fat, 0)) continue;
+            fat = bp.tree.fat_aabb(bp.proxy[slot]);
+            ++made;
+            Aabb expected = world.bodies.bounds[slot];  // this step's, before it moved
+            expected.max.x() += speeds[k] * dt;         // swept over the step
+            expected = expected.fattened(0.02 + 0.05);
+            expected.max.x() += ahead;
+            EXPECT_TRUE(same_box(fat, expected, 1e-9))
+                << "speed " << speeds[k] << ", step " << step << ": fat box x " << fat.min.x() << ".." << fat.max.x()
+                << ", expected " << expected.min.x() << ".." << expected.max.x();
+        }
+        EXPECT_GE(made, 3) << "speed " << speeds[k] << ": the box was never made again";
+        if (k == 1) {
+            EXPECT_LE(made, steps / 2) << "the fast cube's box was made again " << made << " times in " << steps;
+        }
+    }
 }
 
 // A 20 cm cube at 30 m/s (half a metre a step) head on into a resting 50 cm cube, no
-// gravity. Its fat box reaches 4 cm ahead of it, so only the bounds swept over the step
-// find the pair in the step before they meet; a pair found later leaves the cube a step
-// deep in the other. Continuous does not help: it sweeps against static geometry only.
+// gravity. Its first fat box reaches 4 cm ahead of it; the bounds swept over the step
+// and the fast body's stretch must find the pair in the step before they meet; a pair
+// found later leaves the cube a step deep in the other. Continuous does not help: it
+// sweeps against static geometry only.
 TEST(FatBoxRule, FastCubeClosingOnAnother_GetsItsContactBeforeTheyMeet) {
     for (const Real start : {-3.0, -3.013, -3.031, -3.047}) {  // each meets at another point of a step
         Space space;
