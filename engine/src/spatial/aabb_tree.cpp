@@ -61,8 +61,8 @@ void DynamicAabbTree::free_node(std::int32_t id) {
     ++m_free_count;
 }
 
-Aabb DynamicAabbTree::fatten(const Aabb& tight, const Vec3& displacement) const {
-    Aabb fat = tight.fattened(m_settings.margin);
+Aabb DynamicAabbTree::fatten(const Aabb& tight, const Vec3& displacement, Real margin) const {
+    Aabb fat = tight.fattened(margin);
     const Vec3 d = displacement * m_settings.displacement_multiplier;
     for (int k = 0; k < 3; ++k) {
         if (d[k] < 0) {
@@ -74,11 +74,12 @@ Aabb DynamicAabbTree::fatten(const Aabb& tight, const Vec3& displacement) const 
     return fat;
 }
 
-std::int32_t DynamicAabbTree::create_proxy(const Aabb& tight, std::uint64_t user) {
+std::int32_t DynamicAabbTree::create_proxy(const Aabb& tight, std::uint64_t user, Real margin) {
     SPINDLE_ASSERT(is_finite_box(tight), "DynamicAabbTree::create_proxy: box must be finite with min <= max");
+    SPINDLE_ASSERT(margin >= 0 && is_finite(margin), "DynamicAabbTree::create_proxy: margin must be finite and >= 0");
     const std::int32_t id = allocate_node();
     Node& node = m_nodes[static_cast<std::size_t>(id)];
-    node.box = fatten(tight, Vec3::Zero());
+    node.box = fatten(tight, Vec3::Zero(), margin);
     node.payload.user = user;
     node.height = 0;
     insert_leaf(id);
@@ -117,7 +118,7 @@ void DynamicAabbTree::create_proxies(std::span<const Aabb> tight, std::span<cons
     for (std::size_t k = 0; k < tight.size(); ++k) {
         const std::int32_t id = allocate_node();
         Node& node = m_nodes[static_cast<std::size_t>(id)];
-        node.box = fatten(tight[k], Vec3::Zero());
+        node.box = fatten(tight[k], Vec3::Zero(), m_settings.margin);
         node.payload.user = user[k];
         ids[k] = id;
         m_build_leaves.push_back(id);
@@ -145,23 +146,24 @@ void DynamicAabbTree::destroy_proxy(std::int32_t id) {
     validate_if_enabled();
 }
 
-bool DynamicAabbTree::needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const {
+bool DynamicAabbTree::needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement, Real margin) const {
     check_proxy(id);
     const Aabb& box = m_nodes[static_cast<std::size_t>(id)].box;
     if (!box.contains(tight)) return true;
     // Keep the old fat box unless it is far bigger than wanted (a fast body slowed
     // down): the slack scales with the motion so a steadily moving body re-inserts
     // only when it leaves its box, not every step.
-    const Real slack = 4 * m_settings.margin + m_settings.displacement_multiplier * displacement.cwiseAbs().maxCoeff();
-    return !fatten(tight, displacement).fattened(slack).contains(box);
+    const Real slack = 4 * margin + m_settings.displacement_multiplier * displacement.cwiseAbs().maxCoeff();
+    return !fatten(tight, displacement, margin).fattened(slack).contains(box);
 }
 
-bool DynamicAabbTree::move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement) {
+bool DynamicAabbTree::move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement, Real margin) {
     check_proxy(id);
     SPINDLE_ASSERT(is_finite_box(tight) && is_finite(displacement),
                    "DynamicAabbTree::move_proxy: box and displacement must be finite");
-    if (!needs_move(id, tight, displacement)) return false;
-    m_nodes[static_cast<std::size_t>(id)].box = fatten(tight, displacement);
+    SPINDLE_ASSERT(margin >= 0 && is_finite(margin), "DynamicAabbTree::move_proxy: margin must be finite and >= 0");
+    if (!needs_move(id, tight, displacement, margin)) return false;
+    m_nodes[static_cast<std::size_t>(id)].box = fatten(tight, displacement, margin);
     enlarge_ancestors(id);
     validate_if_enabled();
     return true;

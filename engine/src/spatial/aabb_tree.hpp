@@ -34,8 +34,12 @@ public:
 
     explicit DynamicAabbTree(AabbTreeSettings settings = {});
 
-    // Adds a proxy whose fat box is `tight` grown by the margin. Returns its id.
-    std::int32_t create_proxy(const Aabb& tight, std::uint64_t user);
+    // Adds a proxy whose fat box is `tight` grown by the margin (the settings' or, given,
+    // its own). Returns its id.
+    std::int32_t create_proxy(const Aabb& tight, std::uint64_t user) {
+        return create_proxy(tight, user, m_settings.margin);
+    }
+    std::int32_t create_proxy(const Aabb& tight, std::uint64_t user, Real margin);
     // Adds many proxies at once: one for tight[k] (grown by the margin) with user[k], its
     // id written to ids[k]. The whole tree, old proxies and new, is then built top down
     // with rebuild()'s binned SAH, its lower parts as jobs when `jobs` is given (the same
@@ -52,12 +56,24 @@ public:
     // where it is: its ancestors grow to hold the new box and are flagged for
     // rebuild_enlarged(), which a caller moving a batch of proxies calls once after them
     // (queries stay exact before it, only slower).
-    bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement);
+    // Each of these takes the proxy's margin, or the settings' when none is given.
+    bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement) {
+        return move_proxy(id, tight, displacement, m_settings.margin);
+    }
+    bool move_proxy(std::int32_t id, const Aabb& tight, const Vec3& displacement, Real margin);
     // Whether move_proxy(id, tight, displacement) would re-insert the proxy. Const: may
     // run on many threads at once while nothing writes.
-    bool needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const;
+    bool needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement) const {
+        return needs_move(id, tight, displacement, m_settings.margin);
+    }
+    bool needs_move(std::int32_t id, const Aabb& tight, const Vec3& displacement, Real margin) const;
     // The fat box move_proxy gives a proxy whose tight box is `tight`. Const.
-    Aabb fat_box(const Aabb& tight, const Vec3& displacement) const { return fatten(tight, displacement); }
+    Aabb fat_box(const Aabb& tight, const Vec3& displacement) const {
+        return fatten(tight, displacement, m_settings.margin);
+    }
+    Aabb fat_box(const Aabb& tight, const Vec3& displacement, Real margin) const {
+        return fatten(tight, displacement, margin);
+    }
     // Gives a proxy a new fat box (from fat_box()) and flags its ancestors without growing
     // them: for a caller that moves many proxies and then calls rebuild_enlarged(), which
     // makes every flagged node's box from its children, so growing them move by move
@@ -162,7 +178,7 @@ private:
     void traverse(Enter&& enter, OnLeaf&& on_leaf) const;
     std::int32_t allocate_node();
     void free_node(std::int32_t id);
-    Aabb fatten(const Aabb& tight, const Vec3& displacement) const;
+    Aabb fatten(const Aabb& tight, const Vec3& displacement, Real margin) const;
     std::int32_t find_best_sibling(const Aabb& box) const;
     void insert_leaf(std::int32_t leaf);
     void remove_leaf(std::int32_t leaf);

@@ -33,9 +33,16 @@ ProxyTrees::ProxyTrees(BroadphaseSettings settings)
     if (m_settings.grain == 0) m_settings.grain = 1;
 }
 
-ProxyId ProxyTrees::create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static) {
-    const std::int32_t tree_id = m_trees[is_static ? 1 : 0].create_proxy(aabb, user);
+ProxyId ProxyTrees::create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static, Real margin) {
+    SPINDLE_ASSERT(margin >= 0 && is_finite(margin), "ProxyTrees::create_proxy: margin must be finite and >= 0");
+    const std::int32_t tree_id = is_static ? m_trees[1].create_proxy(aabb, user)
+                                           : m_trees[0].create_proxy(aabb, user, margin);
     const ProxyId id = ProxyId::make(tree_id, is_static);
+    if (!is_static) {
+        if (m_margins.size() <= static_cast<std::size_t>(tree_id))
+            m_margins.resize(static_cast<std::size_t>(tree_id) + 1);
+        m_margins[static_cast<std::size_t>(tree_id)] = margin;
+    }
     std::vector<std::int32_t>& slots = slots_of(id);
     if (slots.size() <= static_cast<std::size_t>(tree_id)) slots.resize(static_cast<std::size_t>(tree_id) + 1, -1);
     mark_enlarged(id);
@@ -52,7 +59,7 @@ void ProxyTrees::destroy_proxy(ProxyId id) {
 bool ProxyTrees::move_proxy(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) {
     DynamicAabbTree& tree = tree_of(id);
     const Aabb old_fat = tree.fat_aabb(id.tree_id());
-    if (!tree.move_proxy(id.tree_id(), tight_aabb, displacement)) return false;
+    if (!tree.move_proxy(id.tree_id(), tight_aabb, displacement, margin(id))) return false;
     // A re-insert that only shrank the box (a body slowed down) cannot create pairs.
     if (old_fat.contains(tree.fat_aabb(id.tree_id()))) return false;
     mark_enlarged(id);
@@ -243,7 +250,8 @@ std::size_t ProxyTrees::heap_bytes() const noexcept {
                         (m_enlarged_slot[0].capacity() + m_enlarged_slot[1].capacity()) * sizeof(std::int32_t) +
                         m_chunk_pairs.capacity() * sizeof(std::vector<Pair>) +
                         m_run_starts.capacity() * sizeof(std::size_t) + m_merged_pairs.capacity() * sizeof(Pair) +
-                        m_fat_ranges.capacity() * sizeof(FatBoxRange) + m_grown.capacity();
+                        m_fat_ranges.capacity() * sizeof(FatBoxRange) + m_grown.capacity() +
+                        m_margins.capacity() * sizeof(Real);
     for (const std::vector<Pair>& pairs : m_chunk_pairs) bytes += pairs.capacity() * sizeof(Pair);
     return bytes;
 }

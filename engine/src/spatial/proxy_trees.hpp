@@ -54,7 +54,8 @@ struct Pair {
 using PairList = RawRoomVector<Pair>;
 
 struct BroadphaseSettings {
-    // Fat box margin of moving proxies (metres). Static proxies get none: they rarely move.
+    // Fat box margin of moving proxies created without one of their own (metres). Static
+    // proxies get none: they rarely move.
     Real margin = Real(0.1);
     // Moving fat boxes stretch this many displacements ahead (see AabbTreeSettings).
     Real displacement_multiplier = Real(2);
@@ -71,8 +72,13 @@ public:
     explicit ProxyTrees(BroadphaseSettings settings = {});
 
     // Adds a proxy (static: the static tree, else the moving tree) and marks it enlarged,
-    // so its pairs are found at the next update_pairs.
-    ProxyId create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static);
+    // so its pairs are found at the next update_pairs. A moving proxy's fat boxes are its
+    // tight boxes grown by `margin` (its own for its life), else by the settings' margin;
+    // a static proxy's by none. The margin must be finite and >= 0.
+    ProxyId create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static) {
+        return create_proxy(aabb, user, is_static, m_settings.margin);
+    }
+    ProxyId create_proxy(const Aabb& aabb, std::uint64_t user, bool is_static, Real margin);
     void destroy_proxy(ProxyId id);
     // Marks a proxy enlarged without moving it, so that the next update_pairs reports
     // every pair it overlaps again (its collision filter changed).
@@ -83,11 +89,15 @@ public:
     // Whether move_proxy would change the proxy's fat box (const: any number of threads
     // while nothing writes), so callers can test many proxies in parallel and move few.
     bool needs_move(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
-        return tree_of(id).needs_move(id.tree_id(), tight_aabb, displacement);
+        return tree_of(id).needs_move(id.tree_id(), tight_aabb, displacement, margin(id));
     }
     // The fat box move_proxy would give the proxy (when needs_move says it moves). Const.
     Aabb fat_box(ProxyId id, const Aabb& tight_aabb, const Vec3& displacement) const {
-        return tree_of(id).fat_box(tight_aabb, displacement);
+        return tree_of(id).fat_box(tight_aabb, displacement, margin(id));
+    }
+    // The proxy's fat box margin (0 for a static proxy).
+    Real margin(ProxyId id) const {
+        return id.is_static() ? Real(0) : m_margins[static_cast<std::size_t>(id.tree_id())];
     }
     // Gives the proxy a fat box from fat_box() and marks it enlarged when the box grew, as
     // move_proxy does, but leaves the trees' inner boxes to update_pairs' rebuild: for the
@@ -156,6 +166,8 @@ private:
         return m_trees[id.is_static() ? 1 : 0];
     }
     std::vector<std::int32_t>& slots_of(ProxyId id) { return m_enlarged_slot[id.is_static() ? 1 : 0]; }
+    // Per moving tree id: the proxy's margin (create_proxy).
+    std::vector<Real> m_margins;
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
     void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;

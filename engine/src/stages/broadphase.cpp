@@ -2,8 +2,11 @@
 // -> contacts, contacts whose fat bounds separated -> removed.
 #include <algorithm>
 #include <atomic>
+#include <stdexcept>
+#include <string>
 
 #include "collision/compound.hpp"
+#include "collision/convex_hull.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/stages.hpp"
 
@@ -27,10 +30,22 @@ void note_fat_change(BroadphaseState& bp, std::uint32_t slot, const Aabb& before
     if (after.min != before.min || after.max != before.max) mark_refit(bp, slot);
 }
 
+// The box a body's proxy must hold: its bounds (swept or not) grown by the speculative
+// distance where the body can move.
+Aabb reach_box(const BroadphaseState& bp, const Aabb& bounds, bool is_static) {
+    return is_static ? bounds : bounds.fattened(bp.rule.speculative);
+}
+
+// The displacement a proxy's fat box stretches along (FatBoxRule::stretched).
+Vec3 stretch_of(const BroadphaseState& bp, ProxyId proxy, const Vec3& displacement) {
+    return bp.rule.stretched(displacement, bp.tree.margin(proxy));
+}
+
 // Moves a body's proxy (its ancestors grown at once).
 void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
     const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
-    bp.tree.move_proxy(bp.proxy[slot], box, displacement);
+    bp.tree.move_proxy(bp.proxy[slot], reach_box(bp, box, bp.proxy[slot].is_static()),
+                       stretch_of(bp, bp.proxy[slot], displacement));
     note_fat_change(bp, slot, before, bp.tree.fat_aabb(bp.proxy[slot]));
 }
 
@@ -45,6 +60,45 @@ Aabb swept_bounds(const Bodies& b, std::uint32_t i, const Vec3& displacement) {
 }
 
 }  // namespace
+
+Real fat_box_radius(const Shape& shape) {
+    switch (shape.type) {
+        case ShapeType::Sphere: return shape.radius;
+        case ShapeType::Capsule: return shape.half_height + shape.radius;
+        case ShapeType::Box: return shape.half_extents.norm();
+        case ShapeType::ConvexHull: {
+            Real reach = 0;
+            for (const Vec3& v : shape.hull->vertices()) reach = std::max(reach, (v - shape.hull->centroid()).norm());
+            return reach;
+        }
+        case ShapeType::Compound: {
+            // One proxy for the whole body: the reach of its parts from the body's origin.
+            Real reach = 0;
+            for (const CompoundPart& part : shape.parts->parts()) {
+                reach = std::max(reach, part.position.norm() + fat_box_radius(part.shape));
+            }
+            return reach;
+        }
+        default: return kHuge;  // static only: never given a margin
+    }
+}
+
+void FatBoxRule::check() const {
+    const auto require = [](Real value, const char* name) {
+        if (!(value >= 0 && is_finite(value))) {
+            throw std::invalid_argument(std::string("broadphase fat box rule: ") + name +
+                                        " must be finite and >= 0, got " + std::to_string(value));
+        }
+    };
+    require(speculative, "speculative");
+    require(max_margin, "max_margin");
+    require(margin_fraction, "margin_fraction");
+    require(stretch, "stretch");
+}
+
+// The trees stretch the displacements they are given; the stage gives a slow body's as none.
+BroadphaseState::BroadphaseState(const FatBoxRule& fat_rule)
+    : rule((fat_rule.check(), fat_rule)), tree(BroadphaseSettings{.displacement_multiplier = fat_rule.stretch}) {}
 
 void CompoundPartBoxes::add(const Bodies& bodies, std::uint32_t slot) {
     if (bodies.traits[slot].shape.type != ShapeType::Compound || bodies.type[slot] == MotionType::Static) return;
@@ -89,7 +143,9 @@ void add_proxy(World& world, std::uint32_t slot) {
     const Bodies& b = world.bodies;
     if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
     if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
-    bp.proxy[slot] = bp.tree.create_proxy(b.bounds[slot], slot, b.type[slot] == MotionType::Static);
+    const bool is_static = b.type[slot] == MotionType::Static;
+    bp.proxy[slot] = bp.tree.create_proxy(reach_box(bp, b.bounds[slot], is_static), slot, is_static,
+                                          is_static ? Real(0) : bp.rule.margin(fat_box_radius(b.traits[slot].shape)));
     bp.part_boxes.add(b, slot);
     mark_refit(bp, slot);
 }
@@ -239,11 +295,12 @@ void update_broadphase(World& world, Real dt) {
                 b.bounds[i] = shape.bounds(b.transform(i));
             }
             const Vec3 d = b.v[i] * dt;
-            const Aabb swept = swept_bounds(b, i, d);
+            const Aabb swept = reach_box(bp, swept_bounds(b, i, d), bp.proxy[i].is_static());
             bp.refit_marked[k] = 0;
             bp.moved_ids[k] = ProxyId{};
-            if (!bp.tree.needs_move(bp.proxy[i], swept, d)) continue;
-            const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, d);
+            const Vec3 stretch = stretch_of(bp, bp.proxy[i], d);
+            if (!bp.tree.needs_move(bp.proxy[i], swept, stretch)) continue;
+            const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, stretch);
             bp.moved_ids[k] = bp.proxy[i];
             bp.moved_boxes[k] = fat;
             // note_fat_change, for this job's own bodies (a slot is marked by one job).

@@ -1,6 +1,7 @@
 // The broadphase stage's state and the body/contact bookkeeping it owns.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -59,7 +60,40 @@ private:
     std::vector<Aabb> m_boxes;
 };
 
+// Box3D's fat box rule (its shape.c b3UpdateShapeAABBs and b3ComputeShapeMargin, body.c's
+// finalize): a moving body's proxy must hold its bounds swept over the step's motion and
+// grown by `speculative`; when they leave it, its new fat box is those grown by the body's
+// margin, margin_fraction x its shape's radius (fat_box_radius), at most max_margin. A small
+// body gets a small box, so fewer pairs wait in the narrowphase. Static proxies hold their
+// bounds. The bounds are swept over the step already, so two bodies that would meet within
+// the step have their pair (and speculative contact) first. A slow body's box has no stretch
+// along the motion (Box3D has none); a fast one's, moving more than its margin a step, would
+// then leave its box every step and be re-inserted and searched again each time, so its box
+// reaches `stretch` displacements ahead and lasts a few steps.
+struct FatBoxRule {
+    Real speculative = Real(0.02);       // m: Box3D's speculative distance, 4 linear slops
+    Real max_margin = Real(0.05);        // m
+    Real margin_fraction = Real(0.125);  // of the shape's radius
+    Real stretch = Real(2);              // displacements ahead, for a body faster than its margin a step
+    // Throws std::invalid_argument naming the field when one is negative or not finite.
+    void check() const;
+    Real margin(Real radius) const { return std::min(max_margin, margin_fraction * radius); }
+    // The displacement a body's fat box stretches along (times `stretch`): its own when any
+    // axis of it passes the body's margin, else none.
+    Vec3 stretched(const Vec3& displacement, Real body_margin) const {
+        return displacement.cwiseAbs().maxCoeff() > body_margin ? displacement : Vec3::Zero();
+    }
+};
+
+// A shape's radius for FatBoxRule (Box3D's b3ComputeShapeMargin): a sphere's radius, a
+// capsule's half length and radius, a box's or hull's farthest vertex from its centre; a
+// compound has one proxy, so the farthest reach of its parts from the body's origin.
+// Huge for a static-only shape (never given a margin).
+Real fat_box_radius(const Shape& shape);
+
 struct BroadphaseState {
+    explicit BroadphaseState(const FatBoxRule& fat_rule = {});
+    FatBoxRule rule;
     ProxyTrees tree;             // moving and static AABB trees; proxy user value = body slot
     std::vector<ProxyId> proxy;  // per body slot
     PairList pairs;              // scratch: pairs found this step (kept: no allocation per step)

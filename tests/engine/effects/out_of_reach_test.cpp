@@ -24,9 +24,9 @@ BodyHandle add(Space& space, const Shape& shape, const Vec3& p, const Vec3& v = 
     return space.create_body(d);
 }
 
-// Surfaces 0.15 m apart: the fat boxes (0.1 m margin each) overlap, the speculative
-// distance (4 cm) is far short.
-constexpr Real kGap = 0.15;
+// Surfaces 0.1 m apart: the fat boxes (0.02 m speculative and a 0.05 m margin each) overlap,
+// the speculative distance (4 cm) is far short.
+constexpr Real kGap = 0.1;
 
 }  // namespace
 
@@ -86,7 +86,7 @@ TEST(OutOfReach, ReportingPairsAreRuledOutAlike) {
     d.contact_events = true;
     space.create_body(d);
     d.type = MotionType::Static;
-    d.position = Vec3(0.8 + 0.08, 0, 0);  // a static proxy is not fattened: closer, so the pair is found
+    d.position = Vec3(0.8 + 0.06, 0, 0);  // a static proxy is not fattened: closer, so the pair is found
     space.create_body(d);
     space.update();
     EXPECT_EQ(space.counters().contacts_updated, 1u);
