@@ -284,12 +284,12 @@ std::vector<std::vector<std::string>> word_lines(const std::string& output) {
     return lines;
 }
 
-// The serial part lines after bench's two lines: each `tag key=X ... name="..."`, X at
-// least `least` and no more than the line before; their sum.
-double serial_parts(const std::vector<std::vector<std::string>>& lines, const std::string& tag, const std::string& key,
-                    double least, const std::string& output) {
+// The serial part lines from line `first` on: each `tag key=X ... name="..."`, X at least
+// `least` and no more than the line before; their sum.
+double serial_parts(const std::vector<std::vector<std::string>>& lines, std::size_t first, const std::string& tag,
+                    const std::string& key, double least, const std::string& output) {
     double previous = 1e300, sum = 0;
-    for (std::size_t i = 2; i < lines.size(); ++i) {
+    for (std::size_t i = first; i < lines.size(); ++i) {
         const std::vector<std::string>& part = lines[i];
         if (part.empty()) {
             ADD_FAILURE() << "an empty line: " << output;
@@ -333,7 +333,24 @@ TEST(SpindleProgram, BenchSerial_PrintsTheSerialFractionAndItsParts) {
     const double code = field(summary, "serial_code_fraction");
     EXPECT_GT(code, 0.0);  // the stages' own code between jobs
     EXPECT_LE(code, field(summary, "all_steps_serial_fraction"));
-    EXPECT_LE(serial_parts(lines, "serial_part", "share", 0.02, r.output), serial + 1e-3) << r.output;
+    // The serial time by kind (each printed to four decimals) adds up to the serial fraction.
+    ASSERT_GE(lines.size(), 4u) << r.output;
+    const std::vector<std::string>& kinds = lines[2];
+    ASSERT_EQ(kinds.size(), 6u) << r.output;
+    EXPECT_EQ(kinds[0], "serial_kinds") << r.output;
+    double kinds_sum = 0;
+    for (const char* kind : {"phase_start", "phase_tail", "barrier", "stage_code", "lone_jobs"}) {
+        EXPECT_GE(field(kinds, kind), 0.0) << kind << ": " << r.output;
+        kinds_sum += field(kinds, kind);
+    }
+    EXPECT_NEAR(kinds_sum, serial, 5e-4) << r.output;
+    // The solver's phases a step, and the barriers after them: fewer when one-block phases
+    // share one (run_phases), never more.
+    const std::vector<std::string>& phases = lines[3];
+    EXPECT_GT(field(phases, "phases_per_step"), 0.0) << r.output;
+    EXPECT_GT(field(phases, "barriers_per_step"), 0.0) << r.output;
+    EXPECT_LE(field(phases, "barriers_per_step"), field(phases, "phases_per_step")) << r.output;
+    EXPECT_LE(serial_parts(lines, 4, "serial_part", "share", 0.02, r.output), serial + 1e-3) << r.output;
 
     const Result one = spindle("bench pyramid --threads 1 --serial");
     EXPECT_EQ(one.exit_code, 2) << one.output;
@@ -362,7 +379,7 @@ TEST(SpindleProgram, BenchSerialFirst_PrintsTheFirstStepsSerialTimeAndParts) {
     EXPECT_NEAR(field(summary, "first_step_serial_fraction"), serial / traced, 1e-3);
     EXPECT_GT(code, 0.0);
     EXPECT_LE(code, serial + 1e-3);
-    EXPECT_LE(serial_parts(lines, "first_step_part", "ms", 1.0, r.output), serial + 1e-2) << r.output;
+    EXPECT_LE(serial_parts(lines, 2, "first_step_part", "ms", 1.0, r.output), serial + 1e-2) << r.output;
 
     const Result one = spindle("bench pyramid --threads 1 --serial-first");
     EXPECT_EQ(one.exit_code, 2) << one.output;
