@@ -19,30 +19,8 @@ int start_clip_polygon(const Vec3* p, int count, ClipVertex* out) {
 }
 
 int clip_polygon(const ClipVertex* in, int count, const ClipPlane& plane, std::uint32_t side, ClipVertex* out) {
-    if (count == 0) return 0;
-    const auto side_edge = static_cast<std::uint16_t>(kSidePlaneBit | (side & 0x3Fu));
-    int n = 0;
-    const ClipVertex* prev = &in[count - 1];
-    Real d_prev = plane.normal.dot(prev->p) - plane.offset;
-    for (int i = 0; i < count; ++i) {
-        const ClipVertex* cur = &in[i];
-        const Real d_cur = plane.normal.dot(cur->p) - plane.offset;
-        if ((d_prev <= 0) != (d_cur <= 0)) {
-            // The edge prev -> cur crosses the plane; the cut point is named after the
-            // feature that edge lies on and this side plane.
-            const Real t = d_prev / (d_prev - d_cur);
-            ClipVertex& x = out[n++];
-            x.p = prev->p + t * (cur->p - prev->p);
-            const bool on_side_plane = (prev->edge & kSidePlaneBit) != 0;
-            x.key = clip_key(on_side_plane ? 2 : 1, prev->edge & 0x3Fu, side);
-            // Entering: the polygon continues along the old edge. Leaving: along the plane.
-            x.edge = d_cur <= 0 ? prev->edge : side_edge;
-        }
-        if (d_cur <= 0) out[n++] = *cur;
-        prev = cur;
-        d_prev = d_cur;
-    }
-    return n;
+    return clip_polygon_by(
+        in, count, [&plane](const Vec3& p) { return plane.normal.dot(p) - plane.offset; }, side, out);
 }
 
 namespace {

@@ -60,8 +60,39 @@ struct ClipPlane {
 // edge i. Returns count.
 int start_clip_polygon(const Vec3* p, int count, ClipVertex* out);
 
-// One Sutherland-Hodgman step against `plane` (side plane number `side`). `out` must
-// hold count + 1 vertices. Returns the new count (0 when nothing is left).
+// One Sutherland-Hodgman step against the half-space distance(p) <= 0 (side plane number
+// `side`). `out` must hold count + 1 vertices. Returns the new count (0 when nothing is
+// left). Inline, so a caller whose plane is simpler than a general one (a box's side
+// planes lie along its axes: one coordinate is the distance) pays only for that.
+template <typename Distance>
+int clip_polygon_by(const ClipVertex* in, int count, Distance&& distance, std::uint32_t side, ClipVertex* out) {
+    if (count == 0) return 0;
+    const auto side_edge = static_cast<std::uint16_t>(kSidePlaneBit | (side & 0x3Fu));
+    int n = 0;
+    const ClipVertex* prev = &in[count - 1];
+    Real d_prev = distance(prev->p);
+    for (int i = 0; i < count; ++i) {
+        const ClipVertex* cur = &in[i];
+        const Real d_cur = distance(cur->p);
+        if ((d_prev <= 0) != (d_cur <= 0)) {
+            // The edge prev -> cur crosses the plane; the cut point is named after the
+            // feature that edge lies on and this side plane.
+            const Real t = d_prev / (d_prev - d_cur);
+            ClipVertex& x = out[n++];
+            x.p = prev->p + t * (cur->p - prev->p);
+            const bool on_side_plane = (prev->edge & kSidePlaneBit) != 0;
+            x.key = clip_key(on_side_plane ? 2 : 1, prev->edge & 0x3Fu, side);
+            // Entering: the polygon continues along the old edge. Leaving: along the plane.
+            x.edge = d_cur <= 0 ? prev->edge : side_edge;
+        }
+        if (d_cur <= 0) out[n++] = *cur;
+        prev = cur;
+        d_prev = d_cur;
+    }
+    return n;
+}
+
+// clip_polygon_by against `plane`: dot(normal, p) <= offset.
 int clip_polygon(const ClipVertex* in, int count, const ClipPlane& plane, std::uint32_t side, ClipVertex* out);
 
 // ---- Reduction ------------------------------------------------------------------------

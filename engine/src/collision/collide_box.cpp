@@ -27,32 +27,44 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     n[axis] = sign;
     const auto reference_face = static_cast<std::uint32_t>(2 * axis + (sign < 0 ? 1 : 0));
 
-    // Incident face: the face of i whose normal is most against n.
+    // Incident face: the face of i whose normal is most against n (ri' n is a row of ri:
+    // n has one non-zero coordinate).
     const Vec3 along = ri.transpose() * n;
     int j = 0;
     for (int k = 1; k < 3; ++k) {
         if (std::abs(along[k]) > std::abs(along[j])) j = k;
     }
     const auto incident_face = static_cast<std::uint32_t>(2 * j + (along[j] > 0 ? 1 : 0));
-    const BoxPoly incident_box(hi);
-    const PolyView view = incident_box.view();
-    const HullFace& face = view.faces[incident_face];
-    Vec3 quad[4];
-    for (std::uint32_t k = 0; k < 4; ++k) quad[k] = ri * view.face_vertex(face, k) + ti;
-
+    // Its corners in BoxPoly's loop order (the clip keys name them by place in the loop),
+    // made in r's frame as BoxPoly would make them.
     ClipVertex buffer_a[8], buffer_b[8];
-    int count = start_clip_polygon(quad, 4, buffer_a);
+    const std::uint32_t* loop = kBoxLoops + 4 * incident_face;
+    for (std::uint32_t k = 0; k < 4; ++k) {
+        const std::uint32_t v = loop[k];
+        const Vec3 corner(v & 1 ? hi.x() : -hi.x(), v & 2 ? hi.y() : -hi.y(), v & 4 ? hi.z() : -hi.z());
+        buffer_a[k] = {ri * corner + ti, clip_key(0, k, 0), static_cast<std::uint16_t>(k)};
+    }
+    // The reference face's four side planes lie along r's other two axes: a point's
+    // distance past one is a coordinate (the same bits a general plane's dot product gives).
+    // A plane with every point on its inner side would give the polygon back as it is, so
+    // it is not clipped against: a box on a box of its size reaches past one side at most.
+    int count = 4;
     ClipVertex* in = buffer_a;
     ClipVertex* next = buffer_b;
     std::uint32_t side = 0;
-    for (int k = 1; k <= 2; ++k) {
-        const int u = (axis + k) % 3;
-        for (const Real s : {Real(1), Real(-1)}) {
-            Vec3 plane_normal = Vec3::Zero();
-            plane_normal[u] = s;
-            count = clip_polygon(in, count, {plane_normal, hr[u]}, side++, next);
+    const auto clip = [&](const auto& distance) {
+        const auto past = [&](const ClipVertex& v) { return !(distance(v.p) <= 0); };  // NaN too, as clipping drops it
+        if (std::any_of(in, in + count, past)) {
+            count = clip_polygon_by(in, count, distance, side, next);
             std::swap(in, next);
         }
+        ++side;
+    };
+    for (int k = 1; k <= 2; ++k) {
+        const int u = (axis + k) % 3;
+        const Real reach = hr[u];
+        clip([u, reach](const Vec3& p) { return p[u] - reach; });
+        clip([u, reach](const Vec3& p) { return -p[u] - reach; });
     }
     int n_out = 0;
     for (int k = 0; k < count; ++k) {
@@ -145,14 +157,22 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         if (s > speculative) return 0;
         if (s > face_b.separation) face_b = {s, j};
     }
+    // Edge axes e_i x r_j. The cross product's i-th coordinate is zero, and the products
+    // with it add nothing: each sum below is the same two terms, in the same order, that
+    // the whole vectors' dot products add (the bits are those of Vec3::cross and dot).
     for (int i = 0; i < 3; ++i) {
+        const int p = i == 0 ? 1 : 0, q = i == 2 ? 1 : 2;  // the other two coordinates, ascending
         for (int j = 0; j < 3; ++j) {
-            const Vec3 axis = Vec3::Unit(i).cross(r.col(j));
-            const Real length = axis.norm();
+            // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
+            const Real ap = i == 1 ? r(2, j) : -r(i == 0 ? 2 : 1, j);
+            const Real aq = i == 1 ? -r(0, j) : r(i == 0 ? 1 : 0, j);
+            const Real length = std::sqrt(ap * ap + aq * aq);
             if (length < Real(1e-6)) continue;  // parallel edges: the face axes cover them
-            const Real ra = ha.dot(axis.cwiseAbs());
-            const Real rb = hb.dot((r.transpose() * axis).cwiseAbs());
-            const Real s = (std::abs(axis.dot(t)) - ra - rb) / length;
+            const Real ra = ha[p] * std::abs(ap) + ha[q] * std::abs(aq);
+            const Vec3 on_b(std::abs(r(p, 0) * ap + r(q, 0) * aq), std::abs(r(p, 1) * ap + r(q, 1) * aq),
+                            std::abs(r(p, 2) * ap + r(q, 2) * aq));  // |r' axis|
+            const Real rb = hb.dot(on_b);
+            const Real s = (std::abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
             if (s > speculative) return 0;
             if (s > edge.separation) edge = {s, 3 * i + j};
         }

@@ -9,16 +9,6 @@
 namespace spindle::detail {
 namespace {
 
-// Face loops of the box, counter-clockwise seen from outside (see BoxPoly for numbering).
-constexpr std::uint32_t kBoxLoops[24] = {
-    1, 3, 7, 5,  // +x
-    0, 4, 6, 2,  // -x
-    2, 6, 7, 3,  // +y
-    0, 1, 5, 4,  // -y
-    4, 5, 7, 6,  // +z
-    0, 2, 3, 1,  // -z
-};
-
 struct BoxTopology {
     std::array<HullEdge, 12> edges;
     BoxTopology() {

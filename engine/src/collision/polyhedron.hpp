@@ -42,6 +42,17 @@ struct PolyView {
 
 PolyView view_of(const ConvexHull& hull);
 
+// Face loops of the box, counter-clockwise seen from outside (see BoxPoly for numbering):
+// face f's vertices are kBoxLoops[4 f .. 4 f + 3].
+inline constexpr std::uint32_t kBoxLoops[24] = {
+    1, 3, 7, 5,  // +x
+    0, 4, 6, 2,  // -x
+    2, 6, 7, 3,  // +y
+    0, 1, 5, 4,  // -y
+    4, 5, 7, 6,  // +z
+    0, 2, 3, 1,  // -z
+};
+
 // A box as a polyhedron: vertex i has coordinate signs (bit0 x, bit1 y, bit2 z; set =
 // positive); face 2k is +axis k, face 2k+1 is -axis k.
 class BoxPoly {
