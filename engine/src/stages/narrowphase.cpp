@@ -117,16 +117,36 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
     }
 }
 
-// Anchors the fresh manifolds to their bodies and keeps the poses they were collided at.
+// A collided manifold as the record keeps it: every field a new ContactManifold has, but
+// no impulse yet (carry_impulses gives the old ones), and each point's separation kept as
+// the one it was collided with (recycling measures from it). The points past the count
+// are left as they were: nothing reads them.
+void make_manifold(const Manifold& found, const Shape& shape_a, const Shape& shape_b, ContactManifold& made) {
+    made.normal = found.normal;
+    made.part_a = found.part_a;
+    made.part_b = found.part_b;
+    made.point_count = static_cast<std::uint8_t>(found.point_count);
+    made.pushed_point = -1;
+    made.pushed_speed = 0;
+    made.twist_impulse = 0;
+    std::fill(std::begin(made.rolling_impulse), std::end(made.rolling_impulse), 0.0f);
+    made.radius_a = round_radius(part_shape(shape_a, found.part_a));
+    made.radius_b = round_radius(part_shape(shape_b, found.part_b));
+    for (int j = 0; j < found.point_count; ++j) {
+        ContactPoint& p = made.points[j];
+        p.point = found.points[j].point;
+        p.separation = found.points[j].separation;
+        p.base_separation = p.separation;
+        p.normal_impulse = 0;
+        p.id = found.points[j].id;
+    }
+    made.friction_impulse = Vec3::Zero();
+}
+
+// Keeps the poses the fresh manifolds were collided at: their points are anchored to the
+// bodies from there.
 void remember(Contact& contact, const Bodies& b) {
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
-    for (int m = 0; m < contact.manifold_count; ++m) {
-        ContactManifold& manifold = contact.manifold_at(m);
-        for (int j = 0; j < manifold.point_count; ++j) {
-            ContactPoint& p = manifold.points[j];
-            p.base_separation = p.separation;
-        }
-    }
     contact.cached = true;
     contact.cached_xa = b.x[a];  // both anchors meet at the point now
     contact.cached_xb = b.x[bb];
@@ -213,8 +233,8 @@ void update_narrowphase(World& world) {
     // where a phase's first block (half a share) could hold all the expensive pairs.
     world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         Manifold found[kMaxManifolds];
-        // Per range, not per pair, and reset only as far as used: a convex pair fills one
-        // of the kMaxManifolds a compound may need.
+        // Per range, not per pair: make_manifold writes every field a manifold is read by,
+        // so a convex pair's one manifold costs nothing for the kMaxManifolds a compound may need.
         ContactManifold fresh[kMaxManifolds];
         TriangleFeatures no_triangles;  // what a pair of no mesh is given (it only clears them)
         ContactCounts& counts = world.contact_counts[worker];
@@ -266,24 +286,16 @@ void update_narrowphase(World& world) {
             if (compound) motion = {b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
                                          triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries);
+            // A pair with no manifolds (every pair of a first step) has no impulses to carry:
+            // its first manifold is made in the record itself, not in `fresh` and copied.
+            const bool carries = contact.manifold_count > 0;
             for (int m = 0; m < n; ++m) {
-                fresh[m] = ContactManifold{};
-                fresh[m].normal = found[m].normal;
-                fresh[m].point_count = static_cast<std::uint8_t>(found[m].point_count);
-                fresh[m].part_a = found[m].part_a;
-                fresh[m].part_b = found[m].part_b;
-                fresh[m].radius_a = round_radius(part_shape(shape_a, found[m].part_a));
-                fresh[m].radius_b = round_radius(part_shape(shape_b, found[m].part_b));
-                for (int j = 0; j < found[m].point_count; ++j) {
-                    ContactPoint& p = fresh[m].points[j];
-                    p.point = found[m].points[j].point;
-                    p.separation = found[m].points[j].separation;
-                    p.id = found[m].points[j].id;
-                }
-                carry_impulses(contact, fresh[m]);
+                ContactManifold& made = carries || m > 0 ? fresh[m] : contact.manifold;
+                make_manifold(found[m], shape_a, shape_b, made);
+                if (carries) carry_impulses(contact, made);
             }
+            if (n > 0 && carries) contact.manifold = fresh[0];
             contact.manifold_count = static_cast<std::uint8_t>(n);
-            if (n > 0) contact.manifold = fresh[0];
             if (n > 1) contact.made_extra().manifolds.assign(fresh + 1, fresh + n);
             remember(contact, b);
             // New manifolds, new summary (a cached pair, above, keeps both).
