@@ -2,6 +2,7 @@
 // -> contacts, contacts whose fat bounds separated -> removed.
 #include <algorithm>
 #include <atomic>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -276,8 +277,13 @@ void update_broadphase(World& world, Real dt) {
     Bodies& b = world.bodies;
     BroadphaseState& bp = *world.broadphase;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
+    // The stage's parts are named in the trace (each its own serial time, "BroadphasePairs
+    // outside jobs"), so the serial code of a first step can be told apart.
+    std::optional<StageScope> part;
+    part.emplace(*world.jobs, "BroadphaseBounds");
     // Bounds, and whether each proxy must move and to which fat box, in parallel; the
-    // proxies that left their fat boxes then get them in jobs too (set_fat_boxes).
+    // proxies that left their fat boxes then get them in jobs too (set_fat_boxes). Raw
+    // room: the Bounds jobs write each body's mark and id.
     bp.refit_marked.resize(n);
     bp.moved_ids.resize(n);
     bp.moved_boxes.resize(n);
@@ -322,8 +328,14 @@ void update_broadphase(World& world, Real dt) {
     const auto has_contact = [&world](std::uint64_t i, std::uint64_t j) {
         return world.contact_index.contains((i << 32) | j);  // user values are slots, i <= j
     };
+    part.reset();
+    part.emplace(*world.jobs, "BroadphasePairs");
     bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact);  // sorted: the same order for any worker count
+    part.reset();
+    part.emplace(*world.jobs, "BroadphaseNewContacts");
     make_contacts(world, bp);
+    part.reset();
+    part.emplace(*world.jobs, "BroadphaseLostContacts");
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
     // can have stopped overlapping.

@@ -103,9 +103,9 @@ struct BroadphaseState {
     std::vector<std::uint32_t> refit_slots;  // the slots marked in refit, to clear just them
     // Scratch, per awake body: 1 when this step's move set its refit mark (those marks are
     // not in refit_slots: the stage clears them through this).
-    std::vector<std::uint8_t> refit_marked;
-    std::vector<ProxyId> moved_ids;   // scratch, per awake body: its proxy where it moves, else invalid
-    RawRoomVector<Aabb> moved_boxes;  // scratch, per awake body: its new fat box where it moves
+    RawRoomVector<std::uint8_t> refit_marked;
+    RawRoomVector<ProxyId> moved_ids;  // scratch, per awake body: its proxy where it moves, else invalid
+    RawRoomVector<Aabb> moved_boxes;   // scratch, per awake body: its new fat box where it moves
     // Scratch on raw room: the jobs after each growing resize write what is read (a first
     // step's tens of thousands, not value-initialised by the resizing thread first).
     RawRoomVector<std::uint64_t> new_keys;       // keys of the new pairs that may make contacts

@@ -340,6 +340,29 @@ TEST(BroadphaseContacts, ContactsMadeIntoDirtyRoom_AreNewRecords) {
     expect_contacts_are_the_allowed_overlaps(world);
 }
 
+// The Bounds jobs' per-body scratch (refit_marked, moved_ids) is raw room too: a first step
+// whose scratch grows into room full of 0x5a bytes (each id a valid-looking proxy, each mark
+// set) makes the same contacts and the same states as one into zeros, step after step.
+TEST(BroadphaseContacts, BoundsScratchGrownIntoDirtyRoom_StepsAsIntoZeros) {
+    SingleThreadedJobSystem jobs;
+    Block dirty(jobs), clean(jobs);
+    for (int step = 0; step < 3; ++step) {
+        for (Block* block : {&dirty, &clean}) {
+            World& world = SpaceInternals::world(block->space);
+            const std::size_t n = world.awake.size() + 16;
+            const unsigned char byte = block == &dirty ? 0x5a : 0;
+            fill_room(world.broadphase->refit_marked, n, byte);
+            fill_room(world.broadphase->moved_ids, n, byte);
+            block->space.update();
+        }
+        const World& a = SpaceInternals::world(dirty.space);
+        const World& b = SpaceInternals::world(clean.space);
+        ASSERT_EQ(contact_list(a), contact_list(b)) << "step " << step;
+        ASSERT_EQ(dirty.space.state_hash(), clean.space.state_hash()) << "step " << step;
+        expect_contacts_are_the_allowed_overlaps(a);
+    }
+}
+
 // A removal fills the removed places with the kept contacts past the new end, so each
 // record moves at most once and only as many move as are removed; the index follows the
 // moved ones, and the awake list (with sleeping contacts among the moved) stays the
