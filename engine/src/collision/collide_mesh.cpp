@@ -75,9 +75,10 @@ bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t act
 // be measured from its far side. False when nothing is within reach.
 bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
                      const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3& on_plane,
-                     Real speculative) {
+                     Real speculative, FeatureCache* cache) {
     const Vec3& n = tri.normal();
-    if (polyhedron) return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m);
+    if (polyhedron)
+        return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m, cache);
     const Vec3 face = front ? Vec3(-n) : n;
     Vec3 core[2];
     rounded_core(a, core[0], core[1]);
@@ -172,7 +173,7 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const bool through = centre_in_front && facing > 0;
         const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
         if ((through || off_face) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative))
+            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative, cache))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;

@@ -401,13 +401,17 @@ bool over_face(const Posed& ref, std::uint32_t face, const Vec3& n, const Vec3& 
 // holds its deepest point there). The face's plane carried on past its edges says nothing of
 // A beyond them: a long hull across a sloping triangle of a mesh lies far under that plane
 // there, over other triangles. False when nothing over the face is within reach.
-bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real speculative, Manifold& m) {
+// With a cache, a manifold from the incident face's clip (the one face_manifold makes with this
+// face as the reference) keeps the face there as FaceB.
+bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real speculative, Manifold& m,
+                    FeatureCache* cache) {
     const Vec3 n = pb.normal(face);
     ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
     int count = clipped_contact(pb, face, n, pa, incident_face(pa, n), true, speculative, candidates.data());
     m.normal = -n;
     if (count > 0) {
         reduce_to_manifold(candidates.data(), count, m);
+        if (cache) remember_axis(cache, FeatureCache::Kind::FaceB, 0, face, face_separation(pb, pa, face));
         return true;
     }
     const Vec3& deepest = pa.vertices[pa.support(-n)];
@@ -579,9 +583,10 @@ bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa,
 }
 
 bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
-                        const RelativePose& b_in_a, std::uint32_t face_b, Real speculative, Manifold& m) {
+                        const RelativePose& b_in_a, std::uint32_t face_b, Real speculative, Manifold& m,
+                        FeatureCache* cache) {
     return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
-        if (!face_of_b_over(pa, pb, face_b, speculative, m)) return false;
+        if (!face_of_b_over(pa, pb, face_b, speculative, m, cache)) return false;
         manifold_to_world(m, xa);
         return true;
     });

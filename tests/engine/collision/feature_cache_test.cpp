@@ -430,6 +430,46 @@ TEST(MeshQueries, ATriangleRaisedUnderARestingPartIsFoundOnANewMesh) {
     for (int m = 0; m < n; ++m) EXPECT_EQ(out[m].normal, plain[m].normal) << "manifold " << m;
 }
 
+// A hexagonal log (3 m, 0.5 m radius) lying on a face on the flat mesh, one end 1.15 degrees
+// up, creeping along: the triangles under its raised length meet its bottom face (or an edge)
+// in the SAT, whose normal the mesh does not admit, and the contact is measured again against
+// each triangle's face. That face is kept as the triangle's feature, so the next collide clips
+// it alone (no whole SAT and no second clip), and every collide is the whole SAT's, bit for bit.
+TEST(FeatureCache, ATrianglesFaceAContactWasMeasuredAgainIsKeptAndMakesTheSameManifold) {
+    std::vector<Vec3> prism;
+    for (int k = 0; k < 6; ++k) {
+        const Real angle = k * kPi / 3 + kPi / 6;  // a face straight down
+        for (const Real x : {-1.5, 1.5}) prism.emplace_back(x, 0.5 * std::cos(angle), 0.5 * std::sin(angle));
+    }
+    const Shape log = Shape::convex_hull(prism);
+    const Shape mesh = flat_mesh();
+    const Transform xm = at(Vec3::Zero());
+    const Quat q = about(Vec3::UnitY(), 0.3) * about(Vec3::UnitZ(), 0.02);
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    int faces_kept = 0;
+    for (int step = 0; step < 20; ++step) {
+        const Transform xl = sunk(log, -0.5 + 0.002 * step, 0.2, q, 0.003);
+        const TriangleFeatures before = triangles;
+        Manifold cached[8], plain[8];
+        const int nc = collide_cached(log, xl, mesh, xm, 0.1, cached, 8, cache, triangles, 0.005);
+        const int np = collide(log, xl, mesh, xm, 0.1, plain, 8);
+        ASSERT_GT(np, 0) << "step " << step;
+        expect_same(cached, nc, plain, np, step);
+        int faces = 0;
+        for (const TriangleFeature& t : triangles) {
+            const bool face = t.feature == FeatureCache(FeatureCache::Kind::FaceB, 0, 0, t.feature.separation());
+            faces += face;
+            for (const TriangleFeature& was : before)
+                faces_kept += face && was.triangle == t.triangle && was.feature == t.feature;
+        }
+        // Of its 30 triangles, the SAT gives the low end's two their own face; the raised
+        // length's (ten or more) are measured again and keep it too.
+        EXPECT_GE(faces, 8) << "step " << step;
+    }
+    EXPECT_GT(faces_kept, 0);
+}
+
 TEST(FeatureCache, OtherPairsClearIt) {
     FeatureCache cache(FeatureCache::Kind::FaceA, 3, 0);
     TriangleFeatures triangles;
