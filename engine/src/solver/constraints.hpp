@@ -342,10 +342,12 @@ struct SolverScratch {
     // is read by many constraints of a colour at once; joints are not marked).
     bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
     bool folded = false;           // this step's plan folds the integration
-    // Per wide contact, its lanes' bodies that no constraint before it in a pass touches
-    // (bit l: lane l's body a, bit kLanes + l: its body b), and the awake bodies that no
-    // constraint touches; made with the colouring (find_first_touches).
-    std::vector<std::uint16_t> first_touch;
+    // The bodies that no constraint before them in a pass touches, wide contact by wide
+    // contact: wide contact w's are first_touched[first_touch[w], first_touch[w + 1]), so a
+    // block's are one span. And the awake bodies that no constraint touches. Made with the
+    // colouring (find_first_touches).
+    std::vector<std::uint32_t> first_touch;  // wide.size() + 1 offsets
+    std::vector<std::uint32_t> first_touched;
     std::vector<std::uint32_t> untouched;
     std::vector<std::uint8_t> touched;       // find_first_touches' per-body scratch, kept for its capacity
     std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity

@@ -240,8 +240,8 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
 // and the overflow last, one by one, which is the order of `wide`; within a colour no two
 // lanes share a dynamic body. Bodies n and up (the immovable one) are never integrated.
 void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
-    static_assert(2 * kLanes <= 16, "a bit per lane and body in first_touch");
-    scratch.first_touch.resize(scratch.wide.size());
+    scratch.first_touch.resize(scratch.wide.size() + 1);
+    scratch.first_touched.clear();
     scratch.touched.assign(n, 0);
     std::uint8_t* touched = scratch.touched.data();
     auto first = [&](std::uint32_t k) {
@@ -251,13 +251,13 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
     };
     for (std::size_t w = 0; w < scratch.wide.size(); ++w) {
         const WideContact& wc = scratch.wide[w];
-        std::uint32_t mask = 0;
+        scratch.first_touch[w] = static_cast<std::uint32_t>(scratch.first_touched.size());
         for (int l = 0; l < wc.lanes; ++l) {
-            if (first(wc.a[l])) mask |= 1u << l;
-            if (first(wc.b[l])) mask |= 1u << (kLanes + l);
+            if (first(wc.a[l])) scratch.first_touched.push_back(wc.a[l]);
+            if (first(wc.b[l])) scratch.first_touched.push_back(wc.b[l]);
         }
-        scratch.first_touch[w] = static_cast<std::uint16_t>(mask);
     }
+    scratch.first_touch[scratch.wide.size()] = static_cast<std::uint32_t>(scratch.first_touched.size());
     scratch.untouched.clear();
     for (std::uint32_t k = 0; k < n; ++k) {
         if (touched[k] == 0) scratch.untouched.push_back(k);
@@ -265,7 +265,7 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
 }
 
 // Calls integrate(list) on the bodies that constraints [lo, hi) of colour `color` are the
-// first of their pass to touch, a buffer at a time, before the phase's block runs them:
+// first of their pass to touch (one span), before the phase's block runs them:
 // no other constraint of the colour touches those bodies, so all of them may go first (and
 // the overflow, one block, has the first touches of its whole pass). A folded step has no
 // joints: a colour's constraints are its wide contacts.
@@ -274,21 +274,9 @@ void integrate_first_touched(const SolverScratch& scratch, int color, std::uint3
                              IntegrateFn&& integrate) {
     const std::size_t first = color == kColorCount ? scratch.wide_begin[kColorCount] : scratch.wide_begin[color] + lo;
     const std::size_t last = color == kColorCount ? scratch.wide.size() : scratch.wide_begin[color] + hi;
-    constexpr std::size_t kBuffer = 16 * kLanes;
-    std::uint32_t list[kBuffer];
-    std::size_t count = 0;
-    for (std::size_t w = first; w < last; ++w) {
-        if (count > kBuffer - 2 * kLanes) {
-            integrate(std::span<const std::uint32_t>(list, count));
-            count = 0;
-        }
-        const WideContact& wc = scratch.wide[w];
-        for (std::uint32_t mask = scratch.first_touch[w]; mask != 0; mask &= mask - 1) {
-            const int bit = std::countr_zero(mask);
-            list[count++] = bit < kLanes ? wc.a[bit] : wc.b[bit - kLanes];
-        }
-    }
-    if (count > 0) integrate(std::span<const std::uint32_t>(list, count));
+    const std::uint32_t from = scratch.first_touch[first];
+    const std::uint32_t to = scratch.first_touch[last];
+    if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
 }
 
 // Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
