@@ -257,9 +257,16 @@ enum class Pass : std::uint8_t {
     StoreJoints,
     FinalizeBodies
 };
+// A phase that carries a body pass (SolverScratch::fold_body_passes): a warm-start or first
+// relax phase of a folded step integrates, before a wide contact, the bodies it is the first
+// of its pass to touch (first_touch), and in its items past `constraints`, chunks of the
+// bodies no constraint touches; a StoreImpulses phase finalizes every awake body in chunks
+// past them.
 struct SolverPhase {
     Pass pass = Pass::Solve;
     int color = 0;
+    bool integrates = false;        // carries its body pass
+    std::uint32_t constraints = 0;  // items of its own pass, when it does; the chunks of bodies follow
 };
 
 // Support mass scaling (support_scales.cpp): the factors a manifold's rows multiply each
@@ -324,6 +331,25 @@ struct SolverScratch {
     // least and greatest of each chunk of bodies): then no scale differs from 1.
     bool one_dynamic_mass = false;
     std::vector<std::pair<Real, Real>> chunk_inv_mass;
+    std::vector<std::uint8_t> chunk_all_dynamic;  // per chunk of bodies: no kinematic body in it
+    // The body passes folded into the constraint passes (solver.cpp), so a step has fewer
+    // phases and barriers: each body's velocities are integrated just before the first
+    // constraint of a warm-start pass that touches it, its positions just before the first
+    // of the first relax pass (two phases fewer a substep), and the bodies are finalized in
+    // the phase that stores the contacts' impulses. Each body's arithmetic and its order
+    // against its own constraints stay the same: bitwise the results of the passes of
+    // their own. The integration only for contacts among dynamic bodies (a kinematic body
+    // is read by many constraints of a colour at once; joints are not marked).
+    bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
+    bool folded = false;           // this step's plan folds the integration
+    // The bodies that no constraint before them in a pass touches, wide contact by wide
+    // contact: wide contact w's are first_touched[first_touch[w], first_touch[w + 1]), so a
+    // block's are one span. And the awake bodies that no constraint touches. Made with the
+    // colouring (find_first_touches).
+    std::vector<std::uint32_t> first_touch;  // wide.size() + 1 offsets
+    std::vector<std::uint32_t> first_touched;
+    std::vector<std::uint32_t> untouched;
+    std::vector<std::uint8_t> touched;       // find_first_touches' per-body scratch, kept for its capacity
     std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity
     std::vector<std::uint32_t> support_first, support_by_lower, support_queue;
     std::vector<std::uint8_t> supported;

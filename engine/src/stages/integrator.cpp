@@ -4,6 +4,8 @@
 // keep their angular momentum with the velocities, before the solve.
 #include <algorithm>
 #include <cmath>
+#include <ranges>
+#include <span>
 
 #include "solver/solver_body.hpp"
 #include "solver/speed_limit.hpp"
@@ -44,15 +46,15 @@ void keep_momentum(SolverBody& sb, const Quat& start, const Mat3& inertia_local,
     sb.w = mid_spin;
 }
 
-}  // namespace
-
-void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
-                          std::uint32_t hi, EffectCounts& c) {
+// Over awake bodies `ks`: a range of them, or a list (a folded step's, solver.cpp).
+template <typename Indices>
+void integrate_velocities_of(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, const Indices& ks,
+                             EffectCounts& c) {
     const Bodies& b = world.bodies;
     const Vec3 gravity = world.settings.gravity;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
-    for (std::uint32_t k = lo; k < hi; ++k) {
+    for (const std::uint32_t k : ks) {
         SolverBody& sb = bodies[k];
         if (!sb.dynamic) {
             // A kinematic body moves by its velocity alone: limited all the same.
@@ -87,10 +89,10 @@ void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_
     }
 }
 
-void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
-                         std::uint32_t hi) {
+template <typename Indices>
+void integrate_positions_of(World& world, SolverBody* bodies, PushVelocity* push, Real h, const Indices& ks) {
     const Real push_out = world.settings.solver.push_out_speed;
-    for (std::uint32_t k = lo; k < hi; ++k) {
+    for (const std::uint32_t k : ks) {
         SolverBody& sb = bodies[k];
         PushVelocity& pv = push[k];
         // The push-out velocity is capped per body, not only per contact: a chain of
@@ -103,6 +105,25 @@ void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, R
         sb.dq = integrate_rotation(sb.dq, sb.w + pv.w, h);
         pv = PushVelocity{};
     }
+}
+
+}  // namespace
+
+void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
+                          std::uint32_t hi, EffectCounts& counts) {
+    integrate_velocities_of(world, bodies, gravity_scales, h, std::views::iota(lo, hi), counts);
+}
+void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h,
+                          std::span<const std::uint32_t> ks, EffectCounts& counts) {
+    integrate_velocities_of(world, bodies, gravity_scales, h, ks, counts);
+}
+void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
+                         std::uint32_t hi) {
+    integrate_positions_of(world, bodies, push, h, std::views::iota(lo, hi));
+}
+void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h,
+                         std::span<const std::uint32_t> ks) {
+    integrate_positions_of(world, bodies, push, h, ks);
 }
 
 }  // namespace spindle

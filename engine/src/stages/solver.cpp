@@ -55,7 +55,8 @@ constexpr std::uint32_t kJointGrain = 32;
 // Awake contacts per range when listing their manifolds (a parallel_for).
 constexpr std::uint32_t kListGrain = 512;
 
-void prepare_bodies(World& world, SolverScratch& scratch) {
+// Returns whether every awake body is dynamic.
+bool prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     // A first step's are megabytes of new pages: mapped in jobs, then first written by the
@@ -69,8 +70,10 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
     // by the grain): equal over all of them, no body is lighter than another it carries.
     const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
     scratch.chunk_inv_mass.assign(chunks, {kHuge, -kHuge});
+    scratch.chunk_all_dynamic.assign(chunks, 1);
     world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         auto& [least, greatest] = scratch.chunk_inv_mass[lo / kBodyGrain];
+        bool all_dynamic = true;
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
@@ -92,7 +95,9 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
                 least = std::min(least, sb.inv_mass);
                 greatest = std::max(greatest, sb.inv_mass);
             }
+            all_dynamic = all_dynamic && sb.dynamic;
         }
+        scratch.chunk_all_dynamic[lo / kBodyGrain] = all_dynamic ? 1 : 0;
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
     scratch.push_velocities[n] = PushVelocity{};
@@ -103,6 +108,8 @@ void prepare_bodies(World& world, SolverScratch& scratch) {
         greatest = std::max(greatest, chunk_greatest);
     }
     scratch.one_dynamic_mass = !(least < greatest);
+    return std::find(scratch.chunk_all_dynamic.begin(), scratch.chunk_all_dynamic.end(), 0) ==
+           scratch.chunk_all_dynamic.end();
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
@@ -228,6 +235,50 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
     return same;
 }
 
+// Which bodies each wide contact is the first of its pass to touch, and the awake bodies no
+// contact touches (SolverScratch::first_touch, untouched). A pass runs the colours in order
+// and the overflow last, one by one, which is the order of `wide`; within a colour no two
+// lanes share a dynamic body. Bodies n and up (the immovable one) are never integrated.
+void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
+    scratch.first_touch.resize(scratch.wide.size() + 1);
+    scratch.first_touched.clear();
+    scratch.touched.assign(n, 0);
+    std::uint8_t* touched = scratch.touched.data();
+    auto first = [&](std::uint32_t k) {
+        if (k >= n || touched[k] != 0) return false;
+        touched[k] = 1;
+        return true;
+    };
+    for (std::size_t w = 0; w < scratch.wide.size(); ++w) {
+        const WideContact& wc = scratch.wide[w];
+        scratch.first_touch[w] = static_cast<std::uint32_t>(scratch.first_touched.size());
+        for (int l = 0; l < wc.lanes; ++l) {
+            if (first(wc.a[l])) scratch.first_touched.push_back(wc.a[l]);
+            if (first(wc.b[l])) scratch.first_touched.push_back(wc.b[l]);
+        }
+    }
+    scratch.first_touch[scratch.wide.size()] = static_cast<std::uint32_t>(scratch.first_touched.size());
+    scratch.untouched.clear();
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (touched[k] == 0) scratch.untouched.push_back(k);
+    }
+}
+
+// Calls integrate(list) on the bodies that constraints [lo, hi) of colour `color` are the
+// first of their pass to touch (one span), before the phase's block runs them:
+// no other constraint of the colour touches those bodies, so all of them may go first (and
+// the overflow, one block, has the first touches of its whole pass). A folded step has no
+// joints: a colour's constraints are its wide contacts.
+template <typename IntegrateFn>
+void integrate_first_touched(const SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi,
+                             IntegrateFn&& integrate) {
+    const std::size_t first = color == kColorCount ? scratch.wide_begin[kColorCount] : scratch.wide_begin[color] + lo;
+    const std::size_t last = color == kColorCount ? scratch.wide.size() : scratch.wide_begin[color] + hi;
+    const std::uint32_t from = scratch.first_touch[first];
+    const std::uint32_t to = scratch.first_touch[last];
+    if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
+}
+
 // Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
 // `color`: its wide joints (joint_lanes.cpp) and other joints (if kJoints), then its wide
 // contacts. The overflow (color == kColorCount) is one block, run serially, joints first.
@@ -260,7 +311,11 @@ void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint3
 
 // Adds the phases of one pass over the constraints: one per colour that has any (its
 // joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
-void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints) {
+// With `integrates`, each of its phases integrates the bodies it touches first, and the
+// first one also the untouched bodies, in chunks after its constraints.
+void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints,
+                          bool integrates = false) {
+    const std::size_t first = scratch.phases.size();
     for (int c = 0; c < kColorCount; ++c) {
         const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) +
                                               (scratch.wide_joint_begin[c + 1] - scratch.wide_joint_begin[c])
@@ -276,6 +331,15 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
         scratch.phases.push_back(Phase{name, 1, 1});
         scratch.plan.push_back(SolverPhase{pass, kColorCount});
     }
+    if (!integrates || first == scratch.phases.size()) return;
+    for (std::size_t p = first; p < scratch.phases.size(); ++p) {
+        scratch.plan[p].integrates = true;
+        scratch.plan[p].constraints = scratch.phases[p].count;
+    }
+    const auto chunks = static_cast<std::uint32_t>((scratch.untouched.size() + kBodyPassGrain - 1) / kBodyPassGrain);
+    Phase& phase = scratch.phases[first];
+    phase.count += chunks;
+    phase.grain = phase.count <= kOneBlockColor ? phase.count : kConstraintGrain;
 }
 
 void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
@@ -301,15 +365,25 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
             Phase{"PrepareJoints", static_cast<std::uint32_t>(scratch.wide_joints.size()), kWideGrain});
         scratch.plan.push_back(SolverPhase{Pass::PrepareJoints, 0});
     }
+    const bool folded = scratch.folded;
     for (int sub = 0; sub < settings.substeps; ++sub) {
-        plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
-        plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true);
+        if (!folded) plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
+        plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, folded);
         for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
-        plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
+        if (!folded) plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
         for (int it = 0; it < settings.relax_iterations; ++it)
-            plan_constraint_pass(scratch, Pass::Relax, "Relax", true);
+            plan_constraint_pass(scratch, Pass::Relax, "Relax", true, folded && it == 0);
     }
     if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
+    if (scratch.fold_body_passes && scratch.joints.empty() && !scratch.wide.empty()) {
+        // Storing the contacts' impulses and finalizing the bodies read and write nothing of
+        // each other's: one phase, the bodies in chunks after the wide contacts.
+        const auto wide = static_cast<std::uint32_t>(scratch.wide.size());
+        scratch.phases.push_back(
+            Phase{"StoreAndFinalize", wide + (n + kBodyPassGrain - 1) / kBodyPassGrain, kWideGrain});
+        scratch.plan.push_back(SolverPhase{Pass::StoreImpulses, 0, true, wide});
+        return;
+    }
     plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
     if (!scratch.joints.empty()) {
         // The lanes' impulses go back to their constraints before the joints keep them.
@@ -357,7 +431,7 @@ void solve(World& world, Real dt) {
 
     world.fast_lists.resize(world.jobs->worker_count());
     for (std::vector<FastStart>& list : world.fast_lists) list.clear();
-    prepare_bodies(world, scratch);
+    const bool all_dynamic = prepare_bodies(world, scratch);
     const bool restitution = list_manifolds(world, scratch);
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
@@ -365,8 +439,12 @@ void solve(World& world, Real dt) {
         color(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
+        if (scratch.joints.empty()) find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
         world.counters.constraint_colorings += 1;
     }
+    // Folded only where every phase that integrates has a constraint to carry it.
+    scratch.folded = scratch.fold_body_passes && all_dynamic && scratch.joints.empty() && !scratch.wide.empty() &&
+                     settings.relax_iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
     if (world.awake.empty() && scratch.wide.empty() && scratch.joints.empty()) return;
@@ -403,6 +481,24 @@ void solve(World& world, Real dt) {
     auto push_anchors = [&](const WideContact& wc) {
         return scratch.push_anchors.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
     };
+    // Items [lo, hi) of a phase that carries a body pass, past its own: chunks of `count`
+    // bodies, fn(from, to) for each.
+    auto body_chunks = [](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, std::uint32_t count,
+                          auto&& fn) {
+        for (std::uint32_t c = std::max(lo, phase.constraints); c < hi; ++c) {
+            const std::uint32_t from = (c - phase.constraints) * kBodyPassGrain;
+            fn(from, std::min(count, from + kBodyPassGrain));
+        }
+    };
+    // A folded phase's block [lo, hi): its constraints' first touches, then its chunks of
+    // the untouched bodies.
+    const std::span<const std::uint32_t> untouched(scratch.untouched);
+    auto integrate_folded = [&](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, auto&& integrate) {
+        const std::uint32_t own = std::min(hi, phase.constraints);
+        if (lo < own) integrate_first_touched(scratch, phase.color, lo, own, integrate);
+        body_chunks(phase, lo, hi, static_cast<std::uint32_t>(untouched.size()),
+                    [&](std::uint32_t from, std::uint32_t to) { integrate(untouched.subspan(from, to - from)); });
+    };
     world.jobs->run_phases(
         "Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
             const SolverPhase phase = scratch.plan[p];
@@ -410,7 +506,18 @@ void solve(World& world, Real dt) {
             switch (phase.pass) {
                 case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
                 case Pass::PrepareJoints: prepare_joint_lanes(scratch, lo, hi); break;
-                case Pass::StoreImpulses: store_contact_impulses(world, scratch, lo, hi); break;
+                case Pass::StoreImpulses:
+                    if (!phase.integrates) {
+                        store_contact_impulses(world, scratch, lo, hi);
+                        break;
+                    }
+                    store_contact_impulses(world, scratch, std::min(lo, phase.constraints),
+                                           std::min(hi, phase.constraints));
+                    body_chunks(phase, lo, hi, static_cast<std::uint32_t>(world.awake.size()),
+                                [&](std::uint32_t from, std::uint32_t to) {
+                                    finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
+                                });
+                    break;
                 case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
                 case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
                 case Pass::FinalizeBodies: finalize_bodies(world, scratch, dt, lo, hi, world.fast_lists[worker]); break;
@@ -418,13 +525,21 @@ void solve(World& world, Real dt) {
                     integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
                     break;
                 case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi); break;
-                case Pass::WarmStart:
+                case Pass::WarmStart: {
+                    if (phase.integrates) {
+                        integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
+                            integrate_velocities(world, bodies, gravity_scales, h, ks, counts);
+                        });
+                    }
+                    const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
+                    if (lo >= own) break;
                     for_colored<true>(
-                        scratch, phase.color, lo, hi,
+                        scratch, phase.color, lo, own,
                         [&](WideJoint& wj) { warm_start_joint_lanes(scratch, wj, bodies); },
                         [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
                         [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies, push); });
                     break;
+                }
                 case Pass::Solve:
                     for_colored<true>(
                         scratch, phase.color, lo, hi,
@@ -434,15 +549,23 @@ void solve(World& world, Real dt) {
                             solve_contact(wc, push_anchors(wc), bodies, push, solve_params, counts);
                         });
                     break;
-                case Pass::Relax:
+                case Pass::Relax: {
+                    if (phase.integrates) {
+                        integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
+                            integrate_positions(world, bodies, push, h, ks);
+                        });
+                    }
+                    const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
+                    if (lo >= own) break;
                     for_colored<true>(
-                        scratch, phase.color, lo, hi,
+                        scratch, phase.color, lo, own,
                         [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_relax, counts); },
                         [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
                         [&](WideContact& wc) {
                             solve_contact(wc, push_anchors(wc), bodies, push, relax_params, counts);
                         });
                     break;
+                }
                 case Pass::Restitution:
                     for_colored<false>(
                         scratch, phase.color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},

@@ -3,6 +3,9 @@
 // through world.jobs; update.cpp calls them in order.
 #pragma once
 
+#include <cstdint>
+#include <span>
+
 #include "world.hpp"
 
 namespace spindle {
@@ -24,13 +27,18 @@ void solve(World& world, Real dt);
 bool bodies_to_sweep(const World& world);
 void sweep_fast_bodies(World& world);
 // integrator.cpp (called by the solver once per substep, in blocks of the awake
-// bodies [lo, hi); effects used are counted into `counts`).
+// bodies [lo, hi), or on lists of them `ks` where the solver folds the passes into its
+// colours; effects used are counted into `counts`).
 struct SolverBody;
 struct PushVelocity;
 void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
                           std::uint32_t hi, EffectCounts& counts);
+void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h,
+                          std::span<const std::uint32_t> ks, EffectCounts& counts);
 void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
                          std::uint32_t hi);
+void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h,
+                         std::span<const std::uint32_t> ks);
 // record.cpp: previous <- current for interpolating bodies; bounds of moved bodies.
 void record(World& world);
 

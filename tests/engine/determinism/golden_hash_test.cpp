@@ -144,3 +144,86 @@ TEST(GoldenHash, ReusedJointColoursGiveTheSameBitsAsFreshColouring) {
         EXPECT_EQ(hex(reused), hex(fresh)) << workers << " workers";
     }
 }
+
+namespace {
+
+// 36 boxes resting on one dynamic slab (more contacts on one body than there are colours:
+// some go to the overflow) and four spheres falling far above, which no constraint touches.
+constexpr const char* kSlabScene = R"(
+[defaults]
+allow_sleep = false
+
+[[body]]
+type = "static"
+shape = { box = [20, 1, 20] }
+position = [0, -1, 0]
+
+[[body]]
+shape = { box = [6, 0.25, 6] }
+position = [0, 0.25, 0]
+
+[[body]]
+shape = { box = [0.4, 0.4, 0.4] }
+position = [-5, 0.9, -5]
+copies = { count = [6, 1, 6], step = [2, 1, 2] }
+
+[[body]]
+shape = { sphere = 0.3 }
+position = [15, 30, 15]
+copies = { count = [2, 1, 2], step = [1, 1, 1] }
+)";
+
+struct FoldRun {
+    std::uint64_t hash = 0;
+    std::uint64_t phases = 0;  // phases run_phases ran (work stealing only)
+    bool folded = false, overflow = false, untouched = false;
+};
+
+FoldRun run_folded(const SceneDesc& scene, int steps, JobSystem& jobs, bool fold) {
+    Space space(SpaceSettings{}, &jobs);
+    build(scene, space);
+    SolverScratch& solver = *SpaceInternals::world(space).solver;
+    solver.fold_body_passes = fold;
+    auto* stealing = dynamic_cast<WorkStealingJobSystem*>(&jobs);
+    const std::uint64_t phases_before = stealing ? stealing->phases_run() : 0;
+    for (int i = 0; i < steps; ++i) space.update();
+    FoldRun run;
+    run.hash = space.state_hash();
+    run.phases = stealing ? stealing->phases_run() - phases_before : 0;
+    run.folded = solver.folded;
+    run.overflow = solver.wide.size() > solver.wide_begin[kColorCount];
+    run.untouched = !solver.untouched.empty();
+    return run;
+}
+
+}  // namespace
+
+// The body passes folded into the constraint passes (SolverScratch::fold_body_passes) run
+// each body's arithmetic in the same order against its own constraints as the passes of
+// their own: the same bits, with two phases fewer a substep and one fewer a step. The slab scene has bodies
+// first touched in the overflow and bodies no constraint touches.
+TEST(GoldenHash, FoldedIntegrationGivesTheSameBitsAsItsOwnPasses) {
+    const SceneDesc slab = parse_scene(kSlabScene, "slab");
+    const SceneDesc pyramid = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
+    const int substeps = SpaceSettings{}.solver.substeps;
+    for (const auto& [name, scene, steps] : {std::tuple{"slab", &slab, 30}, {"pyramid", &pyramid, 8}}) {
+        SingleThreadedJobSystem single;
+        const FoldRun single_own = run_folded(*scene, steps, single, false);
+        const FoldRun single_folded = run_folded(*scene, steps, single, true);
+        EXPECT_EQ(hex(single_folded.hash), hex(single_own.hash)) << name << ", single-threaded";
+        EXPECT_TRUE(single_folded.folded) << name;
+        EXPECT_FALSE(single_own.folded) << name;
+        for (unsigned workers : {1u, 2u}) {
+            auto jobs = jobs_for(workers);
+            const FoldRun own = run_folded(*scene, steps, *jobs, false);
+            const FoldRun folded = run_folded(*scene, steps, *jobs, true);
+            EXPECT_EQ(hex(own.hash), hex(single_own.hash)) << name << ", " << workers << " workers";
+            EXPECT_EQ(hex(folded.hash), hex(single_own.hash)) << name << ", " << workers << " workers";
+            EXPECT_EQ(own.phases - folded.phases, std::uint64_t((2 * substeps + 1) * steps)) << name << ", " << workers;
+        }
+        if (std::string(name) == "slab") {
+            EXPECT_TRUE(single_folded.overflow) << "the slab's boxes should fill every colour";
+            EXPECT_TRUE(single_folded.untouched) << "the spheres should be falling, touching nothing";
+        }
+    }
+}
