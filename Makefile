@@ -53,7 +53,10 @@ tidy: configure-release
 	@git ls-files -- $(foreach d,$(SOURCE_DIRS),'$(d)/*.cpp') | xargs -r -P$(JOBS) -n1 $(CLANG_TIDY) -p $(BUILD)/release --quiet \
 		--extra-arg=-Wno-unknown-warning-option --extra-arg=-Wno-error
 
-test-release: setup-test release
+# Builds what the Release ctest runs (tests_all: the suites and the spindle program), not
+# the benchmark programs, which no test runs (`make release` and `make bench` build them).
+test-release: setup-test configure-release
+	@cmake --build $(BUILD)/release -j$(JOBS) --target tests_all
 	cd $(BUILD)/release && ctest --output-on-failure -j$(JOBS)
 
 test-asan: setup
