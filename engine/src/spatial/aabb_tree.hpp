@@ -20,8 +20,9 @@ struct AabbTreeSettings {
     // The fat box is also stretched by this times the displacement passed to move_proxy,
     // so a speculative contact finds its pair before the bodies get there.
     Real displacement_multiplier = Real(2);
-    // Walk the whole tree after every change (O(n) each). On by default where
-    // SPINDLE_VALIDATE is on; big debug scenes may turn it off.
+    // Walk the whole tree after changes: after each one while the tree is small, then once
+    // every n / 16 changes for n proxies (each walk is O(n)). On by default where
+    // SPINDLE_VALIDATE is on.
     bool validate_each_operation = SPINDLE_VALIDATE_ENABLED != 0;
 };
 
@@ -134,6 +135,8 @@ public:
     // Height of the root; 0 for one proxy or none.
     int height() const noexcept { return m_root == kNull ? 0 : m_nodes[static_cast<std::size_t>(m_root)].height; }
     std::int32_t proxy_count() const noexcept { return m_proxy_count; }
+    // Whole-tree walks made after changes (validate_each_operation) so far.
+    std::int64_t whole_checks() const noexcept { return m_whole_checks; }
     // Nodes allocated so far (used and free); constant in steady state.
     std::size_t node_capacity() const noexcept { return m_nodes.size(); }
     // Sum of the internal nodes' half areas: the SAH cost of a query, for tests and benches.
@@ -188,8 +191,17 @@ private:
     void enlarge_ancestors(std::int32_t leaf);
     void flag_ancestors(std::int32_t leaf);
     std::int32_t flag_ancestors_shared(std::int32_t leaf);
+    // The whole-tree check after an operation (validate_each_operation), amortised: a tree of
+    // n proxies is checked once every n / kValidateSpread operations (after each one while it
+    // is small), so a world of n bodies made one by one costs O(n) node visits of checking,
+    // not O(n^2); a broken tree is still found within n / kValidateSpread operations.
+    static constexpr std::int32_t kValidateSpread = 16;
     void validate_if_enabled() const {
-        if (m_settings.validate_each_operation) validate();
+        if (!m_settings.validate_each_operation) return;
+        if (++m_unvalidated_operations < m_proxy_count / kValidateSpread) return;
+        m_unvalidated_operations = 0;
+        ++m_whole_checks;
+        validate();
     }
     // rebuild() helpers (aabb_tree_build.cpp).
     struct BuildTask;
@@ -206,6 +218,8 @@ private:
     std::int32_t m_root = kNull;
     std::int32_t m_free_list = kNull;
     std::int32_t m_proxy_count = 0;
+    mutable std::int32_t m_unvalidated_operations = 0;  // since the last whole-tree check
+    mutable std::int64_t m_whole_checks = 0;            // validate_if_enabled's walks
     std::int32_t m_free_count = 0;
     // Per node: 1 when a move grew it (or moved a leaf below it) since the last rebuild.
     // Apart from the nodes, which fill their cache line; queries never read it. A flagged
