@@ -280,7 +280,11 @@ void update_broadphase(World& world, Real dt) {
     // The stage's parts are named in the trace (each its own serial time, "BroadphasePairs
     // outside jobs"), so the serial code of a first step can be told apart.
     std::optional<StageScope> part;
-    part.emplace(*world.jobs, "BroadphaseBounds");
+    const auto next_part = [&](const char* name) {
+        part.reset();  // the last part ends before the next begins
+        part.emplace(*world.jobs, name);
+    };
+    next_part("BroadphaseBounds");
     // Bounds, and whether each proxy must move and to which fat box, in parallel; the
     // proxies that left their fat boxes then get them in jobs too (set_fat_boxes). Raw
     // room: the Bounds jobs write each body's mark and id.
@@ -328,14 +332,11 @@ void update_broadphase(World& world, Real dt) {
     const auto has_contact = [&world](std::uint64_t i, std::uint64_t j) {
         return world.contact_index.contains((i << 32) | j);  // user values are slots, i <= j
     };
-    part.reset();
-    part.emplace(*world.jobs, "BroadphasePairs");
+    next_part("BroadphasePairs");
     bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact);  // sorted: the same order for any worker count
-    part.reset();
-    part.emplace(*world.jobs, "BroadphaseNewContacts");
+    next_part("BroadphaseNewContacts");
     make_contacts(world, bp);
-    part.reset();
-    part.emplace(*world.jobs, "BroadphaseLostContacts");
+    next_part("BroadphaseLostContacts");
 
     // Lost pairs: awake contacts whose fat bounds no longer overlap; only a refitted box
     // can have stopped overlapping.
