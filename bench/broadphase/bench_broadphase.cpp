@@ -40,7 +40,7 @@ class Scene {
 public:
     explicit Scene(const SceneSpec& spec) : m_rng(1234), m_world(1.5 * std::cbrt(double(spec.moving + spec.statics))) {
         BroadphaseSettings settings;
-        settings.validate_each_operation = false;
+        settings.validate_after_changes = false;
         m_bp = ProxyTrees(settings);
         for (int i = 0; i < spec.statics; ++i) {
             const Body b = make_body(0);
@@ -125,7 +125,7 @@ void bm_build(benchmark::State& state, bool bulk) {
     int height = 0;
     for (auto _ : state) {
         DynamicAabbTree tree(
-            AabbTreeSettings{.margin = 0, .displacement_multiplier = 0, .validate_each_operation = false});
+            AabbTreeSettings{.margin = 0, .displacement_multiplier = 0, .validate_after_changes = false});
         for (int i = 0; i < n; ++i) tree.create_proxy(boxes[static_cast<std::size_t>(i)], std::uint64_t(i));
         if (bulk) tree.rebuild();
         cost = tree.area_cost();

@@ -22,7 +22,7 @@ namespace {
 // per moved proxy in debug builds); tests call validate() themselves.
 AabbTreeSettings query_tree_settings() {
     AabbTreeSettings settings;
-    settings.validate_each_operation = false;
+    settings.validate_after_changes = false;
     settings.margin = Real(0.3);
     return settings;
 }

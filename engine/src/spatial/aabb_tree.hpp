@@ -23,7 +23,7 @@ struct AabbTreeSettings {
     // Walk the whole tree after changes: after each one while the tree is small, then once
     // every n / 16 changes for n proxies (each walk is O(n)). On by default where
     // SPINDLE_VALIDATE is on.
-    bool validate_each_operation = SPINDLE_VALIDATE_ENABLED != 0;
+    bool validate_after_changes = SPINDLE_VALIDATE_ENABLED != 0;
 };
 
 // Proxy ids are leaf node indices: stable for the proxy's life (moves and rebuild() keep
@@ -135,7 +135,7 @@ public:
     // Height of the root; 0 for one proxy or none.
     int height() const noexcept { return m_root == kNull ? 0 : m_nodes[static_cast<std::size_t>(m_root)].height; }
     std::int32_t proxy_count() const noexcept { return m_proxy_count; }
-    // Whole-tree walks made after changes (validate_each_operation) so far.
+    // Whole-tree walks made after changes (validate_after_changes) so far.
     std::int64_t whole_checks() const noexcept { return m_whole_checks; }
     // Nodes allocated so far (used and free); constant in steady state.
     std::size_t node_capacity() const noexcept { return m_nodes.size(); }
@@ -191,13 +191,13 @@ private:
     void enlarge_ancestors(std::int32_t leaf);
     void flag_ancestors(std::int32_t leaf);
     std::int32_t flag_ancestors_shared(std::int32_t leaf);
-    // The whole-tree check after an operation (validate_each_operation), amortised: a tree of
+    // The whole-tree check after an operation (validate_after_changes), amortised: a tree of
     // n proxies is checked once every n / kValidateSpread operations (after each one while it
     // is small), so a world of n bodies made one by one costs O(n) node visits of checking,
     // not O(n^2); a broken tree is still found within n / kValidateSpread operations.
     static constexpr std::int32_t kValidateSpread = 16;
     void validate_if_enabled() const {
-        if (!m_settings.validate_each_operation) return;
+        if (!m_settings.validate_after_changes) return;
         if (++m_unvalidated_operations < m_proxy_count / kValidateSpread) return;
         m_unvalidated_operations = 0;
         ++m_whole_checks;

@@ -9,10 +9,10 @@ namespace spindle {
 namespace {
 
 AabbTreeSettings moving_tree_settings(const BroadphaseSettings& s) {
-    return {s.margin, s.displacement_multiplier, s.validate_each_operation};
+    return {s.margin, s.displacement_multiplier, s.validate_after_changes};
 }
 AabbTreeSettings static_tree_settings(const BroadphaseSettings& s) {
-    return {Real(0), Real(0), s.validate_each_operation};
+    return {Real(0), Real(0), s.validate_after_changes};
 }
 
 Pair make_pair(ProxyId p, std::uint64_t user_p, ProxyId q, std::uint64_t user_q) {

@@ -61,8 +61,9 @@ struct BroadphaseSettings {
     Real displacement_multiplier = Real(2);
     // Enlarged proxies per pair-finding job. Fixed, so chunks do not depend on workers.
     std::uint32_t grain = 64;
-    // Validate both trees after every change (O(n) each); default on with SPINDLE_VALIDATE.
-    bool validate_each_operation = SPINDLE_VALIDATE_ENABLED != 0;
+    // The trees check themselves after changes (amortised: see AabbTreeSettings) and the
+    // enlarged list after each change; default on with SPINDLE_VALIDATE.
+    bool validate_after_changes = SPINDLE_VALIDATE_ENABLED != 0;
 };
 
 // Thread use: every function is called by one thread at a time (the physics stage that
@@ -175,7 +176,7 @@ private:
     void validate_enlarged() const;
     // The trees validate themselves after each change; this adds the enlarged list.
     void validate_if_enabled() const {
-        if (m_settings.validate_each_operation) validate_enlarged();
+        if (m_settings.validate_after_changes) validate_enlarged();
     }
 
     BroadphaseSettings m_settings;

@@ -187,7 +187,7 @@ TEST(AabbTreeMoves, ShrunkFatBox_RebuildRefitsTheAncestors) {
 // every operation validated: the flags stay a tree from the root down through them all.
 TEST(AabbTreeMoves, Churn_FlagsStayConsistentThroughInsertsRemovalsAndRotations) {
     Rng rng(15);
-    DynamicAabbTree tree(AabbTreeSettings{.validate_each_operation = true});
+    DynamicAabbTree tree(AabbTreeSettings{.validate_after_changes = true});
     std::vector<std::int32_t> live;
     const int target = 60 * kScale;
     for (int op = 0; op < 1500 * kScale; ++op) {

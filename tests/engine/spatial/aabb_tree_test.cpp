@@ -27,13 +27,13 @@ TEST(AabbTree, EmptyTree_QueriesNothingAndValidates) {
     tree.validate();
 }
 
-// With validate_each_operation, the whole tree is walked after each change while it is
+// With validate_after_changes, the whole tree is walked after each change while it is
 // small and then once every n / 16 changes: a world made body by body pays O(n) walks'
 // worth of checking, not one walk per body (O(n^2): 71 % of a 6,400-body TSan test), and
 // moves are still checked.
 TEST(AabbTree, ValidatingTree_WalksItselfAboutEverySixteenthOfItsSizeInChanges) {
     AabbTreeSettings settings;
-    settings.validate_each_operation = true;
+    settings.validate_after_changes = true;
     DynamicAabbTree tree(settings);
     Rng rng(5);
     constexpr int kProxies = 2000;
