@@ -26,8 +26,8 @@ void fill_lanes(const Vec3* vertices, std::uint32_t count, VertexLanes* out) {
 // identity gives it back (a zero's sign aside), so both read the same planes.
 struct Posed {
     const PolyView& view;
-    const Vec3* vertices;  // in the common frame
-    const VertexLanes* lanes;
+    const Vec3* vertices;      // in the common frame
+    const VertexLanes* lanes;  // null: a polyhedron of at most four vertices (a triangle), walked one by one
     Mat3 r = Mat3::Identity();
     Vec3 t = Vec3::Zero();
     Vec3 inner_centre = Vec3::Zero();  // view.inner_centre in the common frame
@@ -40,6 +40,17 @@ struct Posed {
     // The vertex farthest along d, the first of equals: four vertices a step, each lane
     // keeping its own best and the first index it was found at.
     std::uint32_t support(const Vec3& d) const {
+        if (lanes == nullptr) {
+            // The same products and sums as one lane's, the first of equals as the lanes pick it.
+            std::uint32_t best_index = 0;
+            Real best = -kHuge;
+            for (std::uint32_t i = 0; i < view.vertex_count; ++i) {
+                const Vec3& v = vertices[i];
+                const Real x = (v.x() * d.x() + v.y() * d.y()) + v.z() * d.z();
+                if (x > best || i == 0) best = x, best_index = i;
+            }
+            return best_index;
+        }
         const Lanes dx = Lanes{} + d.x(), dy = Lanes{} + d.y(), dz = Lanes{} + d.z();
         using Indices = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
         Lanes best = (lanes[0].x * dx + lanes[0].y * dy) + lanes[0].z * dz;
@@ -512,10 +523,12 @@ template <typename With>
     const Vec3& t = b_in_a.t;
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
-    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
-    fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
+    // Lanes pay for themselves only past one group: a triangle's support walks its three vertices.
+    const bool b_in_lanes = b.vertex_count > 4;
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes(b_in_lanes ? (b.vertex_count + 3) / 4 : 0);
+    if (b_in_lanes) fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
     const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
-    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
+    const Posed pb{b, b_vertices.data(), b_in_lanes ? b_lanes.data() : nullptr, r, t, r * b.inner_centre + t, false};
     return with(pa, pb);
 }
 
