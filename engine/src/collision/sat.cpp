@@ -301,6 +301,11 @@ CachedAxis cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b
     return axis;
 }
 
+// A FaceB cache's index_a (unused by B's face otherwise) when the face was not the SAT's
+// choice but the one a contact was measured over past the incident face's clip (the
+// fallbacks of face_of_b_manifold): the cached path measures it over the face again.
+constexpr std::uint32_t kOverFaceOfB = 1;
+
 void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t index_a, std::uint32_t index_b,
                    Real separation) {
     if (cache) *cache = FeatureCache(kind, index_a, index_b, static_cast<float>(separation));
@@ -434,6 +439,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     if (over_face(pb, face, n, deepest)) {
         count = deepest_vertex_contact(pb, face, pa, true, speculative, candidates.data());
         reduce_to_manifold(candidates.data(), count, m);
+        if (count > 0 && cache)
+            remember_axis(cache, FeatureCache::Kind::FaceB, kOverFaceOfB, face, face_separation(pb, pa, face));
         return count > 0;
     }
     // Each face of A clipped leaves at most its own vertices and one more per side of B's face.
@@ -452,6 +459,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     }
     // Neighbouring faces share the points clipped on their common edge: pruned.
     reduce_to_manifold(surface.data(), count, m, true);
+    if (m.point_count > 0 && cache)
+        remember_axis(cache, FeatureCache::Kind::FaceB, kOverFaceOfB, face, face_separation(pb, pa, face));
     return m.point_count > 0;
 }
 
@@ -481,7 +490,10 @@ bool cached_manifold(const FeatureCache& cache, const CachedAxis& axis, const Po
                      Real speculative, Manifold& m) {
     switch (cache.kind()) {
         case FeatureCache::Kind::FaceA: return face_manifold(pa, pb, cache.index_a(), false, speculative, true, m);
-        case FeatureCache::Kind::FaceB: return face_manifold(pa, pb, cache.index_b(), true, speculative, true, m);
+        case FeatureCache::Kind::FaceB:
+            if (cache.index_a() == kOverFaceOfB)
+                return face_of_b_over(pa, pb, cache.index_b(), speculative, m, nullptr);
+            return face_manifold(pa, pb, cache.index_b(), true, speculative, true, m);
         case FeatureCache::Kind::EdgePair:
             return edge_manifold(pa, pb, cache.index_a(), cache.index_b(), axis.unit, true, m) &&
                    m.points[0].separation <= speculative;
