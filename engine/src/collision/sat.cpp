@@ -420,8 +420,9 @@ bool over_face(const Posed& ref, std::uint32_t face, const Vec3& n, const Vec3& 
 // holds its deepest point there). The face's plane carried on past its edges says nothing of
 // A beyond them: a long hull across a sloping triangle of a mesh lies far under that plane
 // there, over other triangles. False when nothing over the face is within reach.
-// With a cache, a manifold from the incident face's clip (the one face_manifold makes with this
-// face as the reference) keeps the face there as FaceB.
+// With a cache, a manifold made keeps the face there as FaceB: from the incident face's clip
+// (the one face_manifold makes with this face as the reference) as the SAT would keep it,
+// from the fallbacks marked kOverFaceOfB, so the cached path measures it over the face again.
 bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real speculative, Manifold& m,
                     FeatureCache* cache) {
     const Vec3 n = pb.normal(face);
