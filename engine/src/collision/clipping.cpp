@@ -30,8 +30,11 @@ constexpr Real kEqualDepth = 1e-5;
 // Points closer than this are one point to the reduction.
 constexpr Real kSamePoint = 1e-6;
 
-// Signed area (times two) of triangle a b c seen along n.
-Real signed_area(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) { return (b - a).cross(c - a).dot(n); }
+// Signed area (times two) of triangle a b c seen along n. Inlined: the reduction calls it
+// for every candidate against each side of its triangle.
+[[gnu::always_inline]] inline Real signed_area(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& n) {
+    return (b - a).cross(c - a).dot(n);
+}
 
 ManifoldPoint to_point(const ContactCandidate& c) {
     ManifoldPoint p;

@@ -39,10 +39,11 @@ inline constexpr std::uint32_t other_contact_id(std::uint32_t key) { return 3u <
 //   kind 2: side plane a cut by side plane b (a corner of the reference face).
 // `edge` names what the polygon edge leaving this vertex lies on: an incident edge
 // (bit 15 clear) or a side plane (bit 15 set), so the next cut knows its features.
+// Left unset until written (every clip writes all three): a clip's room is made on each call.
 struct ClipVertex {
     Vec3 p;
-    std::uint16_t key = 0;
-    std::uint16_t edge = 0;
+    std::uint16_t key;
+    std::uint16_t edge;
 };
 
 inline constexpr std::uint16_t clip_key(std::uint32_t kind, std::uint32_t a, std::uint32_t b) {

@@ -124,10 +124,11 @@ bool collide_polyhedra(const PreparedPolyhedron& a, const Transform& xa, const P
 // not admit): a's incident face clipped against it; when nothing clipped is within reach, a's
 // vertex deepest along the normal if it lies over the face, else a's faces that face against
 // the normal, each clipped against it. False when nothing of a over the face is within the
-// speculative distance of its plane. With a cache, a manifold made by the incident face's clip
-// keeps face_b there (FaceB, with the separation along its normal): while that stays within
-// the slop, collide_polyhedra's cached path clips the same face again, making this manifold
-// without a whole SAT and its re-measure.
+// speculative distance of its plane. With a cache, a manifold made keeps face_b there (FaceB,
+// with the separation along its normal; marked as measured over the face when it came from
+// the fallbacks): while that stays within the slop, collide_polyhedra's cached path makes this
+// manifold again (the incident face's clip, or the same measure over the face) without a
+// whole SAT and its re-measure.
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const Transform& xb,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out);
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,

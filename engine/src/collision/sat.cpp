@@ -26,8 +26,8 @@ void fill_lanes(const Vec3* vertices, std::uint32_t count, VertexLanes* out) {
 // identity gives it back (a zero's sign aside), so both read the same planes.
 struct Posed {
     const PolyView& view;
-    const Vec3* vertices;  // in the common frame
-    const VertexLanes* lanes;
+    const Vec3* vertices;      // in the common frame
+    const VertexLanes* lanes;  // null: a polyhedron of at most four vertices (a triangle), walked one by one
     Mat3 r = Mat3::Identity();
     Vec3 t = Vec3::Zero();
     Vec3 inner_centre = Vec3::Zero();  // view.inner_centre in the common frame
@@ -40,6 +40,17 @@ struct Posed {
     // The vertex farthest along d, the first of equals: four vertices a step, each lane
     // keeping its own best and the first index it was found at.
     std::uint32_t support(const Vec3& d) const {
+        if (lanes == nullptr) {
+            // The same products and sums as one lane's, the first of equals as the lanes pick it.
+            std::uint32_t best_index = 0;
+            Real best = -kHuge;
+            for (std::uint32_t i = 0; i < view.vertex_count; ++i) {
+                const Vec3& v = vertices[i];
+                const Real x = (v.x() * d.x() + v.y() * d.y()) + v.z() * d.z();
+                if (x > best || i == 0) best = x, best_index = i;
+            }
+            return best_index;
+        }
         const Lanes dx = Lanes{} + d.x(), dy = Lanes{} + d.y(), dz = Lanes{} + d.z();
         using Indices = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
         Lanes best = (lanes[0].x * dx + lanes[0].y * dy) + lanes[0].z * dz;
@@ -290,6 +301,11 @@ CachedAxis cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b
     return axis;
 }
 
+// A FaceB cache's index_a (unused by B's face otherwise) when the face was not the SAT's
+// choice but the one a contact was measured over past the incident face's clip (the
+// fallbacks of face_of_b_manifold): the cached path measures it over the face again.
+constexpr std::uint32_t kOverFaceOfB = 1;
+
 void remember_axis(FeatureCache* cache, FeatureCache::Kind kind, std::uint32_t index_a, std::uint32_t index_b,
                    Real separation) {
     if (cache) *cache = FeatureCache(kind, index_a, index_b, static_cast<float>(separation));
@@ -327,7 +343,10 @@ int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const P
         const Vec3& v0 = ref.vertices[ref.view.face_vertices[ref_face.first + k]];
         const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1) % ref_face.count]];
         const Vec3 side = (v1 - v0).cross(n).normalized();
-        count = clip_polygon(in, count, {side, side.dot(v0)}, k, next);
+        const Real offset = side.dot(v0);
+        // clip_polygon's step, inlined here (the narrowphase's most frequent clip).
+        count = clip_polygon_by(
+            in, count, [&](const Vec3& p) { return side.dot(p) - offset; }, k, next);
         std::swap(in, next);
     }
     int n_out = 0;
@@ -401,8 +420,9 @@ bool over_face(const Posed& ref, std::uint32_t face, const Vec3& n, const Vec3& 
 // holds its deepest point there). The face's plane carried on past its edges says nothing of
 // A beyond them: a long hull across a sloping triangle of a mesh lies far under that plane
 // there, over other triangles. False when nothing over the face is within reach.
-// With a cache, a manifold from the incident face's clip (the one face_manifold makes with this
-// face as the reference) keeps the face there as FaceB.
+// With a cache, a manifold made keeps the face there as FaceB: from the incident face's clip
+// (the one face_manifold makes with this face as the reference) as the SAT would keep it,
+// from the fallbacks marked kOverFaceOfB, so the cached path measures it over the face again.
 bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real speculative, Manifold& m,
                     FeatureCache* cache) {
     const Vec3 n = pb.normal(face);
@@ -420,6 +440,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     if (over_face(pb, face, n, deepest)) {
         count = deepest_vertex_contact(pb, face, pa, true, speculative, candidates.data());
         reduce_to_manifold(candidates.data(), count, m);
+        if (count > 0 && cache)
+            remember_axis(cache, FeatureCache::Kind::FaceB, kOverFaceOfB, face, face_separation(pb, pa, face));
         return count > 0;
     }
     // Each face of A clipped leaves at most its own vertices and one more per side of B's face.
@@ -438,6 +460,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     }
     // Neighbouring faces share the points clipped on their common edge: pruned.
     reduce_to_manifold(surface.data(), count, m, true);
+    if (m.point_count > 0 && cache)
+        remember_axis(cache, FeatureCache::Kind::FaceB, kOverFaceOfB, face, face_separation(pb, pa, face));
     return m.point_count > 0;
 }
 
@@ -467,7 +491,10 @@ bool cached_manifold(const FeatureCache& cache, const CachedAxis& axis, const Po
                      Real speculative, Manifold& m) {
     switch (cache.kind()) {
         case FeatureCache::Kind::FaceA: return face_manifold(pa, pb, cache.index_a(), false, speculative, true, m);
-        case FeatureCache::Kind::FaceB: return face_manifold(pa, pb, cache.index_b(), true, speculative, true, m);
+        case FeatureCache::Kind::FaceB:
+            if (cache.index_a() == kOverFaceOfB)
+                return face_of_b_over(pa, pb, cache.index_b(), speculative, m, nullptr);
+            return face_manifold(pa, pb, cache.index_b(), true, speculative, true, m);
         case FeatureCache::Kind::EdgePair:
             return edge_manifold(pa, pb, cache.index_a(), cache.index_b(), axis.unit, true, m) &&
                    m.points[0].separation <= speculative;
@@ -512,10 +539,12 @@ template <typename With>
     const Vec3& t = b_in_a.t;
     ScratchBuffer<Vec3, kInlineVertices> b_vertices(b.vertex_count);
     for (std::uint32_t i = 0; i < b.vertex_count; ++i) b_vertices[i] = r * b.vertices[i] + t;
-    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes((b.vertex_count + 3) / 4);
-    fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
+    // Lanes pay for themselves only past one group: a triangle's support walks its three vertices.
+    const bool b_in_lanes = b.vertex_count > 4;
+    ScratchBuffer<VertexLanes, kInlineVertices / 4> b_lanes(b_in_lanes ? (b.vertex_count + 3) / 4 : 0);
+    if (b_in_lanes) fill_lanes(b_vertices.data(), b.vertex_count, b_lanes.data());
     const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
-    const Posed pb{b, b_vertices.data(), b_lanes.data(), r, t, r * b.inner_centre + t, false};
+    const Posed pb{b, b_vertices.data(), b_in_lanes ? b_lanes.data() : nullptr, r, t, r * b.inner_centre + t, false};
     return with(pa, pb);
 }
 

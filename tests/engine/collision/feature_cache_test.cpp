@@ -430,20 +430,36 @@ TEST(MeshQueries, ATriangleRaisedUnderARestingPartIsFoundOnANewMesh) {
     for (int m = 0; m < n; ++m) EXPECT_EQ(out[m].normal, plain[m].normal) << "manifold " << m;
 }
 
+// A hexagonal log (3 m along x, 0.5 m radius) with a face straight down.
+Shape hexagonal_log() {
+    std::vector<Vec3> prism;
+    for (int k = 0; k < 6; ++k) {
+        const Real angle = k * kPi / 3 + kPi / 6;
+        for (const Real x : {-1.5, 1.5}) prism.emplace_back(x, 0.5 * std::cos(angle), 0.5 * std::sin(angle));
+    }
+    return Shape::convex_hull(prism);
+}
+
+// A collide of `a` with the flat mesh through its triangles' caches beside one without
+// (the whole SAT each triangle): they must touch and give the same manifolds, bit for bit.
+void expect_cached_is_whole_sat(const Shape& a, const Transform& xa, const Shape& mesh, FeatureCache& cache,
+                                TriangleFeatures& triangles, int step) {
+    const Transform xm = at(Vec3::Zero());
+    Manifold cached[8], plain[8];
+    const int nc = collide_cached(a, xa, mesh, xm, 0.1, cached, 8, cache, triangles, 0.005);
+    const int np = collide(a, xa, mesh, xm, 0.1, plain, 8);
+    ASSERT_GT(np, 0) << "step " << step;
+    expect_same(cached, nc, plain, np, step);
+}
+
 // A hexagonal log (3 m, 0.5 m radius) lying on a face on the flat mesh, one end 1.15 degrees
 // up, creeping along: the triangles under its raised length meet its bottom face (or an edge)
 // in the SAT, whose normal the mesh does not admit, and the contact is measured again against
 // each triangle's face. That face is kept as the triangle's feature, so the next collide clips
 // it alone (no whole SAT and no second clip), and every collide is the whole SAT's, bit for bit.
 TEST(FeatureCache, ATrianglesFaceAContactWasMeasuredAgainIsKeptAndMakesTheSameManifold) {
-    std::vector<Vec3> prism;
-    for (int k = 0; k < 6; ++k) {
-        const Real angle = k * kPi / 3 + kPi / 6;  // a face straight down
-        for (const Real x : {-1.5, 1.5}) prism.emplace_back(x, 0.5 * std::cos(angle), 0.5 * std::sin(angle));
-    }
-    const Shape log = Shape::convex_hull(prism);
+    const Shape log = hexagonal_log();
     const Shape mesh = flat_mesh();
-    const Transform xm = at(Vec3::Zero());
     const Quat q = about(Vec3::UnitY(), 0.3) * about(Vec3::UnitZ(), 0.02);
     FeatureCache cache;
     TriangleFeatures triangles;
@@ -451,11 +467,7 @@ TEST(FeatureCache, ATrianglesFaceAContactWasMeasuredAgainIsKeptAndMakesTheSameMa
     for (int step = 0; step < 20; ++step) {
         const Transform xl = sunk(log, -0.5 + 0.002 * step, 0.2, q, 0.003);
         const TriangleFeatures before = triangles;
-        Manifold cached[8], plain[8];
-        const int nc = collide_cached(log, xl, mesh, xm, 0.1, cached, 8, cache, triangles, 0.005);
-        const int np = collide(log, xl, mesh, xm, 0.1, plain, 8);
-        ASSERT_GT(np, 0) << "step " << step;
-        expect_same(cached, nc, plain, np, step);
+        ASSERT_NO_FATAL_FAILURE(expect_cached_is_whole_sat(log, xl, mesh, cache, triangles, step));
         int faces = 0;
         for (const TriangleFeature& t : triangles) {
             const bool face = t.feature == FeatureCache(FeatureCache::Kind::FaceB, 0, 0, t.feature.separation());
@@ -468,6 +480,36 @@ TEST(FeatureCache, ATrianglesFaceAContactWasMeasuredAgainIsKeptAndMakesTheSameMa
         EXPECT_GE(faces, 8) << "step " << step;
     }
     EXPECT_GT(faces_kept, 0);
+}
+
+// The same log rolled onto a long edge (29 degrees: its two faces there lean 29 and 31 degrees
+// off the mesh): a triangle beside that edge, under the steeper face, gets the SAT's face of
+// the log, and measured again against the triangle's face the incident face (the other one)
+// clips to nothing over it, so the log's faces over the triangle are clipped instead. That
+// face is kept too, marked as measured over it (FaceB, index_a 1): the next collide measures
+// it over the face again, with no whole SAT, and every collide is the whole SAT's bit for bit.
+TEST(FeatureCache, ATrianglesFaceMeasuredPastTheIncidentFaceIsKeptAndMakesTheSameManifold) {
+    const Shape log = hexagonal_log();
+    const Shape mesh = flat_mesh();
+    const Quat q = about(Vec3::UnitY(), 0.3) * about(Vec3::UnitX(), kPi / 6 - 0.035);
+    const FeatureCache over(FeatureCache::Kind::FaceB, 1, 0);
+    FeatureCache cache;
+    TriangleFeatures triangles;
+    int measured_over = 0, kept = 0;
+    for (int step = 0; step < 20; ++step) {
+        // Sinking 0.2 mm a call: a face kept is kept with the separation it was measured at.
+        const Transform xl = sunk(log, -0.5 + 0.002 * step, 0.2, q, 0.003 + 0.0002 * step);
+        const TriangleFeatures before = triangles;
+        ASSERT_NO_FATAL_FAILURE(expect_cached_is_whole_sat(log, xl, mesh, cache, triangles, step));
+        for (const TriangleFeature& t : triangles) {
+            const bool is_over = t.feature == FeatureCache(over.kind(), 1, 0, t.feature.separation());
+            measured_over += is_over;
+            for (const TriangleFeature& was : before)
+                kept += is_over && was.triangle == t.triangle && was.feature == t.feature;
+        }
+    }
+    EXPECT_GT(measured_over, 0);
+    EXPECT_GT(kept, 0);
 }
 
 TEST(FeatureCache, OtherPairsClearIt) {

@@ -35,6 +35,16 @@ void expect_same_bits(const Vec3& got, const Vec3& expected, const char* what, s
     for (int i = 0; i < 3; ++i) EXPECT_EQ(got[i], expected[i]) << what << " of edge " << j << ", coordinate " << i;
 }
 
+void expect_same_manifold(const Manifold& got, const Manifold& expected, int pose) {
+    ASSERT_EQ(got.point_count, expected.point_count) << "pose " << pose;
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(got.normal[i], expected.normal[i]) << "pose " << pose;
+    for (int k = 0; k < got.point_count; ++k) {
+        for (int i = 0; i < 3; ++i) EXPECT_EQ(got.points[k].point[i], expected.points[k].point[i]) << "pose " << pose;
+        EXPECT_EQ(got.points[k].separation, expected.points[k].separation) << "pose " << pose;
+        EXPECT_EQ(got.points[k].id, expected.points[k].id) << "pose " << pose;
+    }
+}
+
 TEST(SatPrepared, HullKeepsTheArcsOfItsEdges) {
     std::mt19937 random(11);
     for (const int count : {4, 8, 32, 64}) {
@@ -95,19 +105,56 @@ TEST(SatPrepared, KeptArcsGiveTheBitsOfArcsMadePerTest) {
             if (!kept_touch) continue;
             ++touching;
             if (kept_cache.kind() == FeatureCache::Kind::EdgePair) ++edge_pairs;
-            ASSERT_EQ(kept.point_count, made.point_count) << "pose " << pose;
-            for (int i = 0; i < 3; ++i) EXPECT_EQ(kept.normal[i], made.normal[i]) << "pose " << pose;
-            for (int k = 0; k < kept.point_count; ++k) {
-                for (int i = 0; i < 3; ++i)
-                    EXPECT_EQ(kept.points[k].point[i], made.points[k].point[i]) << "pose " << pose;
-                EXPECT_EQ(kept.points[k].separation, made.points[k].separation) << "pose " << pose;
-                EXPECT_EQ(kept.points[k].id, made.points[k].id) << "pose " << pose;
-            }
+            expect_same_manifold(kept, made, pose);
         }
     }
     // The poses reach both kinds of answer, else the comparison says little.
     EXPECT_GT(touching, 200);
     EXPECT_GT(edge_pairs, 10);
+}
+
+// A triangle as B (three vertices) has its support walked vertex by vertex, not in lanes;
+// the same triangle padded to five vertices (the last two repeat the first, so the first of
+// equals is the same vertex) goes through the lanes. Boxes and hulls near touching it, half
+// of them lying square on it (ties in the supports), must get the same manifold and cached
+// feature from both, bit for bit.
+TEST(SatPrepared, ATriangleWalkedVertexByVertexGivesTheBitsOfLanes) {
+    std::mt19937 random(7);
+    const ConvexHull hull(sphere_points(random, 1.2, 16));
+    const detail::BoxPoly box(Vec3(1.5, 0.4, 0.9));
+    const detail::PolyView shapes[] = {box.view(), detail::view_of(hull)};
+    const Real heights[] = {0.4, 1.2};
+    const detail::TrianglePoly triangle(Vec3(-2, 0, -1), Vec3(0, 0, 2), Vec3(2, 0, -1));
+    const detail::PolyView walked = triangle.view();
+    const Vec3 padded_vertices[5] = {walked.vertices[0], walked.vertices[1], walked.vertices[2], walked.vertices[0],
+                                     walked.vertices[0]};
+    detail::PolyView in_lanes = walked;
+    in_lanes.vertices = padded_vertices;
+    in_lanes.vertex_count = 5;
+    const Transform xt = at(Vec3::Zero());
+    std::uniform_real_distribution<Real> across(-1.5, 1.5), gap(-0.3, 0.05);
+    const Real speculative = 0.04;
+    int touching = 0;
+    for (int pose = 0; pose < 400; ++pose) {
+        const int ia = pose % 2;
+        const bool square = pose % 4 < 2;
+        const Vec3 p(across(random), heights[ia] + gap(random), across(random));
+        const Transform xa = at(p, square ? Quat::Identity() : random_turn(random));
+        FeatureCache walked_cache, lanes_cache;
+        for (int repeat = 0; repeat < 2; ++repeat) {  // the second time from the cached feature
+            Manifold by_vertex, by_lanes;
+            const bool touch = detail::collide_polyhedra(shapes[ia], xa, walked, xt, speculative, by_vertex,
+                                                         &walked_cache, 0.01);
+            const bool lanes_touch = detail::collide_polyhedra(shapes[ia], xa, in_lanes, xt, speculative, by_lanes,
+                                                               &lanes_cache, 0.01);
+            ASSERT_EQ(touch, lanes_touch) << "pose " << pose;
+            EXPECT_EQ(walked_cache, lanes_cache) << "pose " << pose;
+            if (!touch) continue;
+            ++touching;
+            expect_same_manifold(by_vertex, by_lanes, pose);
+        }
+    }
+    EXPECT_GT(touching, 300);
 }
 
 }  // namespace
