@@ -330,8 +330,14 @@ struct SolverScratch {
     // Whether every awake dynamic body has the same inverse mass (prepare_bodies, from the
     // least and greatest of each chunk of bodies): then no scale differs from 1.
     bool one_dynamic_mass = false;
-    std::vector<std::pair<Real, Real>> chunk_inv_mass;
-    std::vector<std::uint8_t> chunk_all_dynamic;  // per chunk of bodies: no kinematic body in it
+    // Per chunk of bodies (prepare_bodies): the least and greatest inverse mass of its
+    // dynamic bodies, and whether it has no kinematic body.
+    struct BodyChunk {
+        Real least_inv_mass = kHuge;
+        Real greatest_inv_mass = -kHuge;
+        bool all_dynamic = true;
+    };
+    std::vector<BodyChunk> body_chunks;
     // The body passes folded into the constraint passes (solver.cpp), so a step has fewer
     // phases and barriers: each body's velocities are integrated just before the first
     // constraint of a warm-start pass that touches it, its positions just before the first

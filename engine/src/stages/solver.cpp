@@ -69,11 +69,9 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
     // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
     // by the grain): equal over all of them, no body is lighter than another it carries.
     const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
-    scratch.chunk_inv_mass.assign(chunks, {kHuge, -kHuge});
-    scratch.chunk_all_dynamic.assign(chunks, 1);
+    scratch.body_chunks.assign(chunks, SolverScratch::BodyChunk{});
     world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        auto& [least, greatest] = scratch.chunk_inv_mass[lo / kBodyGrain];
-        bool all_dynamic = true;
+        SolverScratch::BodyChunk& chunk = scratch.body_chunks[lo / kBodyGrain];
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
@@ -92,24 +90,25 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
             if (sb.dynamic) {
-                least = std::min(least, sb.inv_mass);
-                greatest = std::max(greatest, sb.inv_mass);
+                chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
+                chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
+            } else {
+                chunk.all_dynamic = false;
             }
-            all_dynamic = all_dynamic && sb.dynamic;
         }
-        scratch.chunk_all_dynamic[lo / kBodyGrain] = all_dynamic ? 1 : 0;
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
     scratch.push_velocities[n] = PushVelocity{};
     scratch.gravity_scales[n] = 0;
     Real least = kHuge, greatest = -kHuge;
-    for (const auto& [chunk_least, chunk_greatest] : scratch.chunk_inv_mass) {
-        least = std::min(least, chunk_least);
-        greatest = std::max(greatest, chunk_greatest);
+    bool all_dynamic = true;
+    for (const SolverScratch::BodyChunk& chunk : scratch.body_chunks) {
+        least = std::min(least, chunk.least_inv_mass);
+        greatest = std::max(greatest, chunk.greatest_inv_mass);
+        all_dynamic = all_dynamic && chunk.all_dynamic;
     }
     scratch.one_dynamic_mass = !(least < greatest);
-    return std::find(scratch.chunk_all_dynamic.begin(), scratch.chunk_all_dynamic.end(), 0) ==
-           scratch.chunk_all_dynamic.end();
+    return all_dynamic;
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
