@@ -234,29 +234,65 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
     return same;
 }
 
-// Which bodies each wide contact is the first of its pass to touch, and the awake bodies no
-// contact touches (SolverScratch::first_touch, untouched). A pass runs the colours in order
-// and the overflow last, one by one, which is the order of `wide`; within a colour no two
-// lanes share a dynamic body. Bodies n and up (the immovable one) are never integrated.
+// Which bodies each constraint is the first of its pass to touch, and the awake bodies no
+// constraint touches (SolverScratch::first_touch, untouched). A pass runs the colours in
+// order, each as for_colored does (its wide joints, its other joints, its wide contacts),
+// and the overflow last (its joints, then its wide contacts); within a colour no two
+// constraints share a dynamic body. Bodies n and up (the immovable one) are never
+// integrated.
 void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
-    scratch.first_touch.resize(scratch.wide.size() + 1);
+    scratch.first_touch.clear();
     scratch.first_touched.clear();
     scratch.touched.assign(n, 0);
     std::uint8_t* touched = scratch.touched.data();
-    auto first = [&](std::uint32_t k) {
-        if (k >= n || touched[k] != 0) return false;
+    auto touch = [&](std::uint32_t k) {
+        if (k >= n || touched[k] != 0) return;
         touched[k] = 1;
-        return true;
+        scratch.first_touched.push_back(k);
     };
-    for (std::size_t w = 0; w < scratch.wide.size(); ++w) {
+    auto item = [&] { scratch.first_touch.push_back(static_cast<std::uint32_t>(scratch.first_touched.size())); };
+    auto wide_contacts = [&](std::size_t from, std::size_t to) {
+        for (std::size_t w = from; w < to; ++w) {
+            item();
+            const WideContact& wc = scratch.wide[w];
+            for (int l = 0; l < wc.lanes; ++l) {
+                touch(wc.a[l]);
+                touch(wc.b[l]);
+            }
+        }
+    };
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.first_item[c] = static_cast<std::uint32_t>(scratch.first_touch.size());
+        for (std::uint32_t w = scratch.wide_joint_begin[c]; w < scratch.wide_joint_begin[c + 1]; ++w) {
+            item();
+            const WideJoint& wj = scratch.wide_joints[w];
+            for (int l = 0; l < wj.lanes; ++l) {
+                touch(wj.a[l]);
+                touch(wj.b[l]);
+            }
+        }
+        for (const std::uint32_t k : scratch.joint_colors[c]) {
+            item();
+            touch(scratch.joints[k].a);
+            touch(scratch.joints[k].b);
+        }
+        wide_contacts(scratch.wide_begin[c], scratch.wide_begin[c + 1]);
+    }
+    // The overflow is one block: one item.
+    scratch.first_item[kColorCount] = static_cast<std::uint32_t>(scratch.first_touch.size());
+    item();
+    for (const std::uint32_t k : scratch.joint_overflow) {
+        touch(scratch.joints[k].a);
+        touch(scratch.joints[k].b);
+    }
+    for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) {
         const WideContact& wc = scratch.wide[w];
-        scratch.first_touch[w] = static_cast<std::uint32_t>(scratch.first_touched.size());
         for (int l = 0; l < wc.lanes; ++l) {
-            if (first(wc.a[l])) scratch.first_touched.push_back(wc.a[l]);
-            if (first(wc.b[l])) scratch.first_touched.push_back(wc.b[l]);
+            touch(wc.a[l]);
+            touch(wc.b[l]);
         }
     }
-    scratch.first_touch[scratch.wide.size()] = static_cast<std::uint32_t>(scratch.first_touched.size());
+    item();  // the end of the last item
     scratch.untouched.clear();
     for (std::uint32_t k = 0; k < n; ++k) {
         if (touched[k] == 0) scratch.untouched.push_back(k);
@@ -266,13 +302,12 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
 // Calls integrate(list) on the bodies that constraints [lo, hi) of colour `color` are the
 // first of their pass to touch (one span), before the phase's block runs them:
 // no other constraint of the colour touches those bodies, so all of them may go first (and
-// the overflow, one block, has the first touches of its whole pass). A folded step has no
-// joints: a colour's constraints are its wide contacts.
+// the overflow, one block, has the first touches of its whole pass).
 template <typename IntegrateFn>
 void integrate_first_touched(const SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi,
                              IntegrateFn&& integrate) {
-    const std::size_t first = color == kColorCount ? scratch.wide_begin[kColorCount] : scratch.wide_begin[color] + lo;
-    const std::size_t last = color == kColorCount ? scratch.wide.size() : scratch.wide_begin[color] + hi;
+    const std::size_t first = scratch.first_item[color] + (color == kColorCount ? 0 : lo);
+    const std::size_t last = color == kColorCount ? first + 1 : scratch.first_item[color] + hi;
     const std::uint32_t from = scratch.first_touch[first];
     const std::uint32_t to = scratch.first_touch[last];
     if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
@@ -438,11 +473,11 @@ void solve(World& world, Real dt) {
         color(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
-        if (scratch.joints.empty()) find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
+        find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
         world.counters.constraint_colorings += 1;
     }
     // Folded only where every phase that integrates has a constraint to carry it.
-    scratch.folded = scratch.fold_body_passes && all_dynamic && scratch.joints.empty() && !scratch.wide.empty() &&
+    scratch.folded = scratch.fold_body_passes && all_dynamic && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
