@@ -258,7 +258,7 @@ enum class Pass : std::uint8_t {
     FinalizeBodies
 };
 // A phase that carries a body pass (SolverScratch::fold_body_passes): a warm-start or first
-// relax phase of a folded step integrates, before a wide contact, the bodies it is the first
+// relax phase of a folded step integrates, before a constraint, the bodies it is the first
 // of its pass to touch (first_touch), and in its items past `constraints`, chunks of the
 // bodies no constraint touches; a StoreImpulses phase finalizes every awake body in chunks
 // past them.
