@@ -1,6 +1,7 @@
 // WorkStealingJobSystem::run_phases: one participant per worker runs every phase, each
 // phase's items in shares and blocks, with a spinning barrier between phases (one after a
-// run of phases that fit in one block each).
+// run of phases that fit in one block each): each participant publishes the blocks it
+// finished, the others add them up.
 #include "worker.hpp"
 
 #include <spindle/platform/clock.hpp>
@@ -50,20 +51,44 @@ bool one_block(const Phase& phase) { return phase.count <= std::max<std::uint32_
 
 // One run_phases call, on the caller's stack. Each phase is cut into one share per
 // participant and each share into blocks. claimed[j] counts the blocks taken from share
-// j over every phase so far, done the blocks finished: a phase is over when done
-// reaches the blocks of all phases up to it. No counter is reset between phases, so
-// a participant that starts late just walks past the phases that are over. A round of
-// one-block phases is one block of share 0.
+// j over every phase so far, finished[j] the blocks participant j has run: a phase is
+// over when the finished blocks add up to the blocks of all phases up to it. No counter
+// is reset between phases, so a participant that starts late just walks past the phases
+// that are over. A round of one-block phases is one block of share 0.
+//
+// Each participant writes only its own finished count (a plain store), and the others
+// read it: the last to finish a phase does not first take a shared counter from the
+// cores that wait on it (a locked add), so they see its count one cache-line transfer
+// after it is done, while it reads theirs. A participant that claimed no block of the
+// phase is not waited for (it may be descheduled, or not started: the same thread may
+// run two participants one after the other).
 struct PhaseRun {
     std::span<const Phase> phases;
     PhaseFn fn;
     const char* name;
     unsigned participants;
     CacheLinePadded<std::atomic<std::uint32_t>> claimed[WorkStealingJobSystem::kMaxPhaseWorkers];
-    CacheLinePadded<std::atomic<std::uint64_t>> done;
+    CacheLinePadded<std::atomic<std::uint64_t>> finished[WorkStealingJobSystem::kMaxPhaseWorkers];
     std::uint64_t phases_run = 0;  // phases with items and rounds, counted by participant 0,
     std::uint64_t barriers = 0;    // which walks every round
 };
+
+// Waits until the blocks finished by all participants add up to `target`, this one's
+// being `mine`.
+void wait_for_blocks(PhaseRun& run, unsigned me, std::uint64_t mine, std::uint64_t target) noexcept {
+    for (int spins = 0;; ++spins) {
+        std::uint64_t sum = mine;
+        for (unsigned j = 0; j < run.participants; ++j) {
+            if (j != me) sum += run.finished[j].value.load(std::memory_order_acquire);
+        }
+        if (sum >= target) return;
+        if (spins < kSpinsBeforeYield) {
+            cpu_pause();
+        } else {
+            std::this_thread::yield();
+        }
+    }
+}
 
 // Participant `me`'s part of a round of one-block phases [p, end): the whole round if it
 // claims it. Returns the blocks it ran (0 or 1).
@@ -91,7 +116,8 @@ std::uint64_t run_one_block_round(PhaseRun& run, std::uint32_t p, std::uint32_t 
 void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexcept {
     const unsigned n = run.participants;
     std::uint32_t taken_before[WorkStealingJobSystem::kMaxPhaseWorkers] = {};  // claimed[j] when the phase began
-    std::uint64_t done_target = 0;
+    std::uint64_t done_target = 0;                                             // blocks of the rounds so far
+    std::uint64_t mine = 0;  // blocks this participant ran, as in finished[me]
     const bool tracing = self.system->trace_enabled();
     const auto phase_count = static_cast<std::uint32_t>(run.phases.size());
     for (std::uint32_t p = 0, end = 0; p < phase_count; p = end) {
@@ -139,15 +165,12 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
             // only the barrier below is left out of it (and a block costs no clock reads).
             if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         }
-        // Publish this round's blocks at once (one shared write per round, not per block).
-        if (ran > 0) run.done.value.fetch_add(ran, std::memory_order_release);
-        for (int spins = 0; run.done.value.load(std::memory_order_acquire) < done_target; ++spins) {
-            if (spins < kSpinsBeforeYield) {
-                cpu_pause();
-            } else {
-                std::this_thread::yield();
-            }
+        // Publish this round's blocks at once (one store per round, not per block).
+        if (ran > 0) {
+            mine += ran;
+            run.finished[me].value.store(mine, std::memory_order_release);
         }
+        wait_for_blocks(run, me, mine, done_target);
     }
 }
 

@@ -417,6 +417,44 @@ TEST(WorkStealing, PhasesFinishWhenAWorkerNeverJoins) {
     EXPECT_EQ(chain.values, expected.values);
 }
 
+// The barrier after a phase is each participant's finished blocks added up: no item of a
+// phase starts before every item of the phase before it has finished, whichever participant
+// finished last (items of uneven cost, so the last finisher and the thieves change from
+// phase to phase), and every item runs once.
+TEST(WorkStealing, EachPhaseStartsAfterEveryItemOfTheOneBeforeFinished) {
+    std::mt19937 rng(19);
+    std::vector<Phase> phases;
+    for (int p = 0; p < 300; ++p) {
+        const auto count = static_cast<std::uint32_t>(std::uniform_int_distribution<int>(2, 40)(rng));
+        phases.push_back(Phase{"uneven", count, p % 3 == 0 ? 4u : 1u});
+    }
+    std::vector<std::uint32_t> cost(phases.size() * 40);
+    for (std::uint32_t& c : cost) c = std::uniform_int_distribution<std::uint32_t>(0, 400)(rng);
+    for (unsigned workers : {2u, 3u, 4u}) {
+        auto jobs = make(workers);
+        for (int repeat = 0; repeat < 4; ++repeat) {
+            std::vector<std::atomic<std::uint32_t>> finished(phases.size());
+            std::vector<std::atomic<std::uint32_t>> runs(phases.size() * 40);
+            std::atomic<int> early{0};
+            jobs->run_phases("uneven", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
+                if (p > 0 && finished[p - 1].load() != phases[p - 1].count) early.fetch_add(1);
+                for (std::uint32_t i = lo; i < hi; ++i) {
+                    volatile double x = i;
+                    for (std::uint32_t k = 0; k < cost[p * 40 + i]; ++k) x = x * 0.999 + 1;
+                    runs[p * 40 + i].fetch_add(1);
+                }
+                finished[p].fetch_add(hi - lo);
+            });
+            EXPECT_EQ(early.load(), 0) << workers << " workers: blocks began before the phase before them was over";
+            for (std::size_t p = 0; p < phases.size(); ++p) {
+                for (std::uint32_t i = 0; i < 40; ++i) {
+                    ASSERT_EQ(runs[p * 40 + i].load(), i < phases[p].count ? 1u : 0u) << "phase " << p << " item " << i;
+                }
+            }
+        }
+    }
+}
+
 // Phases that fit in one block each (count <= grain), one after another, are one round: the
 // worker that claims the first runs them all, in order, and the others meet it at one barrier
 // after the last; a phase with more blocks, or one after it, is not in the round.

@@ -258,7 +258,7 @@ enum class Pass : std::uint8_t {
     FinalizeBodies
 };
 // A phase that carries a body pass (SolverScratch::fold_body_passes): a warm-start or first
-// relax phase of a folded step integrates, before a wide contact, the bodies it is the first
+// relax phase of a folded step integrates, before a constraint, the bodies it is the first
 // of its pass to touch (first_touch), and in its items past `constraints`, chunks of the
 // bodies no constraint touches; a StoreImpulses phase finalizes every awake body in chunks
 // past them.
@@ -330,23 +330,32 @@ struct SolverScratch {
     // Whether every awake dynamic body has the same inverse mass (prepare_bodies, from the
     // least and greatest of each chunk of bodies): then no scale differs from 1.
     bool one_dynamic_mass = false;
-    std::vector<std::pair<Real, Real>> chunk_inv_mass;
-    std::vector<std::uint8_t> chunk_all_dynamic;  // per chunk of bodies: no kinematic body in it
+    // Per chunk of bodies (prepare_bodies): the least and greatest inverse mass of its
+    // dynamic bodies, and whether it has no kinematic body.
+    struct BodyChunk {
+        Real least_inv_mass = kHuge;
+        Real greatest_inv_mass = -kHuge;
+        bool all_dynamic = true;
+    };
+    std::vector<BodyChunk> body_chunks;
     // The body passes folded into the constraint passes (solver.cpp), so a step has fewer
     // phases and barriers: each body's velocities are integrated just before the first
     // constraint of a warm-start pass that touches it, its positions just before the first
     // of the first relax pass (two phases fewer a substep), and the bodies are finalized in
     // the phase that stores the contacts' impulses. Each body's arithmetic and its order
     // against its own constraints stay the same: bitwise the results of the passes of
-    // their own. The integration only for contacts among dynamic bodies (a kinematic body
-    // is read by many constraints of a colour at once; joints are not marked).
+    // their own. The integration only among dynamic bodies (a kinematic body is read by
+    // many constraints of a colour at once); the finalizing only without joints (their
+    // impulses are stored in phases of their own).
     bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
     bool folded = false;           // this step's plan folds the integration
-    // The bodies that no constraint before them in a pass touches, wide contact by wide
-    // contact: wide contact w's are first_touched[first_touch[w], first_touch[w + 1]), so a
-    // block's are one span. And the awake bodies that no constraint touches. Made with the
-    // colouring (find_first_touches).
-    std::vector<std::uint32_t> first_touch;  // wide.size() + 1 offsets
+    // The bodies that no constraint before them in a pass touches, constraint by constraint
+    // in a pass's order: item k of colour c (its wide joints, other joints, wide contacts)
+    // has first_touched[first_touch[i], first_touch[i + 1]) with i = first_item[c] + k, so a
+    // block's are one span; the overflow is one item. And the awake bodies that no
+    // constraint touches. Made with the colouring (find_first_touches).
+    std::vector<std::uint32_t> first_touch;  // an offset per item, and one past the last
+    std::uint32_t first_item[kColorCount + 1] = {};
     std::vector<std::uint32_t> first_touched;
     std::vector<std::uint32_t> untouched;
     std::vector<std::uint8_t> touched;       // find_first_touches' per-body scratch, kept for its capacity

@@ -37,10 +37,16 @@ inline Vec3 limit_speed(const Vec3& v, Real limit) {
 // as written while that is finite. When a huge j makes it overflow (m j may then hold
 // inf - inf, a NaN), a vector of length `limit` in m j's direction instead: what the
 // speed limit would have made of it.
+// The overflow case apart and out of line, so that the sum is inlined where it is hot
+// (the integrator's loops).
+[[gnu::noinline, gnu::cold]] inline Vec3 overflowed_angular(const Mat3& m, const Vec3& j, Real limit) {
+    return limit * unit_of(m * (j / j.cwiseAbs().maxCoeff()));
+}
 inline Vec3 add_angular(const Vec3& v, Real scale, const Mat3& m, const Vec3& j, Real limit) {
     const Vec3 sum = v + scale * (m * j);
-    if (is_finite(sum)) return sum;
-    return limit * unit_of(m * (j / j.cwiseAbs().maxCoeff()));
+    if (is_finite(sum)) [[likely]]
+        return sum;
+    return overflowed_angular(m, j, limit);
 }
 
 // An accumulated force or torque stays finite however many huge ones are added.

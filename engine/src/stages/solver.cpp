@@ -69,11 +69,9 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
     // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
     // by the grain): equal over all of them, no body is lighter than another it carries.
     const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
-    scratch.chunk_inv_mass.assign(chunks, {kHuge, -kHuge});
-    scratch.chunk_all_dynamic.assign(chunks, 1);
+    scratch.body_chunks.assign(chunks, SolverScratch::BodyChunk{});
     world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        auto& [least, greatest] = scratch.chunk_inv_mass[lo / kBodyGrain];
-        bool all_dynamic = true;
+        SolverScratch::BodyChunk& chunk = scratch.body_chunks[lo / kBodyGrain];
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
@@ -92,24 +90,25 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
             sb.inv_mass = b.inv_mass[i];
             sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
             if (sb.dynamic) {
-                least = std::min(least, sb.inv_mass);
-                greatest = std::max(greatest, sb.inv_mass);
+                chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
+                chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
+            } else {
+                chunk.all_dynamic = false;
             }
-            all_dynamic = all_dynamic && sb.dynamic;
         }
-        scratch.chunk_all_dynamic[lo / kBodyGrain] = all_dynamic ? 1 : 0;
     });
     scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
     scratch.push_velocities[n] = PushVelocity{};
     scratch.gravity_scales[n] = 0;
     Real least = kHuge, greatest = -kHuge;
-    for (const auto& [chunk_least, chunk_greatest] : scratch.chunk_inv_mass) {
-        least = std::min(least, chunk_least);
-        greatest = std::max(greatest, chunk_greatest);
+    bool all_dynamic = true;
+    for (const SolverScratch::BodyChunk& chunk : scratch.body_chunks) {
+        least = std::min(least, chunk.least_inv_mass);
+        greatest = std::max(greatest, chunk.greatest_inv_mass);
+        all_dynamic = all_dynamic && chunk.all_dynamic;
     }
     scratch.one_dynamic_mass = !(least < greatest);
-    return std::find(scratch.chunk_all_dynamic.begin(), scratch.chunk_all_dynamic.end(), 0) ==
-           scratch.chunk_all_dynamic.end();
+    return all_dynamic;
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
@@ -235,29 +234,65 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
     return same;
 }
 
-// Which bodies each wide contact is the first of its pass to touch, and the awake bodies no
-// contact touches (SolverScratch::first_touch, untouched). A pass runs the colours in order
-// and the overflow last, one by one, which is the order of `wide`; within a colour no two
-// lanes share a dynamic body. Bodies n and up (the immovable one) are never integrated.
+// Which bodies each constraint is the first of its pass to touch, and the awake bodies no
+// constraint touches (SolverScratch::first_touch, untouched). A pass runs the colours in
+// order, each as for_colored does (its wide joints, its other joints, its wide contacts),
+// and the overflow last (its joints, then its wide contacts); within a colour no two
+// constraints share a dynamic body. Bodies n and up (the immovable one) are never
+// integrated.
 void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
-    scratch.first_touch.resize(scratch.wide.size() + 1);
+    scratch.first_touch.clear();
     scratch.first_touched.clear();
     scratch.touched.assign(n, 0);
     std::uint8_t* touched = scratch.touched.data();
-    auto first = [&](std::uint32_t k) {
-        if (k >= n || touched[k] != 0) return false;
+    auto touch = [&](std::uint32_t k) {
+        if (k >= n || touched[k] != 0) return;
         touched[k] = 1;
-        return true;
+        scratch.first_touched.push_back(k);
     };
-    for (std::size_t w = 0; w < scratch.wide.size(); ++w) {
+    auto item = [&] { scratch.first_touch.push_back(static_cast<std::uint32_t>(scratch.first_touched.size())); };
+    auto wide_contacts = [&](std::size_t from, std::size_t to) {
+        for (std::size_t w = from; w < to; ++w) {
+            item();
+            const WideContact& wc = scratch.wide[w];
+            for (int l = 0; l < wc.lanes; ++l) {
+                touch(wc.a[l]);
+                touch(wc.b[l]);
+            }
+        }
+    };
+    for (int c = 0; c < kColorCount; ++c) {
+        scratch.first_item[c] = static_cast<std::uint32_t>(scratch.first_touch.size());
+        for (std::uint32_t w = scratch.wide_joint_begin[c]; w < scratch.wide_joint_begin[c + 1]; ++w) {
+            item();
+            const WideJoint& wj = scratch.wide_joints[w];
+            for (int l = 0; l < wj.lanes; ++l) {
+                touch(wj.a[l]);
+                touch(wj.b[l]);
+            }
+        }
+        for (const std::uint32_t k : scratch.joint_colors[c]) {
+            item();
+            touch(scratch.joints[k].a);
+            touch(scratch.joints[k].b);
+        }
+        wide_contacts(scratch.wide_begin[c], scratch.wide_begin[c + 1]);
+    }
+    // The overflow is one block: one item.
+    scratch.first_item[kColorCount] = static_cast<std::uint32_t>(scratch.first_touch.size());
+    item();
+    for (const std::uint32_t k : scratch.joint_overflow) {
+        touch(scratch.joints[k].a);
+        touch(scratch.joints[k].b);
+    }
+    for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) {
         const WideContact& wc = scratch.wide[w];
-        scratch.first_touch[w] = static_cast<std::uint32_t>(scratch.first_touched.size());
         for (int l = 0; l < wc.lanes; ++l) {
-            if (first(wc.a[l])) scratch.first_touched.push_back(wc.a[l]);
-            if (first(wc.b[l])) scratch.first_touched.push_back(wc.b[l]);
+            touch(wc.a[l]);
+            touch(wc.b[l]);
         }
     }
-    scratch.first_touch[scratch.wide.size()] = static_cast<std::uint32_t>(scratch.first_touched.size());
+    item();  // the end of the last item
     scratch.untouched.clear();
     for (std::uint32_t k = 0; k < n; ++k) {
         if (touched[k] == 0) scratch.untouched.push_back(k);
@@ -267,13 +302,12 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
 // Calls integrate(list) on the bodies that constraints [lo, hi) of colour `color` are the
 // first of their pass to touch (one span), before the phase's block runs them:
 // no other constraint of the colour touches those bodies, so all of them may go first (and
-// the overflow, one block, has the first touches of its whole pass). A folded step has no
-// joints: a colour's constraints are its wide contacts.
+// the overflow, one block, has the first touches of its whole pass).
 template <typename IntegrateFn>
 void integrate_first_touched(const SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi,
                              IntegrateFn&& integrate) {
-    const std::size_t first = color == kColorCount ? scratch.wide_begin[kColorCount] : scratch.wide_begin[color] + lo;
-    const std::size_t last = color == kColorCount ? scratch.wide.size() : scratch.wide_begin[color] + hi;
+    const std::size_t first = scratch.first_item[color] + (color == kColorCount ? 0 : lo);
+    const std::size_t last = color == kColorCount ? first + 1 : scratch.first_item[color] + hi;
     const std::uint32_t from = scratch.first_touch[first];
     const std::uint32_t to = scratch.first_touch[last];
     if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
@@ -439,11 +473,11 @@ void solve(World& world, Real dt) {
         color(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
-        if (scratch.joints.empty()) find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
+        find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
         world.counters.constraint_colorings += 1;
     }
     // Folded only where every phase that integrates has a constraint to carry it.
-    scratch.folded = scratch.fold_body_passes && all_dynamic && scratch.joints.empty() && !scratch.wide.empty() &&
+    scratch.folded = scratch.fold_body_passes && all_dynamic && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
