@@ -42,12 +42,12 @@ struct Posed {
     std::uint32_t support(const Vec3& d) const {
         if (lanes == nullptr) {
             // The same products and sums as one lane's, the first of equals as the lanes pick it.
+            const auto along = [&d](const Vec3& v) { return (v.x() * d.x() + v.y() * d.y()) + v.z() * d.z(); };
             std::uint32_t best_index = 0;
-            Real best = -kHuge;
-            for (std::uint32_t i = 0; i < view.vertex_count; ++i) {
-                const Vec3& v = vertices[i];
-                const Real x = (v.x() * d.x() + v.y() * d.y()) + v.z() * d.z();
-                if (x > best || i == 0) best = x, best_index = i;
+            Real best = along(vertices[0]);
+            for (std::uint32_t i = 1; i < view.vertex_count; ++i) {
+                const Real x = along(vertices[i]);
+                if (x > best) best = x, best_index = i;
             }
             return best_index;
         }

@@ -174,7 +174,7 @@ private:
     void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;
     void merge_runs(JobSystem& jobs, PairList& pairs);
     void validate_enlarged() const;
-    // The trees validate themselves after each change; this adds the enlarged list.
+    // The trees check themselves (amortised); this adds the enlarged list, after each change.
     void validate_if_enabled() const {
         if (m_settings.validate_after_changes) validate_enlarged();
     }

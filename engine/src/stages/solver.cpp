@@ -250,33 +250,28 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
         touched[k] = 1;
         scratch.first_touched.push_back(k);
     };
-    auto item = [&] { scratch.first_touch.push_back(static_cast<std::uint32_t>(scratch.first_touched.size())); };
-    auto wide_contacts = [&](std::size_t from, std::size_t to) {
-        for (std::size_t w = from; w < to; ++w) {
-            item();
-            const WideContact& wc = scratch.wide[w];
-            for (int l = 0; l < wc.lanes; ++l) {
-                touch(wc.a[l]);
-                touch(wc.b[l]);
-            }
+    auto touch_lanes = [&](const auto& wide) {  // a WideJoint or a WideContact
+        for (int l = 0; l < wide.lanes; ++l) {
+            touch(wide.a[l]);
+            touch(wide.b[l]);
         }
     };
+    auto item = [&] { scratch.first_touch.push_back(static_cast<std::uint32_t>(scratch.first_touched.size())); };
     for (int c = 0; c < kColorCount; ++c) {
         scratch.first_item[c] = static_cast<std::uint32_t>(scratch.first_touch.size());
         for (std::uint32_t w = scratch.wide_joint_begin[c]; w < scratch.wide_joint_begin[c + 1]; ++w) {
             item();
-            const WideJoint& wj = scratch.wide_joints[w];
-            for (int l = 0; l < wj.lanes; ++l) {
-                touch(wj.a[l]);
-                touch(wj.b[l]);
-            }
+            touch_lanes(scratch.wide_joints[w]);
         }
         for (const std::uint32_t k : scratch.joint_colors[c]) {
             item();
             touch(scratch.joints[k].a);
             touch(scratch.joints[k].b);
         }
-        wide_contacts(scratch.wide_begin[c], scratch.wide_begin[c + 1]);
+        for (std::size_t w = scratch.wide_begin[c]; w < scratch.wide_begin[c + 1]; ++w) {
+            item();
+            touch_lanes(scratch.wide[w]);
+        }
     }
     // The overflow is one block: one item.
     scratch.first_item[kColorCount] = static_cast<std::uint32_t>(scratch.first_touch.size());
@@ -285,13 +280,7 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
         touch(scratch.joints[k].a);
         touch(scratch.joints[k].b);
     }
-    for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) {
-        const WideContact& wc = scratch.wide[w];
-        for (int l = 0; l < wc.lanes; ++l) {
-            touch(wc.a[l]);
-            touch(wc.b[l]);
-        }
-    }
+    for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) touch_lanes(scratch.wide[w]);
     item();  // the end of the last item
     scratch.untouched.clear();
     for (std::uint32_t k = 0; k < n; ++k) {
