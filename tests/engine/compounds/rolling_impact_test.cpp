@@ -1,0 +1,103 @@
+// A tree as trees100's (22 hexagonal prism parts, tapering) lying on its side and rolled
+// down a gentle slope: each time a face lands it pivots on an edge and the landing takes
+// most of its roll (an impact about the new edge keeps 11/17 of the spin of one prism),
+// so it stops after a face or two, the same on a flat triangle mesh as on a plane and the
+// same rolling either way. Box3D's tree does the same on both. Before the narrowphase put
+// a landing manifold's points fastest approaching first, the solver took them in the
+// collide's order: the mesh's merge listed the edge a tree pivots on before the landing
+// edge, the plane its face's vertices (the landing edge first rolling one way, the pivot
+// the other), and with the pivot taken first it kept pushing through the landing and the
+// tree rolled a face further.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "grid_mesh.hpp"
+
+namespace spindle {
+namespace rolling_impact {
+namespace {
+
+constexpr Real kSlope = 0.1;
+
+// A six-sided prism of radius r along y, from y0 to y0 + height (Box3D's b3CreateCylinder).
+Shape hexagonal_prism(Real r, Real y0, Real height) {
+    std::vector<Vec3> points;
+    for (int k = 0; k < 6; ++k) {
+        const Real a = k * std::numbers::pi / 3;
+        for (Real y : {y0, y0 + height}) points.emplace_back(r * std::cos(a), y, r * std::sin(a));
+    }
+    return Shape::convex_hull(points);
+}
+
+// trees.toml's tree: 22 prisms, each 1.5 m plus two radii tall, the radius 0.75 shrinking
+// by 0.95 a part.
+Shape tree() {
+    std::vector<CompoundPart> parts;
+    Real y = 1, r = 0.75;
+    for (int i = 0; i < 22; ++i) {
+        parts.push_back({hexagonal_prism(r, y - r, 1.5 + 2 * r)});
+        y += 1.5 + 2 * r;
+        r *= 0.95;
+    }
+    return Shape::compound(parts);
+}
+
+// How far (m, down the slope) the tree lying along z rolls before it sleeps, set rolling
+// down the slope at `spin` rad/s about its first part's bottom edge. The slope is gravity
+// tilted along x over level ground, down toward +x (`way` 1) or -x (-1): a manifold lists
+// its points in the same order either way, so one of the two rolls lands on the points
+// listed last.
+Real roll(bool mesh, Real spin, Real way) {
+    SpaceSettings settings;
+    const Real tilt = std::atan(kSlope);
+    settings.gravity = Vec3(way * 10 * std::sin(tilt), -10 * std::cos(tilt), 0);
+    settings.sleep.linear_threshold = 0.2;  // trees100's
+    Space space(settings);
+    BodyDesc ground;
+    ground.type = MotionType::Static;
+    ground.shape = mesh ? test::flat_grid_mesh(120, 1) : Shape::plane(Vec3(0, 1, 0), 0);
+    space.create_body(ground);
+    BodyDesc desc;
+    desc.shape = tree();
+    desc.density = 1;
+    desc.friction = 0.9;
+    desc.rolling_resistance = 0.05;
+    desc.orientation = Quat(Eigen::AngleAxis<Real>(std::numbers::pi / 2, Vec3::UnitX()));
+    const Real inner = 0.75 * std::sqrt(Real(3)) / 2;  // the first part's face from its axis
+    desc.position = Vec3(-5 * way, inner + 0.001, -1.75);
+    const BodyHandle log = space.create_body(desc);
+    for (int step = 0; step < 30; ++step) space.update();  // settle on a face
+    MotionState state = space.internal_motion_state(log);
+    state.angular_velocity = Vec3(0, 0, -way * spin);  // rolls down the slope
+    state.linear_velocity = Vec3(way * spin * inner, 0, 0);
+    space.set_internal_motion_state(log, state);
+    const Real start = state.center_of_mass.x();
+    for (int step = 0; step < 600 && space.internal_is_awake(log); ++step) space.update();
+    EXPECT_FALSE(space.internal_is_awake(log)) << (mesh ? "mesh" : "plane") << ", spin " << spin << ", way " << way
+                                               << ": still rolling";
+    return way * (space.internal_motion_state(log).center_of_mass.x() - start);
+}
+
+TEST(RollingImpact, ATreeRolledDownASlopeStopsAfterAsManyFacesOnAFlatMeshAsOnAPlaneEitherWay) {
+    const Real face = 0.75;  // the first part's side: how far one face's roll takes it
+    for (const Real spin : {2.0, 4.5}) {
+        Real first_way = 0;
+        for (const Real way : {1.0, -1.0}) {
+            const Real on_plane = roll(false, spin, way);
+            const Real on_mesh = roll(true, spin, way);
+            EXPECT_GT(on_plane, 0.5 * face) << "spin " << spin << ", way " << way << ": never rolled over a face";
+            EXPECT_NEAR(on_mesh, on_plane, 0.4 * face) << "spin " << spin << ", way " << way;
+            if (way > 0) first_way = on_plane;
+            else EXPECT_NEAR(on_plane, first_way, 0.4 * face) << "spin " << spin << ": the plane, one way and the other";
+        }
+    }
+}
+
+}  // namespace
+}  // namespace rolling_impact
+}  // namespace spindle
