@@ -78,8 +78,8 @@ Real roll(bool mesh, Real spin, Real way) {
     space.set_internal_motion_state(log, state);
     const Real start = state.center_of_mass.x();
     for (int step = 0; step < 600 && space.internal_is_awake(log); ++step) space.update();
-    EXPECT_FALSE(space.internal_is_awake(log)) << (mesh ? "mesh" : "plane") << ", spin " << spin << ", way " << way
-                                               << ": still rolling";
+    EXPECT_FALSE(space.internal_is_awake(log))
+        << (mesh ? "mesh" : "plane") << ", spin " << spin << ", way " << way << ": still rolling";
     return way * (space.internal_motion_state(log).center_of_mass.x() - start);
 }
 
@@ -93,7 +93,8 @@ TEST(RollingImpact, ATreeRolledDownASlopeStopsAfterAsManyFacesOnAFlatMeshAsOnAPl
             EXPECT_GT(on_plane, 0.5 * face) << "spin " << spin << ", way " << way << ": never rolled over a face";
             EXPECT_NEAR(on_mesh, on_plane, 0.4 * face) << "spin " << spin << ", way " << way;
             if (way > 0) first_way = on_plane;
-            else EXPECT_NEAR(on_plane, first_way, 0.4 * face) << "spin " << spin << ": the plane, one way and the other";
+            else
+                EXPECT_NEAR(on_plane, first_way, 0.4 * face) << "spin " << spin << ": the plane, one way and the other";
         }
     }
 }
