@@ -250,6 +250,7 @@ enum class Pass : std::uint8_t {
     WarmStart,
     Solve,
     IntegratePositions,
+    IntegrateKinematic,
     Relax,
     Restitution,
     StoreImpulses,
@@ -331,11 +332,10 @@ struct SolverScratch {
     // least and greatest of each chunk of bodies): then no scale differs from 1.
     bool one_dynamic_mass = false;
     // Per chunk of bodies (prepare_bodies): the least and greatest inverse mass of its
-    // dynamic bodies, and whether it has no kinematic body.
+    // dynamic bodies.
     struct BodyChunk {
         Real least_inv_mass = kHuge;
         Real greatest_inv_mass = -kHuge;
-        bool all_dynamic = true;
     };
     std::vector<BodyChunk> body_chunks;
     // The body passes folded into the constraint passes (solver.cpp), so a step has fewer
@@ -344,9 +344,10 @@ struct SolverScratch {
     // of the first relax pass (two phases fewer a substep), and the bodies are finalized in
     // the phase that stores the contacts' impulses. Each body's arithmetic and its order
     // against its own constraints stay the same: bitwise the results of the passes of
-    // their own. The integration only among dynamic bodies (a kinematic body is read by
-    // many constraints of a colour at once); the finalizing only without joints (their
-    // impulses are stored in phases of their own).
+    // their own. Only the dynamic bodies' integration folds: a kinematic body is read by
+    // many constraints of a colour at once, so its positions move in a phase of their own
+    // before the first relax pass (its velocities are constant over a step). The
+    // finalizing folds only without joints (their impulses are stored in phases of their own).
     bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
     bool folded = false;           // this step's plan folds the integration
     // The bodies that no constraint before them in a pass touches, constraint by constraint
@@ -358,6 +359,7 @@ struct SolverScratch {
     std::uint32_t first_item[kColorCount + 1] = {};
     std::vector<std::uint32_t> first_touched;
     std::vector<std::uint32_t> untouched;
+    std::vector<std::uint32_t> kinematic;    // the awake kinematic bodies, in awake order
     std::vector<std::uint8_t> touched;       // find_first_touches' per-body scratch, kept for its capacity
     std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity
     std::vector<std::uint32_t> support_first, support_by_lower, support_queue;

@@ -212,6 +212,15 @@ private:
     bool builds_most_of_tree() const noexcept;
     BuildCost build_cost() const;
     bool refit_holds(const BuildCost& refitted) const noexcept;
+    // A subtree of rebuild_enlarged()'s walk left to a job, and where its lists go in the
+    // walk's: before the top's pool node `pool_at` and leaf `leaves_at`.
+    struct WalkJob {
+        std::int32_t root;
+        std::size_t pool_at, leaves_at;
+    };
+    void collect_flagged(std::int32_t root, std::vector<std::int32_t>& pool, std::vector<std::int32_t>& leaves,
+                         std::int32_t job_height, std::vector<WalkJob>* jobs_out);
+    bool collect_flagged_in_jobs(JobSystem& jobs);
 
     AabbTreeSettings m_settings;
     std::vector<Node> m_nodes;
@@ -261,6 +270,15 @@ private:
     std::vector<BuildTask> m_build_subtrees;             // ranges left to the jobs
     std::vector<std::vector<BuildTask>> m_build_stacks;  // per worker: a job's own ranges
     std::vector<std::int32_t> m_build_order;
+    // rebuild_enlarged()'s walk over many flagged nodes: the subtrees below the top walked
+    // and refitted in jobs (kWalkJobLevels below the root, from kWalkJobNodes flagged nodes
+    // on), each into its own lists, spliced into the build lists in the walk's order.
+    static constexpr int kWalkJobLevels = 6;
+    static constexpr std::int32_t kWalkJobNodes = 2048;
+    std::vector<WalkJob> m_walk_jobs;
+    std::vector<std::int32_t> m_walk_top;  // the top's pool nodes: refitted after the jobs
+    std::vector<std::vector<std::int32_t>> m_walk_pools, m_walk_leaves;
+    std::vector<std::int32_t> m_walk_spliced;
 
     // A traversal stack that lives on the C++ stack and spills to the heap only for
     // trees deeper than any balanced tree gets (a pathological rebuild()).

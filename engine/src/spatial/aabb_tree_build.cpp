@@ -35,6 +35,77 @@ void DynamicAabbTree::rebuild() {
     validate_if_enabled();
 }
 
+// Walks the flagged nodes from `root` down in pre-order: appends them to `pool` (clearing
+// their flags) and what hangs off them (a leaf or an unflagged subtree) to `leaves`. With
+// `jobs_out`, a flagged node of height job_height or less is not walked but listed there.
+void DynamicAabbTree::collect_flagged(std::int32_t root, std::vector<std::int32_t>& pool,
+                                      std::vector<std::int32_t>& leaves, std::int32_t job_height,
+                                      std::vector<WalkJob>* jobs_out) {
+    TraversalStack stack;
+    stack.push(root);
+    while (!stack.empty()) {
+        const std::int32_t id = stack.pop();
+        const Node& node = m_nodes[static_cast<std::size_t>(id)];
+        if (m_enlarged[static_cast<std::size_t>(id)] == 0) {
+            leaves.push_back(id);
+            continue;
+        }
+        if (jobs_out != nullptr && node.height <= job_height) {
+            jobs_out->push_back({id, pool.size(), leaves.size()});
+            continue;
+        }
+        stack.push(node.payload.children.second);
+        stack.push(node.payload.children.first);
+        m_enlarged[static_cast<std::size_t>(id)] = 0;
+        pool.push_back(id);
+    }
+}
+
+// The walk of rebuild_enlarged() with the subtrees below its top walked in jobs, each
+// refitting its own flagged nodes (children first) while its nodes are in its cache; the
+// top's nodes are refitted by rebuild_enlarged where it keeps the refit. A refit the build
+// then replaces changes nothing it reads. The lists come out as the one walk makes them.
+// Returns false (nothing done) for a tree too small or too little flagged for it.
+bool DynamicAabbTree::collect_flagged_in_jobs(JobSystem& jobs) {
+    const std::int32_t job_height = m_nodes[static_cast<std::size_t>(m_root)].height - kWalkJobLevels;
+    if (jobs.worker_count() < 2 || m_enlarged_nodes < kWalkJobNodes || job_height < 1) return false;
+    m_walk_jobs.clear();
+    m_walk_top.clear();
+    collect_flagged(m_root, m_walk_top, m_build_leaves, job_height, &m_walk_jobs);
+    const auto count = static_cast<std::uint32_t>(m_walk_jobs.size());
+    if (m_walk_pools.size() < count) {
+        m_walk_pools.resize(count);
+        m_walk_leaves.resize(count);
+    }
+    jobs.parallel_for("TreeWalk", 0, count, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t k = lo; k < hi; ++k) {
+            std::vector<std::int32_t>& pool = m_walk_pools[k];
+            pool.clear();
+            m_walk_leaves[k].clear();
+            collect_flagged(m_walk_jobs[k].root, pool, m_walk_leaves[k], 0, nullptr);
+            for (auto it = pool.rbegin(); it != pool.rend(); ++it) refit(*it);  // pre-order: children first
+        }
+    });
+    // Each job's lists go where its subtree stood in the top's walk.
+    const auto splice = [&](std::vector<std::int32_t>& top, std::vector<std::vector<std::int32_t>>& parts,
+                            std::size_t WalkJob::*at, std::vector<std::int32_t>& out) {
+        out.clear();
+        std::size_t from = 0;
+        for (std::uint32_t k = 0; k < count; ++k) {
+            const std::size_t to = m_walk_jobs[k].*at;
+            out.insert(out.end(), top.begin() + static_cast<std::ptrdiff_t>(from),
+                       top.begin() + static_cast<std::ptrdiff_t>(to));
+            out.insert(out.end(), parts[k].begin(), parts[k].end());
+            from = to;
+        }
+        out.insert(out.end(), top.begin() + static_cast<std::ptrdiff_t>(from), top.end());
+    };
+    splice(m_walk_top, m_walk_pools, &WalkJob::pool_at, m_build_pool);
+    splice(m_build_leaves, m_walk_leaves, &WalkJob::leaves_at, m_walk_spliced);
+    m_build_leaves.swap(m_walk_spliced);
+    return true;
+}
+
 void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     if (m_enlarged_nodes == 0) {
         m_stale_boxes = false;  // only flagged nodes go stale
@@ -45,26 +116,16 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     // kept whole.
     m_build_leaves.clear();
     m_build_pool.clear();
-    TraversalStack stack;
-    stack.push(m_root);
-    while (!stack.empty()) {
-        const std::int32_t id = stack.pop();
-        const Node& node = m_nodes[static_cast<std::size_t>(id)];
-        if (m_enlarged[static_cast<std::size_t>(id)] == 0) {
-            m_build_leaves.push_back(id);
-            continue;
-        }
-        stack.push(node.payload.children.second);
-        stack.push(node.payload.children.first);
-        m_enlarged[static_cast<std::size_t>(id)] = 0;
-        m_build_pool.push_back(id);
-    }
+    const bool in_jobs = jobs != nullptr && collect_flagged_in_jobs(*jobs);
+    if (!in_jobs) collect_flagged(m_root, m_build_pool, m_build_leaves, 0, nullptr);
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
     const bool most = builds_most_of_tree();
     if (most && m_built_cost.leaves > 0) {
-        // The pool is in pre-order: walking it backwards fits children first.
-        for (auto it = m_build_pool.rbegin(); it != m_build_pool.rend(); ++it) refit(*it);
+        // The pool is in pre-order: walking it backwards fits children first (the jobs' own
+        // subtrees are fitted already).
+        const std::vector<std::int32_t>& unfitted = in_jobs ? m_walk_top : m_build_pool;
+        for (auto it = unfitted.rbegin(); it != unfitted.rend(); ++it) refit(*it);
         if (refit_holds(build_cost())) {
             ++m_refit_count;
             validate_if_enabled();

@@ -208,9 +208,14 @@ void remove_contacts(World& world, std::span<const std::uint32_t> positions) {
     world.contacts.resize(size);
     world.contact_keys.resize(size);
     world.contact_summaries.resize(size);
-    if (!world.awake_contacts_dirty) {
-        drop_from_awake_list(world.awake_contact_list, positions, moves, size, world.scratch_moved_awake);
+    if (world.awake_contacts_dirty) return;
+    std::vector<std::uint32_t>& awake = world.awake_contact_list;
+    if (awake.size() == world.contacts.size() + positions.size()) {
+        // Every contact was awake, so the list was 0, 1, 2, ...: so is every one kept.
+        awake.resize(size);
+        return;
     }
+    drop_from_awake_list(awake, positions, moves, size, world.scratch_moved_awake);
 }
 
 void remove_contacts_of(World& world, std::uint32_t slot) {

@@ -56,12 +56,7 @@ void integrate_velocities_of(World& world, SolverBody* bodies, const Real* gravi
     const Real max_angular = world.settings.solver.max_angular_speed;
     for (const std::uint32_t k : ks) {
         SolverBody& sb = bodies[k];
-        if (!sb.dynamic) {
-            // A kinematic body moves by its velocity alone: limited all the same.
-            sb.v = limit_speed(sb.v, max_linear);
-            sb.w = limit_speed(sb.w, max_angular);
-            continue;
-        }
+        if (!sb.dynamic) continue;  // a kinematic body's velocities were limited once, by prepare_bodies
         const std::uint32_t i = world.awake[k];
         if (gravity_scales[k] != 0) {
             sb.v += project_linear(h * gravity_scales[k] * gravity, sb.locks);

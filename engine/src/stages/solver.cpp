@@ -55,9 +55,10 @@ constexpr std::uint32_t kJointGrain = 32;
 // Awake contacts per range when listing their manifolds (a parallel_for).
 constexpr std::uint32_t kListGrain = 512;
 
-// Returns whether every awake body is dynamic.
-bool prepare_bodies(World& world, SolverScratch& scratch) {
+void prepare_bodies(World& world, SolverScratch& scratch) {
     const Bodies& b = world.bodies;
+    const Real max_linear = world.settings.solver.max_linear_speed;
+    const Real max_angular = world.settings.solver.max_angular_speed;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     // A first step's are megabytes of new pages: mapped in jobs, then first written by the
     // PrepareBodies jobs (raw room: the resizes write nothing).
@@ -75,12 +76,14 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             SolverBody& sb = scratch.bodies[k];
-            sb.v = b.v[i];
-            sb.w = b.w[i];
+            sb.dynamic = b.type[i] == MotionType::Dynamic;
+            // A kinematic body moves by its velocities alone, limited all the same: once, as
+            // nothing changes them within the step (integrate_velocities passes it by).
+            sb.v = sb.dynamic ? b.v[i] : limit_speed(b.v[i], max_linear);
+            sb.w = sb.dynamic ? b.w[i] : limit_speed(b.w[i], max_angular);
             scratch.push_velocities[k] = PushVelocity{};
             sb.dp = Vec3::Zero();
             sb.dq = Quat::Identity();
-            sb.dynamic = b.type[i] == MotionType::Dynamic;
             sb.locks = b.locks[i];
             const BodyTraits& d = b.traits[i];
             sb.gyroscopic = sb.dynamic && (d.gyroscopic || b.elongated[i] != 0) && (sb.locks & kLockRotation) == 0;
@@ -92,8 +95,6 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
             if (sb.dynamic) {
                 chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
                 chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
-            } else {
-                chunk.all_dynamic = false;
             }
         }
     });
@@ -101,14 +102,11 @@ bool prepare_bodies(World& world, SolverScratch& scratch) {
     scratch.push_velocities[n] = PushVelocity{};
     scratch.gravity_scales[n] = 0;
     Real least = kHuge, greatest = -kHuge;
-    bool all_dynamic = true;
     for (const SolverScratch::BodyChunk& chunk : scratch.body_chunks) {
         least = std::min(least, chunk.least_inv_mass);
         greatest = std::max(greatest, chunk.greatest_inv_mass);
-        all_dynamic = all_dynamic && chunk.all_dynamic;
     }
     scratch.one_dynamic_mass = !(least < greatest);
-    return all_dynamic;
 }
 
 // One ref per touching manifold of an awake contact, in contact order; returns whether
@@ -235,7 +233,8 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
 }
 
 // Which bodies each constraint is the first of its pass to touch, and the awake bodies no
-// constraint touches (SolverScratch::first_touch, untouched). A pass runs the colours in
+// constraint touches (SolverScratch::first_touch, untouched); the kinematic bodies apart
+// (SolverScratch::kinematic), as if touched already. A pass runs the colours in
 // order, each as for_colored does (its wide joints, its other joints, its wide contacts),
 // and the overflow last (its joints, then its wide contacts); within a colour no two
 // constraints share a dynamic body. Bodies n and up (the immovable one) are never
@@ -245,6 +244,12 @@ void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
     scratch.first_touched.clear();
     scratch.touched.assign(n, 0);
     std::uint8_t* touched = scratch.touched.data();
+    scratch.kinematic.clear();
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (scratch.bodies[k].dynamic) continue;
+        touched[k] = 1;
+        scratch.kinematic.push_back(k);
+    }
     auto touch = [&](std::uint32_t k) {
         if (k >= n || touched[k] != 0) return;
         touched[k] = 1;
@@ -389,11 +394,18 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
         scratch.plan.push_back(SolverPhase{Pass::PrepareJoints, 0});
     }
     const bool folded = scratch.folded;
+    const auto kinematic = static_cast<std::uint32_t>(scratch.kinematic.size());
     for (int sub = 0; sub < settings.substeps; ++sub) {
         if (!folded) plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
         plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, folded);
         for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
         if (!folded) plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
+        if (folded && kinematic != 0) {
+            // Many constraints of a colour read a kinematic body at once: it moves between the
+            // passes, in a phase of its own (its velocities do not change within a step).
+            scratch.phases.push_back(Phase{"IntegrateKinematic", kinematic, kBodyPassGrain});
+            scratch.plan.push_back(SolverPhase{Pass::IntegrateKinematic, 0});
+        }
         for (int it = 0; it < settings.relax_iterations; ++it)
             plan_constraint_pass(scratch, Pass::Relax, "Relax", true, folded && it == 0);
     }
@@ -454,7 +466,7 @@ void solve(World& world, Real dt) {
 
     world.fast_lists.resize(world.jobs->worker_count());
     for (std::vector<FastStart>& list : world.fast_lists) list.clear();
-    const bool all_dynamic = prepare_bodies(world, scratch);
+    prepare_bodies(world, scratch);
     const bool restitution = list_manifolds(world, scratch);
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
@@ -466,7 +478,7 @@ void solve(World& world, Real dt) {
         world.counters.constraint_colorings += 1;
     }
     // Folded only where every phase that integrates has a constraint to carry it.
-    scratch.folded = scratch.fold_body_passes && all_dynamic && !(scratch.wide.empty() && scratch.joints.empty()) &&
+    scratch.folded = scratch.fold_body_passes && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
@@ -548,6 +560,10 @@ void solve(World& world, Real dt) {
                     integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
                     break;
                 case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi); break;
+                case Pass::IntegrateKinematic:
+                    integrate_positions(world, bodies, push, h,
+                                        std::span<const std::uint32_t>(scratch.kinematic).subspan(lo, hi - lo));
+                    break;
                 case Pass::WarmStart: {
                     if (phase.integrates) {
                         integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {

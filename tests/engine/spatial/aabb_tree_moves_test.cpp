@@ -9,7 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "api/space_internals.hpp"
@@ -216,21 +219,28 @@ TEST(AabbTreeMoves, Churn_FlagsStayConsistentThroughInsertsRemovalsAndRotations)
     }
 }
 
-// The lower parts of a big rebuild are built as jobs: on three threads, in reverse chunk
-// order, the tree comes out the same as on the calling thread alone (the same walk order,
-// the same cost to the bit), and valid.
-TEST(AabbTreeMoves, RebuildEnlargedInJobs_SameTreeAsOnOneThread) {
-    Rng rng(18);
+namespace {
+
+// Moves every proxy of two copies of one tree of `proxies` five times, rebuilding one on
+// the calling thread alone and the other on three threads that run chunks in reverse
+// order: the trees must come out the same (the same walk order, the same cost to the bit)
+// and valid. Proxies moving `together` take one step (the rebuild keeps the refit), else
+// each its own. Returns the fewest flagged nodes a rebuild saw and the refits kept.
+std::pair<std::int32_t, std::int64_t> expect_rebuild_in_jobs_same_as_on_one_thread(int proxies, std::uint64_t seed,
+                                                                                   bool together = false) {
+    Rng rng(seed);
     DynamicAabbTree serial;
     std::vector<std::int32_t> live;
-    for (int i = 0; i < 400 * kScale; ++i) {
+    for (int i = 0; i < proxies; ++i) {
         live.push_back(serial.create_proxy(Aabb::from_center_extents(rng.vec(-50, 50), Vec3::Constant(0.5)), i));
     }
     DynamicAabbTree parallel = serial;
     test::ReverseThreadedJobSystem jobs(3);
+    std::int32_t fewest_flagged = std::numeric_limits<std::int32_t>::max();
     for (int round = 0; round < 5; ++round) {
         std::vector<Vec3> steps;
-        for (std::size_t k = 0; k < live.size(); ++k) steps.push_back(rng.vec(-1.5, 1.5));
+        const Vec3 common = rng.vec(-1.5, 1.5);
+        for (std::size_t k = 0; k < live.size(); ++k) steps.push_back(together ? common : rng.vec(-1.5, 1.5));
         for (DynamicAabbTree* tree : {&serial, &parallel}) {
             for (std::size_t k = 0; k < live.size(); ++k) {
                 const Aabb tight = Aabb::from_center_extents(tree->fat_aabb(live[k]).center() + steps[k],
@@ -238,21 +248,41 @@ TEST(AabbTreeMoves, RebuildEnlargedInJobs_SameTreeAsOnOneThread) {
                 tree->move_proxy(live[k], tight, steps[k]);
             }
         }
-        // Enough to be split into jobs (ranges of up to 256 leaves): 800 proxies in the
-        // sanitizer builds (kScale), 3200 in Release.
-        ASSERT_GT(parallel.enlarged_node_count(), 2 * 256);
+        fewest_flagged = std::min(fewest_flagged, parallel.enlarged_node_count());
         serial.rebuild_enlarged();
         parallel.rebuild_enlarged(&jobs);
         parallel.validate();
         EXPECT_EQ(parallel.enlarged_node_count(), 0);
-        ASSERT_EQ(walk_order(parallel), walk_order(serial)) << "round " << round;
-        ASSERT_EQ(parallel.area_cost(), serial.area_cost());
-        ASSERT_EQ(parallel.height(), serial.height());
+        EXPECT_EQ(walk_order(parallel), walk_order(serial)) << "round " << round;
+        EXPECT_EQ(parallel.area_cost(), serial.area_cost());
+        EXPECT_EQ(parallel.height(), serial.height());
         for (int q = 0; q < 20; ++q) {
             const Aabb box = rng.box(50, 6);
-            ASSERT_EQ(query_sorted(parallel, box), brute_sorted(parallel, live, box));
+            EXPECT_EQ(query_sorted(parallel, box), brute_sorted(parallel, live, box));
         }
     }
+    return {fewest_flagged, parallel.refit_count()};
+}
+
+}  // namespace
+
+// The lower parts of a big rebuild are built as jobs: the same tree as on one thread.
+TEST(AabbTreeMoves, RebuildEnlargedInJobs_SameTreeAsOnOneThread) {
+    // Enough to be split into jobs (ranges of up to 256 leaves): 800 proxies in the
+    // sanitizer builds (kScale), 3200 in Release.
+    EXPECT_GT(expect_rebuild_in_jobs_same_as_on_one_thread(400 * kScale, 18).first, 2 * 256);
+}
+
+// With 2,048 flagged nodes or more, the walk over them is split too: the subtrees below its
+// top are walked and refitted in jobs, their lists spliced into the walk's order: the same
+// tree whether it is then built again (proxies scattered) or the refit is kept (moving together).
+TEST(AabbTreeMoves, RebuildEnlargedWalkInJobs_SameTreeAsOnOneThread) {
+    const auto [flagged, refits] = expect_rebuild_in_jobs_same_as_on_one_thread(2400, 20);
+    EXPECT_GE(flagged, 2048);
+    EXPECT_LT(refits, 5) << "scattered proxies should be built again";
+    const auto [together_flagged, together_refits] = expect_rebuild_in_jobs_same_as_on_one_thread(2400, 21, true);
+    EXPECT_GE(together_flagged, 2048);
+    EXPECT_GT(together_refits, 0) << "proxies moving together should keep the refit";
 }
 
 // The broadphase's moves: set_fat_box gives the leaf its box and only flags the ancestors
