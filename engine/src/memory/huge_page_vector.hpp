@@ -1,16 +1,13 @@
 // Arrays that grow to megabytes with the scene's contacts (contact records, wide contacts,
-// their push-out anchors, solver bodies) are placed on whole huge pages. A first step
-// fills tens of megabytes of them, and on virtual machines a small page's first touch
-// costs microseconds (the guest's fault and the hypervisor's): 512 of them per 2 MB
-// where a huge page takes one. Blocks of half a huge page or more are allocated aligned
-// to it and rounded up to whole huge pages, so no small page is left at either end, and
-// the whole block is asked for as transparent huge pages. Smaller blocks are ordinary
-// ones, but from a few pages up their pages are mapped at once, in one call: a fresh
-// block's pages faulted one by one cost about 14 us each on this project's VM, mapped in
-// one madvise about 1 us each (1.5 MB: 5.1-8.4 ms against 0.34-0.66 ms, docs/benchmarks.md).
-// Even so mapped, a small page's first write still costs the hypervisor's fault on such
-// machines, which only a huge page spares. Pages already mapped (a block from reused
-// heap memory) stay as they are.
+// their push-out anchors, solver bodies, the broadphase's pair lists) are placed on huge
+// pages. A first step fills tens of megabytes of them, and on virtual machines a small
+// page's first touch costs microseconds (the guest's fault and the hypervisor's): 512 of
+// them per 2 MB where a huge page takes one, and mapping the small pages at once in one
+// madvise still leaves each first write the hypervisor's fault (docs/benchmarks.md).
+// Blocks of half a huge page or more are allocated aligned to it and rounded up to whole
+// huge pages, so no small page is left at either end, and the whole block is asked for as
+// transparent huge pages. Blocks of a few pages up to that share huge pages
+// (medium_blocks.hpp). Smaller blocks are ordinary ones.
 #pragma once
 
 #include <cstddef>
@@ -20,6 +17,8 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include "memory/medium_blocks.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -32,9 +31,9 @@ inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 // the block's bytes, while its small pages would each cost a first write's fault: a
 // block just under a huge page (a 10k-body scene's solver bodies) paid 500 of them.
 inline constexpr std::size_t kOnHugePagesBytes = kHugePageBytes / 2;
-// Below this a small block mostly comes from heap memory already mapped, and the call's
-// own cost is about that of the few faults it would save.
-inline constexpr std::size_t kMapAtOnceBytes = std::size_t{64} << 10;
+// Blocks from kMediumBlockMinBytes up to this share huge pages; smaller ones mostly come
+// from heap memory already mapped.
+static_assert(kOnHugePagesBytes == kMediumBlockEndBytes, "medium blocks end where whole huge pages begin");
 
 // Maps the whole small pages inside [p, p + bytes) now, for writing, without changing
 // their contents. A hint: where the call is missing, the pages fault on first touch.
@@ -95,18 +94,23 @@ struct HugePageAllocator {
         return (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
 
+    static bool medium(std::size_t n) { return n * sizeof(T) >= kMediumBlockMinBytes; }
+
     T* allocate(std::size_t n) {
         if (!on_huge_pages(n)) {
-            void* p = ::operator new (n * sizeof(T), std::align_val_t{alignof(T)});
-            if (n * sizeof(T) >= kMapAtOnceBytes) map_pages_now(p, n * sizeof(T));
-            return static_cast<T*>(p);
+            if (medium(n)) return static_cast<T*>(allocate_medium_block(n * sizeof(T)));
+            return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{alignof(T)}));
         }
         if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
         return static_cast<T*>(map_huge_pages(rounded_bytes(n)));
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (!on_huge_pages(n)) {
-            ::operator delete (p, std::align_val_t{alignof(T)});
+            if (medium(n)) {
+                free_medium_block(p, n * sizeof(T));
+            } else {
+                ::operator delete (p, std::align_val_t{alignof(T)});
+            }
         } else {
             unmap_huge_pages(p, rounded_bytes(n));
         }

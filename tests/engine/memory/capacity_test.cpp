@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "memory/huge_page_vector.hpp"
+#include "memory/medium_blocks.hpp"
 #include "stages/capacity.hpp"
 #include "stages/contact_index.hpp"
 
@@ -125,14 +126,65 @@ TEST(HugePageVector, SmallBlocksAreOrdinaryOnes) {
 }
 
 TEST(HugePageVector, MapsTheSmallPagesOfABlockOfAFewPagesAtOnce) {
-    // Under kOnHugePagesBytes but over kMapAtOnceBytes: an ordinary block, its pages mapped
-    // by the allocation itself, before anything is written there.
+    // Under kOnHugePagesBytes but over kMediumBlockMinBytes: a medium block, its pages
+    // mapped before anything is written there.
     HugePageVector<unsigned char> v;
     v.reserve(kOnHugePagesBytes / 2);
     ASSERT_LT(v.capacity(), kOnHugePagesBytes);
-    ASSERT_GE(v.capacity(), kMapAtOnceBytes);
+    ASSERT_GE(v.capacity(), kMediumBlockMinBytes);
     const auto begin = reinterpret_cast<std::uintptr_t>(v.data());
     EXPECT_TRUE(all_pages_mapped(begin, begin + v.capacity()));
+}
+
+TEST(MediumBlocks, ArraysOfAFewPagesShareAHugePage) {
+    // A first step's dozen arrays of 64 KB to 1 MB each paid a fault per small page; on
+    // whole huge pages of their own each would round up to 2 MB.
+    if (huge_page_mode() != "madvise") GTEST_SKIP() << "transparent huge pages are not given on request here";
+    constexpr std::size_t kBytes = std::size_t{200} << 10;
+    const MediumBlockCounts before = medium_block_counts();
+    ASSERT_EQ(before.chunks, before.empty_chunks) << "no medium block in use before";
+    HugePageVector<unsigned char> a, b;
+    a.reserve(kBytes);
+    b.reserve(kBytes);
+    const auto begin_a = reinterpret_cast<std::uintptr_t>(a.data());
+    const auto begin_b = reinterpret_cast<std::uintptr_t>(b.data());
+    EXPECT_EQ(begin_a / kHugePageBytes, begin_b / kHugePageBytes) << "both blocks in one huge page";
+    EXPECT_NE(begin_a, begin_b);
+    a.resize(kBytes, 1);
+    b.resize(kBytes, 2);
+    EXPECT_EQ(a.back(), 1);  // neither block overlaps the other
+    EXPECT_EQ(b.front(), 2);
+    // The kernel may have no huge page free: then the chunk is small pages, and this says so.
+    EXPECT_GT(huge_page_kb_over(begin_a, begin_a + kBytes), 0u);
+}
+
+TEST(MediumBlocks, AFreedBlockServesTheNextOfItsSize) {
+    // An array that moves as it grows (fit_capacity, a vector's regrowth) takes memory
+    // already written instead of fresh pages.
+    constexpr std::size_t kBytes = std::size_t{300} << 10;
+    std::uintptr_t first = 0;
+    {
+        HugePageVector<unsigned char> v;
+        v.reserve(kBytes);
+        first = reinterpret_cast<std::uintptr_t>(v.data());
+    }
+    HugePageVector<unsigned char> w;
+    w.reserve(kBytes + 1000);  // another size, the same power-of-two block
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(w.data()), first);
+}
+
+TEST(MediumBlocks, EmptyChunksBeyondAFewAreGivenBack) {
+    // A pile that came apart leaves its arrays small again: the pool keeps a few empty huge
+    // pages for the next blocks, not every one it ever held.
+    const MediumBlockCounts before = medium_block_counts();
+    {
+        std::vector<HugePageVector<unsigned char>> arrays(40);
+        for (auto& v : arrays) v.reserve(kOnHugePagesBytes - 1);  // two to a chunk: 20 chunks
+        EXPECT_GE(medium_block_counts().chunks, 20u);
+    }
+    const MediumBlockCounts after = medium_block_counts();
+    EXPECT_LE(after.empty_chunks, kKeptEmptyMediumChunks);
+    EXPECT_LE(after.chunks, before.chunks - before.empty_chunks + kKeptEmptyMediumChunks);
 }
 
 TEST(HugePageVector, PutsABlockJustUnderAHugePageOnOne) {

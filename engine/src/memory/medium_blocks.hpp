@@ -1,0 +1,41 @@
+// Blocks of a few pages up to half a huge page (HugePageAllocator's middle sizes: a 10k-body
+// scene's pair lists, keys, push velocities, manifold lists), several to a huge page. A
+// first step makes a dozen such arrays; as ordinary blocks each page's first write cost a
+// fault of its own on virtual machines, even mapped at once (huge_page_vector.hpp), and on
+// whole huge pages of their own a 100 KB array would round up to 2 MB. Here huge pages
+// (chunks) are shared by blocks of power-of-two sizes, 64 KB to 1 MB, and a freed block
+// serves the next that fits, so an array that moves as it grows takes memory already
+// written. Process-wide, under a lock: such blocks come and go a few times a step.
+#pragma once
+
+#include <cstddef>
+
+namespace spindle {
+
+// The smallest and one past the largest block size served: smaller blocks stay ordinary
+// heap blocks (mostly from memory the heap holds mapped already), larger ones are whole
+// huge pages of their own.
+inline constexpr std::size_t kMediumBlockMinBytes = std::size_t{64} << 10;
+inline constexpr std::size_t kMediumBlockEndBytes = std::size_t{1} << 20;
+
+// Empty chunks kept for the next blocks beyond those in use: a scene whose contacts come
+// and go moves its arrays between sizes, and a kept chunk is memory already written.
+inline constexpr std::size_t kKeptEmptyMediumChunks = 2;
+
+// A block of at least `bytes` (kMediumBlockMinBytes <= bytes < kMediumBlockEndBytes),
+// aligned to its power-of-two size, its pages mapped. Throws std::bad_alloc when the system
+// has no memory for a new chunk.
+void* allocate_medium_block(std::size_t bytes);
+
+// Gives back a block from allocate_medium_block(bytes), the same `bytes`.
+void free_medium_block(void* p, std::size_t bytes) noexcept;
+
+// Chunks the pool holds (in use or kept empty for the next blocks) and how many of them are
+// empty: for tests and the memory report.
+struct MediumBlockCounts {
+    std::size_t chunks = 0;
+    std::size_t empty_chunks = 0;
+};
+MediumBlockCounts medium_block_counts();
+
+}  // namespace spindle
