@@ -621,6 +621,27 @@ bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa,
     });
 }
 
+bool kept_axis_separates(const PreparedPolyhedron& prepared, const Vec3 (&triangle)[3], const Vec3& normal,
+                         const RelativePose& b_in_a, const FeatureCache& cache, Real speculative) {
+    if (cache.kind() != FeatureCache::Kind::FaceA && cache.kind() != FeatureCache::Kind::EdgePair) return false;
+    // The triangle as with_posed_pair poses it, and as a TrianglePoly views it (its faces'
+    // offsets aside, which neither axis reads), so the axis is measured to the bit as there.
+    const PolyView& a = prepared.view();
+    const HullFace faces[2] = {{normal, 0, 0, 3}, {-normal, 0, 3, 3}};
+    PolyView b;
+    b.vertices = triangle;
+    b.faces = faces;
+    b.face_vertices = kTriangleLoops;
+    b.edges = kTriangleEdges;
+    b.vertex_count = 3, b.face_count = 2, b.edge_count = 3;
+    const Vec3 posed[3] = {b_in_a.r * triangle[0] + b_in_a.t, b_in_a.r * triangle[1] + b_in_a.t,
+                           b_in_a.r * triangle[2] + b_in_a.t};
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
+    const Posed pb{b, posed, nullptr, b_in_a.r, b_in_a.t, Vec3::Zero(), false};
+    const CachedAxis axis = cached_axis(cache, pa, pb);
+    return axis.valid && axis.separation > speculative;
+}
+
 int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                      Manifold* out, int) {
     const BoxPoly box(a.half_extents);
