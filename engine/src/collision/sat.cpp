@@ -344,6 +344,10 @@ int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const P
         const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1) % ref_face.count]];
         const Vec3 side = (v1 - v0).cross(n).normalized();
         const Real offset = side.dot(v0);
+        // A side plane with every vertex inside leaves the polygon as it is: no copy.
+        int inside = 0;
+        while (inside < count && side.dot(in[inside].p) - offset <= 0) ++inside;
+        if (inside == count) continue;
         // clip_polygon's step, inlined here (the narrowphase's most frequent clip).
         count = clip_polygon_by(
             in, count, [&](const Vec3& p) { return side.dot(p) - offset; }, k, next);
