@@ -149,20 +149,23 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
         const Vec3 normal = triangle_normal(v[0], v[1], v[2]);  // made once for the cull and the polyhedron
         if (span.clear_of_plane(v, normal, speculative)) return;
-        const TrianglePoly poly(v[0], v[1], v[2], normal);
         // Triangles are one-sided for a shape lying across their plane (Box3D culls by the
         // shape's centre too). With its centre behind, it has passed the middle and gets no
         // contact here: pushed on out of the back while its body's other parts are pushed out
         // of the front, it would lever the body up about them. One wholly behind is pushed on
         // out of the back, as a shape that started there should be.
-        const bool centre_in_front = poly.normal().dot(centre - v[0]) >= 0;  // on the plane: in front
+        const bool centre_in_front = normal.dot(centre - v[0]) >= 0;  // on the plane: in front
         if (!centre_in_front) {
             Real lo, hi;
-            span.along(poly.normal(), lo, hi);
-            if (hi > poly.normal().dot(v[0])) return;
+            span.along(normal, lo, hi);
+            if (hi > normal.dot(v[0])) return;
         }
-        Manifold m;
         FeatureCache* const cache = walk && polyhedron ? walk->next(part, t) : nullptr;
+        // Half the tests end on the kept axis (a part resting on a few of the triangles under
+        // it): told from the three corners, before the triangle's polyhedron is made.
+        if (cache && kept_axis_separates(*polyhedron, v, normal, mesh_in_a, *cache, speculative)) return;
+        const TrianglePoly poly(v[0], v[1], v[2], normal);
+        Manifold m;
         if (!collide_triangle(a, a_in_mesh, polyhedron, mesh_in_a, poly, speculative, cache, walk ? walk->slop() : 0,
                               m))
             return;

@@ -134,6 +134,14 @@ bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const 
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
 
+// True when the feature `cache` keeps for a against a triangle (B: corners `triangle` and
+// unit front normal `normal`, posed in a's frame by b_in_a), an A's face or an edge pair,
+// separates them past the speculative distance: collide_polyhedra with that cache would
+// end there, with no manifold and the cache as it is. Measured as collide_polyhedra
+// measures it, to the bit, without building the triangle's polyhedron.
+bool kept_axis_separates(const PreparedPolyhedron& a, const Vec3 (&triangle)[3], const Vec3& normal,
+                         const RelativePose& b_in_a, const FeatureCache& cache, Real speculative_distance);
+
 // A rounded shape A (the segment p0-p1 in A's frame, p0 == p1 for a sphere, swept by
 // radius) against polyhedron b: GJK distance between the cores while they are apart, SAT
 // when they overlap; a capsule lying on a face gets two points.

@@ -24,10 +24,6 @@ const BoxTopology& box_topology() {
     return topology;
 }
 
-// Triangle edges i -> i+1 run counter-clockwise on the front face 0.
-constexpr std::uint32_t kTriangleLoops[6] = {0, 1, 2, 0, 2, 1};
-constexpr HullEdge kTriangleEdges[3] = {{0, 1, 0, 1}, {1, 2, 0, 1}, {2, 0, 0, 1}};
-
 PolyView make_view(std::span<const Vec3> vertices, std::span<const HullFace> faces, const std::uint32_t* face_vertices,
                    std::span<const HullEdge> edges, const Vec3& inner_centre, Real inner_radius) {
     PolyView v;

@@ -66,6 +66,10 @@ private:
 };
 
 // A triangle as a polyhedron: face 0 is the front (counter-clockwise) side, face 1 the back.
+// Its face loops, and its edges i -> i+1, running counter-clockwise on the front face.
+inline constexpr std::uint32_t kTriangleLoops[6] = {0, 1, 2, 0, 2, 1};
+inline constexpr HullEdge kTriangleEdges[3] = {{0, 1, 0, 1}, {1, 2, 0, 1}, {2, 0, 0, 1}};
+
 // The unit normal of triangle (a, b, c), counter-clockwise seen from its front.
 inline Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a).normalized(); }
 

@@ -344,6 +344,10 @@ int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const P
         const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1) % ref_face.count]];
         const Vec3 side = (v1 - v0).cross(n).normalized();
         const Real offset = side.dot(v0);
+        // A side plane with every vertex inside leaves the polygon as it is: no copy.
+        int inside = 0;
+        while (inside < count && side.dot(in[inside].p) - offset <= 0) ++inside;
+        if (inside == count) continue;
         // clip_polygon's step, inlined here (the narrowphase's most frequent clip).
         count = clip_polygon_by(
             in, count, [&](const Vec3& p) { return side.dot(p) - offset; }, k, next);
@@ -619,6 +623,27 @@ bool face_of_b_manifold(const PreparedPolyhedron& prepared, const Transform& xa,
         manifold_to_world(m, xa);
         return true;
     });
+}
+
+bool kept_axis_separates(const PreparedPolyhedron& prepared, const Vec3 (&triangle)[3], const Vec3& normal,
+                         const RelativePose& b_in_a, const FeatureCache& cache, Real speculative) {
+    if (cache.kind() != FeatureCache::Kind::FaceA && cache.kind() != FeatureCache::Kind::EdgePair) return false;
+    // The triangle as with_posed_pair poses it, and as a TrianglePoly views it (its faces'
+    // offsets aside, which neither axis reads), so the axis is measured to the bit as there.
+    const PolyView& a = prepared.view();
+    const HullFace faces[2] = {{normal, 0, 0, 3}, {-normal, 0, 3, 3}};
+    PolyView b;
+    b.vertices = triangle;
+    b.faces = faces;
+    b.face_vertices = kTriangleLoops;
+    b.edges = kTriangleEdges;
+    b.vertex_count = 3, b.face_count = 2, b.edge_count = 3;
+    const Vec3 posed[3] = {b_in_a.r * triangle[0] + b_in_a.t, b_in_a.r * triangle[1] + b_in_a.t,
+                           b_in_a.r * triangle[2] + b_in_a.t};
+    const Posed pa{a, a.vertices, prepared.vertex_lanes(), Mat3::Identity(), Vec3::Zero(), a.inner_centre, true};
+    const Posed pb{b, posed, nullptr, b_in_a.r, b_in_a.t, Vec3::Zero(), false};
+    const CachedAxis axis = cached_axis(cache, pa, pb);
+    return axis.valid && axis.separation > speculative;
 }
 
 int collide_box_hull(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
