@@ -284,15 +284,15 @@ struct SupportEdge {
 // The arrays on RawRoomAllocator are written whole before they are read in every step
 // that grows them (their comments say where): a resize does not zero them.
 struct SolverScratch {
-    RawRoomVector<SolverBody> bodies;  // awake bodies, then the static body (prepare_bodies)
+    RawRoomVector<SolverBody> bodies;  // awake bodies, then the static body (prepare_body_chunk)
     // Per solver body, apart from it (SolverBody says why): its push-out velocities, and
     // BodyDesc::gravity_scale of a dynamic body (else 0) so that integrate_velocities and
-    // prepare_wide stay off the cold descriptions, each a cache miss (prepare_bodies).
+    // prepare_wide stay off the cold descriptions, each a cache miss (prepare_body_chunk).
     RawRoomVector<PushVelocity> push_velocities;
     RawRoomVector<Real> gravity_scales;
-    // Touching manifolds of awake contacts, in contact order (list_manifolds' ranges).
+    // Touching manifolds of awake contacts, in contact order (list_range's ranges, joined).
     RawRoomVector<ManifoldRef> manifolds;
-    // list_manifolds' lists of its fixed ranges of contacts, before they are joined.
+    // The lists of fixed ranges of contacts (list_range), before they are joined.
     struct ListedRange {
         std::vector<ManifoldRef> refs;
         bool restitution = false;  // any of them has restitution
@@ -328,10 +328,11 @@ struct SolverScratch {
     HugePageVector<std::uint32_t> body_colors;  // per solver body: a bit for each colour it is in
     // Per manifold ref, or empty when every scale is 1 (most steps of most scenes).
     std::vector<SupportScale> support_scales;
-    // Whether every awake dynamic body has the same inverse mass (prepare_bodies, from the
-    // least and greatest of each chunk of bodies): then no scale differs from 1.
+    // Whether every awake dynamic body has the same inverse mass (from the least and
+    // greatest of each chunk of bodies, prepare_bodies_and_list_manifolds): then no scale
+    // differs from 1.
     bool one_dynamic_mass = false;
-    // Per chunk of bodies (prepare_bodies): the least and greatest inverse mass of its
+    // Per chunk of bodies (prepare_body_chunk): the least and greatest inverse mass of its
     // dynamic bodies.
     struct BodyChunk {
         Real least_inv_mass = kHuge;

@@ -38,7 +38,7 @@ namespace {
 // The last block of a phase is the one the other workers wait for at its barrier, and
 // block sizes halve down to the grain, so the grains of run_phases' passes are small: a
 // few claims more per phase, a shorter wait at every barrier.
-constexpr std::uint32_t kBodyGrain = 128;  // PrepareBodies, a parallel_for
+constexpr std::uint32_t kBodyGrain = 128;  // bodies per chunk of PrepareBodies
 // Bodies per block of a pass over the bodies in run_phases.
 constexpr std::uint32_t kBodyPassGrain = 32;
 // Joints or wide contacts (kLanes manifolds each) per block of a colour.
@@ -52,118 +52,151 @@ constexpr std::uint32_t kOneBlockColor = 4;
 constexpr std::uint32_t kWideGrain = 1;
 // Joints per block when storing their impulses.
 constexpr std::uint32_t kJointGrain = 32;
-// Awake contacts per range when listing their manifolds (a parallel_for).
+// Awake contacts per range when listing their manifolds.
 constexpr std::uint32_t kListGrain = 512;
 
-void prepare_bodies(World& world, SolverScratch& scratch) {
+// PrepareBodies' chunk of awake bodies [lo, hi): their solver bodies, and the chunk's
+// least and greatest inverse mass of its dynamic bodies (chunks are fixed by the grain).
+void prepare_body_chunk(const World& world, SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {
     const Bodies& b = world.bodies;
     const Real max_linear = world.settings.solver.max_linear_speed;
     const Real max_angular = world.settings.solver.max_angular_speed;
-    const auto n = static_cast<std::uint32_t>(world.awake.size());
-    // A first step's are megabytes of new pages: mapped in jobs, then first written by the
-    // PrepareBodies jobs (raw room: the resizes write nothing).
-    reserve_for(scratch.bodies, n + 1);
-    map_room(*world.jobs, scratch.bodies, n + 1);
-    scratch.bodies.resize(n + 1);
-    scratch.push_velocities.resize(n + 1);
-    scratch.gravity_scales.resize(n + 1);
-    // Per chunk, the least and greatest inverse mass of its dynamic bodies (chunks are fixed
-    // by the grain): equal over all of them, no body is lighter than another it carries.
-    const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
-    scratch.body_chunks.assign(chunks, SolverScratch::BodyChunk{});
-    world.jobs->parallel_for("PrepareBodies", 0, n, kBodyGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        SolverScratch::BodyChunk& chunk = scratch.body_chunks[lo / kBodyGrain];
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            const std::uint32_t i = world.awake[k];
-            SolverBody& sb = scratch.bodies[k];
-            sb.dynamic = b.type[i] == MotionType::Dynamic;
-            // A kinematic body moves by its velocities alone, limited all the same: once, as
-            // nothing changes them within the step (integrate_velocities passes it by).
-            sb.v = sb.dynamic ? b.v[i] : limit_speed(b.v[i], max_linear);
-            sb.w = sb.dynamic ? b.w[i] : limit_speed(b.w[i], max_angular);
-            scratch.push_velocities[k] = PushVelocity{};
-            sb.dp = Vec3::Zero();
-            sb.dq = Quat::Identity();
-            sb.locks = b.locks[i];
-            const BodyTraits& d = b.traits[i];
-            sb.gyroscopic = sb.dynamic && (d.gyroscopic || b.elongated[i] != 0) && (sb.locks & kLockRotation) == 0;
-            sb.sweep = !sb.dynamic || d.sensor ? kSweepNever : d.fast ? kSweepAlways : kSweepWhenFast;
-            scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
-            sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
-            sb.inv_mass = b.inv_mass[i];
-            sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
-            if (sb.dynamic) {
-                chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
-                chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
-            }
+    SolverScratch::BodyChunk& chunk = scratch.body_chunks[lo / kBodyGrain];
+    chunk = SolverScratch::BodyChunk{};
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const std::uint32_t i = world.awake[k];
+        SolverBody& sb = scratch.bodies[k];
+        sb.dynamic = b.type[i] == MotionType::Dynamic;
+        // A kinematic body moves by its velocities alone, limited all the same: once, as
+        // nothing changes them within the step (integrate_velocities passes it by).
+        sb.v = sb.dynamic ? b.v[i] : limit_speed(b.v[i], max_linear);
+        sb.w = sb.dynamic ? b.w[i] : limit_speed(b.w[i], max_angular);
+        scratch.push_velocities[k] = PushVelocity{};
+        sb.dp = Vec3::Zero();
+        sb.dq = Quat::Identity();
+        sb.locks = b.locks[i];
+        const BodyTraits& d = b.traits[i];
+        sb.gyroscopic = sb.dynamic && (d.gyroscopic || b.elongated[i] != 0) && (sb.locks & kLockRotation) == 0;
+        sb.sweep = !sb.dynamic || d.sensor ? kSweepNever : d.fast ? kSweepAlways : kSweepWhenFast;
+        scratch.gravity_scales[k] = sb.dynamic ? d.gravity_scale : 0;
+        sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
+        sb.inv_mass = b.inv_mass[i];
+        sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+        if (sb.dynamic) {
+            chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
+            chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
         }
-    });
-    scratch.bodies[n] = SolverBody{};  // the immovable partner of static and sleeping bodies
-    scratch.push_velocities[n] = PushVelocity{};
-    scratch.gravity_scales[n] = 0;
-    Real least = kHuge, greatest = -kHuge;
-    for (const SolverScratch::BodyChunk& chunk : scratch.body_chunks) {
-        least = std::min(least, chunk.least_inv_mass);
-        greatest = std::max(greatest, chunk.greatest_inv_mass);
     }
-    scratch.one_dynamic_mass = !(least < greatest);
 }
 
-// One ref per touching manifold of an awake contact, in contact order; returns whether
-// any has restitution. Reads only the packed keys and summaries, never a contact. Fixed
-// ranges of contacts list into their own buffers in parallel, joined in range order, so
-// the list does not depend on who listed which range.
-bool list_manifolds(World& world, SolverScratch& scratch) {
+// ListManifolds' range of awake contacts [lo, hi): one ref per touching manifold, in
+// contact order, into the range's own buffer. Reads only the packed keys and summaries,
+// never a contact.
+void list_range(const World& world, std::span<const std::uint32_t> contacts, SolverScratch& scratch, std::uint32_t lo,
+                std::uint32_t hi) {
     const Bodies& b = world.bodies;
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     auto solver_index = [&](std::uint32_t slot) {
         const std::int32_t k = b.awake_index[slot];
         return k >= 0 ? static_cast<std::uint32_t>(k) : n;
     };
+    SolverScratch::ListedRange& range = scratch.listed[lo / kListGrain];
+    range.refs.clear();
+    bool restitution = false;
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        const std::uint32_t c = contacts[k];
+        const std::uint32_t summary = world.contact_summaries[c];
+        SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]), "solver: a contact's packed summary is stale");
+        const std::uint64_t key = world.contact_keys[c];
+        const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
+        const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
+        constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
+        std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
+        for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
+            if ((point_counts & kCountMask) == 0) continue;
+            range.refs.push_back({c, m, a, bb});
+            restitution = restitution || (summary & kSummaryRestitution) != 0;
+        }
+    }
+    range.restitution = restitution;
+}
+
+// What the step's bodies and manifold list say about the solve.
+struct Listed {
+    bool restitution = false;  // some listed manifold has restitution
+};
+
+// The step's solver bodies (PrepareBodies) and its list of touching manifolds of awake
+// contacts, in contact order (ListManifolds, then JoinManifolds), in one run_phases: one
+// fork and join, not three. Fixed chunks of bodies and ranges of contacts are listed in
+// parallel, each into its own slots, and the ranges joined in range order, so neither
+// depends on who ran what.
+Listed prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
+    const auto n = static_cast<std::uint32_t>(world.awake.size());
+    // A first step's are megabytes of new pages: mapped in jobs, then first written by the
+    // PrepareBodies blocks (raw room: the resizes write nothing).
+    reserve_for(scratch.bodies, n + 1);
+    map_room(*world.jobs, scratch.bodies, n + 1);
+    scratch.bodies.resize(n + 1);
+    scratch.push_velocities.resize(n + 1);
+    scratch.gravity_scales.resize(n + 1);
+    const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
+    scratch.body_chunks.resize(chunks);  // each written whole by its chunk
+    scratch.bodies[n] = SolverBody{};    // the immovable partner of static and sleeping bodies
+    scratch.push_velocities[n] = PushVelocity{};
+    scratch.gravity_scales[n] = 0;
+
     const std::vector<std::uint32_t>& contacts = awake_contacts(world);
     const auto count = static_cast<std::uint32_t>(contacts.size());
     const std::uint32_t ranges = (count + kListGrain - 1) / kListGrain;
     if (scratch.listed.size() < ranges) scratch.listed.resize(ranges);  // capacity kept from step to step
-    world.jobs->parallel_for("ListManifolds", 0, count, kListGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        SolverScratch::ListedRange& range = scratch.listed[lo / kListGrain];
-        range.refs.clear();
-        bool restitution = false;
-        for (std::uint32_t k = lo; k < hi; ++k) {
-            const std::uint32_t c = contacts[k];
-            const std::uint32_t summary = world.contact_summaries[c];
-            SPINDLE_ASSERT(summary == contact_summary(world.contacts[c]),
-                           "solver: a contact's packed summary is stale");
-            const std::uint64_t key = world.contact_keys[c];
-            const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
-            const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
-            constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
-            std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
-            for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
-                if ((point_counts & kCountMask) == 0) continue;
-                range.refs.push_back({c, m, a, bb});
-                restitution = restitution || (summary & kSummaryRestitution) != 0;
+    const std::span<SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
+
+    // Items of the first phase: the chunks of bodies, then the ranges of contacts. The
+    // second (one block) places the ranges and sizes the list; the third copies them in,
+    // in jobs: a first step's list is hundreds of new pages, each a fault on its first write.
+    const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1},
+                            {"PlaceManifolds", 1, 1},
+                            {"JoinManifolds", ranges, 1}};
+    Listed result;
+    if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
+        scratch.manifolds.clear();
+        return result;
+    }
+    world.jobs->run_phases("SolverLists", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
+        if (p == 0) {
+            for (std::uint32_t item = lo; item < hi; ++item) {
+                if (item < chunks) {
+                    prepare_body_chunk(world, scratch, item * kBodyGrain, std::min(n, (item + 1) * kBodyGrain));
+                } else {
+                    const std::uint32_t r = item - chunks;
+                    list_range(world, contacts, scratch, r * kListGrain, std::min(count, (r + 1) * kListGrain));
+                }
+            }
+        } else if (p == 1) {
+            std::size_t total = 0;
+            for (SolverScratch::ListedRange& range : listed) {
+                range.first = total;
+                total += range.refs.size();
+                result.restitution = result.restitution || range.restitution;
+            }
+            scratch.manifolds.resize(total);
+        } else {
+            for (std::uint32_t r = lo; r < hi; ++r) {
+                std::copy(listed[r].refs.begin(), listed[r].refs.end(),
+                          scratch.manifolds.begin() + static_cast<std::ptrdiff_t>(listed[r].first));
             }
         }
-        range.restitution = restitution;
     });
-    const std::span<SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
-    std::size_t total = 0;
-    bool restitution = false;
-    for (auto& range : listed) {
-        range.first = total;
-        total += range.refs.size();
-        restitution = restitution || range.restitution;
+    // Equal least and greatest inverse mass over every chunk: no body is lighter than
+    // another it carries.
+    Real least = kHuge, greatest = -kHuge;
+    for (const SolverScratch::BodyChunk& chunk : scratch.body_chunks) {
+        least = std::min(least, chunk.least_inv_mass);
+        greatest = std::max(greatest, chunk.greatest_inv_mass);
     }
-    // Joined in jobs too: a first step's list is hundreds of new pages, each a fault on
-    // its first write.
-    scratch.manifolds.resize(total);
-    world.jobs->parallel_for("JoinManifolds", 0, ranges, 1, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        for (std::uint32_t r = lo; r < hi; ++r) {
-            std::copy(listed[r].refs.begin(), listed[r].refs.end(),
-                      scratch.manifolds.begin() + static_cast<std::ptrdiff_t>(listed[r].first));
-        }
-    });
-    return restitution;
+    scratch.one_dynamic_mass = !(least < greatest);
+    return result;
 }
 
 // Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
@@ -466,8 +499,8 @@ void solve(World& world, Real dt) {
 
     world.fast_lists.resize(world.jobs->worker_count());
     for (std::vector<FastStart>& list : world.fast_lists) list.clear();
-    prepare_bodies(world, scratch);
-    const bool restitution = list_manifolds(world, scratch);
+    const Listed listed = prepare_bodies_and_list_manifolds(world, scratch);
+    const bool restitution = listed.restitution;
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
