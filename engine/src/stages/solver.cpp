@@ -121,17 +121,12 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
     range.restitution = restitution;
 }
 
-// What the step's bodies and manifold list say about the solve.
-struct Listed {
-    bool restitution = false;  // some listed manifold has restitution
-};
-
 // The step's solver bodies (PrepareBodies) and its list of touching manifolds of awake
 // contacts, in contact order (ListManifolds, then JoinManifolds), in one run_phases: one
 // fork and join, not three. Fixed chunks of bodies and ranges of contacts are listed in
 // parallel, each into its own slots, and the ranges joined in range order, so neither
-// depends on who ran what.
-Listed prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
+// depends on who ran what. Returns whether any listed manifold has restitution.
+bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     // A first step's are megabytes of new pages: mapped in jobs, then first written by the
     // PrepareBodies blocks (raw room: the resizes write nothing).
@@ -158,10 +153,10 @@ Listed prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1},
                             {"PlaceManifolds", 1, 1},
                             {"JoinManifolds", ranges, 1}};
-    Listed result;
+    bool restitution = false;
     if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
         scratch.manifolds.clear();
-        return result;
+        return restitution;
     }
     world.jobs->run_phases("SolverLists", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
         if (p == 0) {
@@ -178,7 +173,7 @@ Listed prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
             for (SolverScratch::ListedRange& range : listed) {
                 range.first = total;
                 total += range.refs.size();
-                result.restitution = result.restitution || range.restitution;
+                restitution = restitution || range.restitution;
             }
             scratch.manifolds.resize(total);
         } else {
@@ -196,7 +191,7 @@ Listed prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
         greatest = std::max(greatest, chunk.greatest_inv_mass);
     }
     scratch.one_dynamic_mass = !(least < greatest);
-    return result;
+    return restitution;
 }
 
 // Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
@@ -499,8 +494,7 @@ void solve(World& world, Real dt) {
 
     world.fast_lists.resize(world.jobs->worker_count());
     for (std::vector<FastStart>& list : world.fast_lists) list.clear();
-    const Listed listed = prepare_bodies_and_list_manifolds(world, scratch);
-    const bool restitution = listed.restitution;
+    const bool restitution = prepare_bodies_and_list_manifolds(world, scratch);
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
