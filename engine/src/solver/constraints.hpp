@@ -360,8 +360,13 @@ struct SolverScratch {
     std::uint32_t first_item[kColorCount + 1] = {};
     std::vector<std::uint32_t> first_touched;
     std::vector<std::uint32_t> untouched;
-    std::vector<std::uint32_t> kinematic;    // the awake kinematic bodies, in awake order
-    std::vector<std::uint8_t> touched;       // find_first_touches' per-body scratch, kept for its capacity
+    std::vector<std::uint32_t> kinematic;  // the awake kinematic bodies, in awake order
+    // find_first_touches' scratch, kept for its capacity: per body whether the overflow
+    // touched it (only with an overflow), the overflow's first touches, and per chunk of
+    // bodies its untouched and kinematic counts.
+    std::vector<std::uint8_t> touched;
+    std::vector<std::uint32_t> overflow_touches;
+    std::vector<std::uint32_t> touch_counts;
     std::vector<SupportEdge> support_edges;  // find_support_scales' working lists, kept for their capacity
     std::vector<std::uint32_t> support_first, support_by_lower, support_queue;
     std::vector<std::uint8_t> supported;

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <span>
 #include <type_traits>
+#include <utility>
 
 #include <spindle/platform/assert.hpp>
 
@@ -260,6 +261,36 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
     return same;
 }
 
+// Calls fn(k) for each body item `item` of colour `color` touches, in the order a pass
+// touches them: a wide joint's or wide contact's lanes (A, then B, lane by lane), or a
+// joint's A and B. Items of a colour: its wide joints, its other joints, its wide contacts.
+template <typename Fn>
+void for_item_bodies(const SolverScratch& scratch, int color, std::uint32_t item, Fn&& fn) {
+    const std::uint32_t k = item - scratch.first_item[color];
+    const std::uint32_t ball_sockets = scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color];
+    const auto joints = static_cast<std::uint32_t>(scratch.joint_colors[color].size());
+    auto lanes = [&](const auto& wide) {  // a WideJoint or a WideContact
+        for (int l = 0; l < wide.lanes; ++l) {
+            fn(wide.a[l]);
+            fn(wide.b[l]);
+        }
+    };
+    if (k < ball_sockets) {
+        lanes(scratch.wide_joints[scratch.wide_joint_begin[color] + k]);
+    } else if (k < ball_sockets + joints) {
+        const JointConstraint& joint = scratch.joints[scratch.joint_colors[color][k - ball_sockets]];
+        fn(joint.a);
+        fn(joint.b);
+    } else {
+        lanes(scratch.wide[scratch.wide_begin[color] + (k - ball_sockets - joints)]);
+    }
+}
+
+// Items (constraints of the colours, in pass order) and awake bodies per block of
+// find_first_touches' phases.
+constexpr std::uint32_t kTouchItemGrain = 256;
+constexpr std::uint32_t kTouchBodyGrain = 1024;
+
 // Which bodies each constraint is the first of its pass to touch, and the awake bodies no
 // constraint touches (SolverScratch::first_touch, untouched); the kinematic bodies apart
 // (SolverScratch::kinematic), as if touched already. A pass runs the colours in
@@ -267,58 +298,137 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
 // and the overflow last (its joints, then its wide contacts); within a colour no two
 // constraints share a dynamic body. Bodies n and up (the immovable one) are never
 // integrated.
-void find_first_touches(SolverScratch& scratch, std::uint32_t n) {
-    scratch.first_touch.clear();
-    scratch.first_touched.clear();
-    scratch.touched.assign(n, 0);
-    std::uint8_t* touched = scratch.touched.data();
-    scratch.kinematic.clear();
-    for (std::uint32_t k = 0; k < n; ++k) {
-        if (scratch.bodies[k].dynamic) continue;
-        touched[k] = 1;
-        scratch.kinematic.push_back(k);
-    }
-    auto touch = [&](std::uint32_t k) {
-        if (k >= n || touched[k] != 0) return;
-        touched[k] = 1;
-        scratch.first_touched.push_back(k);
-    };
-    auto touch_lanes = [&](const auto& wide) {  // a WideJoint or a WideContact
-        for (int l = 0; l < wide.lanes; ++l) {
-            touch(wide.a[l]);
-            touch(wide.b[l]);
-        }
-    };
-    auto item = [&] { scratch.first_touch.push_back(static_cast<std::uint32_t>(scratch.first_touched.size())); };
+//
+// So a dynamic body's first toucher is the one constraint of the first colour it is in
+// (the lowest bit of its body_colors mask, set by the colouring), or, in none, the overflow
+// (one item, after every colour). Each item's first touches are then counted and written
+// in jobs, apart from the others': the lists are those of a walk through the pass in
+// order, made without one. In one run_phases: items and chunks of bodies counted, the
+// counts placed (one block), the lists written.
+void find_first_touches(JobSystem& jobs, SolverScratch& scratch, std::uint32_t n) {
+    std::uint32_t items = 0;
     for (int c = 0; c < kColorCount; ++c) {
-        scratch.first_item[c] = static_cast<std::uint32_t>(scratch.first_touch.size());
-        for (std::uint32_t w = scratch.wide_joint_begin[c]; w < scratch.wide_joint_begin[c + 1]; ++w) {
-            item();
-            touch_lanes(scratch.wide_joints[w]);
-        }
-        for (const std::uint32_t k : scratch.joint_colors[c]) {
-            item();
+        scratch.first_item[c] = items;
+        items += scratch.wide_joint_begin[c + 1] - scratch.wide_joint_begin[c] +
+                 static_cast<std::uint32_t>(scratch.joint_colors[c].size()) + scratch.wide_begin[c + 1] -
+                 scratch.wide_begin[c];
+    }
+    scratch.first_item[kColorCount] = items;
+    // Per item its count, then (placed) its offset; the overflow's item, and one past it.
+    scratch.first_touch.resize(std::size_t{items} + 2);
+    const std::uint32_t* colors = scratch.body_colors.data();
+    auto first_touched_by = [&](int color, std::uint32_t k) {
+        return k < n && std::countr_zero(colors[k]) == color;  // 32 for a body in no colour
+    };
+    // The overflow is one block, run serially after every colour: its first touches are the
+    // bodies in no colour, in the order it touches them. Rare; marked to be met once.
+    std::vector<std::uint32_t>& overflow_touches = scratch.overflow_touches;
+    overflow_touches.clear();
+    const bool overflow = !scratch.joint_overflow.empty() || scratch.wide.size() > scratch.wide_begin[kColorCount];
+    if (overflow) {
+        scratch.touched.assign(n, 0);
+        auto touch = [&](std::uint32_t k) {
+            if (k >= n || colors[k] != 0 || scratch.touched[k] != 0 || !scratch.bodies[k].dynamic) return;
+            scratch.touched[k] = 1;
+            overflow_touches.push_back(k);
+        };
+        for (const std::uint32_t k : scratch.joint_overflow) {
             touch(scratch.joints[k].a);
             touch(scratch.joints[k].b);
         }
-        for (std::size_t w = scratch.wide_begin[c]; w < scratch.wide_begin[c + 1]; ++w) {
-            item();
-            touch_lanes(scratch.wide[w]);
+        for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) {
+            for (int l = 0; l < scratch.wide[w].lanes; ++l) {
+                touch(scratch.wide[w].a[l]);
+                touch(scratch.wide[w].b[l]);
+            }
         }
     }
-    // The overflow is one block: one item.
-    scratch.first_item[kColorCount] = static_cast<std::uint32_t>(scratch.first_touch.size());
-    item();
-    for (const std::uint32_t k : scratch.joint_overflow) {
-        touch(scratch.joints[k].a);
-        touch(scratch.joints[k].b);
+    // A body no colour holds: kinematic, untouched, or the overflow's.
+    auto untouched_body = [&](std::uint32_t k) {
+        return scratch.bodies[k].dynamic && colors[k] == 0 && !(overflow && scratch.touched[k] != 0);
+    };
+
+    const std::uint32_t item_blocks = (items + kTouchItemGrain - 1) / kTouchItemGrain;
+    const std::uint32_t body_blocks = (n + kTouchBodyGrain - 1) / kTouchBodyGrain;
+    // Per chunk of bodies: its untouched and kinematic counts, then their offsets.
+    std::vector<std::uint32_t>& body_counts = scratch.touch_counts;
+    body_counts.assign(2 * std::size_t{body_blocks}, 0);
+    auto color_of = [&](std::uint32_t item) {
+        return static_cast<int>(std::upper_bound(scratch.first_item, scratch.first_item + kColorCount, item) -
+                                scratch.first_item) -
+               1;
+    };
+    auto each_item = [&](std::uint32_t block, auto&& fn) {
+        const std::uint32_t last = std::min(items, (block + 1) * kTouchItemGrain);
+        int c = color_of(block * kTouchItemGrain);
+        for (std::uint32_t i = block * kTouchItemGrain; i < last; ++i) {
+            while (i >= scratch.first_item[c + 1]) ++c;  // past empty colours too
+            fn(c, i);
+        }
+    };
+    if (item_blocks + body_blocks == 0) {  // no awake body, no constraint: no jobs at all
+        scratch.first_touch.assign(2, 0);
+        scratch.first_touched.clear();
+        scratch.untouched.clear();
+        scratch.kinematic.clear();
+        return;
     }
-    for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) touch_lanes(scratch.wide[w]);
-    item();  // the end of the last item
-    scratch.untouched.clear();
-    for (std::uint32_t k = 0; k < n; ++k) {
-        if (touched[k] == 0) scratch.untouched.push_back(k);
-    }
+    const Phase phases[] = {{"CountFirstTouches", item_blocks + body_blocks, 1},
+                            {"PlaceFirstTouches", 1, 1},
+                            {"ListFirstTouches", item_blocks + body_blocks, 1}};
+    jobs.run_phases("FirstTouches", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
+        if (p == 1) {
+            std::uint32_t total = 0;
+            for (std::uint32_t i = 0; i < items; ++i) total += std::exchange(scratch.first_touch[i], total);
+            scratch.first_touch[items] = total;
+            total += static_cast<std::uint32_t>(overflow_touches.size());
+            scratch.first_touch[std::size_t{items} + 1] = total;
+            scratch.first_touched.resize(total);
+            std::copy(overflow_touches.begin(), overflow_touches.end(),
+                      scratch.first_touched.begin() + scratch.first_touch[items]);
+            std::uint32_t untouched = 0, kinematic = 0;
+            for (std::uint32_t b = 0; b < body_blocks; ++b) {
+                untouched += std::exchange(body_counts[2 * b], untouched);
+                kinematic += std::exchange(body_counts[2 * b + 1], kinematic);
+            }
+            scratch.untouched.resize(untouched);
+            scratch.kinematic.resize(kinematic);
+            return;
+        }
+        for (std::uint32_t block = lo; block < hi; ++block) {
+            if (block < item_blocks) {
+                each_item(block, [&](int c, std::uint32_t i) {
+                    if (p == 0) {
+                        std::uint32_t count = 0;
+                        for_item_bodies(scratch, c, i, [&](std::uint32_t k) { count += first_touched_by(c, k); });
+                        scratch.first_touch[i] = count;
+                    } else {
+                        std::uint32_t* out = scratch.first_touched.data() + scratch.first_touch[i];
+                        for_item_bodies(scratch, c, i, [&](std::uint32_t k) {
+                            if (first_touched_by(c, k)) *out++ = k;
+                        });
+                    }
+                });
+                continue;
+            }
+            const std::uint32_t chunk = block - item_blocks;
+            const std::uint32_t last = std::min(n, (chunk + 1) * kTouchBodyGrain);
+            std::uint32_t* untouched = scratch.untouched.data() + body_counts[2 * chunk];
+            std::uint32_t* kinematic = scratch.kinematic.data() + body_counts[2 * chunk + 1];
+            for (std::uint32_t k = chunk * kTouchBodyGrain; k < last; ++k) {
+                const bool moving = !scratch.bodies[k].dynamic;
+                const bool alone = untouched_body(k);
+                if (p == 0) {
+                    body_counts[2 * chunk] += alone;
+                    body_counts[2 * chunk + 1] += moving;
+                } else if (alone) {
+                    *untouched++ = k;
+                } else if (moving) {
+                    *kinematic++ = k;
+                }
+            }
+        }
+    });
 }
 
 // Calls integrate(list) on the bodies that constraints [lo, hi) of colour `color` are the
@@ -501,7 +611,7 @@ void solve(World& world, Real dt) {
         color(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
-        find_first_touches(scratch, static_cast<std::uint32_t>(world.awake.size()));
+        find_first_touches(*world.jobs, scratch, static_cast<std::uint32_t>(world.awake.size()));
         world.counters.constraint_colorings += 1;
     }
     // Folded only where every phase that integrates has a constraint to carry it.
