@@ -341,7 +341,7 @@ int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const P
     }
     for (std::uint32_t k = 0; k < ref_face.count && count > 0; ++k) {
         const Vec3& v0 = ref.vertices[ref.view.face_vertices[ref_face.first + k]];
-        const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1) % ref_face.count]];
+        const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1 == ref_face.count ? 0 : k + 1)]];
         const Vec3 side = (v1 - v0).cross(n).normalized();
         const Real offset = side.dot(v0);
         // A side plane with every vertex inside leaves the polygon as it is: no copy.
