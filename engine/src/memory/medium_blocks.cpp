@@ -65,6 +65,7 @@ public:
         try {
             m_chunks.push_back(Chunk{reinterpret_cast<std::uintptr_t>(p), 0});
         } catch (...) {
+            SPINDLE_UNPOISON(p, kHugePageBytes);  // the next mapping there may be anyone's
             unmap_huge_pages(p, kHugePageBytes);
             throw;
         }
@@ -83,6 +84,9 @@ public:
             chunk.used &= ~(mask << ((address - base) / kMediumBlockMinBytes));
             SPINDLE_POISON(p, std::size_t{units} * kMediumBlockMinBytes);
             if (chunk.used != 0 || ++m_empty <= kKeptEmptyMediumChunks) return;
+            // ASan (of GCC 12) keeps a range's poison past munmap: the next mapping there,
+            // a huge-page array of someone else's, would start poisoned.
+            SPINDLE_UNPOISON(reinterpret_cast<void*>(chunk.base), kHugePageBytes);
             unmap_huge_pages(reinterpret_cast<void*>(chunk.base), kHugePageBytes);
             m_chunks[i] = m_chunks.back();
             m_chunks.pop_back();
