@@ -36,6 +36,13 @@ struct Chunk {
     std::uint32_t used = 0;  // a bit per unit
 };
 
+// Gives a chunk back to the system. ASan (of GCC 12) keeps a range's poison past munmap,
+// so the chunk is unpoisoned first: the next mapping there may be anyone's.
+void unmap_chunk(void* p) noexcept {
+    SPINDLE_UNPOISON(p, kHugePageBytes);
+    unmap_huge_pages(p, kHugePageBytes);
+}
+
 // The units of a block of `bytes`: a power of two, under kUnits.
 std::uint32_t units_of(std::size_t bytes) {
     return static_cast<std::uint32_t>(std::bit_ceil(bytes) / kMediumBlockMinBytes);
@@ -65,8 +72,7 @@ public:
         try {
             m_chunks.push_back(Chunk{reinterpret_cast<std::uintptr_t>(p), 0});
         } catch (...) {
-            SPINDLE_UNPOISON(p, kHugePageBytes);  // the next mapping there may be anyone's
-            unmap_huge_pages(p, kHugePageBytes);
+            unmap_chunk(p);
             throw;
         }
         return take(m_chunks.back(), 0, mask, bytes);
@@ -84,10 +90,7 @@ public:
             chunk.used &= ~(mask << ((address - base) / kMediumBlockMinBytes));
             SPINDLE_POISON(p, std::size_t{units} * kMediumBlockMinBytes);
             if (chunk.used != 0 || ++m_empty <= kKeptEmptyMediumChunks) return;
-            // ASan (of GCC 12) keeps a range's poison past munmap: the next mapping there,
-            // a huge-page array of someone else's, would start poisoned.
-            SPINDLE_UNPOISON(reinterpret_cast<void*>(chunk.base), kHugePageBytes);
-            unmap_huge_pages(reinterpret_cast<void*>(chunk.base), kHugePageBytes);
+            unmap_chunk(reinterpret_cast<void*>(chunk.base));
             m_chunks[i] = m_chunks.back();
             m_chunks.pop_back();
             --m_empty;

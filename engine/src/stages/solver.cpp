@@ -261,29 +261,53 @@ bool same_constraints(const World& world, SolverScratch& scratch) {
     return same;
 }
 
-// Calls fn(k) for each body item `item` of colour `color` touches, in the order a pass
-// touches them: a wide joint's or wide contact's lanes (A, then B, lane by lane), or a
-// joint's A and B. Items of a colour: its wide joints, its other joints, its wide contacts.
+// Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
+// `color`: its wide joints (joint_lanes.cpp) and other joints (if kJoints), then its wide
+// contacts. The overflow (color == kColorCount) is one block, run serially, joints first.
+template <bool kJoints, typename BallSocketFn, typename JointFn, typename ContactFn>
+void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, BallSocketFn&& ball_socket_fn,
+                 JointFn&& joint_fn, ContactFn&& contact_fn) {
+    if (color == kColorCount) {
+        if (kJoints) {
+            for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
+        }
+        for (std::size_t k = scratch.wide_begin[kColorCount]; k < scratch.wide.size(); ++k) contact_fn(scratch.wide[k]);
+        return;
+    }
+    const std::vector<std::uint32_t>& joints = scratch.joint_colors[color];
+    const std::uint32_t ball_sockets = kJoints ? scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color]
+                                               : 0u;
+    const auto joint_count = kJoints ? ball_sockets + static_cast<std::uint32_t>(joints.size()) : 0u;
+    WideJoint* wide_joints = scratch.wide_joints.data() + scratch.wide_joint_begin[color];
+    WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
+    for (std::uint32_t k = lo; k < hi; ++k) {
+        if (k < ball_sockets) {
+            ball_socket_fn(wide_joints[k]);
+        } else if (k < joint_count) {
+            joint_fn(scratch.joints[joints[k - ball_sockets]]);
+        } else {
+            contact_fn(contacts[k - joint_count]);
+        }
+    }
+}
+
+// Calls fn(k) for each body constraint item `item` of colour `color` touches (the overflow:
+// every body of its block), in the order a pass touches them: a wide joint's or wide
+// contact's lanes (A, then B, lane by lane), or a joint's A and B.
 template <typename Fn>
-void for_item_bodies(const SolverScratch& scratch, int color, std::uint32_t item, Fn&& fn) {
+void for_item_bodies(SolverScratch& scratch, int color, std::uint32_t item, Fn&& fn) {
     const std::uint32_t k = item - scratch.first_item[color];
-    const std::uint32_t ball_sockets = scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color];
-    const auto joints = static_cast<std::uint32_t>(scratch.joint_colors[color].size());
     auto lanes = [&](const auto& wide) {  // a WideJoint or a WideContact
         for (int l = 0; l < wide.lanes; ++l) {
             fn(wide.a[l]);
             fn(wide.b[l]);
         }
     };
-    if (k < ball_sockets) {
-        lanes(scratch.wide_joints[scratch.wide_joint_begin[color] + k]);
-    } else if (k < ball_sockets + joints) {
-        const JointConstraint& joint = scratch.joints[scratch.joint_colors[color][k - ball_sockets]];
-        fn(joint.a);
-        fn(joint.b);
-    } else {
-        lanes(scratch.wide[scratch.wide_begin[color] + (k - ball_sockets - joints)]);
-    }
+    auto joint = [&](const JointConstraint& j) {
+        fn(j.a);
+        fn(j.b);
+    };
+    for_colored<true>(scratch, color, k, k + 1, lanes, joint, lanes);
 }
 
 // Items (constraints of the colours, in pass order) and awake bodies per block of
@@ -332,16 +356,7 @@ void find_first_touches(JobSystem& jobs, SolverScratch& scratch, std::uint32_t n
             scratch.touched[k] = 1;
             overflow_touches.push_back(k);
         };
-        for (const std::uint32_t k : scratch.joint_overflow) {
-            touch(scratch.joints[k].a);
-            touch(scratch.joints[k].b);
-        }
-        for (std::size_t w = scratch.wide_begin[kColorCount]; w < scratch.wide.size(); ++w) {
-            for (int l = 0; l < scratch.wide[w].lanes; ++l) {
-                touch(scratch.wide[w].a[l]);
-                touch(scratch.wide[w].b[l]);
-            }
-        }
+        for_item_bodies(scratch, kColorCount, scratch.first_item[kColorCount], touch);
     }
     // A body no colour holds: kinematic, untouched, or the overflow's.
     auto untouched_body = [&](std::uint32_t k) {
@@ -443,36 +458,6 @@ void integrate_first_touched(const SolverScratch& scratch, int color, std::uint3
     const std::uint32_t from = scratch.first_touch[first];
     const std::uint32_t to = scratch.first_touch[last];
     if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
-}
-
-// Runs ball_socket_fn, joint_fn and contact_fn over constraints [lo, hi) of colour
-// `color`: its wide joints (joint_lanes.cpp) and other joints (if kJoints), then its wide
-// contacts. The overflow (color == kColorCount) is one block, run serially, joints first.
-template <bool kJoints, typename BallSocketFn, typename JointFn, typename ContactFn>
-void for_colored(SolverScratch& scratch, int color, std::uint32_t lo, std::uint32_t hi, BallSocketFn&& ball_socket_fn,
-                 JointFn&& joint_fn, ContactFn&& contact_fn) {
-    if (color == kColorCount) {
-        if (kJoints) {
-            for (std::uint32_t k : scratch.joint_overflow) joint_fn(scratch.joints[k]);
-        }
-        for (std::size_t k = scratch.wide_begin[kColorCount]; k < scratch.wide.size(); ++k) contact_fn(scratch.wide[k]);
-        return;
-    }
-    const std::vector<std::uint32_t>& joints = scratch.joint_colors[color];
-    const std::uint32_t ball_sockets = kJoints ? scratch.wide_joint_begin[color + 1] - scratch.wide_joint_begin[color]
-                                               : 0u;
-    const auto joint_count = kJoints ? ball_sockets + static_cast<std::uint32_t>(joints.size()) : 0u;
-    WideJoint* wide_joints = scratch.wide_joints.data() + scratch.wide_joint_begin[color];
-    WideContact* contacts = scratch.wide.data() + scratch.wide_begin[color];
-    for (std::uint32_t k = lo; k < hi; ++k) {
-        if (k < ball_sockets) {
-            ball_socket_fn(wide_joints[k]);
-        } else if (k < joint_count) {
-            joint_fn(scratch.joints[joints[k - ball_sockets]]);
-        } else {
-            contact_fn(contacts[k - joint_count]);
-        }
-    }
 }
 
 // Adds the phases of one pass over the constraints: one per colour that has any (its
