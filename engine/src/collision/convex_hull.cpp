@@ -305,6 +305,8 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
         a.t0 = a.direction.cross(a.n0);
         a.t1 = a.n1.cross(a.direction);
     }
+    m_arc_lanes.resize((m_arc_edges.size() + 3) / 4);
+    detail::fill_arc_lanes(m_arc_edges.data(), static_cast<std::uint32_t>(m_arc_edges.size()), m_arc_lanes.data());
     compute_volume_properties();
 }
 

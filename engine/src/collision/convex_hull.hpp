@@ -43,9 +43,10 @@ public:
     std::span<const HullEdge> edges() const noexcept { return m_edges; }
     // Made once with the hull, for the SAT, which would otherwise make them for every pair
     // the hull is in: the vertices in lanes, and each edge of edges() with its Gauss-map arc
-    // in the hull's own frame.
+    // in the hull's own frame, alone and four in lanes.
     std::span<const detail::VertexLanes> vertex_lanes() const noexcept { return m_vertex_lanes; }
     std::span<const detail::ArcEdge> arc_edges() const noexcept { return m_arc_edges; }
+    std::span<const detail::ArcLanes> arc_lanes() const noexcept { return m_arc_lanes; }
 
     // Centre of the volume (uniform density) and the volume itself.
     const Vec3& centroid() const noexcept { return m_centroid; }
@@ -77,6 +78,7 @@ private:
     std::vector<HullEdge> m_edges;
     std::vector<detail::VertexLanes> m_vertex_lanes;
     std::vector<detail::ArcEdge> m_arc_edges;
+    std::vector<detail::ArcLanes> m_arc_lanes;
     Vec3 m_centroid = Vec3::Zero();
     Real m_volume = 0;
     Real m_inner_radius = 0;

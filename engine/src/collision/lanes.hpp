@@ -1,6 +1,6 @@
 // Four doubles worked on together, and a polyhedron's vertices laid out that way: what the
 // SAT's support queries (sat.cpp) and a hull's bounds (convex_hull.cpp) loop over; and an
-// edge with its Gauss-map arc, which a hull keeps made for the SAT.
+// edge with its Gauss-map arc, alone and four in lanes, which a hull keeps made for the SAT.
 #pragma once
 
 #include <cstdint>
@@ -37,5 +37,39 @@ struct ArcEdge {
     Vec3 n0, n1;  // normals of the two faces
     Vec3 t0, t1;  // direction x n0, n1 x direction
 };
+
+// Four edges' arcs in lanes, lane k of group i holding edge 4i + k: what the edge query's
+// bound on an arc's reach and its cheap rejections read, four edges at a time (sat.cpp).
+// Lanes past the last edge are zero but for `dd`, which is one there (no 0 / 0); the
+// query masks them off.
+struct ArcLanes {
+    Lanes dx, dy, dz;     // direction
+    Lanes dd;             // direction's squared norm, as Eigen sums it: x x + (y y + z z)
+    Lanes n0x, n0y, n0z;  // normals of the two faces
+    Lanes n1x, n1y, n1z;
+    Lanes t0x, t0y, t0z;  // direction x n0
+    Lanes t1x, t1y, t1z;  // n1 x direction
+};
+
+// edges[0, count) into (count + 3) / 4 groups of lanes.
+inline void fill_arc_lanes(const ArcEdge* edges, std::uint32_t count, ArcLanes* out) {
+    for (std::uint32_t k = 0; k < (count + 3) / 4 * 4; ++k) {
+        ArcLanes& l = out[k / 4];
+        const std::uint32_t lane = k % 4;
+        if (k >= count) {
+            l.dx[lane] = l.dy[lane] = l.dz[lane] = l.n0x[lane] = l.n0y[lane] = l.n0z[lane] = l.n1x[lane] = l.n1y[lane] =
+                l.n1z[lane] = l.t0x[lane] = l.t0y[lane] = l.t0z[lane] = l.t1x[lane] = l.t1y[lane] = l.t1z[lane] = 0;
+            l.dd[lane] = 1;
+            continue;
+        }
+        const ArcEdge& e = edges[k];
+        l.dx[lane] = e.direction.x(), l.dy[lane] = e.direction.y(), l.dz[lane] = e.direction.z();
+        l.dd[lane] = e.direction.squaredNorm();
+        l.n0x[lane] = e.n0.x(), l.n0y[lane] = e.n0.y(), l.n0z[lane] = e.n0.z();
+        l.n1x[lane] = e.n1.x(), l.n1y[lane] = e.n1.y(), l.n1z[lane] = e.n1.z();
+        l.t0x[lane] = e.t0.x(), l.t0y[lane] = e.t0.y(), l.t0z[lane] = e.t0.z();
+        l.t1x[lane] = e.t1.x(), l.t1y[lane] = e.t1.y(), l.t1z[lane] = e.t1.z();
+    }
+}
 
 }  // namespace spindle::detail

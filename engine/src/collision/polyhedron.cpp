@@ -46,6 +46,7 @@ PolyView view_of(const ConvexHull& hull) {
                            hull.inner_radius());
     v.vertex_lanes = hull.vertex_lanes().data();
     v.arc_edges = hull.arc_edges().data();
+    v.arc_lanes = hull.arc_lanes().data();
     return v;
 }
 

@@ -23,10 +23,11 @@ struct PolyView {
     // SAT axis can show before its support points are looked at.
     Vec3 inner_centre = Vec3::Zero();
     Real inner_radius = 0;
-    // What a hull keeps made for the SAT (ConvexHull::vertex_lanes, arc_edges); null for a
-    // box or a triangle, made per test, whose SAT makes them itself.
+    // What a hull keeps made for the SAT (ConvexHull::vertex_lanes, arc_edges, arc_lanes);
+    // null for a box or a triangle, made per test, whose SAT makes them itself.
     const VertexLanes* vertex_lanes = nullptr;
     const ArcEdge* arc_edges = nullptr;
+    const ArcLanes* arc_lanes = nullptr;
 
     std::uint32_t support_index(const Vec3& d) const {
         std::uint32_t best = 0;

@@ -162,24 +162,6 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
     return true;
 }
 
-// Edges edges[indices[k]] in lanes of four, lane k % 4 of group k / 4 holding the k-th.
-void prepare_lanes(const ArcEdge* edges, const std::uint32_t* indices, std::uint32_t count, EdgeLanes* out) {
-    for (std::uint32_t k = 0; k < count; ++k) {
-        EdgeLanes& l = out[k / 4];
-        const std::uint32_t lane = k % 4;
-        const ArcEdge& e = edges[indices[k]];
-        l.dx[lane] = e.direction.x(), l.dy[lane] = e.direction.y(), l.dz[lane] = e.direction.z();
-        l.n0x[lane] = e.n0.x(), l.n0y[lane] = e.n0.y(), l.n0z[lane] = e.n0.z();
-        l.n1x[lane] = e.n1.x(), l.n1y[lane] = e.n1.y(), l.n1z[lane] = e.n1.z();
-    }
-    for (std::uint32_t k = count; k % 4 != 0; ++k) {  // lanes past the last edge: never tested further
-        EdgeLanes& l = out[k / 4];
-        const std::uint32_t lane = k % 4;
-        l.dx[lane] = l.dy[lane] = l.dz[lane] = l.n0x[lane] = l.n0y[lane] = l.n0z[lane] = l.n1x[lane] = l.n1y[lane] =
-            l.n1z[lane] = 0;
-    }
-}
-
 // Edge j with what arc_reach needs, in the polyhedron's own frame (no origin).
 ArcEdge own_arc_edge(const PolyView& v, std::uint32_t j) {
     const HullEdge& e = v.edges[j];
@@ -192,8 +174,8 @@ ArcEdge own_arc_edge(const PolyView& v, std::uint32_t j) {
     return a;
 }
 
-// How far along d any direction on an edge's Gauss-map arc reaches: the largest L . d
-// over the arc, where d's projection on the arc's great circle falls, else at an end.
+}  // namespace
+
 Real arc_reach(const ArcEdge& e, const Vec3& d) {
     if (d.dot(e.t0) >= 0 && d.dot(e.t1) >= 0) {
         const Real along = d.dot(e.direction);
@@ -201,6 +183,26 @@ Real arc_reach(const ArcEdge& e, const Vec3& d) {
     }
     return std::max(e.n0.dot(d), e.n1.dot(d));
 }
+
+Lanes arc_reach(const ArcLanes& e, const Vec3& d) {
+    const Lanes x = Lanes{} + d.x(), y = Lanes{} + d.y(), z = Lanes{} + d.z();
+    // Each dot product summed as Eigen sums a 3-vector's: a0 b0 + (a1 b1 + a2 b2).
+    const auto dot = [&](const Lanes& ax, const Lanes& ay, const Lanes& az) { return x * ax + (y * ay + z * az); };
+    const LaneMask on_arc = (dot(e.t0x, e.t0y, e.t0z) >= 0) & (dot(e.t1x, e.t1y, e.t1z) >= 0);
+    const Lanes along = dot(e.dx, e.dy, e.dz);
+    const Lanes rest = d.squaredNorm() - along * along / e.dd;
+    Lanes across = rest < 0 ? Lanes{} : rest;  // std::max(rest, 0)
+#ifdef __AVX__
+    across = __builtin_ia32_sqrtpd256(across);
+#else
+    for (int k = 0; k < 4; ++k) across[k] = std::sqrt(across[k]);
+#endif
+    const Lanes r0 = dot(e.n0x, e.n0y, e.n0z), r1 = dot(e.n1x, e.n1y, e.n1z);
+    const Lanes at_end = r0 < r1 ? r1 : r0;  // std::max(r0, r1)
+    return on_arc ? across : at_end;
+}
+
+namespace {
 
 // Edge pairs that form a face of the Minkowski difference: A's edge arc and B's
 // negated edge arc cross on the Gauss map, at the direction L = +-(ea x eb). Only a pair
@@ -211,20 +213,26 @@ Real arc_reach(const ArcEdge& e, const Vec3& d) {
 // dropped before the pairs are formed. Of the pairs left, most fail the first two tests
 // of edge_pair_axis (an arc that does not cross the other's great circle): those run on
 // four of A's edges at once, each lane computing what the scalar test computes in the
-// same order. The pairs tested keep their order, so the answer is the whole query's
-// whenever it beats `floor`; otherwise it is `floor` with no pair found.
+// same order; A's bounds do too. The pairs tested keep their order, so the answer is the
+// whole query's whenever it beats `floor`; otherwise it is `floor` with no pair found.
 EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, const Posed& b, Real floor, Real limit) {
     const Vec3 d = b.inner_centre - a.inner_centre;
     const Real radii = a.view.inner_radius + b.view.inner_radius;
     const Real needed = floor + radii - kBoundRounding * (d.norm() + radii + std::abs(floor));
 
+    // A's edges kept, four bits a group.
     const ArcEdge* edges_a = prepared_a.edges();
-    ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_a(a.view.edge_count);
-    std::uint32_t count_a = 0;
-    for (std::uint32_t j = 0; j < a.view.edge_count; ++j) {
-        if (arc_reach(edges_a[j], d) > needed) kept_a[count_a++] = j;
+    const ArcLanes* lanes_a = prepared_a.edge_lanes();
+    const std::uint32_t groups = (a.view.edge_count + 3) / 4;
+    ScratchBuffer<std::uint8_t, kInlineVertices> kept_a(groups);
+    unsigned any_a = 0;
+    for (std::uint32_t g = 0; g < groups; ++g) {
+        unsigned bits = lane_bits(arc_reach(lanes_a[g], d) > needed);
+        if (4 * g + 4 > a.view.edge_count) bits &= (1u << (a.view.edge_count - 4 * g)) - 1;  // past the last edge
+        kept_a[g] = static_cast<std::uint8_t>(bits);
+        any_a |= bits;
     }
-    if (count_a == 0) return {floor};
+    if (any_a == 0) return {floor};
     // B's edges are bounded in B's own frame (-d turned into it): only those kept are turned.
     const Vec3 d_in_b = b.r.transpose() * -d;
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
@@ -237,10 +245,7 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
         }
     }
     if (count_b == 0) return {floor};
-    ScratchBuffer<EdgeLanes, kInlineVertices> lanes((count_a + 3) / 4);
-    prepare_lanes(edges_a, kept_a.data(), count_a, lanes.data());
 
-    const std::uint32_t groups = (count_a + 3) / 4;
     EdgeQuery best{floor};
     for (std::uint32_t kb = 0; kb < count_b; ++kb) {
         const std::uint32_t jb = kept_b[kb];
@@ -250,20 +255,19 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
         const Lanes bdx = Lanes{} + eb.direction.x(), bdy = Lanes{} + eb.direction.y(),
                     bdz = Lanes{} + eb.direction.z();
         for (std::uint32_t g = 0; g < groups; ++g) {
-            const EdgeLanes& l = lanes[g];
+            if (kept_a[g] == 0) continue;
+            const ArcLanes& l = lanes_a[g];
             const Lanes b0 = (bn0x * l.dx + bn0y * l.dy) + bn0z * l.dz;
             const Lanes b1 = (bn1x * l.dx + bn1y * l.dy) + bn1z * l.dz;
             const Lanes a0 = (l.n0x * bdx + l.n0y * bdy) + l.n0z * bdz;
             const Lanes a1 = (l.n1x * bdx + l.n1y * bdy) + l.n1z * bdz;
-            // Lanes past the last edge (all zero) pass; their indices are dropped below.
-            for (unsigned crossing = lane_bits((b0 * b1 <= 0) & (a0 * a1 <= 0)); crossing != 0;
+            for (unsigned crossing = lane_bits((b0 * b1 <= 0) & (a0 * a1 <= 0)) & kept_a[g]; crossing != 0;
                  crossing &= crossing - 1) {
-                const std::uint32_t ka = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
-                if (ka >= count_a) break;
+                const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
                 Vec3 unit;
                 Real s;
-                if (!edge_pair_axis(edges_a[kept_a[ka]], eb, unit, s)) continue;
-                if (s > best.separation) best = {s, kept_a[ka], jb, unit, true};
+                if (!edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
+                if (s > best.separation) best = {s, ja, jb, unit, true};
                 if (s > limit) return best;
             }
         }
@@ -292,8 +296,10 @@ CachedAxis cached_axis(const FeatureCache& cache, const Posed& a, const Posed& b
             break;
         case FeatureCache::Kind::EdgePair:
             if (cache.index_a() < a.view.edge_count && cache.index_b() < b.view.edge_count) {
-                axis.valid = edge_pair_axis(arc_edge(a, cache.index_a()), arc_edge(b, cache.index_b()), axis.unit,
-                                            axis.separation);
+                // A in its own frame: a hull's kept arc is arc_edge's to the bit.
+                const std::uint32_t ja = cache.index_a();
+                axis.valid = edge_pair_axis(a.at_home && a.view.arc_edges ? a.view.arc_edges[ja] : arc_edge(a, ja),
+                                            arc_edge(b, cache.index_b()), axis.unit, axis.separation);
             }
             break;
         case FeatureCache::Kind::None: break;
@@ -514,14 +520,22 @@ PreparedPolyhedron::PreparedPolyhedron(const PolyView& view)
       m_lane_buffer(view.vertex_lanes ? 0 : (view.vertex_count + 3) / 4),
       m_lanes(view.vertex_lanes ? view.vertex_lanes : m_lane_buffer.data()),
       m_edge_buffer(view.arc_edges ? 0 : view.edge_count),
-      m_edges(view.arc_edges) {
+      m_edges(view.arc_edges),
+      m_edge_lane_buffer(view.arc_edges && view.arc_lanes ? 0 : (view.edge_count + 3) / 4),
+      m_edge_lanes(view.arc_edges ? view.arc_lanes : nullptr) {
     if (!view.vertex_lanes) fill_lanes(view.vertices, view.vertex_count, m_lane_buffer.data());
 }
 
 void PreparedPolyhedron::prepare_edges() const {
-    const Posed own{m_view, m_view.vertices, m_lanes, Mat3::Identity(), Vec3::Zero(), m_view.inner_centre, true};
-    detail::prepare_edges(own, m_edge_buffer.data());
-    m_edges = m_edge_buffer.data();
+    if (m_edges == nullptr) {
+        const Posed own{m_view, m_view.vertices, m_lanes, Mat3::Identity(), Vec3::Zero(), m_view.inner_centre, true};
+        detail::prepare_edges(own, m_edge_buffer.data());
+        m_edges = m_edge_buffer.data();
+    }
+    if (m_edge_lanes == nullptr) {
+        fill_arc_lanes(m_edges, m_view.edge_count, m_edge_lane_buffer.data());
+        m_edge_lanes = m_edge_lane_buffer.data();
+    }
 }
 
 bool collide_polyhedra(const PolyView& a, const Transform& xa, const PolyView& b, const Transform& xb, Real speculative,

@@ -11,18 +11,12 @@
 
 namespace spindle::detail {
 
-// Four of A's edges for the edge query's cheap rejections: the components of each edge's
-// direction and two face normals.
-struct EdgeLanes {
-    Lanes dx, dy, dz, n0x, n0y, n0z, n1x, n1y, n1z;
-};
-
 inline constexpr std::size_t kInlineVertices = 64;
 
 // A polyhedron in its own frame (the frame sat.cpp works in, the first polyhedron's),
-// with its vertices in lanes, and its edges prepared on first use: most tests of a pair
-// that stays apart end on a face before any edge is looked at. A hull's view brings both
-// made (PolyView::vertex_lanes, arc_edges), and they are read from there.
+// with its vertices in lanes, and its edges (alone and in lanes) prepared on first use: most
+// tests of a pair that stays apart end on a face before any edge is looked at. A hull's view
+// brings them made (PolyView::vertex_lanes, arc_edges, arc_lanes), and they are read from there.
 class PreparedPolyhedron {
 public:
     explicit PreparedPolyhedron(const PolyView& view);
@@ -36,6 +30,11 @@ public:
         if (m_edges == nullptr) prepare_edges();
         return m_edges;
     }
+    // The same edges four in lanes.
+    const ArcLanes* edge_lanes() const {
+        if (m_edge_lanes == nullptr) prepare_edges();
+        return m_edge_lanes;
+    }
 
 private:
     void prepare_edges() const;
@@ -45,6 +44,15 @@ private:
     const VertexLanes* m_lanes;
     mutable ScratchBuffer<ArcEdge, 2 * kInlineVertices> m_edge_buffer;
     mutable const ArcEdge* m_edges;
+    mutable ScratchBuffer<ArcLanes, 2 * kInlineVertices / 4> m_edge_lane_buffer;
+    mutable const ArcLanes* m_edge_lanes;
 };
+
+// How far along d any direction on an edge's Gauss-map arc reaches: the largest L . d over
+// the arc, where d's projection on the arc's great circle falls, else at an end (the edge
+// query's bound, sat.cpp). The lanes' version does it for four edges, each lane giving the
+// bits the single edge's gives.
+Real arc_reach(const ArcEdge& e, const Vec3& d);
+Lanes arc_reach(const ArcLanes& e, const Vec3& d);
 
 }  // namespace spindle::detail

@@ -29,6 +29,7 @@ detail::PolyView unprepared(const ConvexHull& hull) {
     detail::PolyView v = detail::view_of(hull);
     v.vertex_lanes = nullptr;
     v.arc_edges = nullptr;
+    v.arc_lanes = nullptr;
     return v;
 }
 
@@ -64,6 +65,22 @@ TEST(SatPrepared, HullKeepsTheArcsOfItsEdges) {
             expect_same_bits(a.t0, direction.cross(faces[e.f0].normal), "t0", j);
             expect_same_bits(a.t1, faces[e.f1].normal.cross(direction), "t1", j);
         }
+        // The same arcs four in lanes; lanes past the last edge zero, their squared length one.
+        ASSERT_EQ(hull.arc_lanes().size(), (hull.edges().size() + 3) / 4);
+        for (std::size_t j = 0; j < 4 * hull.arc_lanes().size(); ++j) {
+            const detail::ArcLanes& l = hull.arc_lanes()[j / 4];
+            const std::size_t k = j % 4;
+            const bool edge = j < hull.edges().size();
+            const detail::ArcEdge none{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(),
+                                       Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+            const detail::ArcEdge& a = edge ? hull.arc_edges()[j] : none;
+            expect_same_bits(Vec3(l.dx[k], l.dy[k], l.dz[k]), a.direction, "direction in lanes", j);
+            expect_same_bits(Vec3(l.n0x[k], l.n0y[k], l.n0z[k]), a.n0, "n0 in lanes", j);
+            expect_same_bits(Vec3(l.n1x[k], l.n1y[k], l.n1z[k]), a.n1, "n1 in lanes", j);
+            expect_same_bits(Vec3(l.t0x[k], l.t0y[k], l.t0z[k]), a.t0, "t0 in lanes", j);
+            expect_same_bits(Vec3(l.t1x[k], l.t1y[k], l.t1z[k]), a.t1, "t1 in lanes", j);
+            EXPECT_EQ(l.dd[k], edge ? a.direction.squaredNorm() : Real(1)) << "squared length of edge " << j;
+        }
         ASSERT_EQ(hull.vertex_lanes().size(), (vertices.size() + 3) / 4);
         for (std::size_t i = 0; i < 4 * hull.vertex_lanes().size(); ++i) {
             const detail::VertexLanes& group = hull.vertex_lanes()[i / 4];
@@ -73,6 +90,43 @@ TEST(SatPrepared, HullKeepsTheArcsOfItsEdges) {
             EXPECT_EQ(group.z[i % 4], v.z()) << "lane " << i;
         }
     }
+}
+
+// The edge query bounds each of A's edges by how far its arc reaches along a direction,
+// four edges at a time: each lane must give the bits of the single edge's bound, on the
+// arc (the square root) and at its ends, for hulls' edges and a box's, and for directions
+// of any length, among them ones on an arc's end planes.
+TEST(SatPrepared, ArcsInLanesReachAsFarAsEachArcAlone) {
+    std::mt19937 random(17);
+    std::vector<detail::ArcEdge> arcs;
+    for (const int count : {8, 24}) {
+        const ConvexHull hull(sphere_points(random, 1.3, count));
+        arcs.insert(arcs.end(), hull.arc_edges().begin(), hull.arc_edges().end());
+    }
+    const ConvexHull cube(std::vector<Vec3>{Vec3(-1, -1, -1), Vec3(1, -1, -1), Vec3(-1, 1, -1), Vec3(1, 1, -1),
+                                            Vec3(-1, -1, 1), Vec3(1, -1, 1), Vec3(-1, 1, 1), Vec3(1, 1, 1)});
+    arcs.insert(arcs.end(), cube.arc_edges().begin(), cube.arc_edges().end());
+    arcs.resize(arcs.size() - arcs.size() % 4 - 2);  // a last group with two lanes past the end
+    std::vector<detail::ArcLanes> lanes((arcs.size() + 3) / 4);
+    detail::fill_arc_lanes(arcs.data(), static_cast<std::uint32_t>(arcs.size()), lanes.data());
+    std::normal_distribution<Real> normal(0, 1);
+    std::uniform_real_distribution<Real> length(0.01, 5);
+    int on_arc = 0, at_end = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        Vec3 d = length(random) * Vec3(normal(random), normal(random), normal(random)).normalized();
+        if (trial % 8 == 0) d = arcs[trial % arcs.size()].n0;  // on an end plane of that arc
+        for (std::size_t j = 0; j < arcs.size(); ++j) {
+            const Real alone = detail::arc_reach(arcs[j], d);
+            const Real in_lanes = detail::arc_reach(lanes[j / 4], d)[j % 4];
+            EXPECT_EQ(in_lanes, alone) << "edge " << j << ", trial " << trial;
+            const bool across = d.dot(arcs[j].t0) >= 0 && d.dot(arcs[j].t1) >= 0;
+            on_arc += across;
+            at_end += !across;
+        }
+    }
+    // Both ways of bounding are compared, else the test says little.
+    EXPECT_GT(on_arc, 1000);
+    EXPECT_GT(at_end, 1000);
 }
 
 // Hull-hull and box-hull pairs near touching, the hull as A and as B, through the SAT with
