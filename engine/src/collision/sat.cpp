@@ -328,26 +328,25 @@ std::uint32_t incident_face(const Posed& inc, const Vec3& n) {
     return incident;
 }
 
-// Clips face `incident` of `inc` against reference face `face` of `ref` (normal n) and
-// returns the points within reach. A vertex that clipping drops lies beside the reference
-// face, outside `ref`, and is not kept.
-int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const Posed& inc, std::uint32_t incident,
-                    bool reference_is_b, Real speculative, ContactCandidate* out) {
-    const Real d = ref.offset(face, n);
-    const HullFace& ref_face = ref.view.faces[face];
-    const HullFace& inc_face = inc.view.faces[incident];
-    const std::size_t capacity = inc_face.count + ref_face.count + 1;
-    ScratchBuffer<ClipVertex, 2 * kInlineVertices> buffer(2 * capacity);
-    ClipVertex* in = buffer.data();
-    ClipVertex* next = buffer.data() + capacity;
-    int count = static_cast<int>(inc_face.count);
+// The incident face's vertices clipped against the reference face's side planes in turn,
+// in `in` and `next` by turns (each with room for the incident face and one vertex more
+// per side plane); returns where the polygon left lies, its count in `count`. kSides is
+// the reference face's count when known (a triangle's three: the loop unrolled), else 0.
+template <std::uint32_t kSides>
+[[gnu::always_inline]] inline const ClipVertex* clip_incident(const Posed& ref, const HullFace& ref_face, const Vec3& n,
+                                                              const Posed& inc, const HullFace& inc_face,
+                                                              ClipVertex* in, ClipVertex* next, int& count) {
+    count = static_cast<int>(inc_face.count);
     for (std::uint32_t k = 0; k < inc_face.count; ++k) {
         in[k] = {inc.vertices[inc.view.face_vertices[inc_face.first + k]], clip_key(0, k, 0),
                  static_cast<std::uint16_t>(k)};
     }
-    for (std::uint32_t k = 0; k < ref_face.count && count > 0; ++k) {
+    const std::uint32_t sides = kSides != 0 ? kSides : ref_face.count;
+#pragma GCC unroll 3
+    for (std::uint32_t k = 0; k < sides; ++k) {
+        if (count == 0) break;
         const Vec3& v0 = ref.vertices[ref.view.face_vertices[ref_face.first + k]];
-        const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1 == ref_face.count ? 0 : k + 1)]];
+        const Vec3& v1 = ref.vertices[ref.view.face_vertices[ref_face.first + (k + 1 == sides ? 0 : k + 1)]];
         const Vec3 side = (v1 - v0).cross(n).normalized();
         const Real offset = side.dot(v0);
         // A side plane with every vertex inside leaves the polygon as it is: no copy.
@@ -359,13 +358,42 @@ int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const P
             in, count, [&](const Vec3& p) { return side.dot(p) - offset; }, k, next);
         std::swap(in, next);
     }
-    int n_out = 0;
-    for (int k = 0; k < count; ++k) {
-        const Real s = n.dot(in[k].p) - d;
-        if (s > speculative) continue;
-        out[n_out++] = {in[k].p - n * (Real(0.5) * s), s, face_contact_id(reference_is_b, face, incident, in[k].key)};
+    return in;
+}
+
+// A triangle of a mesh clipping a hull's face is the common clip: its polygon fits in two
+// fixed arrays when the incident face has at most this many vertices.
+constexpr std::uint32_t kTriangleClipIncident = 13;
+
+// Clips face `incident` of `inc` against reference face `face` of `ref` (normal n) and
+// returns the points within reach. A vertex that clipping drops lies beside the reference
+// face, outside `ref`, and is not kept.
+int clipped_contact(const Posed& ref, std::uint32_t face, const Vec3& n, const Posed& inc, std::uint32_t incident,
+                    bool reference_is_b, Real speculative, ContactCandidate* out) {
+    const HullFace& ref_face = ref.view.faces[face];
+    const HullFace& inc_face = inc.view.faces[incident];
+    const auto within_reach = [&](const ClipVertex* left, int count) {
+        const Real d = ref.offset(face, n);
+        int n_out = 0;
+        for (int k = 0; k < count; ++k) {
+            const Real s = n.dot(left[k].p) - d;
+            if (s > speculative) continue;
+            out[n_out++] = {left[k].p - n * (Real(0.5) * s), s,
+                            face_contact_id(reference_is_b, face, incident, left[k].key)};
+        }
+        return n_out;
+    };
+    int count = 0;
+    if (ref_face.count == 3 && inc_face.count <= kTriangleClipIncident) {
+        ClipVertex first[kTriangleClipIncident + 3], second[kTriangleClipIncident + 3];
+        const ClipVertex* left = clip_incident<3>(ref, ref_face, n, inc, inc_face, first, second, count);
+        return within_reach(left, count);
     }
-    return n_out;
+    const std::size_t capacity = inc_face.count + ref_face.count + 1;
+    ScratchBuffer<ClipVertex, 2 * kInlineVertices> buffer(2 * capacity);
+    const ClipVertex* left = clip_incident<0>(ref, ref_face, n, inc, inc_face, buffer.data(), buffer.data() + capacity,
+                                              count);
+    return within_reach(left, count);
 }
 
 // The incident face of `inc` (the one facing most against the reference face's normal)
