@@ -184,6 +184,29 @@ Real arc_reach(const ArcEdge& e, const Vec3& d) {
     return std::max(e.n0.dot(d), e.n1.dot(d));
 }
 
+// Eigen's cross product, lane by lane: a1 b2 - a2 b1, a2 b0 - a0 b2, a0 b1 - a1 b0.
+ArcLanes own_arc_lanes(const PolyView& v) {
+    ArcLanes l;
+    for (std::uint32_t j = 0; j < 4; ++j) {
+        if (j >= v.edge_count) {  // past the last edge: a unit direction (no 0 / 0), masked off by the caller
+            l.dy[j] = l.dz[j] = l.n0x[j] = l.n0y[j] = l.n0z[j] = l.n1x[j] = l.n1y[j] = l.n1z[j] = 0;
+            l.dx[j] = 1;
+            continue;
+        }
+        const HullEdge& e = v.edges[j];
+        const Vec3 direction = v.vertices[e.v1] - v.vertices[e.v0];
+        const Vec3& n0 = v.faces[e.f0].normal;
+        const Vec3& n1 = v.faces[e.f1].normal;
+        l.dx[j] = direction.x(), l.dy[j] = direction.y(), l.dz[j] = direction.z();
+        l.n0x[j] = n0.x(), l.n0y[j] = n0.y(), l.n0z[j] = n0.z();
+        l.n1x[j] = n1.x(), l.n1y[j] = n1.y(), l.n1z[j] = n1.z();
+    }
+    l.dd = l.dx * l.dx + (l.dy * l.dy + l.dz * l.dz);
+    l.t0x = l.dy * l.n0z - l.dz * l.n0y, l.t0y = l.dz * l.n0x - l.dx * l.n0z, l.t0z = l.dx * l.n0y - l.dy * l.n0x;
+    l.t1x = l.n1y * l.dz - l.n1z * l.dy, l.t1y = l.n1z * l.dx - l.n1x * l.dz, l.t1z = l.n1x * l.dy - l.n1y * l.dx;
+    return l;
+}
+
 Lanes arc_reach(const ArcLanes& e, const Vec3& d) {
     const Lanes x = Lanes{} + d.x(), y = Lanes{} + d.y(), z = Lanes{} + d.z();
     // Each dot product summed as Eigen sums a 3-vector's: a0 b0 + (a1 b1 + a2 b2).
@@ -238,10 +261,21 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
-    for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
-        if (arc_reach(b.view.arc_edges ? b.view.arc_edges[j] : own_arc_edge(b.view, j), d_in_b) > needed) {
+    if (b.view.arc_edges == nullptr && b.view.edge_count <= 4) {
+        // A triangle's edges, made and bounded in one group of lanes.
+        const unsigned bits = lane_bits(arc_reach(own_arc_lanes(b.view), d_in_b) > needed) &
+                              ((1u << b.view.edge_count) - 1);
+        for (unsigned left = bits; left != 0; left &= left - 1) {
+            const auto j = static_cast<std::uint32_t>(__builtin_ctz(left));
             kept_b[count_b] = j;
             edges_b[count_b++] = arc_edge(b, j);
+        }
+    } else {
+        for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
+            if (arc_reach(b.view.arc_edges ? b.view.arc_edges[j] : own_arc_edge(b.view, j), d_in_b) > needed) {
+                kept_b[count_b] = j;
+                edges_b[count_b++] = arc_edge(b, j);
+            }
         }
     }
     if (count_b == 0) return {floor};
@@ -338,8 +372,10 @@ template <std::uint32_t kSides>
                                                               ClipVertex* in, ClipVertex* next, int& count) {
     count = static_cast<int>(inc_face.count);
     for (std::uint32_t k = 0; k < inc_face.count; ++k) {
-        in[k] = {inc.vertices[inc.view.face_vertices[inc_face.first + k]], clip_key(0, k, 0),
-                 static_cast<std::uint16_t>(k)};
+        // Field by field: an aggregate made first and then copied was written twice.
+        in[k].p = inc.vertices[inc.view.face_vertices[inc_face.first + k]];
+        in[k].key = clip_key(0, k, 0);
+        in[k].edge = static_cast<std::uint16_t>(k);
     }
     const std::uint32_t sides = kSides != 0 ? kSides : ref_face.count;
 #pragma GCC unroll 3

@@ -55,4 +55,9 @@ private:
 Real arc_reach(const ArcEdge& e, const Vec3& d);
 Lanes arc_reach(const ArcLanes& e, const Vec3& d);
 
+// The edges' arcs of a polyhedron of at most four edges (a triangle) in its own frame, in
+// one group of lanes: each lane the bits of the edge's ArcEdge (its origin aside); lanes
+// past the last edge hold a unit direction and zero normals.
+ArcLanes own_arc_lanes(const PolyView& v);
+
 }  // namespace spindle::detail

@@ -129,6 +129,33 @@ TEST(SatPrepared, ArcsInLanesReachAsFarAsEachArcAlone) {
     EXPECT_GT(at_end, 1000);
 }
 
+// A triangle's edges (B in the edge query) are made in one group of lanes and bounded
+// there: each lane must hold the bits of the arc made for that edge alone (its direction and
+// squared length, its faces' normals, and the two products), the lane past the last edge a
+// unit direction and zero normals.
+TEST(SatPrepared, ATrianglesArcsInLanesAreTheArcsOfItsEdges) {
+    std::mt19937 random(19);
+    std::normal_distribution<Real> normal(0, 1);
+    for (int trial = 0; trial < 200; ++trial) {
+        const auto corner = [&] { return Vec3(normal(random), normal(random), normal(random)); };
+        const detail::TrianglePoly triangle(corner(), corner(), corner());
+        const detail::PolyView v = triangle.view();
+        const detail::ArcLanes l = detail::own_arc_lanes(v);
+        for (std::uint32_t j = 0; j < 4; ++j) {
+            const bool edge = j < v.edge_count;
+            const Vec3 direction = edge ? Vec3(v.vertices[v.edges[j].v1] - v.vertices[v.edges[j].v0]) : Vec3::UnitX();
+            const Vec3 n0 = edge ? v.faces[v.edges[j].f0].normal : Vec3::Zero();
+            const Vec3 n1 = edge ? v.faces[v.edges[j].f1].normal : Vec3::Zero();
+            expect_same_bits(Vec3(l.dx[j], l.dy[j], l.dz[j]), direction, "direction", j);
+            expect_same_bits(Vec3(l.n0x[j], l.n0y[j], l.n0z[j]), n0, "n0", j);
+            expect_same_bits(Vec3(l.n1x[j], l.n1y[j], l.n1z[j]), n1, "n1", j);
+            expect_same_bits(Vec3(l.t0x[j], l.t0y[j], l.t0z[j]), direction.cross(n0), "t0", j);
+            expect_same_bits(Vec3(l.t1x[j], l.t1y[j], l.t1z[j]), n1.cross(direction), "t1", j);
+            EXPECT_EQ(l.dd[j], direction.squaredNorm()) << "squared length of edge " << j;
+        }
+    }
+}
+
 // Hull-hull and box-hull pairs near touching, the hull as A and as B, through the SAT with
 // the hulls' kept lanes and arcs and through the SAT making them per test: the same
 // manifold and the same cached feature, bit for bit, in every pose.
