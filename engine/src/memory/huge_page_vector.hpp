@@ -89,30 +89,35 @@ struct HugePageAllocator {
     template <typename U>
     HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
 
-    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kOnHugePagesBytes; }
-    static std::size_t rounded_bytes(std::size_t n) {
-        return (n * sizeof(T) + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    // The three kinds of block (this file's head): ordinary heap blocks, medium blocks sharing
+    // huge pages, whole huge pages.
+    enum class Tier { kHeap, kMedium, kHugePages };
+    static Tier tier(std::size_t bytes) {
+        if (bytes >= kOnHugePagesBytes) return Tier::kHugePages;
+        return bytes >= kMediumBlockMinBytes ? Tier::kMedium : Tier::kHeap;
+    }
+    static std::size_t rounded_bytes(std::size_t bytes) {
+        return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
 
-    static bool medium(std::size_t n) { return n * sizeof(T) >= kMediumBlockMinBytes; }
-
+    // std::vector asks for no more than max_size() elements, so n * sizeof(T) does not wrap.
     T* allocate(std::size_t n) {
-        if (!on_huge_pages(n)) {
-            if (medium(n)) return static_cast<T*>(allocate_medium_block(n * sizeof(T)));
-            return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{alignof(T)}));
+        const std::size_t bytes = n * sizeof(T);
+        switch (tier(bytes)) {
+            case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
+            case Tier::kMedium: return static_cast<T*>(allocate_medium_block(bytes));
+            case Tier::kHugePages:
+                if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
+                return static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
         }
-        if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-        return static_cast<T*>(map_huge_pages(rounded_bytes(n)));
+        return nullptr;
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        if (!on_huge_pages(n)) {
-            if (medium(n)) {
-                free_medium_block(p, n * sizeof(T));
-            } else {
-                ::operator delete (p, std::align_val_t{alignof(T)});
-            }
-        } else {
-            unmap_huge_pages(p, rounded_bytes(n));
+        const std::size_t bytes = n * sizeof(T);
+        switch (tier(bytes)) {
+            case Tier::kHeap: ::operator delete (p, std::align_val_t{alignof(T)}); return;
+            case Tier::kMedium: free_medium_block(p, bytes); return;
+            case Tier::kHugePages: unmap_huge_pages(p, rounded_bytes(bytes)); return;
         }
     }
 
