@@ -70,8 +70,9 @@ void parse_settings(const TomlReader& r, const toml::node& node, SceneDesc& scen
         if (const toml::node* n = t.get(key)) field = r.non_negative(*n, name(key));
     };
     auto count = [&](const char* key, int& field, int min) {
-        constexpr std::int64_t kMaxCount = 1000;
-        if (const toml::node* n = t.get(key)) field = static_cast<int>(r.integer(*n, name(key), min, kMaxCount));
+        constexpr std::int64_t kMaxSettingsCount = 1000;
+        if (const toml::node* n = t.get(key))
+            field = static_cast<int>(r.integer(*n, name(key), min, kMaxSettingsCount));
     };
     if (const toml::node* n = t.get("gravity")) s.gravity = r.vec3(*n, name("gravity"), "x, y, z in m/s^2");
     positive("time_step", ts.duration);
