@@ -21,6 +21,15 @@ inline unsigned lane_bits(LaneMask m) {
     return (m[0] ? 1u : 0u) | (m[1] ? 2u : 0u) | (m[2] ? 4u : 0u) | (m[3] ? 8u : 0u);
 #endif
 }
+// The square root of each lane.
+inline Lanes lane_sqrt(Lanes x) {
+#ifdef __AVX__
+    return __builtin_ia32_sqrtpd256(x);
+#else
+    for (int k = 0; k < 4; ++k) x[k] = __builtin_sqrt(x[k]);
+    return x;
+#endif
+}
 
 // Vertices in lanes: lane k of group i holds vertex 4i + k; lanes past the last vertex
 // repeat vertex 0, which never wins a support query over it (ties go to the lower index)
@@ -40,8 +49,8 @@ struct ArcEdge {
 
 // Four edges' arcs in lanes, lane k of group i holding edge 4i + k: what the edge query's
 // bound on an arc's reach and its cheap rejections read, four edges at a time (sat.cpp).
-// Lanes past the last edge are zero but for `dd`, which is one there (no 0 / 0); the
-// query masks them off.
+// Lanes past the last edge hold a unit direction (`dd` one: no 0 / 0) and zero normals;
+// the query masks them off.
 struct ArcLanes {
     Lanes dx, dy, dz;     // direction
     Lanes dd;             // direction's squared norm, as Eigen sums it: x x + (y y + z z)
@@ -53,16 +62,12 @@ struct ArcLanes {
 
 // edges[0, count) into (count + 3) / 4 groups of lanes.
 inline void fill_arc_lanes(const ArcEdge* edges, std::uint32_t count, ArcLanes* out) {
+    const Vec3 zero = Vec3::Zero();
+    const ArcEdge past_the_last{zero, Vec3::UnitX(), zero, zero, zero, zero};  // its t0, t1 are zero too
     for (std::uint32_t k = 0; k < (count + 3) / 4 * 4; ++k) {
         ArcLanes& l = out[k / 4];
         const std::uint32_t lane = k % 4;
-        if (k >= count) {
-            l.dx[lane] = l.dy[lane] = l.dz[lane] = l.n0x[lane] = l.n0y[lane] = l.n0z[lane] = l.n1x[lane] = l.n1y[lane] =
-                l.n1z[lane] = l.t0x[lane] = l.t0y[lane] = l.t0z[lane] = l.t1x[lane] = l.t1y[lane] = l.t1z[lane] = 0;
-            l.dd[lane] = 1;
-            continue;
-        }
-        const ArcEdge& e = edges[k];
+        const ArcEdge& e = k < count ? edges[k] : past_the_last;
         l.dx[lane] = e.direction.x(), l.dy[lane] = e.direction.y(), l.dz[lane] = e.direction.z();
         l.dd[lane] = e.direction.squaredNorm();
         l.n0x[lane] = e.n0.x(), l.n0y[lane] = e.n0.y(), l.n0z[lane] = e.n0.z();

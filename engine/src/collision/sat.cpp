@@ -188,7 +188,7 @@ Real arc_reach(const ArcEdge& e, const Vec3& d) {
 ArcLanes own_arc_lanes(const PolyView& v) {
     ArcLanes l;
     for (std::uint32_t j = 0; j < 4; ++j) {
-        if (j >= v.edge_count) {  // past the last edge: a unit direction (no 0 / 0), masked off by the caller
+        if (j >= v.edge_count) {  // past the last edge, as ArcLanes says: a unit direction, zero normals
             l.dy[j] = l.dz[j] = l.n0x[j] = l.n0y[j] = l.n0z[j] = l.n1x[j] = l.n1y[j] = l.n1z[j] = 0;
             l.dx[j] = 1;
             continue;
@@ -214,12 +214,7 @@ Lanes arc_reach(const ArcLanes& e, const Vec3& d) {
     const LaneMask on_arc = (dot(e.t0x, e.t0y, e.t0z) >= 0) & (dot(e.t1x, e.t1y, e.t1z) >= 0);
     const Lanes along = dot(e.dx, e.dy, e.dz);
     const Lanes rest = d.squaredNorm() - along * along / e.dd;
-    Lanes across = rest < 0 ? Lanes{} : rest;  // std::max(rest, 0)
-#ifdef __AVX__
-    across = __builtin_ia32_sqrtpd256(across);
-#else
-    for (int k = 0; k < 4; ++k) across[k] = std::sqrt(across[k]);
-#endif
+    const Lanes across = lane_sqrt(rest < 0 ? Lanes{} : rest);  // std::max(rest, 0)
     const Lanes r0 = dot(e.n0x, e.n0y, e.n0z), r1 = dot(e.n1x, e.n1y, e.n1z);
     const Lanes at_end = r0 < r1 ? r1 : r0;  // std::max(r0, r1)
     return on_arc ? across : at_end;

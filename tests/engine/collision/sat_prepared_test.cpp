@@ -65,21 +65,21 @@ TEST(SatPrepared, HullKeepsTheArcsOfItsEdges) {
             expect_same_bits(a.t0, direction.cross(faces[e.f0].normal), "t0", j);
             expect_same_bits(a.t1, faces[e.f1].normal.cross(direction), "t1", j);
         }
-        // The same arcs four in lanes; lanes past the last edge zero, their squared length one.
+        // The same arcs four in lanes; lanes past the last edge a unit direction, zero normals.
         ASSERT_EQ(hull.arc_lanes().size(), (hull.edges().size() + 3) / 4);
         for (std::size_t j = 0; j < 4 * hull.arc_lanes().size(); ++j) {
             const detail::ArcLanes& l = hull.arc_lanes()[j / 4];
             const std::size_t k = j % 4;
             const bool edge = j < hull.edges().size();
-            const detail::ArcEdge none{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(),
-                                       Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+            const detail::ArcEdge none{Vec3::Zero(), Vec3::UnitX(), Vec3::Zero(),
+                                       Vec3::Zero(), Vec3::Zero(),  Vec3::Zero()};
             const detail::ArcEdge& a = edge ? hull.arc_edges()[j] : none;
             expect_same_bits(Vec3(l.dx[k], l.dy[k], l.dz[k]), a.direction, "direction in lanes", j);
             expect_same_bits(Vec3(l.n0x[k], l.n0y[k], l.n0z[k]), a.n0, "n0 in lanes", j);
             expect_same_bits(Vec3(l.n1x[k], l.n1y[k], l.n1z[k]), a.n1, "n1 in lanes", j);
             expect_same_bits(Vec3(l.t0x[k], l.t0y[k], l.t0z[k]), a.t0, "t0 in lanes", j);
             expect_same_bits(Vec3(l.t1x[k], l.t1y[k], l.t1z[k]), a.t1, "t1 in lanes", j);
-            EXPECT_EQ(l.dd[k], edge ? a.direction.squaredNorm() : Real(1)) << "squared length of edge " << j;
+            EXPECT_EQ(l.dd[k], a.direction.squaredNorm()) << "squared length of edge " << j;
         }
         ASSERT_EQ(hull.vertex_lanes().size(), (vertices.size() + 3) / 4);
         for (std::size_t i = 0; i < 4 * hull.vertex_lanes().size(); ++i) {
