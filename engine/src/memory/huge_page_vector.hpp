@@ -100,15 +100,16 @@ struct HugePageAllocator {
         return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
 
-    // std::vector asks for no more than max_size() elements, so n * sizeof(T) does not wrap.
+    // The count is checked before it is turned into bytes, for every kind of block: a count
+    // whose bytes wrap would otherwise ask for a small block.
+    static constexpr std::size_t max_size() noexcept { return static_cast<std::size_t>(-1) / 2 / sizeof(T); }
     T* allocate(std::size_t n) {
+        if (n > max_size()) throw std::bad_array_new_length();
         const std::size_t bytes = n * sizeof(T);
         switch (tier(bytes)) {
             case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
             case Tier::kMedium: return static_cast<T*>(allocate_medium_block(bytes));
-            case Tier::kHugePages:
-                if (n > static_cast<std::size_t>(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-                return static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
+            case Tier::kHugePages: return static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
         }
         return nullptr;
     }

@@ -130,6 +130,19 @@ TEST(HugePageVector, SmallBlocksAreOrdinaryOnes) {
     EXPECT_EQ(v.size(), 10u);
 }
 
+TEST(HugePageVector, ACountWhoseBytesWouldWrapIsRefusedForEveryKindOfBlock) {
+    // 2^61 + k doubles are 8k bytes once multiplied out in 64 bits: a heap block and a
+    // medium block's size if the count were not checked first.
+    HugePageAllocator<double> allocator;
+    const std::size_t wraps = (std::size_t{1} << 61) + 1;
+    EXPECT_THROW((void)allocator.allocate(wraps), std::bad_array_new_length);
+    EXPECT_THROW((void)allocator.allocate(wraps + kMediumBlockMinBytes / sizeof(double)), std::bad_array_new_length);
+    EXPECT_THROW((void)allocator.allocate(HugePageAllocator<double>::max_size() + 1), std::bad_array_new_length);
+    double* kept = allocator.allocate(8);
+    kept[7] = 1;
+    allocator.deallocate(kept, 8);
+}
+
 TEST(HugePageVector, MapsTheSmallPagesOfABlockOfAFewPagesAtOnce) {
     // Under kOnHugePagesBytes but over kMediumBlockMinBytes: a medium block, its pages
     // mapped before anything is written there.
