@@ -37,12 +37,23 @@ constexpr Real kSameFace = 0.9;
 constexpr Real kRecycleSlops = 8;
 constexpr Real kRecycleCosHalfAngleSq = 0.99240388;  // cos(5 degrees)^2: a 10 degree turn
 
+// How far a point of body i can be from its centre of mass along each world axis.
+Vec3 far_extent(const Bodies& b, std::uint32_t i) {
+    return (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs());
+}
+
 // How far a point of the body can be from its centre of mass (0 for a static body: only
 // the other body's turn moves the contact).
 Real reach(const Bodies& b, std::uint32_t i) {
     if (b.type[i] == MotionType::Static) return 0;
-    const Vec3 far = (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs());
-    return far.norm();
+    return far_extent(b, i).norm();
+}
+
+// |v x r| bounded axis by axis over every r within the extent e (Box3D's modified cross):
+// a long body turning about its long axis swings its points by its girth, not its length.
+Real cross_bound(const Vec3& v, const Vec3& e) {
+    const Vec3 a = v.cwiseAbs();
+    return Vec3(a.y() * e.z() + a.z() * e.y(), a.z() * e.x() + a.x() * e.z(), a.x() * e.y() + a.y() * e.x()).norm();
 }
 
 // Tight bounds further apart than the speculative reach by more than this rule a pair out:
@@ -92,7 +103,13 @@ bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& tu
     turns.dqb = b.q[bb] * contact.cached_qb.conjugate();
     // The relative turn dqa^-1 dqb (the same angle as the turn of B in A's frame):
     // 2 |sin(angle / 2)| ~ the angle, so this is how far a point at the reach has swung.
-    const Real swing = 2 * (turns.dqa.conjugate() * turns.dqb).vec().norm() * std::max(reach(b, a), reach(b, bb));
+    const Vec3 turn = (turns.dqa.conjugate() * turns.dqb).vec();
+    const Real reach_a = reach(b, a), reach_b = reach(b, bb);
+    Real swing = 2 * turn.norm() * std::max(reach_a, reach_b);
+    // Against a static body the turn is the other body's own, in the world: its points
+    // swing no further than its extent along each axis allows.
+    if (reach_a == 0 || reach_b == 0)
+        swing = std::min(swing, 2 * cross_bound(turn, far_extent(b, reach_a == 0 ? bb : a)));
     return distance + swing < tolerance;
 }
 
