@@ -37,12 +37,26 @@ constexpr Real kSameFace = 0.9;
 constexpr Real kRecycleSlops = 8;
 constexpr Real kRecycleCosHalfAngleSq = 0.99240388;  // cos(5 degrees)^2: a 10 degree turn
 
+// How far a point of body i can be from its centre of mass along each world axis.
+[[gnu::always_inline]] inline Vec3 far_extent(const Bodies& b, std::uint32_t i) {
+    return (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs());
+}
+
 // How far a point of the body can be from its centre of mass (0 for a static body: only
-// the other body's turn moves the contact).
-Real reach(const Bodies& b, std::uint32_t i) {
+// the other body's turn moves the contact). Out of line, and far_extent inlined in it: the
+// other way round, every recycled pair paid for a call more.
+[[gnu::noinline]] Real reach(const Bodies& b, std::uint32_t i) {
     if (b.type[i] == MotionType::Static) return 0;
-    const Vec3 far = (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs());
-    return far.norm();
+    return far_extent(b, i).norm();
+}
+
+// |v x r| over the points r of body i, bounded axis by axis by its extent about its centre
+// (Box3D's modified cross): a long body turning about its long axis swings its points by
+// its girth, not its length. Out of line: the recycling test's common path stays small.
+[[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Vec3& v) {
+    const Vec3 e = far_extent(b, i);
+    const Vec3 a = v.cwiseAbs();
+    return Vec3(a.y() * e.z() + a.z() * e.y(), a.z() * e.x() + a.x() * e.z(), a.x() * e.y() + a.y() * e.x()).norm();
 }
 
 // Tight bounds further apart than the speculative reach by more than this rule a pair out:
@@ -92,8 +106,13 @@ bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& tu
     turns.dqb = b.q[bb] * contact.cached_qb.conjugate();
     // The relative turn dqa^-1 dqb (the same angle as the turn of B in A's frame):
     // 2 |sin(angle / 2)| ~ the angle, so this is how far a point at the reach has swung.
-    const Real swing = 2 * (turns.dqa.conjugate() * turns.dqb).vec().norm() * std::max(reach(b, a), reach(b, bb));
-    return distance + swing < tolerance;
+    const Vec3 turn = (turns.dqa.conjugate() * turns.dqb).vec();
+    const Real reach_a = reach(b, a), reach_b = reach(b, bb);
+    if (distance + 2 * turn.norm() * std::max(reach_a, reach_b) < tolerance) return true;
+    // Against a static body the turn is the other body's own, in the world: its points
+    // swing no further than its extent along each axis allows (asked only when the whole
+    // reach is too far: most resting pairs pass above).
+    return (reach_a == 0 || reach_b == 0) && distance + 2 * swing_bound(b, reach_a == 0 ? bb : a, turn) < tolerance;
 }
 
 // A recycled manifold keeps its points, normal and impulses; each point's separation is

@@ -258,3 +258,31 @@ TEST(Effects, SlidingContactsAreRecomputed) {
         EXPECT_NEAR(space.internal_linear_velocity(box).x(), speed, 1e-6);
     }
 }
+
+// Recycling measures how far the body's points have swung by its extent along each axis
+// (Box3D's modified cross): a 10.5 m capsule lying on a frictionless ground and spinning
+// about its long axis at 0.6 rad/s swings its points by its girth, 0.35 cm a step, and
+// keeps its manifold for about ten steps of eleven; spun as fast about the vertical, its
+// ends swing 5 cm a step, past the recycle distance, and it collides every step.
+TEST(Effects, ALongBodySpinningAboutItsLengthKeepsItsManifold) {
+    for (const bool about_length : {true, false}) {
+        Space space(awake());
+        add_ground(space, 0);
+        BodyDesc d;
+        d.shape = Shape::capsule(5, 0.25);
+        d.orientation = Quat(Eigen::AngleAxis<Real>(-kPi / 2, Vec3::UnitZ()));  // lying along x
+        d.position = Vec3(0, 0.25, 0);
+        d.friction = 0;
+        d.angular_velocity = about_length ? Vec3(0.6, 0, 0) : Vec3(0, 0.6, 0);
+        const BodyHandle capsule = space.create_body(d);
+        for (int i = 0; i < 30; ++i) space.update();
+        EXPECT_EQ(space.counters().contacts_updated, 30u);
+        if (about_length) {
+            EXPECT_GE(space.counters().manifolds_reused, 24u);
+        } else {
+            EXPECT_EQ(space.counters().manifolds_reused, 0u);
+        }
+        EXPECT_NEAR(space.internal_position(capsule).y(), 0.25, 0.01);
+        EXPECT_NEAR(space.internal_angular_velocity(capsule).norm(), 0.6, 1e-3);
+    }
+}
