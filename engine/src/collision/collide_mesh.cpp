@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include <spindle/platform/assert.hpp>
 
@@ -96,30 +97,67 @@ bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const Pre
     return m.point_count > 0;
 }
 
-// Adds m to the list, merging it into a manifold with nearly the same normal; when the
-// list is full a deeper manifold replaces the shallowest.
-void gather(ManifoldSlots<kMaxMeshManifolds>& list, int& count, const Manifold& m) {
+// A point of a manifold gathered into list slot `slot`. Manifolds with nearly the same
+// normal merge; their points are kept here and reduced once when the walk is done.
+// Reduced at each merge, the result followed the order the triangles came in: a face
+// landing across two triangles lost its far corner to a point on the triangles' shared
+// edge barely deeper, met before the deepest point had come, and the push there, behind
+// the landing edge, turned the body on over it.
+struct GatheredPoint {
+    int slot;
+    ContactCandidate point;
+};
+
+void keep_points(std::vector<GatheredPoint>& points, int slot, const Manifold& m) {
+    for (int k = 0; k < m.point_count; ++k) {
+        points.push_back({slot, {m.points[k].point, m.points[k].separation, m.points[k].id}});
+    }
+}
+
+// Adds m to the list, merging it into a manifold with nearly the same normal (its points
+// go to `points` only: reduce_gathered chooses among them); when the list is full a deeper
+// manifold replaces the shallowest. depth[i]: the deepest separation merged into slot i.
+void gather(ManifoldSlots<kMaxMeshManifolds>& list, Real (&depth)[kMaxMeshManifolds], int& count, const Manifold& m,
+            std::vector<GatheredPoint>& points) {
+    const Real m_depth = deepest(m);
     for (int i = 0; i < count; ++i) {
         if (list[i].normal.dot(m.normal) < kSameNormal) continue;
-        ContactCandidate c[2 * kMaxManifoldPoints];
-        int n = 0;
-        for (const Manifold* src : {static_cast<const Manifold*>(&list[i]), &m}) {
-            for (int k = 0; k < src->point_count; ++k) {
-                c[n++] = {src->points[k].point, src->points[k].separation, src->points[k].id};
-            }
-        }
-        reduce_to_manifold(c, n, list[i], true);
+        depth[i] = std::min(depth[i], m_depth);
+        keep_points(points, i, m);
         return;
     }
     if (count < kMaxMeshManifolds) {
+        keep_points(points, count, m);
+        depth[count] = m_depth;
         list.fill(static_cast<std::size_t>(count++), m);
         return;
     }
     int shallowest = 0;
     for (int i = 1; i < count; ++i) {
-        if (deepest(list[i]) > deepest(list[shallowest])) shallowest = i;
+        if (depth[i] > depth[shallowest]) shallowest = i;
     }
-    if (deepest(m) < deepest(list[shallowest])) list[shallowest] = m;
+    if (m_depth < depth[shallowest]) {
+        list[shallowest] = m;
+        depth[shallowest] = m_depth;
+        std::erase_if(points, [&](const GatheredPoint& p) { return p.slot == shallowest; });
+        keep_points(points, shallowest, m);
+    }
+}
+
+// Each merged manifold reduced once from all the points its manifolds brought, whatever
+// the order they came in (a slot holding one manifold's points keeps them as they are).
+void reduce_gathered(ManifoldSlots<kMaxMeshManifolds>& list, int count, const std::vector<GatheredPoint>& points) {
+    int held[kMaxMeshManifolds] = {};
+    for (const GatheredPoint& p : points) ++held[p.slot];
+    thread_local std::vector<ContactCandidate> slot_points;
+    for (int i = 0; i < count; ++i) {
+        if (held[i] <= list[i].point_count) continue;
+        slot_points.clear();
+        for (const GatheredPoint& p : points) {
+            if (p.slot == i) slot_points.push_back(p.point);
+        }
+        reduce_to_manifold(slot_points.data(), static_cast<int>(slot_points.size()), list[i], true);
+    }
 }
 
 // True when x leaves every point where it is: the mesh's frame is then the world's.
@@ -144,6 +182,9 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
 
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
+    Real depth[kMaxMeshManifolds];
+    thread_local std::vector<GatheredPoint> gathered;  // kept from call to call: no allocation once grown
+    gathered.clear();
     const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
@@ -180,11 +221,12 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;
-        gather(found, found_count, m);
+        gather(found, depth, found_count, m, gathered);
     };
     if (walk) walk->query(part, mesh, query, visit);
     else mesh.query(query, visit);
 
+    reduce_gathered(found, found_count, gathered);
     std::sort(found.data(), found.data() + found_count,
               [](const Manifold& x, const Manifold& y) { return deepest(x) < deepest(y); });
     const int count = std::min({found_count, capacity, kMaxMeshOutput});

@@ -4,10 +4,11 @@
 // WideContact share no dynamic body, so gathering their velocities, solving and
 // scattering them back is the same as solving them one after another.
 //
-// Per pass: each point's normal row (soft push-out of resting overlap while biased,
-// speculative for a gap); in the relax passes then the manifold's central friction
-// (Box3D's): a twist row about the normal and two coupled tangent rows at the points'
-// centre, inside Coulomb's cone of the manifold's total normal impulse. Each body is pushed at its own anchor of
+// Per pass: the manifold's central friction (Box3D's): a twist row about the normal and
+// two coupled tangent rows at the points' centre, inside Coulomb's cone of the manifold's
+// touching normal impulse; and each point's normal row (soft push-out of resting overlap
+// while biased, speculative for a gap). The biased pass solves friction before its normal
+// rows, the relax pass after them. Each body is pushed at its own anchor of
 // a point (the manifold may be recycled, and the anchors moved apart with their bodies:
 // narrowphase.cpp). Overlap deeper than the recovery depth (or than the point's load
 // holds it) is pushed out by a split impulse on separate push-out velocities, per lane
@@ -444,6 +445,74 @@ inline void solve_rolling(WideRolling& r, WideVelocities& s, Wide pressed) {
     s.wb += r.inv_inertia_b * delta;
 }
 
+// The lanes' normal impulses of the touching points only, summed (the friction cone) and
+// weighted by each point's lever arm from the friction centre (the twist's): a
+// speculative point far from the body (a fast sphere's, metres ahead) would spin it up
+// through the lever arm.
+struct TouchingImpulses {
+    Wide pressed, twist_reach;
+};
+
+inline TouchingImpulses touching_impulses(const WideContact& wc, const Wide (&gap)[kMaxManifoldPoints],
+                                          const ContactSolveParams& params) {
+    const Wide slop = splat(params.slop);
+    TouchingImpulses t{splat(0), splat(0)};
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        const Wide touching_impulse = select(gap[j] <= slop, wc.points[j].normal_impulse, splat(0));
+        t.pressed += touching_impulse;
+        t.twist_reach += wc.points[j].lever_arm * touching_impulse;
+    }
+    return t;
+}
+
+// The two tangent rows' impulse changes d0, d1 at the friction centre applied as one: a
+// linear impulse along d0 t0 + d1 t1 and both rows' angular terms.
+template <bool kLocked>
+inline void apply_tangents(const WideContact& wc, const WideAxisMasses& m, WideVelocities& s, Wide d0, Wide d1) {
+    const Wide3 impulse = d0 * wc.tangent[0] + d1 * wc.tangent[1];
+    if constexpr (kLocked) {
+        s.va -= Wide3{m.a.x * impulse.x, m.a.y * impulse.y, m.a.z * impulse.z};
+        s.vb += Wide3{m.b.x * impulse.x, m.b.y * impulse.y, m.b.z * impulse.z};
+    } else {
+        s.va -= wc.inv_mass_a * impulse;
+        s.vb += wc.inv_mass_b * impulse;
+    }
+    s.wa -= d0 * wc.friction_row[0].ia + d1 * wc.friction_row[1].ia;
+    s.wb += d0 * wc.friction_row[0].ib + d1 * wc.friction_row[1].ib;
+}
+
+// Central friction of the lanes (Box3D's): the twist about the normal within friction x
+// the touching impulses' moments, then the two tangent rows at the centre, solved
+// together by their 2x2 mass, within Coulomb's cone of friction x the touching impulse.
+// A lane without friction has an empty cone.
+template <bool kLocked>
+inline void solve_friction(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
+                           const TouchingImpulses& touching, EffectCounts& counts) {
+    counts.friction += static_cast<std::uint64_t>(wc.lanes);
+    {
+        const Wide speed = dot(wc.normal, s.wb - s.wa);
+        const Wide limit = wc.friction * touching.twist_reach;
+        const Wide old = wc.twist_impulse;
+        const Wide total = wide_min(wide_max(old - wc.twist_mass * speed, -limit), limit);
+        wc.twist_impulse = total;
+        apply_angular_row(s, wc.twist_row, total - old);
+    }
+    const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
+    const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
+    const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
+    const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
+    Wide new0 = old0 - (m00 * v0 + m01 * v1);
+    Wide new1 = old1 - (m01 * v0 + m11 * v1);
+    const Wide limit = wc.friction * touching.pressed;
+    const Wide length_sq = new0 * new0 + new1 * new1;
+    const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), splat(1));
+    new0 *= scale;
+    new1 *= scale;
+    wc.friction_impulse[0] = new0;
+    wc.friction_impulse[1] = new1;
+    apply_tangents<kLocked>(wc, masses, s, new0 - old0, new1 - old1);
+}
+
 template <bool kBias, bool kLocked>
 void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
                 const ContactSolveParams& params, EffectCounts& counts) {
@@ -477,10 +546,23 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     Wide3 deep_ra, deep_rb;
     Wide gap[kMaxManifoldPoints];
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        gap[j] = moved + dot(nb, wc.points[j].rb) - dot(na, wc.points[j].ra) + wc.points[j].adjusted_separation;
+    }
+    // Friction comes first in the biased pass, within the cones of the normal impulses the
+    // pass starts with (the warm start's or the last relax pass's): after the normal rows
+    // their soft push would swell and shrink the cones, and a light body pushed against a
+    // heavy one would be tied to it sideways. Without friction here the positions move
+    // with the biased pass's frictionless velocities, and a pile resting on saturated
+    // friction (a log in the groove of two) keeps whatever self-stress the order of the
+    // colours left it.
+    const bool rubs = any(wc.friction > zero);
+    if constexpr (kBias) {
+        if (rubs) solve_friction<kLocked>(wc, masses, s, touching_impulses(wc, gap, params), counts);
+    }
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
         counts.contact_points += wc.slot_points[j];
-        const Wide separation = moved + dot(nb, p.rb) - dot(na, p.ra) + p.adjusted_separation;
-        gap[j] = separation;
+        const Wide separation = gap[j];
         const WideMask speculative = separation > zero;  // may close the gap, no more
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
@@ -515,55 +597,16 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         p.normal_impulse = total;
         apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
     }
-    // Central friction, in the relax passes only (Box3D's), when any lane has friction (a
-    // lane without has an empty cone). In the biased pass the normal rows carry the soft
-    // push of the overlap; friction there ties a light body sideways to a heavy one it is
-    // pushed against, and a 100 kg box on a 1 kg cube rocked for ever instead of resting.
-    // Its cones scale with the normal impulses of the touching points only: a speculative
-    // point far from the body (a fast sphere's, metres ahead) would spin it up through
-    // the lever arm. Rolling resistance (where a lane has it) goes first, as Box3D's, within
-    // the same touching impulse.
-    const bool rubs = any(wc.friction > zero);
-    if (!kBias && (rubs || wc.rolls)) {
-        const Wide slop = splat(params.slop);
-        Wide pressed = zero, twist_reach = zero;
-        for (int j = 0; j < kMaxManifoldPoints; ++j) {
-            const Wide touching_impulse = select(gap[j] <= slop, wc.points[j].normal_impulse, zero);
-            pressed += touching_impulse;
-            twist_reach += wc.points[j].lever_arm * touching_impulse;
-        }
-        if (wc.rolls) {
-            counts.rolling += static_cast<std::uint64_t>(wc.lanes);
-            solve_rolling(*wc.rolling, s, pressed);
-        }
-        if (rubs) {
-            counts.friction += static_cast<std::uint64_t>(wc.lanes);
-            // Twist about the normal, within friction x the normal impulses' moments.
-            {
-                const Wide speed = dot(wc.normal, s.wb - s.wa);
-                const Wide limit = wc.friction * twist_reach;
-                const Wide old = wc.twist_impulse;
-                const Wide total = wide_min(wide_max(old - wc.twist_mass * speed, -limit), limit);
-                wc.twist_impulse = total;
-                apply_angular_row(s, wc.twist_row, total - old);
+    // The relax pass: rolling resistance first (Box3D's), then friction, both within the
+    // touching impulses the normal rows have just solved.
+    if constexpr (!kBias) {
+        if (rubs || wc.rolls) {
+            const TouchingImpulses touching = touching_impulses(wc, gap, params);
+            if (wc.rolls) {
+                counts.rolling += static_cast<std::uint64_t>(wc.lanes);
+                solve_rolling(*wc.rolling, s, touching.pressed);
             }
-            // The two tangent rows at the centre, solved together by their 2x2 mass, within
-            // Coulomb's cone of friction x the total normal impulse.
-            const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
-            const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
-            const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
-            const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
-            Wide new0 = old0 - (m00 * v0 + m01 * v1);
-            Wide new1 = old1 - (m01 * v0 + m11 * v1);
-            const Wide limit = wc.friction * pressed;
-            const Wide length_sq = new0 * new0 + new1 * new1;
-            const Wide scale = select(length_sq > limit * limit, limit / wide_sqrt(length_sq), one);
-            new0 *= scale;
-            new1 *= scale;
-            wc.friction_impulse[0] = new0;
-            wc.friction_impulse[1] = new1;
-            apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], new0 - old0);
-            apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], new1 - old1);
+            if (rubs) solve_friction<kLocked>(wc, masses, s, touching, counts);
         }
     }
     scatter(wc, bodies, s);
@@ -586,8 +629,7 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
     for (const WidePoint& p : wc.points) apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, p.normal_impulse);
     if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
-        apply_row<kLocked>(wc, masses, s, wc.tangent[0], wc.friction_row[0], wc.friction_impulse[0]);
-        apply_row<kLocked>(wc, masses, s, wc.tangent[1], wc.friction_row[1], wc.friction_impulse[1]);
+        apply_tangents<kLocked>(wc, masses, s, wc.friction_impulse[0], wc.friction_impulse[1]);
         apply_angular_row(s, wc.twist_row, wc.twist_impulse);
     }
     if (wc.rolls) {

@@ -56,6 +56,37 @@ TEST(ConvexMesh, BoxOnGridMergesIntoOneFourPointManifold) {
     }
 }
 
+// A face lying across two triangles, tilted a little along both its sides (as a rolling
+// log's face lands), keeps its four corners: the triangles' manifolds merge into one whose
+// points are chosen from all of theirs, whatever the order the triangles come in. Reduced
+// at each merge, the far corner of the low side was lost to a point on the triangles'
+// shared edge x = 4 that had come first and lay barely deeper.
+TEST(ConvexMesh, AFaceAcrossTwoTrianglesKeepsItsFourCorners) {
+    const Shape ground = unit_grid(8);
+    const Vec3 h(0.375, 0.5, 1.5);
+    for (const Shape& shape : {Shape::box(h), test::hull_box(h)}) {
+        for (const Real tilt : {0.0003, 0.0006, -0.0003, -0.0006}) {
+            // The z = +1.5 side 2.6 cm lower than the other, 1 mm into the ground.
+            const Quat q = about(Vec3::UnitX(), 0.026 / 3) * about(Vec3::UnitZ(), tilt);
+            const Transform xa = at(Vec3(4.25, 0.512, 4), q);
+            const auto m = run(shape, xa, ground, at(Vec3::Zero()), 0.04);
+            ASSERT_EQ(m.size(), 1u) << "tilt " << tilt;
+            ASSERT_EQ(m[0].point_count, 4) << "tilt " << tilt;
+            for (const Real x : {-h.x(), h.x()}) {
+                for (const Real z : {-h.z(), h.z()}) {
+                    const Vec3 corner = xa.apply(Vec3(x, -h.y(), z));
+                    bool kept = false;
+                    for (int i = 0; i < m[0].point_count; ++i) {
+                        const Vec3& p = m[0].points[i].point;
+                        kept = kept || (std::abs(p.x() - corner.x()) < 1e-3 && std::abs(p.z() - corner.z()) < 1e-3);
+                    }
+                    EXPECT_TRUE(kept) << "tilt " << tilt << ": corner (" << corner.x() << ", " << corner.z() << ")";
+                }
+            }
+        }
+    }
+}
+
 TEST(ConvexMesh, SlidingBoxNeverCatchesOnInteriorEdges) {
     const Shape ground = unit_grid(6);
     const Shape box = Shape::box(Vec3(0.3, 0.3, 0.3));

@@ -31,7 +31,7 @@ std::uint64_t solver_passes(const Space& space) {
     return static_cast<std::uint64_t>(s.substeps * (s.iterations + s.relax_iterations));
 }
 
-// Friction is solved in the relax passes only (contact_solver.cpp).
+// Rolling resistance is solved in the relax passes only (contact_solver.cpp).
 std::uint64_t relax_passes(const Space& space) {
     const SolverSettings& s = space.settings().solver;
     return static_cast<std::uint64_t>(s.substeps * s.relax_iterations);
@@ -103,16 +103,16 @@ TEST(Effects, FrictionAndRestitutionOnlyWhereContactsHaveThem) {
 }
 
 // A resting ball has one contact point, through every solve and relax pass of each step;
-// friction is solved once per manifold (central friction) in the relax passes only, so a
-// box resting on its face (four points, one manifold) counts one friction row per relax
-// pass against four point rows per pass.
+// friction is solved once per manifold (central friction) in every pass, so a box resting
+// on its face (four points, one manifold) counts one friction row per pass against four
+// point rows per pass.
 TEST(Effects, FrictionCountsExactlyTheFrictionalManifolds) {
     Space space(awake());
     add_ground(space);
     space.create_body(ball(Vec3(0, 0.5, 0)));
     for (int i = 0; i < 30; ++i) space.update();
     EXPECT_EQ(space.counters().contact_points_solved, 30u * solver_passes(space));
-    EXPECT_EQ(space.counters().friction_applied, 30u * relax_passes(space));
+    EXPECT_EQ(space.counters().friction_applied, 30u * solver_passes(space));
     EXPECT_EQ(space.counters().restitution_applied, 0u);
 
     Space boxes(awake());
@@ -123,7 +123,7 @@ TEST(Effects, FrictionCountsExactlyTheFrictionalManifolds) {
     boxes.create_body(box);
     for (int i = 0; i < 30; ++i) boxes.update();
     EXPECT_EQ(boxes.counters().contact_points_solved, 4u * 30u * solver_passes(boxes));
-    EXPECT_EQ(boxes.counters().friction_applied, 30u * relax_passes(boxes));
+    EXPECT_EQ(boxes.counters().friction_applied, 30u * solver_passes(boxes));
 }
 
 // Rolling resistance is one row per manifold in the relax passes, and only where a contact
@@ -147,7 +147,7 @@ TEST(Effects, RollingResistanceOnlyWhereContactsHaveIt) {
     rolling.create_body(d);
     for (int i = 0; i < 30; ++i) rolling.update();
     EXPECT_EQ(rolling.counters().rolling_applied, 30u * relax_passes(rolling));
-    EXPECT_EQ(rolling.counters().friction_applied, 30u * relax_passes(rolling));
+    EXPECT_EQ(rolling.counters().friction_applied, 30u * solver_passes(rolling));
 }
 
 // Restitution is one pass after the substeps: each point of a bouncy contact is
