@@ -7,6 +7,8 @@
 
 using namespace spindle;
 
+namespace effects_test {
+
 namespace {
 
 BodyDesc ball(const Vec3& p) {
@@ -258,3 +260,5 @@ TEST(Effects, SlidingContactsAreRecomputed) {
         EXPECT_NEAR(space.internal_linear_velocity(box).x(), speed, 1e-6);
     }
 }
+
+}  // namespace effects_test
