@@ -14,6 +14,8 @@
 
 using namespace spindle;
 
+namespace continuous_test {
+
 namespace {
 
 struct BarRun {
@@ -192,3 +194,5 @@ TEST(Continuous, WithoutFastBodiesTheStageDoesNotRun) {
     for (int i = 0; i < 5; ++i) space.update();
     EXPECT_EQ(continuous_stages(jobs), 1);
 }
+
+}  // namespace continuous_test

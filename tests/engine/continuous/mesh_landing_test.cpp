@@ -19,6 +19,8 @@
 
 using namespace spindle;
 
+namespace mesh_landing_test {
+
 namespace {
 
 constexpr int kPoleParts = 27;
@@ -212,3 +214,5 @@ TEST(MeshLanding, CompoundBarDroppedTiltedOntoAPlaneLiesOnIt) {
 TEST(MeshLanding, CompoundBarDroppedTiltedOntoAFlatMeshLiesOnIt) {
     expect_bar_lies_on_the_floor(drop_bar_onto(flat_floor_mesh()));
 }
+
+}  // namespace mesh_landing_test

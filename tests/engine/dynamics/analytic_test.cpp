@@ -9,6 +9,8 @@
 
 using namespace spindle;
 
+namespace analytic_test {
+
 namespace {
 
 constexpr double kG = 9.81;
@@ -172,3 +174,5 @@ TEST(Validation, BadBodiesAreRejectedNamingTheFieldAndChangeNothing) {
     EXPECT_THROW(Shape::sphere(-1), Error);
     EXPECT_THROW(Shape::box(Vec3(1, 0, 1)), Error);
 }
+
+}  // namespace analytic_test

@@ -11,6 +11,8 @@
 
 using namespace spindle;
 
+namespace tipping_test {
+
 namespace {
 
 constexpr double kGravity = 9.81;
@@ -86,3 +88,5 @@ TEST(Tipping, ThinPoleFallsInItsPivotTimeWithoutSpinningAboutItsAxis) {
     // when it lands: sqrt(w0^2 + 3g/L), 1.02 rad/s.
     EXPECT_LT(largest_axial, 1.03);
 }
+
+}  // namespace tipping_test

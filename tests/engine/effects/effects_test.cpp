@@ -7,6 +7,8 @@
 
 using namespace spindle;
 
+namespace effects_test {
+
 namespace {
 
 BodyDesc ball(const Vec3& p) {
@@ -286,3 +288,4 @@ TEST(Effects, ALongBodySpinningAboutItsLengthKeepsItsManifold) {
         EXPECT_NEAR(space.internal_angular_velocity(capsule).norm(), 0.6, 1e-3);
     }
 }
+}  // namespace effects_test

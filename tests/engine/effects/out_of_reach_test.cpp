@@ -7,6 +7,8 @@
 
 using namespace spindle;
 
+namespace out_of_reach_test {
+
 namespace {
 
 SpaceSettings weightless() {
@@ -99,3 +101,5 @@ TEST(OutOfReach, ReportingPairsAreRuledOutAlike) {
     for (const ContactEvent& e : events) began = began || e.kind == ContactEventKind::Begin;
     EXPECT_TRUE(began);
 }
+
+}  // namespace out_of_reach_test

@@ -13,6 +13,8 @@
 using namespace spindle;
 using namespace spindle::test;
 
+namespace contact_points_test {
+
 namespace {
 
 SpaceSettings with_points(bool on) {
@@ -110,3 +112,5 @@ TEST(ContactPoints, BadSettingsAreRefusedNamingTheField) {
     EXPECT_NE(error_of([&] { space.set_events(bad); }).find("max_contact_points"), std::string::npos);
     EXPECT_EQ(space.settings().events.max_contact_points, EventSettings{}.max_contact_points);
 }
+
+}  // namespace contact_points_test

@@ -20,6 +20,8 @@
 using namespace spindle;
 using namespace spindle::test;
 
+namespace events_test {
+
 namespace {
 
 // A ball dropped 1.5 m onto the ground, run until it has rested a while (it falls asleep).
@@ -354,3 +356,5 @@ TEST(ContactEvents, BadSettings_AreRejectedNamingTheField) {
     EXPECT_EQ(space.settings().events.hit_speed, 3);
     EXPECT_EQ(space.settings().events.max_queued, 7u);
 }
+
+}  // namespace events_test

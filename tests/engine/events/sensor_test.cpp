@@ -10,6 +10,8 @@
 using namespace spindle;
 using namespace spindle::test;
 
+namespace sensor_test {
+
 namespace {
 
 BodyDesc sensor_box(MotionType type, const Vec3& position, const Vec3& half = Vec3(2, 0.5, 2)) {
@@ -167,3 +169,5 @@ TEST(Sensor, MovingSensor_JoinsNoIsland_TheBallItOverlapsSleeps) {
     ASSERT_EQ(events.size(), 1u);
     EXPECT_EQ(events[0].kind, ContactEventKind::Begin);
 }
+
+}  // namespace sensor_test

@@ -10,6 +10,8 @@
 
 using namespace spindle;
 
+namespace filtering_test {
+
 namespace {
 
 constexpr std::uint32_t kGroundLayer = 1;
@@ -290,3 +292,5 @@ TEST(Filtering, BadLayer_IsRejectedNamingItAndNothingChanges) {
     EXPECT_EQ(space.last_update().writes_applied, 0);
     for (std::uint32_t l = 0; l < kLayerCount; ++l) EXPECT_TRUE(space.layers_collide(0, l));
 }
+
+}  // namespace filtering_test

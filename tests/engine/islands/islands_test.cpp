@@ -9,6 +9,8 @@
 
 using namespace spindle;
 
+namespace islands_test {
+
 namespace {
 
 struct Row {
@@ -173,3 +175,5 @@ TEST(Islands, DestroyingASleepingBodyWakesItsIslandAndForgetsIt) {
     EXPECT_FALSE(row.space.internal_is_awake(row.balls[3]));
     EXPECT_FALSE(row.space.internal_is_awake(row.balls[4]));
 }
+
+}  // namespace islands_test

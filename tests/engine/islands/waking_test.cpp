@@ -9,6 +9,8 @@
 
 using namespace spindle;
 
+namespace waking_test {
+
 namespace {
 
 constexpr int kMaxSettleSteps = 600;
@@ -165,3 +167,5 @@ TEST_F(Waking, AVelocityWrittenToASleepingPlatformWakesItsRider) {
     EXPECT_TRUE(space.internal_is_awake(support));
     EXPECT_TRUE(space.internal_is_awake(boxes[0]));
 }
+
+}  // namespace waking_test

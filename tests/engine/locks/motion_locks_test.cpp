@@ -10,6 +10,8 @@
 
 using namespace spindle;
 
+namespace motion_locks_test {
+
 namespace {
 
 SpaceSettings awake() {
@@ -260,3 +262,5 @@ TEST(MotionLocks, PendulumLockedToAPlane_SwingsInIt) {
     }
     EXPECT_LT(lowest, 3.1);  // it swung down
 }
+
+}  // namespace motion_locks_test

@@ -19,6 +19,8 @@
 
 using namespace spindle;
 
+namespace setters_test {
+
 namespace {
 
 BodyHandle add_ground(Space& space) {
@@ -716,3 +718,5 @@ TEST(Setters, WritesFromManyThreadsWhileUpdating_AllApply) {
         EXPECT_EQ(space.user_data(bodies[t]), 100u + static_cast<std::uint64_t>(t));
     }
 }
+
+}  // namespace setters_test
