@@ -1,5 +1,6 @@
 // Helpers the asynchronous suites share: a weightless space that never sleeps (so
-// written velocities stay as written), a 1 kg ball, and a watchdog for would-be deadlocks.
+// written velocities stay as written), a 1 kg ball, a poll with a hang's deadline, and a
+// watchdog for would-be deadlocks.
 #pragma once
 
 #include <spindle/engine/space.hpp>
@@ -34,6 +35,18 @@ inline BodyDesc ball(const Vec3& position = Vec3::Zero(), MotionType type = Moti
     d.shape = Shape::sphere(0.25);
     d.mass = 1;
     return d;
+}
+
+// Polls until pred() holds; false if it still does not after a minute, a bound that only
+// turns a hang into a failure (a loaded TSan run may take many times a quiet one's time).
+template <typename Pred>
+bool eventually(Pred pred) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!pred()) {
+        if (std::chrono::steady_clock::now() > deadline) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return true;
 }
 
 // Runs fn on its own thread and fails the test if it has not finished in time. A
