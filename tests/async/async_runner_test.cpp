@@ -67,7 +67,7 @@ private:
 
 template <typename T>
 bool ready_in_time(std::future<T>& f) {
-    return f.wait_for(std::chrono::seconds(10)) == std::future_status::ready;
+    return f.wait_for(kHang) == std::future_status::ready;
 }
 
 }  // namespace
@@ -81,7 +81,7 @@ TEST(AsyncRunner, LoopThreadIsPinnedAndNamed) {
     std::promise<std::pair<std::vector<unsigned>, std::string>> seen;
     runner.post([&](Space&) { seen.set_value({current_binding(), current_thread_name()}); });
     auto result = seen.get_future();
-    ASSERT_EQ(result.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+    ASSERT_EQ(result.wait_for(kHang), std::future_status::ready);
     const auto [binding, name] = result.get();
     runner.stop();
     EXPECT_EQ(binding, std::vector<unsigned>{pu});
@@ -162,7 +162,7 @@ TEST(AsyncRunner, PostedFunctionsChangeStructureOnTheLoopThread) {
     std::promise<BodyHandle> created;
     runner.post([&](Space& s) { created.set_value(s.create_body(ball())); });
     auto handle = created.get_future();
-    ASSERT_EQ(handle.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+    ASSERT_EQ(handle.wait_for(kHang), std::future_status::ready);
     const BodyHandle body = handle.get();
     runner.stop();
     EXPECT_TRUE(space.contains(body));
@@ -242,7 +242,7 @@ TEST(AsyncRunner, UpdateFailureEndsTheLoopKeepsWritesAndIsReportedByStop) {
     for (; writes < 1000; ++writes) space.apply_impulse(body, Vec3(1, 0, 0));
     jobs.fail_next_broadphase = true;
     // Writes go on being accepted while (and after) the loop fails.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    const auto deadline = std::chrono::steady_clock::now() + kHang;
     while (runner.running() && std::chrono::steady_clock::now() < deadline) {
         space.apply_impulse(body, Vec3(1, 0, 0));
         ++writes;
@@ -279,7 +279,7 @@ TEST(AsyncRunner, DestructorSwallowsAFailureNobodyAskedFor) {
         AsyncRunner runner(space);
         runner.start();
         jobs.fail_next_broadphase = true;
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+        const auto deadline = std::chrono::steady_clock::now() + kHang;
         while (runner.running() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
         ASSERT_FALSE(runner.running());
     }  // must not throw nor terminate
