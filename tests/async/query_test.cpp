@@ -25,9 +25,11 @@ namespace {
 using namespace std::chrono_literals;
 
 // Four threads query (one also reads contact events) while the runner steps balls
-// bouncing in their own columns. Each
-// query is made with the motion-state lock held, beside a read of the ball's motion
-// state: the ray straight down its column must meet it exactly on top, at the pose read.
+// bouncing in their own columns. Each query is made with the motion-state lock held,
+// beside a read of the ball's motion state: the ray straight down its column must meet it
+// exactly on top, at the pose read. They query until every ball has landed (a Begin
+// event read), the loop took 20 steps and 1,000 queries were made: counted, not timed,
+// so a slow or loaded machine only takes longer.
 TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     SpaceSettings settings = test::async_settings();
     settings.gravity = {0, -9.81, 0};
@@ -49,16 +51,26 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     AsyncRunner runner(space);
     runner.start();
     std::atomic<bool> stop{false};
-    std::atomic<int> queries{0}, misses{0}, mismatches{0}, events{0};
+    std::atomic<int> queries{0}, misses{0}, mismatches{0}, landed{0};
     std::vector<std::thread> threads;
     for (int t = 0; t < 4; ++t) {
         threads.emplace_back([&, t] {
             int c = t;
             std::vector<ContactEvent> read;
+            std::vector<bool> seen_landing(kColumns, false);  // thread 0's only
             while (!stop.load(std::memory_order_relaxed)) {
                 if (t == 0) {  // one thread also reads the events as they are published
                     read.clear();
-                    events.fetch_add(static_cast<int>(space.read_contact_events(read)), std::memory_order_relaxed);
+                    space.read_contact_events(read);
+                    for (const ContactEvent& e : read) {
+                        if (e.kind != ContactEventKind::Begin) continue;
+                        for (std::size_t b = 0; b < balls.size(); ++b) {
+                            if ((e.body_a == balls[b] || e.body_b == balls[b]) && !seen_landing[b]) {
+                                seen_landing[b] = true;
+                                landed.fetch_add(1, std::memory_order_relaxed);
+                            }
+                        }
+                    }
                 }
                 c = (c + 1) % kColumns;
                 std::scoped_lock hold(space.motion_states().lock());
@@ -75,16 +87,20 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
         });
     }
     const std::uint64_t steps_before = space.motion_states().published_steps();
-    std::this_thread::sleep_for(1500ms);
+    const bool done = test::eventually([&] {
+        return landed.load() == kColumns && queries.load() > 1000 &&
+               space.motion_states().published_steps() - steps_before > 20;
+    });
     stop = true;
     for (std::thread& thread : threads) thread.join();
     const std::uint64_t steps_after = space.motion_states().published_steps();
     runner.stop();
+    EXPECT_TRUE(done) << "not all of: every ball landed, 1,000 queries, 20 steps";
     EXPECT_GT(queries.load(), 1000);
     EXPECT_EQ(misses.load(), 0);
     EXPECT_EQ(mismatches.load(), 0);
     EXPECT_GT(steps_after - steps_before, 20u);  // the physics loop kept stepping
-    EXPECT_GT(events.load(), kColumns);          // every ball landed at least once
+    EXPECT_EQ(landed.load(), kColumns);          // every ball landed, its Begin event read
 }
 
 // A ray cast down through the origin on its own thread whose filter waits, at its first
@@ -219,13 +235,6 @@ int compare_with_brute_force(const Space& space, const Drifters& d, std::mt19937
     return hits;
 }
 
-// Polls until pred() holds; false after a few seconds.
-template <typename Pred>
-bool eventually(Pred pred) {
-    for (int i = 0; i < 5000 && !pred(); ++i) std::this_thread::sleep_for(1ms);
-    return pred();
-}
-
 // The first query of a space whose runner updates: the game thread may not build the
 // scenes (the loop owns the space), so it waits for the next flip to build the one it
 // publishes. The runner takes no step meanwhile (time scale 0, still publishing), so
@@ -235,10 +244,10 @@ TEST(AsyncQueries, FirstQueryFromTheGameThreadWhileTheRunnerUpdatesMatchesABrute
     const Drifters d = make_drifters(space);
     AsyncRunner runner(space);
     runner.start();
-    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    ASSERT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > 10; }));
     runner.set_time_scale(0);
     std::uint64_t steps = 0;
-    ASSERT_TRUE(eventually([&] {
+    ASSERT_TRUE(test::eventually([&] {
         const std::uint64_t before = space.motion_states().published_steps();
         std::this_thread::sleep_for(50ms);
         steps = space.motion_states().published_steps();
@@ -254,7 +263,7 @@ TEST(AsyncQueries, FirstQueryFromTheGameThreadWhileTheRunnerUpdatesMatchesABrute
         std::scoped_lock hold(space.motion_states().lock());
         compare_with_brute_force(space, d, random, 10);
     }
-    EXPECT_GT(space.motion_states().published_steps(), steps);
+    EXPECT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > steps; }));
     runner.stop();
 }
 
@@ -266,14 +275,14 @@ TEST(AsyncQueries, FirstQueryUnderTheLockWhileTheRunnerStepsMatchesABruteForcePa
     const Drifters d = make_drifters(space);
     AsyncRunner runner(space);
     runner.start();
-    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    ASSERT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > 10; }));
     std::mt19937 random(4);
     test::finishes_in_time([&] {
         std::scoped_lock hold(space.motion_states().lock());
         EXPECT_GT(compare_with_brute_force(space, d, random, 60), 10);
     });
     const std::uint64_t steps = space.motion_states().published_steps();
-    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
+    ASSERT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
     std::scoped_lock hold(space.motion_states().lock());
     compare_with_brute_force(space, d, random, 20);
 }
@@ -285,12 +294,12 @@ TEST(AsyncQueries, FirstQueryInAPostedFunctionWhileTheRunnerStepsMatchesABruteFo
     const Drifters d = make_drifters(space);
     AsyncRunner runner(space);
     runner.start();
-    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > 10; }));
+    ASSERT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > 10; }));
     std::mt19937 random(6);
     std::future<int> hits = runner.post([&](Space& s) { return compare_with_brute_force(s, d, random, 60); });
     test::finishes_in_time([&] { EXPECT_GT(hits.get(), 10); });
     const std::uint64_t steps = space.motion_states().published_steps();
-    ASSERT_TRUE(eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
+    ASSERT_TRUE(test::eventually([&] { return space.motion_states().published_steps() > steps + 3; }));
     std::scoped_lock hold(space.motion_states().lock());
     compare_with_brute_force(space, d, random, 20);
 }

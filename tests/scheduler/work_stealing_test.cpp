@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -180,21 +181,33 @@ TEST(WorkStealing, TheWaitingThreadRunsJobs) {
 
 TEST(WorkStealing, AnIdleWorkerGetsPartOfABusyWorkersRange) {
     // The lower half is free, the upper half slow: the worker done with its half must be
-    // handed part of the other's (ranges are split on demand, not up front). Without that
-    // split one worker runs the whole slow half every time; with it, both share it unless
-    // the OS kept a worker off its CPU throughout, so a few attempts are allowed.
+    // handed part of the other's (ranges are split on demand, not up front). An upper
+    // chunk is slow by waiting for the other worker, not for time: the first one a worker
+    // runs returns once the other is idle (which it stays until it is handed work), every
+    // later one once the other has run an upper chunk. So with the split on demand the
+    // next chunk's split hands the idle worker a piece, however late the OS runs either
+    // thread; without it the waits end only at the deadline, which turns a hang into a
+    // failure and is met by no working scheduler.
     auto jobs = make(2);
-    bool shared = false;
-    for (int attempt = 0; attempt < 20 && !shared; ++attempt) {
-        std::vector<unsigned> ran_by(16, 99);
-        jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
-            if (lo >= 8) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-            ran_by[lo] = worker;
-        });
-        shared = std::count(ran_by.begin() + 8, ran_by.end(), 0u) > 0 &&
-                 std::count(ran_by.begin() + 8, ran_by.end(), 1u) > 0;
-    }
-    EXPECT_TRUE(shared) << "one worker ran the whole slow half in every attempt";
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    std::array<std::atomic<bool>, 2> ran_upper{};
+    std::array<bool, 2> passed_on_idle{};  // each written by its own worker only
+    std::vector<unsigned> ran_by(16, 99);
+    jobs->parallel_for("skewed", 0, 16, 1, [&](std::uint32_t lo, std::uint32_t, unsigned worker) {
+        ran_by[lo] = worker;
+        if (lo < 8) return;
+        ran_upper[worker].store(true);
+        const std::atomic<bool>& other_ran_upper = ran_upper[1 - worker];
+        while (!other_ran_upper.load() && std::chrono::steady_clock::now() < deadline) {
+            if (!passed_on_idle[worker] && jobs->has_idle_worker()) {
+                passed_on_idle[worker] = true;
+                break;
+            }
+            std::this_thread::yield();
+        }
+    });
+    EXPECT_GT(std::count(ran_by.begin() + 8, ran_by.end(), 0u), 0);
+    EXPECT_GT(std::count(ran_by.begin() + 8, ran_by.end(), 1u), 0) << "one worker ran the whole slow half";
 }
 
 TEST(WorkStealing, AGroupIsDoneWhileItsWorkerRunsAnotherGroupsJob) {
