@@ -615,9 +615,11 @@ TEST(SpindleProgram, NoArguments_RunsTheDefaultSceneForFiveSeconds) {
     const std::vector<std::string> w = line_starting_with(r.output, "summary:");
     ASSERT_GE(w.size(), 6u) << r.output;
     // summary: scene pile, layout native, 5.00 s wall, ... The last frame may end up to one
-    // 60 Hz frame before 5 s (4.99 under ASan); a 1 s or 10 s default would be far off.
+    // 60 Hz frame before 5 s (4.99 under ASan); a 1 s or 10 s default would be far off. The
+    // run ends at the first frame past 5 s, and a loaded machine may show that frame late:
+    // the upper bound tells another default apart, not how fast frames come.
     EXPECT_GE(std::stod(w[5]), 4.9) << r.output;
-    EXPECT_LT(std::stod(w[5]), 6.0) << r.output;
+    EXPECT_LT(std::stod(w[5]), 7.5) << r.output;
 }
 
 struct BadCase {
