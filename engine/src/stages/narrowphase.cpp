@@ -13,6 +13,7 @@
 #include "collision/compound.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/contact_events.hpp"
+#include "stages/continuous.hpp"  // modified_cross
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -54,9 +55,7 @@ constexpr Real kRecycleCosHalfAngleSq = 0.99240388;  // cos(5 degrees)^2: a 10 d
 // (Box3D's modified cross): a long body turning about its long axis swings its points by
 // its girth, not its length. Out of line: the recycling test's common path stays small.
 [[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Vec3& v) {
-    const Vec3 e = far_extent(b, i);
-    const Vec3 a = v.cwiseAbs();
-    return Vec3(a.y() * e.z() + a.z() * e.y(), a.z() * e.x() + a.x() * e.z(), a.x() * e.y() + a.y() * e.x()).norm();
+    return modified_cross(v.cwiseAbs(), far_extent(b, i)).norm();
 }
 
 // Tight bounds further apart than the speculative reach by more than this rule a pair out:
