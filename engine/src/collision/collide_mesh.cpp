@@ -97,37 +97,36 @@ bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const Pre
     return m.point_count > 0;
 }
 
-// A point of a manifold gathered into list slot `slot`. Manifolds with nearly the same
-// normal merge; their points are kept here and reduced once when the walk is done.
-// Reduced at each merge, the result followed the order the triangles came in: a face
-// landing across two triangles lost its far corner to a point on the triangles' shared
-// edge barely deeper, met before the deepest point had come, and the push there, behind
-// the landing edge, turned the body on over it.
-struct GatheredPoint {
-    int slot;
-    ContactCandidate point;
-};
+// The points each list slot's manifolds brought. Manifolds with nearly the same normal
+// merge; their points are kept here and reduced once when the walk is done. Reduced at
+// each merge, the result followed the order the triangles came in: a face landing across
+// two triangles lost its far corner to a point on the triangles' shared edge barely
+// deeper, met before the deepest point had come, and the push there, behind the landing
+// edge, turned the body on over it.
+using SlotPoints = std::array<std::vector<ContactCandidate>, kMaxMeshManifolds>;
 
-void keep_points(std::vector<GatheredPoint>& points, int slot, const Manifold& m) {
+void keep_points(std::vector<ContactCandidate>& points, const Manifold& m) {
     for (int k = 0; k < m.point_count; ++k) {
-        points.push_back({slot, {m.points[k].point, m.points[k].separation, m.points[k].id}});
+        points.push_back({m.points[k].point, m.points[k].separation, m.points[k].id});
     }
 }
 
 // Adds m to the list, merging it into a manifold with nearly the same normal (its points
-// go to `points` only: reduce_gathered chooses among them); when the list is full a deeper
-// manifold replaces the shallowest. depth[i]: the deepest separation merged into slot i.
+// go to the slot's points only: reduce_gathered chooses among them); when the list is full
+// a deeper manifold replaces the shallowest. depth[i]: the deepest separation merged into
+// slot i.
 void gather(ManifoldSlots<kMaxMeshManifolds>& list, Real (&depth)[kMaxMeshManifolds], int& count, const Manifold& m,
-            std::vector<GatheredPoint>& points) {
+            SlotPoints& points) {
     const Real m_depth = deepest(m);
     for (int i = 0; i < count; ++i) {
         if (list[i].normal.dot(m.normal) < kSameNormal) continue;
         depth[i] = std::min(depth[i], m_depth);
-        keep_points(points, i, m);
+        keep_points(points[i], m);
         return;
     }
     if (count < kMaxMeshManifolds) {
-        keep_points(points, count, m);
+        points[count].clear();
+        keep_points(points[count], m);
         depth[count] = m_depth;
         list.fill(static_cast<std::size_t>(count++), m);
         return;
@@ -139,24 +138,18 @@ void gather(ManifoldSlots<kMaxMeshManifolds>& list, Real (&depth)[kMaxMeshManifo
     if (m_depth < depth[shallowest]) {
         list[shallowest] = m;
         depth[shallowest] = m_depth;
-        std::erase_if(points, [&](const GatheredPoint& p) { return p.slot == shallowest; });
-        keep_points(points, shallowest, m);
+        points[shallowest].clear();
+        keep_points(points[shallowest], m);
     }
 }
 
 // Each merged manifold reduced once from all the points its manifolds brought, whatever
 // the order they came in (a slot holding one manifold's points keeps them as they are).
-void reduce_gathered(ManifoldSlots<kMaxMeshManifolds>& list, int count, const std::vector<GatheredPoint>& points) {
-    int held[kMaxMeshManifolds] = {};
-    for (const GatheredPoint& p : points) ++held[p.slot];
-    thread_local std::vector<ContactCandidate> slot_points;
+void reduce_gathered(ManifoldSlots<kMaxMeshManifolds>& list, int count, SlotPoints& points) {
     for (int i = 0; i < count; ++i) {
-        if (held[i] <= list[i].point_count) continue;
-        slot_points.clear();
-        for (const GatheredPoint& p : points) {
-            if (p.slot == i) slot_points.push_back(p.point);
-        }
-        reduce_to_manifold(slot_points.data(), static_cast<int>(slot_points.size()), list[i], true);
+        std::vector<ContactCandidate>& held = points[i];
+        if (static_cast<int>(held.size()) <= list[i].point_count) continue;
+        reduce_to_manifold(held.data(), static_cast<int>(held.size()), list[i], true);
     }
 }
 
@@ -183,8 +176,8 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
     ManifoldSlots<kMaxMeshManifolds> found;
     int found_count = 0;
     Real depth[kMaxMeshManifolds];
-    thread_local std::vector<GatheredPoint> gathered;  // kept from call to call: no allocation once grown
-    gathered.clear();
+    // Kept from call to call (no allocation once grown); gather clears a slot as it fills it.
+    thread_local SlotPoints gathered;
     const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
