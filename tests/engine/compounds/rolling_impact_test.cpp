@@ -1,7 +1,7 @@
 // A tree as trees100's (22 hexagonal prism parts, tapering) lying on its side and rolled
 // down a gentle slope: each time a face lands it pivots on an edge and the landing takes
 // most of its roll (an impact about the new edge keeps 11/17 of the spin of one prism),
-// so it stops after a face or two, the same on a flat triangle mesh as on a plane and the
+// so it stops after a few faces, as many on a flat triangle mesh as on a plane and the
 // same rolling either way. Box3D's tree does the same on both. Before the narrowphase put
 // a landing manifold's points fastest approaching first, the solver took them in the
 // collide's order: the mesh's merge listed the edge a tree pivots on before the landing
@@ -12,8 +12,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "grid_mesh.hpp"
@@ -83,20 +86,33 @@ Real roll(bool mesh, Real spin, Real way) {
     return way * (space.internal_motion_state(log).center_of_mass.x() - start);
 }
 
+// The spins sampled run from one face to five. Each number of faces holds over a band of
+// spins, and where two bands meet a landing's last millimetre decides between them, so a
+// spin sampled there may roll one face more one way than the other whatever the engine;
+// the bands move with any change to the solver. So the spins sit inside the bands (each
+// 0.2 rad/s or more from an edge when this was written), two or more a band, and the
+// property is asked over the sweep: at most one sampled spin may disagree by a face. A tree that rolls further on the
+// mesh, or one way, does so over half of each band (the manifold's points in the collide's order disagreed at six of
+// these eight spins).
 TEST(RollingImpact, ATreeRolledDownASlopeStopsAfterAsManyFacesOnAFlatMeshAsOnAPlaneEitherWay) {
     const Real face = 0.75;  // the first part's side: how far one face's roll takes it
-    for (const Real spin : {2.0, 4.5}) {
-        Real first_way = 0;
-        for (const Real way : {1.0, -1.0}) {
-            const Real on_plane = roll(false, spin, way);
-            const Real on_mesh = roll(true, spin, way);
-            EXPECT_GT(on_plane, 0.5 * face) << "spin " << spin << ", way " << way << ": never rolled over a face";
-            EXPECT_NEAR(on_mesh, on_plane, 0.4 * face) << "spin " << spin << ", way " << way;
-            if (way > 0) first_way = on_plane;
-            else
-                EXPECT_NEAR(on_plane, first_way, 0.4 * face) << "spin " << spin << ": the plane, one way and the other";
+    int disagree = 0;
+    std::string differing;
+    Real last = 0;
+    for (const Real spin : {1.85, 2.5, 2.8, 3.6, 3.9, 4.5, 4.65, 5.35}) {
+        const Real rolls[] = {roll(false, spin, 1), roll(false, spin, -1), roll(true, spin, 1), roll(true, spin, -1)};
+        const auto [least, most] = std::minmax_element(std::begin(rolls), std::end(rolls));
+        EXPECT_GT(*least, 0.5 * face) << "spin " << spin << ": never rolled over a face";
+        EXPECT_GE(rolls[0], last - 0.4 * face) << "spin " << spin << ": a faster spin rolled less far";
+        last = rolls[0];
+        if (*most - *least > 0.4 * face) {
+            ++disagree;
+            differing += "spin " + std::to_string(spin) + ": plane " + std::to_string(rolls[0]) + " / " +
+                         std::to_string(rolls[1]) + ", mesh " + std::to_string(rolls[2]) + " / " +
+                         std::to_string(rolls[3]) + " m (down +x / -x); ";
         }
     }
+    EXPECT_LE(disagree, 1) << "the plane and the mesh, one way and the other, differ by a face at " << differing;
 }
 
 }  // namespace
