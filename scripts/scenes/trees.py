@@ -48,7 +48,11 @@ def main():
 # sleeping on (Box3D's default) with the trees' sleep threshold of 0.2 m/s.
 # Differs in: Box3D's tree is a body with 22 hull shapes; here one compound body of 22 hull
 # parts, so each manifold (a part against the mesh) takes its part's rolling radius, as each of
-# Box3D's hull shapes has its own contact. Box3D's sleep
+# Box3D's hull shapes has its own contact. That radius is a quarter of the hull's inner radius
+# here, in every contact; Box3D takes a quarter in a contact between shapes but the whole inner
+# radius in a hull's contact with a mesh (mesh_contact.c), so its trees roll against the mesh
+# with 4x the resistance (given that here, the trees stay awake longer, not shorter:
+# docs/benchmarks.md, session 31). Box3D's sleep
 # threshold is per body; here it is the space's (only the trees are dynamic). The terrain is a
 # generated heightfield: its heights use libm's sine where Box3D's use its float32
 # approximation (b3ComputeCosSin), and each cell is split along the other diagonal (Box3D's
