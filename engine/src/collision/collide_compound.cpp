@@ -3,6 +3,7 @@
 // it were a body of its own, and its manifolds are labelled with the part indices.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 
 #include "collision/clipping.hpp"
@@ -36,6 +37,35 @@ Real rank(const Manifold& m, const PairMotion* motion) {
     }
     return least;
 }
+
+// How much farther than the pair's reach a part can close in one step. The narrowphase
+// reaches as far as the bodies' centres of mass close, but a part far from its body's
+// centre moves faster as the body turns: a tree tipped over comes down at its top several
+// times faster than at its centre. With the centres' reach only the parts near the base
+// came into reach as it landed; they alone were stopped, and the tree pivoted on them and
+// bounced metres up. So each part reaches as far as the bodies close at its centre.
+// (Box3D's speculative distance is a few slops; its continuous stage moves such a body
+// back to where it first touched, and the next step meets every part.)
+class PartReach {
+public:
+    explicit PartReach(const PairMotion* motion)
+        : m_motion(motion && (motion->w_a.squaredNorm() > 0 || motion->w_b.squaredNorm() > 0) ? motion : nullptr),
+          m_centres2(m_motion ? (motion->v_b - motion->v_a).squaredNorm() : 0) {}
+
+    // The reach past the centres' of a part centred at c.
+    Real operator()(const Vec3& c) const {
+        if (!m_motion) return 0;
+        const PairMotion& m = *m_motion;
+        const Vec3 closing = m.v_b - m.v_a + m.w_b.cross(c - m.centre_b) - m.w_a.cross(c - m.centre_a);
+        const Real closing2 = closing.squaredNorm();
+        if (closing2 <= m_centres2) return 0;
+        return (std::sqrt(closing2) - std::sqrt(m_centres2)) * m.dt;
+    }
+
+private:
+    const PairMotion* m_motion;  // null: neither body turns
+    Real m_centres2;             // the centres' closing speed, squared
+};
 
 struct Gathered {
     explicit Gathered(const PairMotion* m) : motion(m) {}
@@ -148,14 +178,17 @@ std::uint32_t parts_near(PosedParts& b, const Aabb& box, std::uint32_t* out) {
 // Shape a (part `part_a` of its body, 0 if it is whole) against each of compound b's
 // parts listed in `near` (in part order) that comes near it; a_box is a's exact bounds
 // fattened by the speculative distance, and `near` must hold every part whose loose box
-// it overlaps. `pair(i, found)` collides a with part i as collide() does.
-template <class PairFn>
+// it overlaps, a_box widened by `wider(i)`. `pair(i, found, extra)` collides a with part i
+// as collide() does, reaching `extra` farther than the speculative distance.
+template <class WiderFn, class PairFn>
 void collide_parts(std::uint32_t part_a, const Aabb& a_box, PosedParts& b, std::span<const std::uint32_t> near,
-                   Gathered& g, PairFn&& pair) {
+                   Gathered& g, WiderFn&& wider, PairFn&& pair) {
     Manifold found[kPerPair];
     for (const std::uint32_t i : near) {
-        if (!a_box.overlaps(b.loose(i)) || !a_box.overlaps(b.exact(i))) continue;
-        const int n = pair(i, found);
+        const Real extra = wider(i);
+        const Aabb box = extra > 0 ? a_box.fattened(extra) : a_box;
+        if (!box.overlaps(b.loose(i)) || !box.overlaps(b.exact(i))) continue;
+        const int n = pair(i, found, extra);
         for (int m = 0; m < n; ++m) {
             found[m].part_a = part_a;
             found[m].part_b = i;
@@ -181,8 +214,9 @@ int emit(Gathered& g, Manifold* out, int capacity) {
     return g.count;
 }
 
-// Shape a against each of compound b's parts near it, through `pair(part, pose, exact bounds,
-// i, found)` (as collide_parts); with more than `capacity` manifolds, those ranking deepest.
+// Shape a against each of compound b's parts near it, through `pair(part, pose, exact
+// bounds, i, found, reach)` (as collide_parts, `reach` the part's speculative distance);
+// with more than `capacity` manifolds, those ranking deepest.
 template <class PairFn>
 int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                         std::span<const Aabb> b_boxes, Real speculative, Manifold* out, int capacity,
@@ -190,11 +224,20 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
     Gathered g(motion);
     const Aabb a_box = a.bounds(xa).fattened(std::max(speculative, Real(0)));
     PosedParts parts(*b.parts, xb, b_boxes);
+    const PartReach reach(motion);
+    ScratchBuffer<Real, kInlineParts> extra(parts.size());
+    Real most = 0;
+    for (std::uint32_t i = 0; i < parts.size(); ++i) {
+        extra[i] = reach(parts.loose(i).center());
+        most = std::max(most, extra[i]);
+    }
     ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
-    const std::uint32_t count = parts_near(parts, a_box, near.data());
-    collide_parts(0, a_box, parts, {near.data(), count}, g, [&](std::uint32_t i, Manifold* found) {
-        return pair(parts.shape(i), parts.pose(i), parts.exact(i), i, found);
-    });
+    const std::uint32_t count = parts_near(parts, most > 0 ? a_box.fattened(most) : a_box, near.data());
+    collide_parts(
+        0, a_box, parts, {near.data(), count}, g, [&](std::uint32_t i) { return extra[i]; },
+        [&](std::uint32_t i, Manifold* found, Real more) {
+            return pair(parts.shape(i), parts.pose(i), parts.exact(i), i, found, speculative + more);
+        });
     return emit(g, out, capacity);
 }
 
@@ -203,9 +246,8 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
                            Manifold* out, int capacity, const PartBoxes& boxes, const PairMotion* motion) {
     return collide_shape_parts(a, xa, b, xb, boxes.b, speculative, out, capacity, motion,
-                               [&](const Shape& part, const Transform& x, const Aabb&, std::uint32_t, Manifold* found) {
-                                   return collide(a, xa, part, x, speculative, found, kPerPair);
-                               });
+                               [&](const Shape& part, const Transform& x, const Aabb&, std::uint32_t, Manifold* found,
+                                   Real reach) { return collide(a, xa, part, x, reach, found, kPerPair); });
 }
 
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
@@ -213,10 +255,10 @@ int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const S
                                  std::span<const Aabb> b_boxes, const PairMotion* motion) {
     return collide_shape_parts(
         mesh, xm, b, xb, b_boxes, speculative, out, capacity, motion,
-        [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found) {
+        [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found, Real reach) {
             // The mesh's pair function has the part as A: turned round as collide() does.
             // The part's exact box, which the walk's cull has made or was given.
-            const int n = collide_convex_mesh_cached(part, x, mesh, xm, speculative, found, kPerPair, i, walk, &box);
+            const int n = collide_convex_mesh_cached(part, x, mesh, xm, reach, found, kPerPair, i, walk, &box);
             for (int m = 0; m < n; ++m) flip_manifold(found[m]);
             return n;
         });
@@ -229,20 +271,37 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
     const Compound& parts = *a.parts;
     const Real margin = std::max(speculative, Real(0));
     PosedParts a_parts(parts, xa, boxes.a), b_parts(*b.parts, xb, boxes.b);
+    // Each part's reach past the centres' (PartReach) at its centre; a pair of parts
+    // reaches the farther of its two parts', which bounds it at any point between them.
+    const PartReach reach(motion);
+    ScratchBuffer<Real, kInlineParts> a_extra(a_parts.size()), b_extra(b_parts.size());
+    Real a_most = 0, b_most = 0;
+    for (std::uint32_t j = 0; j < a_parts.size(); ++j) {
+        a_extra[j] = reach(a_parts.loose(j).center());
+        a_most = std::max(a_most, a_extra[j]);
+    }
+    for (std::uint32_t i = 0; i < b_parts.size(); ++i) {
+        b_extra[i] = reach(b_parts.loose(i).center());
+        b_most = std::max(b_most, b_extra[i]);
+    }
     const Aabb b_box = b_parts.loose_all();
     // Each of a's parts lies inside a's whole loose box (padded as each part's is), so a
     // part of b whose loose box misses that box, fattened as a part's box is, meets none of
     // them: it is left out once here instead of once for each of a's parts.
     ScratchBuffer<std::uint32_t, kInlineParts> near(b_parts.size());
-    const std::uint32_t count = parts_near(b_parts, a_parts.loose_all().fattened(margin), near.data());
+    const std::uint32_t count = parts_near(b_parts, a_parts.loose_all().fattened(margin + std::max(a_most, b_most)),
+                                           near.data());
     for (std::uint32_t j = 0; j < parts.size() && count > 0; ++j) {
-        if (!a_parts.loose(j).fattened(margin).overlaps(b_box)) continue;
+        if (!a_parts.loose(j).fattened(margin + std::max(a_extra[j], b_most)).overlaps(b_box)) continue;
         const Aabb part_box = a_parts.exact(j).fattened(margin);
         const Shape& part = parts.shape(j);
         const Transform& pose = a_parts.pose(j);
-        collide_parts(j, part_box, b_parts, {near.data(), count}, g, [&](std::uint32_t i, Manifold* found) {
-            return collide(part, pose, b_parts.shape(i), b_parts.pose(i), speculative, found, kPerPair);
-        });
+        collide_parts(
+            j, part_box, b_parts, {near.data(), count}, g,
+            [&](std::uint32_t i) { return std::max(a_extra[j], b_extra[i]); },
+            [&](std::uint32_t i, Manifold* found, Real more) {
+                return collide(part, pose, b_parts.shape(i), b_parts.pose(i), speculative + more, found, kPerPair);
+            });
     }
     return emit(g, out, capacity);
 }
