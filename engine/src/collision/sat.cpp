@@ -496,7 +496,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
                     FeatureCache* cache) {
     const Vec3 n = pb.normal(face);
     ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
-    int count = clipped_contact(pb, face, n, pa, incident_face(pa, n), true, speculative, candidates.data());
+    const std::uint32_t incident = incident_face(pa, n);
+    int count = clipped_contact(pb, face, n, pa, incident, true, speculative, candidates.data());
     m.normal = -n;
     if (count > 0) {
         reduce_to_manifold(candidates.data(), count, m);
@@ -519,7 +520,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     ScratchBuffer<ContactCandidate, 2 * kInlineVertices> surface(room);
     count = 0;
     for (std::uint32_t f = 0; f < pa.view.face_count; ++f) {
-        if (pa.normal(f).dot(n) >= 0) continue;
+        // The incident face was clipped above and left nothing within reach.
+        if (f == incident || pa.normal(f).dot(n) >= 0) continue;
         // What clipping leaves of a face lies between its vertices: none within reach, none left.
         const HullFace& af = pa.view.faces[f];
         bool reaches = false;

@@ -5,6 +5,9 @@
 
 #include <cmath>
 
+#include "collision/pair_functions.hpp"
+#include "collision/polyhedron.hpp"
+#include "collision/sat_prepared.hpp"
 #include "collision_test_util.hpp"
 
 namespace spindle {
@@ -276,6 +279,36 @@ TEST(ConvexMesh, MovedAndRotatedMeshKeepsWorldResults) {
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(q * Vec3(0, -1, 0)), 1e-9);
     EXPECT_NEAR(deepest(m[0]), -0.05, 1e-9);
+}
+
+// A cube rolled 30 degrees about z, its lowest edge 0.1 deep in the triangle's plane but
+// 5 cm beside its long side: measured over the triangle's face, the incident face (the
+// cube's bottom, turned to face down and right) lies wholly beside the triangle and clips to
+// nothing, and the deepest vertex is beside it too; the face turned down and left leans back
+// over the triangle and is what lies there. Its one corner within reach, where it crosses the
+// triangle's side at the triangle's corner, is the manifold's.
+TEST(ConvexMesh, AFaceOverTheTriangleIsMeasuredWhenTheIncidentFaceLiesBesideIt) {
+    const Real turn = kPi / 6;
+    const Real beside = 0.05, depth = -0.1;
+    // The cube's lowest edge, local (-0.5, -0.5, z), turned: (-0.183, -0.683, z).
+    const Vec3 lowest = Vec3(-0.5 * std::cos(turn) + 0.5 * std::sin(turn), -0.5 * std::sin(turn) - 0.5 * std::cos(turn),
+                             0);
+    const Transform xa = at(Vec3(1 + beside, depth, 0.3) - lowest, about(Vec3::UnitZ(), turn));
+    const detail::BoxPoly cube(Vec3(0.5, 0.5, 0.5));
+    const detail::PreparedPolyhedron prepared(cube.view());
+    // Corners (0, 0, 0), (0, 0, 1), (1, 0, 0): facing +y, its long side on x + z = 1.
+    const detail::TrianglePoly triangle(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 0));
+    ASSERT_NEAR(triangle.normal().y(), 1.0, 1e-12);
+    const Transform identity;
+    Manifold m;
+    ASSERT_TRUE(
+        detail::face_of_b_manifold(prepared, xa, triangle.view(), detail::RelativePose(xa, identity), 0, 0.02, m));
+    SPINDLE_EXPECT_VEC_NEAR(m.normal, Vec3(0, -1, 0), 1e-12);
+    ASSERT_EQ(m.point_count, 1);
+    // The face rises at 60 degrees from the lowest edge: at x = 1 it is beside * tan(60) higher.
+    const Real expected = depth + beside * std::tan(kPi / 3);
+    EXPECT_NEAR(m.points[0].separation, expected, 1e-9);
+    SPINDLE_EXPECT_VEC_NEAR(m.points[0].point, Vec3(1, 0.5 * expected, 0), 1e-9);
 }
 
 TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
