@@ -634,52 +634,99 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     return collide_polyhedra(prepared, xa, b, RelativePose(xa, xb), speculative, m, cache, feature_slop);
 }
 
+namespace {
+
+enum class SatResult { Apart, Touching, NormalOnly };
+
+// collide_polyhedra's work on a posed pair: Touching with the manifold in A's frame, or Apart.
+// Before the whole SAT makes the manifold of the axis it chose, normal_only(normal) (the
+// normal in A's frame) may say its points are not wanted: the answer is then NormalOnly, with
+// the cache kept as for Touching and m as it was. (A chosen axis always makes a manifold: the
+// deepest vertex stands in for a face's clip, and it lies at the face's separation, which is
+// within reach.)
+template <typename NormalOnly>
+[[gnu::always_inline]] inline SatResult sat_posed(const PreparedPolyhedron& prepared, const Posed& pa, const Posed& pb,
+                                                  Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop,
+                                                  NormalOnly&& normal_only) {
+    using Kind = FeatureCache::Kind;
+    if (cache && cache->kind() != Kind::None) {
+        const CachedAxis axis = cached_axis(*cache, pa, pb);
+        if (axis.valid && axis.separation > speculative) return SatResult::Apart;
+        if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
+            cached_manifold(*cache, axis, pa, pb, speculative, m))
+            return SatResult::Touching;
+    }
+    const FaceQuery face_a = query_faces(pa, pb, speculative);
+    if (face_a.separation > speculative) {
+        remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
+        return SatResult::Apart;
+    }
+    const FaceQuery face_b = query_faces(pb, pa, speculative);
+    if (face_b.separation > speculative) {
+        remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
+        return SatResult::Apart;
+    }
+    const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation), speculative);
+    if (edge.separation > speculative) {
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+        return SatResult::Apart;
+    }
+
+    if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+        if (normal_only(edge.axis)) return SatResult::NormalOnly;
+        edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
+        return SatResult::Touching;
+    }
+
+    const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
+    const FaceQuery& reference = reference_is_b ? face_b : face_a;
+    if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
+    else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
+    // face_manifold's normal, as it makes it.
+    if (normal_only(reference_is_b ? Vec3(-pb.normal(reference.face)) : pa.normal(reference.face)))
+        return SatResult::NormalOnly;
+    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
+        remember_axis(cache, Kind::None, 0, 0, 0);
+        return SatResult::Apart;
+    }
+    return SatResult::Touching;
+}
+
+}  // namespace
+
 bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
                        const RelativePose& b_in_a, Real speculative, Manifold& m, FeatureCache* cache,
                        Real feature_slop) {
     return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
-        using Kind = FeatureCache::Kind;
-        if (cache && cache->kind() != Kind::None) {
-            const CachedAxis axis = cached_axis(*cache, pa, pb);
-            if (axis.valid && axis.separation > speculative) return false;
-            if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
-                cached_manifold(*cache, axis, pa, pb, speculative, m)) {
+        const auto points_wanted = [](const Vec3&) { return false; };
+        if (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, points_wanted) != SatResult::Touching)
+            return false;
+        manifold_to_world(m, xa);
+        return true;
+    });
+}
+
+bool collide_polyhedron_triangle(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& triangle,
+                                 const RelativePose& triangle_in_a, Real speculative, Manifold& m, FeatureCache* cache,
+                                 Real feature_slop, const FaceMeasure& measure) {
+    return with_posed_pair(prepared, triangle, triangle_in_a, [&](const Posed& pa, const Posed& pb) {
+        // The normal alone decides when the points cannot: m then carries it, with no points.
+        const auto normal_only = [&](const Vec3& normal) {
+            if (measure.points_matter) return false;
+            m.normal = xa.rotate(normal);
+            m.point_count = 0;
+            return measure.again(m);
+        };
+        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only)) {
+            case SatResult::Apart: return false;
+            case SatResult::Touching:
                 manifold_to_world(m, xa);
-                return true;
-            }
+                if (!measure.again(m)) return true;
+                break;
+            case SatResult::NormalOnly: break;
         }
-        const FaceQuery face_a = query_faces(pa, pb, speculative);
-        if (face_a.separation > speculative) {
-            remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
-            return false;
-        }
-        const FaceQuery face_b = query_faces(pb, pa, speculative);
-        if (face_b.separation > speculative) {
-            remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
-            return false;
-        }
-        const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation),
-                                           speculative);
-        if (edge.separation > speculative) {
-            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
-            return false;
-        }
-
-        if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
-            edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
-            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
-            manifold_to_world(m, xa);
-            return true;
-        }
-
-        const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-        const FaceQuery& reference = reference_is_b ? face_b : face_a;
-        if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
-            remember_axis(cache, Kind::None, 0, 0, 0);
-            return false;
-        }
-        if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
-        else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
+        if (!face_of_b_over(pa, pb, measure.face, speculative, m, cache)) return false;
         manifold_to_world(m, xa);
         return true;
     });
