@@ -124,16 +124,22 @@ FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     return best;
 }
 
-ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
+// Edge j's arc, its faces' normals n0 (f0's) and n1 (f1's) turned already.
+ArcEdge arc_edge(const Posed& p, std::uint32_t j, const Vec3& n0, const Vec3& n1) {
     const HullEdge& e = p.view.edges[j];
     ArcEdge a;
     a.origin = p.vertices[e.v0];
     a.direction = p.vertices[e.v1] - a.origin;
-    a.n0 = p.normal(e.f0);
-    a.n1 = p.normal(e.f1);
+    a.n0 = n0;
+    a.n1 = n1;
     a.t0 = a.direction.cross(a.n0);
     a.t1 = a.n1.cross(a.direction);
     return a;
+}
+
+ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
+    const HullEdge& e = p.view.edges[j];
+    return arc_edge(p, j, p.normal(e.f0), p.normal(e.f1));
 }
 
 void prepare_edges(const Posed& p, ArcEdge* out) {
@@ -143,10 +149,9 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
 // Whether edges ea (of A) and eb (of B) form a face of the Minkowski difference: their
 // arcs cross on the Gauss map, A's at the direction L = +-(ea x eb) and B's at -L. If so,
 // the unit axis (from A to B) and the separation of the two edges' lines along it.
-[[gnu::always_inline]] inline bool edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit, Real& separation) {
-    // Cheap rejections first: each arc must cross the other's great circle.
-    if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) return false;
-    if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) return false;
+// crossing_edge_pair_axis: the same for arcs known to cross each other's great circles.
+[[gnu::always_inline]] inline bool crossing_edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit,
+                                                           Real& separation) {
     const Vec3 cross = ea.direction.cross(eb.direction);
     const Real length2 = cross.squaredNorm();
     if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) return false;
@@ -160,6 +165,13 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
     unit = cross * (sign / std::sqrt(length2));
     separation = unit.dot(eb.origin - ea.origin);
     return true;
+}
+
+[[gnu::always_inline]] inline bool edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit, Real& separation) {
+    // Cheap rejections first: each arc must cross the other's great circle.
+    if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) return false;
+    if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) return false;
+    return crossing_edge_pair_axis(ea, eb, unit, separation);
 }
 
 // Edge j with what arc_reach needs, in the polyhedron's own frame (no origin).
@@ -257,13 +269,16 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
     if (b.view.arc_edges == nullptr && b.view.edge_count <= 4) {
-        // A triangle's edges, made and bounded in one group of lanes.
+        // A triangle's edges, made and bounded in one group of lanes; each joins its two
+        // faces, whose normals are turned once.
         const unsigned bits = lane_bits(arc_reach(own_arc_lanes(b.view), d_in_b) > needed) &
                               ((1u << b.view.edge_count) - 1);
+        const Vec3 normals[2] = {b.normal(0), b.normal(1)};
         for (unsigned left = bits; left != 0; left &= left - 1) {
             const auto j = static_cast<std::uint32_t>(__builtin_ctz(left));
             kept_b[count_b] = j;
-            edges_b[count_b++] = arc_edge(b, j);
+            const HullEdge& e = b.view.edges[j];
+            edges_b[count_b++] = arc_edge(b, j, normals[e.f0], normals[e.f1]);
         }
     } else {
         for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
@@ -295,7 +310,8 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
                 const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
                 Vec3 unit;
                 Real s;
-                if (!edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
+                // The lanes ran edge_pair_axis's first two tests, bit for bit.
+                if (!crossing_edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
                 if (s > best.separation) best = {s, ja, jb, unit, true};
                 if (s > limit) return best;
             }
