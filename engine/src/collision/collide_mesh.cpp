@@ -28,58 +28,36 @@ constexpr Real kOnEdge = 1e-6;          // barycentric weight below which a poin
 // B3_MAX_AABB_MARGIN, in metres): a part rocking or creeping where it lies stays inside.
 constexpr Real kQueryMargin = 0.1;
 
-// Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
-// prepared once for all the triangles of the query, with the mesh's pose in its frame
-// (mesh_in_a), and with the triangle's cache when the contact keeps them (null: the whole SAT).
-bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                      const RelativePose& mesh_in_a, const TrianglePoly& tri, Real speculative, FeatureCache* cache,
-                      Real feature_slop, Manifold& m) {
-    const Transform identity;
-    switch (a.type) {
-        case ShapeType::Sphere:
-        case ShapeType::Capsule: {
-            Vec3 p0, p1;
-            rounded_core(a, p0, p1);
-            return collide_rounded_polyhedron(p0, p1, a.radius, xa, tri.view(), identity, speculative, m);
-        }
-        case ShapeType::Box:
-        case ShapeType::ConvexHull:
-            return collide_polyhedra(*polyhedron, xa, tri.view(), mesh_in_a, speculative, m, cache, feature_slop);
-        default: return false;
-    }
-}
-
 // True when some contact point lies on an active edge of the triangle (a, b, c).
 bool touches_active_edge(const Manifold& m, const Vec3 (&v)[3], std::uint8_t active_edges) {
+    if (active_edges == 0) return false;
     const Vec3 n = (v[1] - v[0]).cross(v[2] - v[0]);
     const Real area2 = n.squaredNorm();
     for (int i = 0; i < m.point_count; ++i) {
         const Vec3 q = m.points[i].point + m.normal * (Real(0.5) * m.points[i].separation);
         for (int k = 0; k < 3; ++k) {
+            if ((active_edges >> k & 1) == 0) continue;
             // Weight of the vertex opposite edge k (v[k] -> v[k+1]); zero on that edge.
             const Real w = (v[(k + 1) % 3] - v[k]).cross(q - v[k]).dot(n) / area2;
-            if (w <= kOnEdge && (active_edges >> k & 1)) return true;
+            if (w <= kOnEdge) return true;
         }
     }
     return false;
 }
 
-// Replaces an edge or vertex normal by the face normal, on the side of the triangle's
-// plane the shape reaches into (`front`: its centre is in front; collide_triangles has
-// dropped a shape lying across the plane with its centre behind), and measures the
-// contact again against that face: a sphere or capsule from its deepest core point(s)
-// along the new normal, a polyhedron as its SAT would have had the face chosen, over the
-// triangle only (face_of_b_manifold: the triangle's plane carried on past its edges says
-// nothing of what lies beyond them, over the neighbouring triangles).
-// The SAT's own points do not serve: for shapes apart, its axis may be one beside the
-// triangle, whose points lie off both shapes; for a shape deep in the triangle, they may
-// be measured from its far side. False when nothing is within reach.
-bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
-                     const RelativePose& mesh_in_a, bool front, const TrianglePoly& tri, const Vec3& on_plane,
-                     Real speculative, FeatureCache* cache) {
+// Replaces an edge or vertex normal of a sphere or capsule by the face normal, on the side
+// of the triangle's plane the shape reaches into (`front`: its centre is in front;
+// collide_triangles has dropped a shape lying across the plane with its centre behind), and
+// measures the contact again against that face from its deepest core point(s) along the new
+// normal. (A polyhedron is measured as its SAT would have had the face chosen, over the
+// triangle only: collide_polyhedron_triangle, face_of_b_manifold. The triangle's plane
+// carried on past its edges says nothing of what lies beyond them, over the neighbouring
+// triangles.) The SAT's own points do not serve: for shapes apart, its axis may be one
+// beside the triangle, whose points lie off both shapes; for a shape deep in the triangle,
+// they may be measured from its far side. False when nothing is within reach.
+bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, bool front, const TrianglePoly& tri,
+                     const Vec3& on_plane, Real speculative) {
     const Vec3& n = tri.normal();
-    if (polyhedron)
-        return face_of_b_manifold(*polyhedron, xa, tri.view(), mesh_in_a, front ? 0 : 1, speculative, m, cache);
     const Vec3 face = front ? Vec3(-n) : n;
     Vec3 core[2];
     rounded_core(a, core[0], core[1]);
@@ -95,6 +73,31 @@ bool use_face_normal(Manifold& m, const Shape& a, const Transform& xa, const Pre
     }
     m.normal = face;
     return m.point_count > 0;
+}
+
+// Triangle t in the mesh frame against convex a posed there by xa; a box or hull comes
+// prepared once for all the triangles of the query, with the mesh's pose in its frame
+// (mesh_in_a), and with the triangle's cache when the contact keeps them (null: the whole
+// SAT). A contact `measure` asks for is measured again over the triangle's face
+// (use_face_normal).
+bool collide_triangle(const Shape& a, const Transform& xa, const PreparedPolyhedron* polyhedron,
+                      const RelativePose& mesh_in_a, const TrianglePoly& tri, const Vec3& on_plane, Real speculative,
+                      FeatureCache* cache, Real feature_slop, const FaceMeasure& measure, Manifold& m) {
+    const Transform identity;
+    switch (a.type) {
+        case ShapeType::Sphere:
+        case ShapeType::Capsule: {
+            Vec3 p0, p1;
+            rounded_core(a, p0, p1);
+            if (!collide_rounded_polyhedron(p0, p1, a.radius, xa, tri.view(), identity, speculative, m)) return false;
+            return !measure.again(m) || use_face_normal(m, a, xa, measure.face == 0, tri, on_plane, speculative);
+        }
+        case ShapeType::Box:
+        case ShapeType::ConvexHull:
+            return collide_polyhedron_triangle(*polyhedron, xa, tri.view(), mesh_in_a, speculative, m, cache,
+                                               feature_slop, measure);
+        default: return false;
+    }
 }
 
 // The points each list slot's manifolds brought. Manifolds with nearly the same normal
@@ -199,18 +202,19 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
         // it): told from the three corners, before the triangle's polyhedron is made.
         if (cache && kept_axis_separates(*polyhedron, v, normal, mesh_in_a, *cache, speculative)) return;
         const TrianglePoly poly(v[0], v[1], v[2], normal);
-        Manifold m;
-        if (!collide_triangle(a, a_in_mesh, polyhedron, mesh_in_a, poly, speculative, cache, walk ? walk->slop() : 0,
-                              m))
-            return;
         // With its centre in front, a normal that would push it on through the back (the back
         // face, or an edge axis leaning that way, can win the SAT once it is deep) is measured
-        // again against the front face, from its deep side.
-        const Real facing = m.normal.dot(poly.normal());  // the normal points from the shape to the triangle
-        const bool through = centre_in_front && facing > 0;
-        const bool off_face = std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges);
-        if ((through || off_face) &&
-            !use_face_normal(m, a, a_in_mesh, polyhedron, mesh_in_a, centre_in_front, poly, v[0], speculative, cache))
+        // again against the front face, from its deep side; so is a normal the triangle does not
+        // admit (off its face, with no point on an active edge).
+        const auto again = [&](const Manifold& m) {
+            const Real facing = m.normal.dot(normal);  // the normal points from the shape to the triangle
+            const bool through = centre_in_front && facing > 0;
+            return through || (std::abs(facing) < kFaceNormal && !touches_active_edge(m, v, tri.active_edges));
+        };
+        const FaceMeasure measure{centre_in_front ? 0u : 1u, tri.active_edges != 0, again};
+        Manifold m;
+        if (!collide_triangle(a, a_in_mesh, polyhedron, mesh_in_a, poly, v[0], speculative, cache,
+                              walk ? walk->slop() : 0, measure, m))
             return;
         // Ids from different triangles must differ inside a merged manifold.
         for (int i = 0; i < m.point_count; ++i) m.points[i].id ^= t * 0x9E3779B1u;

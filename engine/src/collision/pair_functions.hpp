@@ -134,6 +134,24 @@ bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const 
 bool face_of_b_manifold(const PreparedPolyhedron& a, const Transform& xa, const PolyView& b, const RelativePose& b_in_a,
                         std::uint32_t face_b, Real speculative_distance, Manifold& out, FeatureCache* cache = nullptr);
 
+// How a mesh takes a polyhedron's contact with one of its triangles (collide_mesh.cpp): when
+// again(m) (m's normal and points in the frame xa places a in, the mesh's) says so, the
+// contact is measured again over the triangle's face `face` (0 front, 1 back) as
+// face_of_b_manifold measures it. Without points_matter, again reads m's normal only, and is
+// asked it before the SAT makes the points (m then has none): none are made that would be
+// measured again.
+struct FaceMeasure {
+    std::uint32_t face;
+    bool points_matter;
+    FunctionRef<bool(const Manifold&)> again;
+};
+// collide_polyhedra of a against a mesh triangle (b), then, when `measure` asks it, its
+// face_of_b_manifold over the triangle's face, in one posing of the triangle: what the two
+// calls give, the same to the bit, with the same cache.
+bool collide_polyhedron_triangle(const PreparedPolyhedron& a, const Transform& xa, const PolyView& triangle,
+                                 const RelativePose& triangle_in_a, Real speculative_distance, Manifold& out,
+                                 FeatureCache* cache, Real feature_slop, const FaceMeasure& measure);
+
 // True when the feature `cache` keeps for a against a triangle (B: corners `triangle` and
 // unit front normal `normal`, posed in a's frame by b_in_a), an A's face or an edge pair,
 // separates them past the speculative distance: collide_polyhedra with that cache would

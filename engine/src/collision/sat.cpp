@@ -124,16 +124,22 @@ FaceQuery query_faces(const Posed& p, const Posed& other, Real limit) {
     return best;
 }
 
-ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
+// Edge j's arc, its faces' normals n0 (f0's) and n1 (f1's) turned already.
+ArcEdge arc_edge(const Posed& p, std::uint32_t j, const Vec3& n0, const Vec3& n1) {
     const HullEdge& e = p.view.edges[j];
     ArcEdge a;
     a.origin = p.vertices[e.v0];
     a.direction = p.vertices[e.v1] - a.origin;
-    a.n0 = p.normal(e.f0);
-    a.n1 = p.normal(e.f1);
+    a.n0 = n0;
+    a.n1 = n1;
     a.t0 = a.direction.cross(a.n0);
     a.t1 = a.n1.cross(a.direction);
     return a;
+}
+
+ArcEdge arc_edge(const Posed& p, std::uint32_t j) {
+    const HullEdge& e = p.view.edges[j];
+    return arc_edge(p, j, p.normal(e.f0), p.normal(e.f1));
 }
 
 void prepare_edges(const Posed& p, ArcEdge* out) {
@@ -143,10 +149,9 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
 // Whether edges ea (of A) and eb (of B) form a face of the Minkowski difference: their
 // arcs cross on the Gauss map, A's at the direction L = +-(ea x eb) and B's at -L. If so,
 // the unit axis (from A to B) and the separation of the two edges' lines along it.
-[[gnu::always_inline]] inline bool edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit, Real& separation) {
-    // Cheap rejections first: each arc must cross the other's great circle.
-    if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) return false;
-    if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) return false;
+// crossing_edge_pair_axis: the same for arcs known to cross each other's great circles.
+[[gnu::always_inline]] inline bool crossing_edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit,
+                                                           Real& separation) {
     const Vec3 cross = ea.direction.cross(eb.direction);
     const Real length2 = cross.squaredNorm();
     if (length2 <= Real(1e-12) * ea.direction.squaredNorm() * eb.direction.squaredNorm()) return false;
@@ -160,6 +165,13 @@ void prepare_edges(const Posed& p, ArcEdge* out) {
     unit = cross * (sign / std::sqrt(length2));
     separation = unit.dot(eb.origin - ea.origin);
     return true;
+}
+
+[[gnu::always_inline]] inline bool edge_pair_axis(const ArcEdge& ea, const ArcEdge& eb, Vec3& unit, Real& separation) {
+    // Cheap rejections first: each arc must cross the other's great circle.
+    if (eb.n0.dot(ea.direction) * eb.n1.dot(ea.direction) > 0) return false;
+    if (ea.n0.dot(eb.direction) * ea.n1.dot(eb.direction) > 0) return false;
+    return crossing_edge_pair_axis(ea, eb, unit, separation);
 }
 
 // Edge j with what arc_reach needs, in the polyhedron's own frame (no origin).
@@ -257,13 +269,16 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
     if (b.view.arc_edges == nullptr && b.view.edge_count <= 4) {
-        // A triangle's edges, made and bounded in one group of lanes.
+        // A triangle's edges, made and bounded in one group of lanes; each joins its two
+        // faces, whose normals are turned once.
         const unsigned bits = lane_bits(arc_reach(own_arc_lanes(b.view), d_in_b) > needed) &
                               ((1u << b.view.edge_count) - 1);
+        const Vec3 normals[2] = {b.normal(0), b.normal(1)};
         for (unsigned left = bits; left != 0; left &= left - 1) {
             const auto j = static_cast<std::uint32_t>(__builtin_ctz(left));
             kept_b[count_b] = j;
-            edges_b[count_b++] = arc_edge(b, j);
+            const HullEdge& e = b.view.edges[j];
+            edges_b[count_b++] = arc_edge(b, j, normals[e.f0], normals[e.f1]);
         }
     } else {
         for (std::uint32_t j = 0; j < b.view.edge_count; ++j) {
@@ -295,7 +310,8 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
                 const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
                 Vec3 unit;
                 Real s;
-                if (!edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
+                // The lanes ran edge_pair_axis's first two tests, bit for bit.
+                if (!crossing_edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
                 if (s > best.separation) best = {s, ja, jb, unit, true};
                 if (s > limit) return best;
             }
@@ -496,7 +512,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
                     FeatureCache* cache) {
     const Vec3 n = pb.normal(face);
     ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
-    int count = clipped_contact(pb, face, n, pa, incident_face(pa, n), true, speculative, candidates.data());
+    const std::uint32_t incident = incident_face(pa, n);
+    int count = clipped_contact(pb, face, n, pa, incident, true, speculative, candidates.data());
     m.normal = -n;
     if (count > 0) {
         reduce_to_manifold(candidates.data(), count, m);
@@ -519,7 +536,8 @@ bool face_of_b_over(const Posed& pa, const Posed& pb, std::uint32_t face, Real s
     ScratchBuffer<ContactCandidate, 2 * kInlineVertices> surface(room);
     count = 0;
     for (std::uint32_t f = 0; f < pa.view.face_count; ++f) {
-        if (pa.normal(f).dot(n) >= 0) continue;
+        // The incident face was clipped above and left nothing within reach.
+        if (f == incident || pa.normal(f).dot(n) >= 0) continue;
         // What clipping leaves of a face lies between its vertices: none within reach, none left.
         const HullFace& af = pa.view.faces[f];
         bool reaches = false;
@@ -632,52 +650,99 @@ bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, 
     return collide_polyhedra(prepared, xa, b, RelativePose(xa, xb), speculative, m, cache, feature_slop);
 }
 
+namespace {
+
+enum class SatResult { Apart, Touching, NormalOnly };
+
+// collide_polyhedra's work on a posed pair: Touching with the manifold in A's frame, or Apart.
+// Before the whole SAT makes the manifold of the axis it chose, normal_only(normal) (the
+// normal in A's frame) may say its points are not wanted: the answer is then NormalOnly, with
+// the cache kept as for Touching and m as it was. (A chosen axis always makes a manifold: the
+// deepest vertex stands in for a face's clip, and it lies at the face's separation, which is
+// within reach.)
+template <typename NormalOnly>
+[[gnu::always_inline]] inline SatResult sat_posed(const PreparedPolyhedron& prepared, const Posed& pa, const Posed& pb,
+                                                  Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop,
+                                                  NormalOnly&& normal_only) {
+    using Kind = FeatureCache::Kind;
+    if (cache && cache->kind() != Kind::None) {
+        const CachedAxis axis = cached_axis(*cache, pa, pb);
+        if (axis.valid && axis.separation > speculative) return SatResult::Apart;
+        if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
+            cached_manifold(*cache, axis, pa, pb, speculative, m))
+            return SatResult::Touching;
+    }
+    const FaceQuery face_a = query_faces(pa, pb, speculative);
+    if (face_a.separation > speculative) {
+        remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
+        return SatResult::Apart;
+    }
+    const FaceQuery face_b = query_faces(pb, pa, speculative);
+    if (face_b.separation > speculative) {
+        remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
+        return SatResult::Apart;
+    }
+    const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation), speculative);
+    if (edge.separation > speculative) {
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+        return SatResult::Apart;
+    }
+
+    if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
+        remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
+        if (normal_only(edge.axis)) return SatResult::NormalOnly;
+        edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
+        return SatResult::Touching;
+    }
+
+    const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
+    const FaceQuery& reference = reference_is_b ? face_b : face_a;
+    if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
+    else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
+    // face_manifold's normal, as it makes it.
+    if (normal_only(reference_is_b ? Vec3(-pb.normal(reference.face)) : pa.normal(reference.face)))
+        return SatResult::NormalOnly;
+    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
+        remember_axis(cache, Kind::None, 0, 0, 0);
+        return SatResult::Apart;
+    }
+    return SatResult::Touching;
+}
+
+}  // namespace
+
 bool collide_polyhedra(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& b,
                        const RelativePose& b_in_a, Real speculative, Manifold& m, FeatureCache* cache,
                        Real feature_slop) {
     return with_posed_pair(prepared, b, b_in_a, [&](const Posed& pa, const Posed& pb) {
-        using Kind = FeatureCache::Kind;
-        if (cache && cache->kind() != Kind::None) {
-            const CachedAxis axis = cached_axis(*cache, pa, pb);
-            if (axis.valid && axis.separation > speculative) return false;
-            if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
-                cached_manifold(*cache, axis, pa, pb, speculative, m)) {
+        const auto points_wanted = [](const Vec3&) { return false; };
+        if (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, points_wanted) != SatResult::Touching)
+            return false;
+        manifold_to_world(m, xa);
+        return true;
+    });
+}
+
+bool collide_polyhedron_triangle(const PreparedPolyhedron& prepared, const Transform& xa, const PolyView& triangle,
+                                 const RelativePose& triangle_in_a, Real speculative, Manifold& m, FeatureCache* cache,
+                                 Real feature_slop, const FaceMeasure& measure) {
+    return with_posed_pair(prepared, triangle, triangle_in_a, [&](const Posed& pa, const Posed& pb) {
+        // The normal alone decides when the points cannot: m then carries it, with no points.
+        const auto normal_only = [&](const Vec3& normal) {
+            if (measure.points_matter) return false;
+            m.normal = xa.rotate(normal);
+            m.point_count = 0;
+            return measure.again(m);
+        };
+        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only)) {
+            case SatResult::Apart: return false;
+            case SatResult::Touching:
                 manifold_to_world(m, xa);
-                return true;
-            }
+                if (!measure.again(m)) return true;
+                break;
+            case SatResult::NormalOnly: break;
         }
-        const FaceQuery face_a = query_faces(pa, pb, speculative);
-        if (face_a.separation > speculative) {
-            remember_axis(cache, Kind::FaceA, face_a.face, 0, face_a.separation);
-            return false;
-        }
-        const FaceQuery face_b = query_faces(pb, pa, speculative);
-        if (face_b.separation > speculative) {
-            remember_axis(cache, Kind::FaceB, 0, face_b.face, face_b.separation);
-            return false;
-        }
-        const EdgeQuery edge = query_edges(prepared, pa, pb, std::max(face_a.separation, face_b.separation),
-                                           speculative);
-        if (edge.separation > speculative) {
-            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
-            return false;
-        }
-
-        if (edge.found && clearly_greater(edge.separation, std::max(face_a.separation, face_b.separation))) {
-            edge_manifold(pa, pb, edge.edge_a, edge.edge_b, edge.axis, false, m);
-            remember_axis(cache, Kind::EdgePair, edge.edge_a, edge.edge_b, edge.separation);
-            manifold_to_world(m, xa);
-            return true;
-        }
-
-        const bool reference_is_b = clearly_greater(face_b.separation, face_a.separation);
-        const FaceQuery& reference = reference_is_b ? face_b : face_a;
-        if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
-            remember_axis(cache, Kind::None, 0, 0, 0);
-            return false;
-        }
-        if (reference_is_b) remember_axis(cache, Kind::FaceB, 0, reference.face, reference.separation);
-        else remember_axis(cache, Kind::FaceA, reference.face, 0, reference.separation);
+        if (!face_of_b_over(pa, pb, measure.face, speculative, m, cache)) return false;
         manifold_to_world(m, xa);
         return true;
     });

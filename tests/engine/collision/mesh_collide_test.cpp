@@ -5,6 +5,9 @@
 
 #include <cmath>
 
+#include "collision/pair_functions.hpp"
+#include "collision/polyhedron.hpp"
+#include "collision/sat_prepared.hpp"
 #include "collision_test_util.hpp"
 
 namespace spindle {
@@ -276,6 +279,105 @@ TEST(ConvexMesh, MovedAndRotatedMeshKeepsWorldResults) {
     ASSERT_EQ(m.size(), 1u);
     SPINDLE_EXPECT_VEC_NEAR(m[0].normal, Vec3(q * Vec3(0, -1, 0)), 1e-9);
     EXPECT_NEAR(deepest(m[0]), -0.05, 1e-9);
+}
+
+// A cube rolled 30 degrees about z, its lowest edge 0.1 deep in the triangle's plane but
+// 5 cm beside its long side: measured over the triangle's face, the incident face (the
+// cube's bottom, turned to face down and right) lies wholly beside the triangle and clips to
+// nothing, and the deepest vertex is beside it too; the face turned down and left leans back
+// over the triangle and is what lies there. Its one corner within reach, where it crosses the
+// triangle's side at the triangle's corner, is the manifold's.
+TEST(ConvexMesh, AFaceOverTheTriangleIsMeasuredWhenTheIncidentFaceLiesBesideIt) {
+    const Real turn = kPi / 6;
+    const Real beside = 0.05, depth = -0.1;
+    // The cube's lowest edge, local (-0.5, -0.5, z), turned: (-0.183, -0.683, z).
+    const Vec3 lowest = Vec3(-0.5 * std::cos(turn) + 0.5 * std::sin(turn), -0.5 * std::sin(turn) - 0.5 * std::cos(turn),
+                             0);
+    const Transform xa = at(Vec3(1 + beside, depth, 0.3) - lowest, about(Vec3::UnitZ(), turn));
+    const detail::BoxPoly cube(Vec3(0.5, 0.5, 0.5));
+    const detail::PreparedPolyhedron prepared(cube.view());
+    // Corners (0, 0, 0), (0, 0, 1), (1, 0, 0): facing +y, its long side on x + z = 1.
+    const detail::TrianglePoly triangle(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 0));
+    ASSERT_NEAR(triangle.normal().y(), 1.0, 1e-12);
+    const Transform identity;
+    Manifold m;
+    ASSERT_TRUE(
+        detail::face_of_b_manifold(prepared, xa, triangle.view(), detail::RelativePose(xa, identity), 0, 0.02, m));
+    SPINDLE_EXPECT_VEC_NEAR(m.normal, Vec3(0, -1, 0), 1e-12);
+    ASSERT_EQ(m.point_count, 1);
+    // The face rises at 60 degrees from the lowest edge: at x = 1 it is beside * tan(60) higher.
+    const Real expected = depth + beside * std::tan(kPi / 3);
+    EXPECT_NEAR(m.points[0].separation, expected, 1e-9);
+    SPINDLE_EXPECT_VEC_NEAR(m.points[0].point, Vec3(1, 0.5 * expected, 0), 1e-9);
+}
+
+void expect_same_bits(const Manifold& got, const Manifold& expected, int pose) {
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(got.normal[i], expected.normal[i]) << "pose " << pose;
+    ASSERT_EQ(got.point_count, expected.point_count) << "pose " << pose;
+    for (int k = 0; k < got.point_count; ++k) {
+        for (int i = 0; i < 3; ++i) EXPECT_EQ(got.points[k].point[i], expected.points[k].point[i]) << "pose " << pose;
+        EXPECT_EQ(got.points[k].separation, expected.points[k].separation) << "pose " << pose;
+        EXPECT_EQ(got.points[k].id, expected.points[k].id) << "pose " << pose;
+    }
+}
+
+// collide_polyhedron_triangle is collide_polyhedra followed, when the mesh's rule asks, by
+// face_of_b_manifold over the triangle's face, in one posing of the triangle; with a rule that
+// reads the normal alone it makes no points the rule throws away. A hull and a box drift and
+// turn across a tilted triangle, each with its own cache carried from pose to pose both ways:
+// the answers, manifolds and caches must be the two calls', bit for bit, for a rule on the
+// normal (asked before any point is made) and one on the points.
+TEST(ConvexMesh, ATriangleMeasuredAgainInOnePosingIsTheTwoCallsToTheBit) {
+    std::vector<Vec3> cloud;
+    for (int i = 0; i < 12; ++i)
+        cloud.emplace_back(std::cos(i * 1.3) * 0.4, std::sin(i * 2.1) * 0.3, std::cos(i * 0.7) * 0.5);
+    const Shape hull = Shape::convex_hull(cloud);
+    const detail::BoxPoly box(Vec3(0.3, 0.4, 0.5));
+    const detail::PreparedPolyhedron shapes[] = {detail::PreparedPolyhedron(detail::view_of(*hull.hull)),
+                                                 detail::PreparedPolyhedron(box.view())};
+    const Transform xm = at(Vec3(0.1, -0.05, 0.2), about(Vec3(1, 0, 2), 0.3));
+    const detail::TrianglePoly triangle(Vec3(-1, 0, -1), Vec3(-0.5, 0.2, 1.5), Vec3(1.5, -0.1, -0.5));
+    const Vec3 up = xm.rotate(triangle.normal());
+    int normal_only = 0, measured = 0, touching = 0;
+    for (const bool on_points : {false, true}) {
+        for (const detail::PreparedPolyhedron& shape : shapes) {
+            FeatureCache kept_two, kept_one;
+            for (int pose = 0; pose < 400; ++pose) {
+                const Real s = 0.01 * pose;
+                const Transform xa =
+                    at(xm.apply(Vec3(std::sin(3 * s) - 0.2, 0.3 + 0.3 * std::sin(7 * s), std::cos(2 * s))),
+                       about(Vec3(std::sin(s), 1, std::cos(5 * s)), 4 * s));
+                const detail::RelativePose triangle_in_a(xa, xm);
+                const std::uint32_t face = pose % 7 == 0 ? 1 : 0;
+                // The rules' normals are in the world here (xa places the shape there).
+                const auto again = [&](const Manifold& m) {
+                    if (m.point_count == 0) ++normal_only;
+                    if (!on_points) return m.normal.dot(up) > -0.95;
+                    for (int k = 0; k < m.point_count; ++k)
+                        if (m.points[k].separation < -0.02) return true;
+                    return false;
+                };
+                Manifold two, one;
+                bool two_touch = detail::collide_polyhedra(shape, xa, triangle.view(), triangle_in_a, 0.05, two,
+                                                           &kept_two, 0.005);
+                const bool two_again = two_touch && again(two);
+                if (two_again)
+                    two_touch = detail::face_of_b_manifold(shape, xa, triangle.view(), triangle_in_a, face, 0.05, two,
+                                                           &kept_two);
+                const detail::FaceMeasure measure{face, on_points, again};
+                const bool one_touch = detail::collide_polyhedron_triangle(shape, xa, triangle.view(), triangle_in_a,
+                                                                           0.05, one, &kept_one, 0.005, measure);
+                ASSERT_EQ(one_touch, two_touch) << "pose " << pose;
+                EXPECT_TRUE(kept_one == kept_two) << "pose " << pose;
+                measured += two_again;
+                touching += two_touch;
+                if (two_touch) expect_same_bits(one, two, pose);
+            }
+        }
+    }
+    EXPECT_GT(normal_only, 100);
+    EXPECT_GT(measured, 100);
+    EXPECT_GT(touching, 400);
 }
 
 TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {
