@@ -59,7 +59,8 @@ MemoryReport memory_report(const Space& space) {
     report.solver_other = solver_other_bytes(solver);
     const BroadphaseState& bp = *world.broadphase;
     report.broadphase = bp.tree.heap_bytes() + held(bp.proxy) + held(bp.pairs) + held(bp.refit) + held(bp.refit_slots) +
-                        held(bp.refit_marked) + held(bp.moved_ids) + bp.part_boxes.heap_bytes();
+                        held(bp.last_velocity) + held(bp.refit_marked) + held(bp.moved_ids) +
+                        bp.part_boxes.heap_bytes();
     for (const std::shared_ptr<QueryScene>& scene : world.query_scenes) {
         if (scene) report.query_scenes += scene->heap_bytes();
     }

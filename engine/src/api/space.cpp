@@ -142,6 +142,7 @@ void Space::reserve_bodies(std::size_t count) {
         room(w.awake_pending);
         room(w.broadphase->proxy);
         room(w.broadphase->refit);
+        room(w.broadphase->last_velocity);
         reserve_published(w, count);
     } catch (const std::bad_alloc&) {
         // Only capacities changed: every body, handle and published state is as it was.

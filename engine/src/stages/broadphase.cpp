@@ -37,16 +37,10 @@ Aabb reach_box(const BroadphaseState& bp, const Aabb& bounds, bool is_static) {
     return is_static ? bounds : bounds.fattened(bp.rule.speculative);
 }
 
-// The displacement a proxy's fat box stretches along (FatBoxRule::stretched).
-Vec3 stretch_of(const BroadphaseState& bp, ProxyId proxy, const Vec3& displacement) {
-    return bp.rule.stretched(displacement, bp.tree.margin(proxy));
-}
-
-// Moves a body's proxy (its ancestors grown at once).
-void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box, const Vec3& displacement) {
+// Moves a body's proxy (its ancestors grown at once), with no stretch: a teleport.
+void move_proxy(BroadphaseState& bp, std::uint32_t slot, const Aabb& box) {
     const Aabb before = bp.tree.fat_aabb(bp.proxy[slot]);
-    bp.tree.move_proxy(bp.proxy[slot], reach_box(bp, box, bp.proxy[slot].is_static()),
-                       stretch_of(bp, bp.proxy[slot], displacement));
+    bp.tree.move_proxy(bp.proxy[slot], reach_box(bp, box, bp.proxy[slot].is_static()), Vec3::Zero());
     note_fat_change(bp, slot, before, bp.tree.fat_aabb(bp.proxy[slot]));
 }
 
@@ -95,6 +89,7 @@ void FatBoxRule::check() const {
     require(max_margin, "max_margin");
     require(margin_fraction, "margin_fraction");
     require(stretch, "stretch");
+    require(free_tolerance, "free_tolerance");
 }
 
 // The trees stretch the displacements they are given; the stage gives a slow body's as none.
@@ -144,6 +139,8 @@ void add_proxy(World& world, std::uint32_t slot) {
     const Bodies& b = world.bodies;
     if (bp.proxy.size() <= slot) bp.proxy.resize(slot + 1);
     if (bp.refit.size() <= slot) bp.refit.resize(slot + 1, 0);
+    if (bp.last_velocity.size() <= slot) bp.last_velocity.resize(slot + 1);
+    bp.last_velocity[slot] = b.v[slot];
     const bool is_static = b.type[slot] == MotionType::Static;
     bp.proxy[slot] = bp.tree.create_proxy(reach_box(bp, b.bounds[slot], is_static), slot, is_static,
                                           is_static ? Real(0) : bp.rule.margin(fat_box_radius(b.traits[slot].shape)));
@@ -158,9 +155,7 @@ void remove_proxy(World& world, std::uint32_t slot) {
     bp.part_boxes.remove(slot);
 }
 
-void refresh_proxy(World& world, std::uint32_t slot) {
-    move_proxy(*world.broadphase, slot, world.bodies.bounds[slot], Vec3::Zero());
-}
+void refresh_proxy(World& world, std::uint32_t slot) { move_proxy(*world.broadphase, slot, world.bodies.bounds[slot]); }
 
 namespace {
 
@@ -293,6 +288,7 @@ void update_broadphase(World& world, Real dt) {
     bp.moved_boxes.resize(n);
     bp.part_boxes.lay_out(b);
     std::atomic<std::uint32_t> marked{0};
+    const Vec3 gravity_change = world.settings.gravity * dt;
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         std::uint32_t range_marked = 0;
         for (std::uint32_t k = lo; k < hi; ++k) {
@@ -308,7 +304,14 @@ void update_broadphase(World& world, Real dt) {
             const Aabb swept = reach_box(bp, swept_bounds(b, i, d), bp.proxy[i].is_static());
             bp.refit_marked[k] = 0;
             bp.moved_ids[k] = ProxyId{};
-            const Vec3 stretch = stretch_of(bp, bp.proxy[i], d);
+            // The displacement the fat box stretches along (times the rule's stretch): a fast
+            // body's in free flight, else none. Only a fast body's flight is asked about.
+            const Vec3 velocity_change = b.v[i] - bp.last_velocity[i];
+            bp.last_velocity[i] = b.v[i];
+            const bool stretches = FatBoxRule::fast(d, bp.tree.margin(bp.proxy[i])) &&
+                                   b.type[i] == MotionType::Dynamic &&
+                                   bp.rule.in_free_flight(velocity_change, gravity_change);
+            const Vec3 stretch = stretches ? d : Vec3::Zero();
             if (!bp.tree.needs_move(bp.proxy[i], swept, stretch)) continue;
             const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, stretch);
             bp.moved_ids[k] = bp.proxy[i];

@@ -68,20 +68,31 @@ private:
 // bounds. The bounds are swept over the step already, so two bodies that would meet within
 // the step have their pair (and speculative contact) first. A slow body's box has no stretch
 // along the motion (Box3D has none); a fast one's, moving more than its margin a step, would
-// then leave its box every step and be re-inserted and searched again each time, so its box
-// reaches `stretch` displacements ahead and lasts a few steps.
+// then leave its box every step and be re-inserted and searched again each time, so the box
+// of a fast body in free flight reaches `stretch` displacements ahead and lasts a few steps.
+// A body its contacts or joints moved last step (its velocity changed by more than gravity's
+// share, within `free_tolerance` of it) gets no stretch, as in Box3D: it moves with what
+// touches it, whose pairs it has, and a box reaching past them makes and loses contacts
+// with the bodies beyond at every new box (a tumbling pile's churn).
 struct FatBoxRule {
     Real speculative = Real(0.02);       // m: Box3D's speculative distance, 4 linear slops
     Real max_margin = Real(0.05);        // m
     Real margin_fraction = Real(0.125);  // of the shape's radius
-    Real stretch = Real(2);              // displacements ahead, for a body faster than its margin a step
+    Real stretch = Real(2);              // displacements ahead, for a fast body in free flight
+    Real free_tolerance = Real(0.25);    // of gravity's velocity change a step
     // Throws std::invalid_argument naming the field when one is negative or not finite.
     void check() const;
     Real margin(Real radius) const { return std::min(max_margin, margin_fraction * radius); }
-    // The displacement a body's fat box stretches along (times `stretch`): its own when any
-    // axis of it passes the body's margin, else none.
-    Vec3 stretched(const Vec3& displacement, Real body_margin) const {
-        return displacement.cwiseAbs().maxCoeff() > body_margin ? displacement : Vec3::Zero();
+    // Whether a dynamic body is in free flight: its velocity changed over the last step by
+    // gravity's `gravity_change` (gravity x the step), to within free_tolerance of it.
+    bool in_free_flight(const Vec3& velocity_change, const Vec3& gravity_change) const {
+        return (velocity_change - gravity_change).squaredNorm() <=
+               free_tolerance * free_tolerance * gravity_change.squaredNorm();
+    }
+    // Whether a body moving `displacement` a step is fast for its margin: a stretch, if it
+    // is in free flight.
+    static bool fast(const Vec3& displacement, Real body_margin) {
+        return displacement.cwiseAbs().maxCoeff() > body_margin;
     }
 };
 
@@ -104,6 +115,9 @@ struct BroadphaseState {
     // Scratch, per awake body: 1 when this step's move set its refit mark (those marks are
     // not in refit_slots: the stage clears them through this).
     RawRoomVector<std::uint8_t> refit_marked;
+    // Per body slot: its velocity at the last broadphase (FatBoxRule::in_free_flight), each
+    // awake body's written by the Bounds job that has it.
+    std::vector<Vec3> last_velocity;
     RawRoomVector<ProxyId> moved_ids;  // scratch, per awake body: its proxy where it moves, else invalid
     RawRoomVector<Aabb> moved_boxes;   // scratch, per awake body: its new fat box where it moves
     // Scratch on raw room: the jobs after each growing resize write what is read (a first
