@@ -46,12 +46,14 @@ constexpr Real kRecycleSlops = 8;
     return (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs()).norm();
 }
 
-// |v x r| over the points r of body i, for v in the world, bounded axis by axis by its
-// reach along its own axes (Box3D's modified cross, in the body's frame as Box3D's): a long
-// body turning about its long axis swings its points by its girth, not its length, however
-// it lies across the world's axes. Out of line: the recycling test's common path stays small.
-[[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Vec3& v) {
-    return modified_cross((b.q[i].conjugate() * v).cwiseAbs(), b.extents[i].reach).norm();
+// |v x r| over the points r of body i, v its turn since it was at `then` (sin(angle / 2)
+// times the axis), bounded axis by axis by its reach along its own axes (Box3D's modified
+// cross, in the body's frame as Box3D's): a long body turning about its long axis swings its
+// points by its girth, not its length, however it lies across the world's axes. Out of line:
+// the recycling test's common path stays small.
+[[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Quat& then) {
+    const Vec3 turn = (then.conjugate() * b.q[i]).vec();  // in the body's frame
+    return modified_cross(turn.cwiseAbs(), b.extents[i].reach).norm();
 }
 
 // Tight bounds further apart than the speculative reach by more than this rule a pair out:
@@ -107,7 +109,19 @@ bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& tu
     // Against a static body the turn is the other body's own: its points swing no further
     // than its reach along each of its axes allows (asked only when the whole reach is too
     // far: most resting pairs pass above).
-    return (reach_a == 0 || reach_b == 0) && distance + 2 * swing_bound(b, reach_a == 0 ? bb : a, turn) < tolerance;
+    if (reach_a != 0 && reach_b != 0) return false;
+    const bool a_static = reach_a == 0;
+    return distance + 2 * swing_bound(b, a_static ? bb : a, a_static ? contact.cached_qb : contact.cached_qa) <
+           tolerance;
+}
+
+// dq^-1 v, as Eigen's product makes it, inlined: Eigen's own call was left out of line in
+// the narrowphase's loop, a call for every recycled manifold.
+[[gnu::always_inline]] inline Vec3 turned_back(const Quat& dq, const Vec3& v) {
+    const Vec3 u = -dq.vec();
+    Vec3 uv = u.cross(v);
+    uv += uv;
+    return v + dq.w() * uv + u.cross(uv);
 }
 
 // A recycled manifold keeps its points, normal and impulses; each point's separation is
@@ -122,7 +136,7 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
         ContactManifold& manifold = contact.manifold_at(m);
         const Vec3& n = manifold.normal;
         // n.(dq r) = (dq^-1 n).r: each rotation applied once per manifold.
-        const Vec3 na = dqa.conjugate() * n, nb = dqb.conjugate() * n;
+        const Vec3 na = turned_back(dqa, n), nb = turned_back(dqb, n);
         const Real base = n.dot(moved) + manifold.radius_a * (na.dot(n) - 1) + manifold.radius_b * (nb.dot(n) - 1);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
@@ -258,6 +272,13 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     }
 }
 
+// What a compound's collide with a mesh did with its parts. Out of line: only those pairs
+// count them, and the narrowphase's loop stays small.
+[[gnu::noinline]] void count_parts(const MeshQueries& queries, ContactCounts& counts) {
+    counts.parts_collided += queries.parts_collided;
+    counts.parts_recycled += queries.parts_recycled;
+}
+
 }  // namespace
 
 void update_narrowphase(World& world) {
@@ -341,10 +362,7 @@ void update_narrowphase(World& world) {
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
                                          triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
                                          recyclable ? recycle_distance : 0);
-            if (compound && queries) {
-                counts.parts_collided += queries->parts_collided;
-                counts.parts_recycled += queries->parts_recycled;
-            }
+            if (compound && queries) count_parts(*queries, counts);
             for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
             // A pair with no manifolds (every pair of a first step) has no impulses to carry:
             // its first manifold is made in the record itself, not in `fresh` and copied.
