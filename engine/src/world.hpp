@@ -268,7 +268,8 @@ struct ContactExtra {
     // A box, hull or compound against a triangle mesh: each triangle's feature, as
     // Contact::feature is for a convex pair (collide_cached).
     TriangleFeatures triangle_features;
-    // The same pairs' mesh queries, each part's kept while it stays near where it was.
+    // The same pairs' mesh queries, each part's kept while it stays near where it was, and
+    // a compound's parts' manifolds, recycled part by part.
     MeshQueries mesh_queries;
 };
 
@@ -371,7 +372,8 @@ struct alignas(64) EffectCounts {
 // Contacts of one worker in the narrowphase, summed after the stage.
 struct alignas(64) ContactCounts {
     std::uint32_t touching = 0, reused = 0, out_of_reach = 0;
-    std::uint32_t event_checks = 0;  // reporting contacts checked for a touch change
+    std::uint32_t event_checks = 0;                        // reporting contacts checked for a touch change
+    std::uint32_t parts_collided = 0, parts_recycled = 0;  // a compound's parts against a mesh
 };
 
 // A sleeping island: its bodies, contacts and joints, kept so one touch wakes them together.

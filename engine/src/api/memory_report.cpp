@@ -48,7 +48,8 @@ MemoryReport memory_report(const Space& space) {
         if (contact.extra) {
             report.contact_extras += sizeof(ContactExtra) + held(contact.extra->manifolds) +
                                      held(contact.extra->triangle_features) + held(contact.extra->mesh_queries.parts) +
-                                     held(contact.extra->mesh_queries.triangles);
+                                     held(contact.extra->mesh_queries.triangles) +
+                                     held(contact.extra->mesh_queries.manifolds);
         }
     }
     report.contact_lookup = world.contact_index.heap_bytes() + held(world.contact_keys) +

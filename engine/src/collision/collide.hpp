@@ -117,17 +117,31 @@ using TriangleFeatures = std::vector<TriangleFeature>;
 // triangles whose bounds overlap it are MeshQueries::triangles[first, first + count), in
 // increasing index. While a later query box lies inside `box`, its triangles are these,
 // filtered by the same overlap test: the mesh is not queried again.
+// A compound's part also keeps the manifolds it was last collided with (before the ranking
+// chose among the parts'), as Box3D keeps each shape's contact: while the part's own points
+// have moved less than the recycle distance since, they stand for a collide (recycled, moved
+// with the part), whatever the body's other parts do. `centre` is then the part's centre in
+// the world and `turn` its body's orientation when collided, and its manifolds (normals from
+// the mesh to the part) are MeshQueries::manifolds[first_manifold, + manifold_count).
 struct MeshQuery {
     std::uint32_t part = 0;
     std::uint32_t first = 0, count = 0;
     Aabb box;
+    bool has_manifolds = false;
+    std::uint32_t first_manifold = 0, manifold_count = 0;
+    Vec3 centre = Vec3::Zero();
+    Quat turn = Quat::Identity();
 };
 // A contact's mesh queries from its last collide, sorted by part, and the mesh they were
-// made on (a contact's mesh stays its own, but a query on another would be wrong).
+// made on (a contact's mesh stays its own, but a query on another would be wrong), at
+// `pose` (a part's manifolds are kept in the world: they stand only while it stays).
 struct MeshQueries {
     const void* mesh = nullptr;
+    Transform pose;
     std::vector<MeshQuery> parts;
     std::vector<std::uint32_t> triangles;
+    std::vector<Manifold> manifolds;
+    std::uint32_t parts_collided = 0, parts_recycled = 0;  // by the last collide of a compound
 };
 
 // collide() with the pair's caches, for the narrowphase: box-hull and hull-hull pairs
@@ -137,10 +151,25 @@ struct MeshQueries {
 // touching feature may drift before the whole SAT runs again (the solver's linear slop;
 // 0 never reuses a touching feature). `boxes` and `motion` as for collide(). `queries`,
 // when given, keeps a mesh pair's mesh queries across calls (the same manifolds as
-// without); null queries the mesh every call.
+// without); null queries the mesh every call. With queries and a `recycle_distance` over
+// 0, a compound's part against a mesh whose points have moved less than that since its
+// manifolds were made keeps them (part_recycles), moved with it, instead of a collide.
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes = {}, const PairMotion* motion = nullptr, MeshQueries* queries = nullptr);
+                   const PartBoxes& boxes = {}, const PairMotion* motion = nullptr, MeshQueries* queries = nullptr,
+                   Real recycle_distance = 0);
+
+// Box3D's a x b with both crossed terms added: with a = |omega| (or a turn's |sin(angle / 2)
+// axis|) and b a body's reach along the same axes, a bound on its farthest point's speed
+// (or half its swing) per axis: a long body turning about its length counts its girth.
+inline Vec3 modified_cross(const Vec3& a, const Vec3& b) {
+    return {a.y() * b.z() + a.z() * b.y(), a.z() * b.x() + a.x() * b.z(), a.x() * b.y() + a.y() * b.x()};
+}
+
+// Contact recycling keeps manifolds only while neither body has turned more than 10 degrees
+// since they were made (their normals stay fixed in the world): cos(5 degrees)^2 against
+// the square of the turn's quaternion's scalar part.
+inline constexpr Real kRecycleCosHalfAngleSq = 0.99240388;
 
 // The radius of a shape's round part (sphere, capsule; else 0): its surface point along
 // any direction is the core's plus this much, so it does not move as the body turns

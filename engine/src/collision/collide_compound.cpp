@@ -241,6 +241,52 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
     return emit(g, out, capacity);
 }
 
+// Whether a compound's part, collided with a mesh where `was` says, has since moved so little
+// that its manifolds then still serve (contact recycling, narrowphase.cpp, for one part): its
+// centre has moved less than `tolerance`, less the swing of its points about it (the body's
+// turn since, in the body's frame, over the part's half-extents there), and the body has
+// turned less than 10 degrees. The mesh has not moved (met_at).
+bool part_recycles(const MeshQuery& was, const Vec3& centre, const Quat& turn, const Vec3& extents, Real tolerance) {
+    if (!was.has_manifolds) return false;
+    const Real distance = (centre - was.centre).norm();
+    if (distance >= tolerance) return false;
+    const Real cos_half = turn.dot(was.turn);
+    if (cos_half * cos_half <= kRecycleCosHalfAngleSq) return false;
+    // sin(angle / 2) times the axis, in the body's frame: twice its cross with a point's
+    // offset from the centre is how far the point has swung.
+    const Vec3 local = (was.turn.conjugate() * turn).vec().cwiseAbs();
+    return distance + 2 * modified_cross(local, extents).norm() < tolerance;
+}
+
+// A recycled part's manifold, as recycle() moves a contact's (narrowphase.cpp): each point
+// stays where it was on the part (its offset from the part's centre kept in the world's axes,
+// as a recycled contact keeps its anchors), and its separation grows by how far the part's
+// point has come away from the mesh along the normal as the part moved and turned, a round
+// part's surface point staying on the normal.
+class PartMove {
+public:
+    PartMove(const MeshQuery& was, const Vec3& centre, const Quat& turn)
+        : m_was(was.centre), m_moved(centre - was.centre), m_turn(turn * was.turn.conjugate()) {}
+
+    Manifold moved(const Manifold& kept, Real radius) const {
+        Manifold m = kept;
+        const Vec3& n = m.normal;                  // from the mesh to the part
+        const Vec3 back = m_turn.conjugate() * n;  // n.(turn r) = (turn^-1 n).r
+        const Real base = n.dot(m_moved) + radius * (back.dot(n) - 1);
+        for (int j = 0; j < m.point_count; ++j) {
+            ManifoldPoint& p = m.points[j];
+            const Vec3 offset = p.point - m_was;
+            p.separation += base + back.dot(offset) - n.dot(offset);
+            p.point += m_moved;
+        }
+        return m;
+    }
+
+private:
+    Vec3 m_was, m_moved;
+    Quat m_turn;  // the body's turn in the world since
+};
+
 }  // namespace
 
 int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative,
@@ -252,14 +298,25 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
 
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
-                                 std::span<const Aabb> b_boxes, const PairMotion* motion) {
+                                 std::span<const Aabb> b_boxes, const PairMotion* motion, Real recycle_distance) {
+    const bool recycling = walk.met_at(*mesh.mesh, xm) && recycle_distance > 0;
+    const Compound& parts = *b.parts;
     return collide_shape_parts(
         mesh, xm, b, xb, b_boxes, speculative, out, capacity, motion,
         [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found, Real reach) {
+            const Vec3 centre = xb.apply(parts.part_bounds(i).center());
+            const MeshQuery* const was = recycling ? walk.last(i) : nullptr;
+            if (was && part_recycles(*was, centre, xb.q, parts.part_bounds(i).extents(), recycle_distance)) {
+                const PartMove move(*was, centre, xb.q);  // before carry() moves the record `was` is in
+                const std::span<const Manifold> kept = walk.carry(i);
+                for (std::size_t m = 0; m < kept.size(); ++m) found[m] = move.moved(kept[m], round_radius(part));
+                return static_cast<int>(kept.size());
+            }
             // The mesh's pair function has the part as A: turned round as collide() does.
             // The part's exact box, which the walk's cull has made or was given.
             const int n = collide_convex_mesh_cached(part, x, mesh, xm, reach, found, kPerPair, i, walk, &box);
             for (int m = 0; m < n; ++m) flip_manifold(found[m]);
+            if (walk.keeps_queries()) walk.keep_manifolds(centre, xb.q, {found, static_cast<std::size_t>(n)});
             return n;
         });
 }

@@ -258,21 +258,17 @@ void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, co
     MeshQueries& q = *m_queries;
     SPINDLE_ASSERT(q.parts.size() == m_last_parts || q.parts.back().part < part,
                    "TriangleFeatureWalk: parts out of order");
-    if (q.mesh != &mesh) {
-        m_part_cursor = m_last_parts;  // made on another mesh: none is kept
-        q.mesh = &mesh;
-    }
-    while (m_part_cursor < m_last_parts && q.parts[m_part_cursor].part < part) ++m_part_cursor;
-    const bool kept = m_part_cursor < m_last_parts && q.parts[m_part_cursor].part == part &&
-                      q.parts[m_part_cursor].box.contains(box);
+    meet(mesh);
+    const MeshQuery* const was = last(part);
+    const bool kept = was && was->box.contains(box);
     MeshQuery now;
     now.part = part;
     now.first = static_cast<std::uint32_t>(q.triangles.size());
     if (kept) {
-        const MeshQuery was = q.parts[m_part_cursor];
-        now.box = was.box;
-        for (std::uint32_t k = 0; k < was.count; ++k) {
-            const std::uint32_t t = q.triangles[was.first + k];
+        const std::uint32_t first = was->first, count = was->count;  // `was` is in q.parts, not pushed to yet
+        now.box = was->box;
+        for (std::uint32_t k = 0; k < count; ++k) {
+            const std::uint32_t t = q.triangles[first + k];
             q.triangles.push_back(t);
         }
     } else {
@@ -291,6 +287,62 @@ void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, co
     }
 }
 
+void TriangleFeatureWalk::meet(const TriangleMesh& mesh) {
+    if (m_queries->mesh == &mesh) return;
+    m_part_cursor = m_last_parts;  // made on another mesh: none is kept
+    m_queries->mesh = &mesh;
+}
+
+bool TriangleFeatureWalk::met_at(const TriangleMesh& mesh, const Transform& pose) {
+    if (!m_queries) return false;
+    MeshQueries& q = *m_queries;
+    const bool same = q.mesh == &mesh && q.pose.p == pose.p && q.pose.q.coeffs() == pose.q.coeffs();
+    meet(mesh);
+    q.pose = pose;
+    q.parts_collided = q.parts_recycled = 0;
+    return same;
+}
+
+const MeshQuery* TriangleFeatureWalk::last(std::uint32_t part) {
+    const MeshQueries& q = *m_queries;
+    while (m_part_cursor < m_last_parts && q.parts[m_part_cursor].part < part) ++m_part_cursor;
+    return m_part_cursor < m_last_parts && q.parts[m_part_cursor].part == part ? &q.parts[m_part_cursor] : nullptr;
+}
+
+std::span<const Manifold> TriangleFeatureWalk::carry(std::uint32_t part) {
+    MeshQueries& q = *m_queries;
+    SPINDLE_ASSERT(last(part) && (q.parts.size() == m_last_parts || q.parts.back().part < part),
+                   "TriangleFeatureWalk: a part carried that was not met, or out of order");
+    MeshQuery now = q.parts[m_part_cursor];
+    const std::uint32_t first = now.first, first_manifold = now.first_manifold;
+    now.first = static_cast<std::uint32_t>(q.triangles.size());
+    for (std::uint32_t k = 0; k < now.count; ++k) q.triangles.push_back(q.triangles[first + k]);
+    now.first_manifold = static_cast<std::uint32_t>(q.manifolds.size());
+    for (std::uint32_t k = 0; k < now.manifold_count; ++k) q.manifolds.push_back(q.manifolds[first_manifold + k]);
+    q.parts.push_back(now);
+    q.parts_recycled += 1;
+    // Its triangles' features as they were, in key order behind this collide's earlier parts'.
+    const std::uint64_t key = order_key(part, 0);
+    while (m_cursor < m_last && order_key(m_features[m_cursor].part, m_features[m_cursor].triangle) < key) ++m_cursor;
+    for (; m_cursor < m_last && m_features[m_cursor].part == part; ++m_cursor) {
+        const TriangleFeature kept = m_features[m_cursor];
+        m_features.push_back(kept);
+    }
+    return {q.manifolds.data() + now.first_manifold, now.manifold_count};
+}
+
+void TriangleFeatureWalk::keep_manifolds(const Vec3& centre, const Quat& turn, std::span<const Manifold> found) {
+    MeshQueries& q = *m_queries;
+    MeshQuery& now = q.parts.back();
+    q.parts_collided += 1;
+    now.has_manifolds = true;
+    now.centre = centre;
+    now.turn = turn;
+    now.first_manifold = static_cast<std::uint32_t>(q.manifolds.size());
+    now.manifold_count = static_cast<std::uint32_t>(found.size());
+    q.manifolds.insert(q.manifolds.end(), found.begin(), found.end());
+}
+
 void TriangleFeatureWalk::finish() {
     m_features.erase(m_features.begin(), m_features.begin() + static_cast<std::ptrdiff_t>(m_last));
     m_last = m_cursor = 0;
@@ -298,8 +350,12 @@ void TriangleFeatureWalk::finish() {
     MeshQueries& q = *m_queries;
     q.parts.erase(q.parts.begin(), q.parts.begin() + static_cast<std::ptrdiff_t>(m_last_parts));
     q.triangles.erase(q.triangles.begin(), q.triangles.begin() + static_cast<std::ptrdiff_t>(m_last_triangles));
-    for (MeshQuery& p : q.parts) p.first -= static_cast<std::uint32_t>(m_last_triangles);
-    m_last_parts = m_last_triangles = m_part_cursor = 0;
+    q.manifolds.erase(q.manifolds.begin(), q.manifolds.begin() + static_cast<std::ptrdiff_t>(m_last_manifolds));
+    for (MeshQuery& p : q.parts) {
+        p.first -= static_cast<std::uint32_t>(m_last_triangles);
+        p.first_manifold -= static_cast<std::uint32_t>(m_last_manifolds);
+    }
+    m_last_parts = m_last_triangles = m_last_manifolds = m_part_cursor = 0;
 }
 
 namespace {

@@ -46,7 +46,8 @@ public:
           m_slop(slop),
           m_queries(queries),
           m_last_parts(queries ? queries->parts.size() : 0),
-          m_last_triangles(queries ? queries->triangles.size() : 0) {}
+          m_last_triangles(queries ? queries->triangles.size() : 0),
+          m_last_manifolds(queries ? queries->manifolds.size() : 0) {}
     // The cache of (part, triangle) for this collide's SAT, holding the feature it had
     // last time (none if it was not met then); valid until the next call. Calls come in
     // increasing (part, triangle).
@@ -59,7 +60,24 @@ public:
     Real slop() const { return m_slop; }
     void finish();
 
+    // A compound's parts' manifolds against the mesh (MeshQuery), with queries kept. Whether
+    // the last collide met `mesh` at `pose` (its parts' manifolds, kept in the world, may
+    // stand for this one's); this collide's are kept as met there. Called before query().
+    bool met_at(const TriangleMesh& mesh, const Transform& pose);
+    bool keeps_queries() const { return m_queries != nullptr; }
+    // The last collide's record of `part`, or null. Calls come in increasing part, each
+    // before that part's query() or carry().
+    const MeshQuery* last(std::uint32_t part);
+    // Takes `part`'s record from the last collide into this one as it was (its query, its
+    // triangles' features and its manifolds), in place of query(): the part is not collided.
+    // Returns its manifolds.
+    std::span<const Manifold> carry(std::uint32_t part);
+    // Keeps `found`, the manifolds just made for the part whose query() came last, and where
+    // it was (its centre and its body's orientation), for the next collide's carry().
+    void keep_manifolds(const Vec3& centre, const Quat& turn, std::span<const Manifold> found);
+
 private:
+    void meet(const TriangleMesh& mesh);  // the queries from here on are on `mesh`
     static std::uint64_t order_key(std::uint32_t part, std::uint32_t triangle) {
         return std::uint64_t{part} << 32 | triangle;
     }
@@ -70,6 +88,7 @@ private:
     MeshQueries* m_queries;         // null: every query goes to the mesh
     std::size_t m_last_parts;       // m_queries->parts[0, m_last_parts) are the last collide's
     std::size_t m_last_triangles;   // and the triangles they hold, m_queries->triangles[0, m_last_triangles)
+    std::size_t m_last_manifolds;   // and their manifolds, m_queries->manifolds[0, m_last_manifolds)
     std::size_t m_part_cursor = 0;  // where the last collide's parts are merged up to
 };
 
@@ -90,10 +109,12 @@ int collide_shape_compound(const Shape& a, const Transform& xa, const Shape& b, 
 int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb,
                               Real speculative, Manifold* out, int capacity, const PartBoxes& boxes,
                               const PairMotion* motion);
-// collide_shape_compound for a triangle mesh A, each part's triangles met through `walk`.
+// collide_shape_compound for a triangle mesh A, each part's triangles met through `walk`;
+// with the walk's queries kept, each part's manifolds are kept too, and a part that has moved
+// less than `recycle_distance` (over 0) since keeps them instead of a collide (collide_cached).
 int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const Shape& b, const Transform& xb,
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
-                                 std::span<const Aabb> b_boxes, const PairMotion* motion);
+                                 std::span<const Aabb> b_boxes, const PairMotion* motion, Real recycle_distance);
 
 // ---- Shared convex machinery (sat.cpp, rounded_polyhedron.cpp) --------------------------
 // Polyhedron a (posed by xa) against polyhedron b (posed by xb): SAT over face normals and

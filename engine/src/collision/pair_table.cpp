@@ -90,7 +90,7 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
-                   const PartBoxes& boxes, const PairMotion* motion, MeshQueries* queries) {
+                   const PartBoxes& boxes, const PairMotion* motion, MeshQueries* queries, Real recycle_distance) {
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
     const bool mesh_a = a.type == ShapeType::TriangleMesh;
     const bool mesh_b = b.type == ShapeType::TriangleMesh;
@@ -105,11 +105,12 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         const bool from_mesh = shape.type == ShapeType::Compound;
         const PairMotion mesh_first = motion && !mesh_a ? motion->swapped() : PairMotion{};
         const PairMotion* const compound_motion = !motion ? nullptr : mesh_a ? motion : &mesh_first;
-        const int count = from_mesh ? detail::collide_mesh_compound_cached(mesh, x_mesh, shape, x_shape,
-                                                                           speculative_distance, out, capacity, walk,
-                                                                           mesh_a ? boxes.b : boxes.a, compound_motion)
-                                    : detail::collide_convex_mesh_cached(shape, x_shape, mesh, x_mesh,
-                                                                         speculative_distance, out, capacity, 0, walk);
+        const int count = from_mesh
+                              ? detail::collide_mesh_compound_cached(mesh, x_mesh, shape, x_shape, speculative_distance,
+                                                                     out, capacity, walk, mesh_a ? boxes.b : boxes.a,
+                                                                     compound_motion, recycle_distance)
+                              : detail::collide_convex_mesh_cached(shape, x_shape, mesh, x_mesh, speculative_distance,
+                                                                   out, capacity, 0, walk);
         walk.finish();
         if (from_mesh != mesh_a) {
             for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);

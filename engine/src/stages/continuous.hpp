@@ -15,12 +15,6 @@ inline constexpr std::uint8_t kSweepNever = 0;     // static, kinematic, a senso
 inline constexpr std::uint8_t kSweepWhenFast = 1;  // a dynamic body, in the steps moves_fast() says
 inline constexpr std::uint8_t kSweepAlways = 2;    // flagged BodyDesc::fast
 
-// Box3D's a - b with both crossed terms added: with a = |omega| and b = the body's reach
-// along its own axes, a bound on the speed of its farthest point per axis.
-inline Vec3 modified_cross(const Vec3& a, const Vec3& b) {
-    return {a.y() * b.z() + a.z() * b.y(), a.z() * b.x() + a.x() * b.z(), a.x() * b.y() + a.y() * b.x()};
-}
-
 // Whether the step just solved (velocities v, w and the motion dp, dq of `body`, whose
 // orientation was q before it) may have carried some point of the body farther than half
 // its thinnest half-size: Box3D's check in b3FinalizeBodiesTask, a spin about a long

@@ -5,7 +5,9 @@
 // the bodies, which skips almost every collision test of a resting pile and, more, holds
 // each resting contact where it was made. A column of boxes on soft contacts with fresh
 // manifolds every step buckles (the support under a box follows the overlap as the box
-// shifts); with recycled ones it stands, as it does in Box3D.
+// shifts); with recycled ones it stands, as it does in Box3D. A compound against a mesh that
+// is collided again recycles part by part (collide_compound.cpp), as Box3D recycles each
+// shape's contact: a part lying still keeps its manifolds while another part swings.
 #include <algorithm>
 #include <cmath>
 #include <iterator>
@@ -13,7 +15,6 @@
 #include "collision/compound.hpp"
 #include "stages/broadphase_state.hpp"
 #include "stages/contact_events.hpp"
-#include "stages/continuous.hpp"  // modified_cross
 #include "stages/stages.hpp"
 
 namespace spindle {
@@ -36,26 +37,23 @@ constexpr Real kSameFace = 0.9;
 // speculative distance when collided cannot have come into touch. Box3D allows 10 slops
 // while touching; at 2 cm a 50-cube column leant and fell.
 constexpr Real kRecycleSlops = 8;
-constexpr Real kRecycleCosHalfAngleSq = 0.99240388;  // cos(5 degrees)^2: a 10 degree turn
-
-// How far a point of body i can be from its centre of mass along each world axis.
-[[gnu::always_inline]] inline Vec3 far_extent(const Bodies& b, std::uint32_t i) {
-    return (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs());
-}
 
 // How far a point of the body can be from its centre of mass (0 for a static body: only
-// the other body's turn moves the contact). Out of line, and far_extent inlined in it: the
-// other way round, every recycled pair paid for a call more.
+// the other body's turn moves the contact), by its tight bounds. Out of line, with the
+// extent made in it: made in a call of its own, every recycled pair paid for a call more.
 [[gnu::noinline]] Real reach(const Bodies& b, std::uint32_t i) {
     if (b.type[i] == MotionType::Static) return 0;
-    return far_extent(b, i).norm();
+    return (b.bounds[i].max - b.x[i]).cwiseAbs().cwiseMax((b.bounds[i].min - b.x[i]).cwiseAbs()).norm();
 }
 
-// |v x r| over the points r of body i, bounded axis by axis by its extent about its centre
-// (Box3D's modified cross): a long body turning about its long axis swings its points by
-// its girth, not its length. Out of line: the recycling test's common path stays small.
-[[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Vec3& v) {
-    return modified_cross(v.cwiseAbs(), far_extent(b, i)).norm();
+// |v x r| over the points r of body i, v its turn since it was at `then` (sin(angle / 2)
+// times the axis), bounded axis by axis by its reach along its own axes (Box3D's modified
+// cross, in the body's frame as Box3D's): a long body turning about its long axis swings its
+// points by its girth, not its length, however it lies across the world's axes. Out of line:
+// the recycling test's common path stays small.
+[[gnu::noinline]] Real swing_bound(const Bodies& b, std::uint32_t i, const Quat& then) {
+    const Vec3 turn = (then.conjugate() * b.q[i]).vec();  // in the body's frame
+    return modified_cross(turn.cwiseAbs(), b.extents[i].reach).norm();
 }
 
 // Tight bounds further apart than the speculative reach by more than this rule a pair out:
@@ -108,10 +106,22 @@ bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& tu
     const Vec3 turn = (turns.dqa.conjugate() * turns.dqb).vec();
     const Real reach_a = reach(b, a), reach_b = reach(b, bb);
     if (distance + 2 * turn.norm() * std::max(reach_a, reach_b) < tolerance) return true;
-    // Against a static body the turn is the other body's own, in the world: its points
-    // swing no further than its extent along each axis allows (asked only when the whole
-    // reach is too far: most resting pairs pass above).
-    return (reach_a == 0 || reach_b == 0) && distance + 2 * swing_bound(b, reach_a == 0 ? bb : a, turn) < tolerance;
+    // Against a static body the turn is the other body's own: its points swing no further
+    // than its reach along each of its axes allows (asked only when the whole reach is too
+    // far: most resting pairs pass above).
+    if (reach_a != 0 && reach_b != 0) return false;
+    const bool a_static = reach_a == 0;
+    return distance + 2 * swing_bound(b, a_static ? bb : a, a_static ? contact.cached_qb : contact.cached_qa) <
+           tolerance;
+}
+
+// dq^-1 v, as Eigen's product makes it, inlined: Eigen's own call was left out of line in
+// the narrowphase's loop, a call for every recycled manifold.
+[[gnu::always_inline]] inline Vec3 turned_back(const Quat& dq, const Vec3& v) {
+    const Vec3 u = -dq.vec();
+    Vec3 uv = u.cross(v);
+    uv += uv;
+    return v + dq.w() * uv + u.cross(uv);
 }
 
 // A recycled manifold keeps its points, normal and impulses; each point's separation is
@@ -126,7 +136,7 @@ void recycle(Contact& contact, const Bodies& b, const Turns& turns) {
         ContactManifold& manifold = contact.manifold_at(m);
         const Vec3& n = manifold.normal;
         // n.(dq r) = (dq^-1 n).r: each rotation applied once per manifold.
-        const Vec3 na = dqa.conjugate() * n, nb = dqb.conjugate() * n;
+        const Vec3 na = turned_back(dqa, n), nb = turned_back(dqb, n);
         const Real base = n.dot(moved) + manifold.radius_a * (na.dot(n) - 1) + manifold.radius_b * (nb.dot(n) - 1);
         for (int j = 0; j < manifold.point_count; ++j) {
             ContactPoint& p = manifold.points[j];
@@ -262,6 +272,13 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     }
 }
 
+// What a compound's collide with a mesh did with its parts. Out of line: only those pairs
+// count them, and the narrowphase's loop stays small.
+[[gnu::noinline]] void count_parts(const MeshQueries& queries, ContactCounts& counts) {
+    counts.parts_collided += queries.parts_collided;
+    counts.parts_recycled += queries.parts_recycled;
+}
+
 }  // namespace
 
 void update_narrowphase(World& world) {
@@ -343,7 +360,9 @@ void update_narrowphase(World& world) {
             const bool compound = shape_a.type == ShapeType::Compound || shape_b.type == ShapeType::Compound;
             const PairMotion motion{b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
             const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries);
+                                         triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
+                                         recyclable ? recycle_distance : 0);
+            if (compound && queries) count_parts(*queries, counts);
             for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
             // A pair with no manifolds (every pair of a first step) has no impulses to carry:
             // its first manifold is made in the record itself, not in `fresh` and copied.
@@ -369,6 +388,8 @@ void update_narrowphase(World& world) {
         reused += c.reused;
         ruled_out += c.out_of_reach;
         world.counters.contact_event_checks += c.event_checks;
+        world.counters.mesh_parts_collided += c.parts_collided;
+        world.counters.mesh_parts_recycled += c.parts_recycled;
     }
     note_touch_changes(world);  // Begin and End in contact order, whichever worker found them
     world.stats.contacts = touching;

@@ -43,6 +43,11 @@ struct WorkCounters {
     std::uint64_t gyroscopic_applied = 0;  // body-substeps with gyroscopic torque
     std::uint64_t contacts_updated = 0;    // contact-steps through the narrowphase
     std::uint64_t manifolds_reused = 0;    // of those, moved with the bodies instead of recomputed
+    // A compound against a triangle mesh, in the contact-steps recomputed: its part-steps
+    // collided with the mesh, and those whose part had moved so little that its manifolds
+    // were moved with it instead (as a recycled contact's).
+    std::uint64_t mesh_parts_collided = 0;
+    std::uint64_t mesh_parts_recycled = 0;
     // Of those, pairs without points whose bounds were too far apart for any: no collision
     // test, and their contact records were not read.
     std::uint64_t contacts_out_of_reach = 0;
