@@ -53,10 +53,6 @@ struct WidePoint {
     Wide adjusted_separation{};  // separation minus n.(rb - ra): current separation = n.d + this
     Wide normal_mass{};
     Wide lever_arm{};  // distance from the friction centre on A: the twist friction's reach
-    // Overlap the soft row corrects itself; deeper overlap is pushed out. The recovery
-    // depth, or deeper where the point's load (its last impulse) compresses the soft
-    // contact further: a heavy body rests where its spring holds it.
-    Wide recovery{};
 };
 
 // A point slot's normal row and accumulated impulse: all the warm start reads of a point.
@@ -95,9 +91,10 @@ struct ManifoldRef {
 // colour's end hold no manifold: both bodies are the immovable one and nothing is written.
 struct WideContact {
     // Laid out by the passes that read it: first what all three read (the warm start, the
-    // biased and the relax pass), then what only the two solve passes read, then what
-    // only preparing, storing and restitution read. The warm start streams the first part
-    // alone, and every pass but restitution leaves the last alone.
+    // biased and the relax pass), then what only the two solve passes read, then what only
+    // the biased pass reads, then what only preparing, storing and restitution read. The
+    // warm start streams the first part alone, the relax pass the first two, and every pass
+    // but restitution leaves the last alone.
     std::uint32_t a[kLanes] = {}, b[kLanes] = {};       // solver bodies per lane
     int lanes = 0;                                      // lanes holding a manifold
     std::uint8_t slot_points[kMaxManifoldPoints] = {};  // lanes with a point in each slot: the work counters
@@ -130,7 +127,6 @@ struct WideContact {
     WideRow twist_row;  // Ia^-1 n, Ib^-1 n
     WidePointRow point_rows[kMaxManifoldPoints];
     // Read by the solve passes only.
-    Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
     // Radius of each body's round part (sphere, capsule; else 0): its surface point along
     // the normal does not turn with the body, so a rolling ball's contact stays below it.
     Wide radius_a{}, radius_b{};
@@ -138,6 +134,12 @@ struct WideContact {
     Wide friction_mass[3]{};   // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
     Wide twist_mass{};
     WidePoint points[kMaxManifoldPoints];
+    // Read by the biased pass only.
+    Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
+    // Per point slot: overlap the soft row corrects itself; deeper overlap is pushed out.
+    // The recovery depth, or deeper where the point's load (its last impulse) compresses
+    // the soft contact further: a heavy body rests where its spring holds it.
+    Wide recovery[kMaxManifoldPoints]{};
     std::uint32_t ref[kLanes] = {};  // manifold ref per lane: for preparing and storing
     // Read by restitution and hit events only, so last: a wide contact that tracks no
     // push leaves these lines alone in every pass.

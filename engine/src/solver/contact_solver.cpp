@@ -324,7 +324,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         r.normal_impulse = normal_impulse[j];
         const Wide mass = p.normal_mass;
         const Wide held = select(mass > splat(0), held_per_impulse * normal_impulse[j] / mass, splat(0));
-        p.recovery = wide_max(splat(params.recovery_depth), held);
+        wc.recovery[j] = wide_max(splat(params.recovery_depth), held);
         wc.max_normal_impulse[j] = Wide{};
         wc.relative_velocity[j] = wc.tracks_push ? dot(wc.normal, point_velocity(s, ra[j], rb[j])) : Wide{};
     }
@@ -569,7 +569,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
         if constexpr (kBias) {
-            const Wide recovery = p.recovery;
+            const Wide recovery = wc.recovery[j];
             const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
             deep_weight += depth;
             deep_excess -= depth * depth;
