@@ -45,18 +45,19 @@ struct WideRow {
     Wide3 ia, ib;
 };
 
-// One point slot of a WideContact's manifolds (contact_solver.cpp). A slot a manifold does not
+// One point slot of a WideContact's manifolds (contact_solver.cpp): what the solve passes
+// read besides the row the warm start reads too (WidePointRow). A slot a manifold does not
 // fill has no mass and lies far apart, so it never pushes and never rubs.
 struct WidePoint {
     Wide3 ra, rb;                // anchors from each centre of mass, world, fixed for the step
     Wide adjusted_separation{};  // separation minus n.(rb - ra): current separation = n.d + this
-    WideRow normal_row;
     Wide normal_mass{};
     Wide lever_arm{};  // distance from the friction centre on A: the twist friction's reach
-    // Overlap the soft row corrects itself; deeper overlap is pushed out. The recovery
-    // depth, or deeper where the point's load (its last impulse) compresses the soft
-    // contact further: a heavy body rests where its spring holds it.
-    Wide recovery{};
+};
+
+// A point slot's normal row and accumulated impulse: all the warm start reads of a point.
+struct WidePointRow {
+    WideRow normal_row;
     Wide normal_impulse{};
 };
 
@@ -89,8 +90,12 @@ struct ManifoldRef {
 // They share no dynamic body, so the lanes never write the same body. Lanes past the
 // colour's end hold no manifold: both bodies are the immovable one and nothing is written.
 struct WideContact {
+    // Laid out by the passes that read it: first what all three read (the warm start, the
+    // biased and the relax pass), then what only the two solve passes read, then what only
+    // the biased pass reads, then what only preparing, storing and restitution read. The
+    // warm start streams the first part alone, the relax pass the first two, and every pass
+    // but restitution leaves the last alone.
     std::uint32_t a[kLanes] = {}, b[kLanes] = {};       // solver bodies per lane
-    std::uint32_t ref[kLanes] = {};                     // manifold ref per lane
     int lanes = 0;                                      // lanes holding a manifold
     std::uint8_t slot_points[kMaxManifoldPoints] = {};  // lanes with a point in each slot: the work counters
     // A lane's body has a translation lock: its passes take each body's inverse mass per
@@ -103,30 +108,39 @@ struct WideContact {
     // prepare_wide), which no pass reads otherwise.
     bool rolls = false;
     WideRolling* rolling = nullptr;  // this wide contact's in SolverScratch::rolling, where it rolls
-    Wide3 normal, tangent[2];
-    Wide inv_mass_a{}, inv_mass_b{};
-    Wide friction{};
-    Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
-    // Radius of each body's round part (sphere, capsule; else 0): its surface point along
-    // the normal does not turn with the body, so a rolling ball's contact stays below it.
-    Wide radius_a{}, radius_b{};
-    WidePoint points[kMaxManifoldPoints];
-    // Central friction (Box3D's): two tangent rows at the manifold's friction centre,
-    // coupled by their 2x2 effective mass, and a twist row about the normal; their cones
-    // scale with the manifold's total normal impulse. Three rows per manifold instead of
-    // two per point, and no point's order favoured over another's.
-    Wide3 center_a, center_b;  // the friction centre from each centre of mass
-    WideRow friction_row[2];   // the tangents' angular terms at the centre
-    Wide friction_mass[3]{};   // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
-    Wide friction_impulse[2]{};
-    WideRow twist_row;  // Ia^-1 n, Ib^-1 n
-    Wide twist_mass{};
-    Wide twist_impulse{};
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The
     // rows' anchors live apart (SolverScratch::push_anchors): they are rarely used, and
     // every pass streams the wide contacts.
     float push_impulse[kLanes] = {};
+    Wide3 normal;
+    Wide inv_mass_a{}, inv_mass_b{};
+    Wide friction{};
+    // Central friction (Box3D's): two tangent rows at the manifold's friction centre,
+    // coupled by their 2x2 effective mass, and a twist row about the normal; their cones
+    // scale with the manifold's total normal impulse. Three rows per manifold instead of
+    // two per point, and no point's order favoured over another's.
+    Wide3 tangent[2];
+    WideRow friction_row[2];  // the tangents' angular terms at the centre
+    Wide friction_impulse[2]{};
+    Wide twist_impulse{};
+    WideRow twist_row;  // Ia^-1 n, Ib^-1 n
+    WidePointRow point_rows[kMaxManifoldPoints];
+    // Read by the solve passes only.
+    // Radius of each body's round part (sphere, capsule; else 0): its surface point along
+    // the normal does not turn with the body, so a rolling ball's contact stays below it.
+    Wide radius_a{}, radius_b{};
+    Wide3 center_a, center_b;  // the friction centre from each centre of mass
+    Wide friction_mass[3]{};   // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
+    Wide twist_mass{};
+    WidePoint points[kMaxManifoldPoints];
+    // Read by the biased pass only.
+    Wide against_static{};  // 1 where a lane's other body is static: its contact is stiffer
+    // Per point slot: overlap the soft row corrects itself; deeper overlap is pushed out.
+    // The recovery depth, or deeper where the point's load (its last impulse) compresses
+    // the soft contact further: a heavy body rests where its spring holds it.
+    Wide recovery[kMaxManifoldPoints]{};
+    std::uint32_t ref[kLanes] = {};  // manifold ref per lane: for preparing and storing
     // Read by restitution and hit events only, so last: a wide contact that tracks no
     // push leaves these lines alone in every pass.
     Wide restitution{};

@@ -313,17 +313,18 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     const Wide held_per_impulse = select(stiff, splat(params.static_held_per_impulse), splat(params.held_per_impulse));
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         WidePoint& p = wc.points[j];
+        WidePointRow& r = wc.point_rows[j];
         p.ra = ra[j];
         p.rb = rb[j];
         p.adjusted_separation = separation[j] - dot(wc.normal, rb[j] - ra[j]);
         // A slot no manifold fills gets no mass: it can never push or rub.
         const WideMask filled = separation[j] < splat(kEmptySeparation);
         p.normal_mass = make_row(inv_inertia_a, inv_inertia_b, select(filled, linear_sum, splat(0)), ra[j], rb[j],
-                                 wc.normal, p.normal_row);
-        p.normal_impulse = normal_impulse[j];
+                                 wc.normal, r.normal_row);
+        r.normal_impulse = normal_impulse[j];
         const Wide mass = p.normal_mass;
         const Wide held = select(mass > splat(0), held_per_impulse * normal_impulse[j] / mass, splat(0));
-        p.recovery = wide_max(splat(params.recovery_depth), held);
+        wc.recovery[j] = wide_max(splat(params.recovery_depth), held);
         wc.max_normal_impulse[j] = Wide{};
         wc.relative_velocity[j] = wc.tracks_push ? dot(wc.normal, point_velocity(s, ra[j], rb[j])) : Wide{};
     }
@@ -458,7 +459,7 @@ inline TouchingImpulses touching_impulses(const WideContact& wc, const Wide (&ga
     const Wide slop = splat(params.slop);
     TouchingImpulses t{splat(0), splat(0)};
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
-        const Wide touching_impulse = select(gap[j] <= slop, wc.points[j].normal_impulse, splat(0));
+        const Wide touching_impulse = select(gap[j] <= slop, wc.point_rows[j].normal_impulse, splat(0));
         t.pressed += touching_impulse;
         t.twist_reach += wc.points[j].lever_arm * touching_impulse;
     }
@@ -560,14 +561,15 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         if (rubs) solve_friction<kLocked>(wc, masses, s, touching_impulses(wc, gap, params), counts);
     }
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
-        WidePoint& p = wc.points[j];
+        const WidePoint& p = wc.points[j];
+        WidePointRow& r = wc.point_rows[j];
         counts.contact_points += wc.slot_points[j];
         const Wide separation = gap[j];
         const WideMask speculative = separation > zero;  // may close the gap, no more
         const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
         Wide impulse;
         if constexpr (kBias) {
-            const Wide recovery = p.recovery;
+            const Wide recovery = wc.recovery[j];
             const Wide depth = select(separation + recovery < zero, -(separation + recovery), zero);
             deep_weight += depth;
             deep_excess -= depth * depth;
@@ -579,12 +581,12 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             const Wide bias = select(speculative, separation * inv_h, soft_bias);
             const Wide mass_scale = select(speculative, one, soft_mass);
             const Wide impulse_scale = select(speculative, zero, soft_impulse);
-            impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+            impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * r.normal_impulse;
         } else {
             impulse = -p.normal_mass * (vn + select(speculative, separation * inv_h, zero));
         }
-        const Wide total = wide_max(p.normal_impulse + impulse, zero);
-        impulse = total - p.normal_impulse;
+        const Wide total = wide_max(r.normal_impulse + impulse, zero);
+        impulse = total - r.normal_impulse;
         // Restitution bounces off the approach speed at impact: the speed when the
         // point first pushes in this step, gravity of the earlier substeps included.
         if (wc.tracks_push) {
@@ -594,8 +596,8 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             approach = select(first_push, wide_min(approach, vn), approach);
             max_impulse = wide_max(max_impulse, impulse);
         }
-        p.normal_impulse = total;
-        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, impulse);
+        r.normal_impulse = total;
+        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, impulse);
     }
     // The relax pass: rolling resistance first (Box3D's), then friction, both within the
     // touching impulses the normal rows have just solved.
@@ -627,7 +629,9 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
-    for (const WidePoint& p : wc.points) apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, p.normal_impulse);
+    for (const WidePointRow& r : wc.point_rows) {
+        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, r.normal_impulse);
+    }
     if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
         apply_tangents<kLocked>(wc, masses, s, wc.friction_impulse[0], wc.friction_impulse[1]);
         apply_angular_row(s, wc.twist_row, wc.twist_impulse);
@@ -666,7 +670,8 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
-        WidePoint& p = wc.points[j];
+        const WidePoint& p = wc.points[j];
+        WidePointRow& r = wc.point_rows[j];
         Wide& max_impulse = wc.max_normal_impulse[j];
         // Only points that approached fast enough and actually pushed bounce.
         const WideMask bounce = bouncy & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
@@ -676,11 +681,11 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
         // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
         const Wide approach = wc.relative_velocity[j] + wc.gravity_normal * splat(h);
         const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
-        const Wide total = wide_max(p.normal_impulse + impulse, zero);
-        const Wide applied = select(bounce, total - p.normal_impulse, zero);
-        p.normal_impulse += applied;
+        const Wide total = wide_max(r.normal_impulse + impulse, zero);
+        const Wide applied = select(bounce, total - r.normal_impulse, zero);
+        r.normal_impulse += applied;
         max_impulse = wide_max(max_impulse, applied);
-        apply_row<kLocked>(wc, masses, s, wc.normal, p.normal_row, applied);
+        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, applied);
     }
     scatter(wc, bodies, s);
 }
@@ -736,7 +741,7 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.pushed_point = -1;
             m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {
-                m.points[j].normal_impulse = wc.points[j].normal_impulse[l];
+                m.points[j].normal_impulse = wc.point_rows[j].normal_impulse[l];
                 if (!wc.tracks_push) continue;  // nothing reads which point pushed
                 const float approach = -wc.relative_velocity[j][l];
                 if (wc.max_normal_impulse[j][l] > 0 && (m.pushed_point < 0 || approach > m.pushed_speed)) {

@@ -1,7 +1,7 @@
 // Wide: eight floats worked on together, the engine's one SIMD header. GCC's vector
 // extensions compile it to one AVX instruction when the build enables AVX and to two
-// SSE halves otherwise, with no intrinsics to port; every operation is IEEE lane by
-// lane, so both give the same bits. The contact solver puts eight manifolds of one
+// SSE halves otherwise, with no intrinsics to port but the square root's (wide_sqrt);
+// every operation is IEEE lane by lane, so both give the same bits. The contact solver puts eight manifolds of one
 // colour in the lanes, so the dependent chain of one manifold's Gauss-Seidel rows
 // overlaps seven others instead of stalling on its own latency. Floats are enough for
 // what it keeps (Box2D v3 and Box3D solve in floats): anchors and separations are
@@ -11,6 +11,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include <spindle/engine/math.hpp>
 
@@ -32,10 +35,18 @@ inline bool any(WideMask m) {
     for (int i = 0; i < kLanes; ++i) set |= m[i];
     return set != 0;
 }
+// One instruction where the target has eight-lane vectors: the lane loop compiles to eight
+// scalar roots, each behind a branch to sqrtf for errno. IEEE roots round correctly either
+// way, so the lanes get the same bits.
 inline Wide wide_sqrt(Wide a) {
+#if defined(__AVX__)
+    static_assert(kLanes == 8, "one __m256 of lanes");
+    return _mm256_sqrt_ps(a);
+#else
     Wide r;
     for (int i = 0; i < kLanes; ++i) r[i] = __builtin_sqrtf(a[i]);
     return r;
+#endif
 }
 
 // Eight rows of eight lanes turned into eight columns (the 8x8 transpose Box2D v3

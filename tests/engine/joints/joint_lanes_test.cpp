@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -305,6 +308,39 @@ TEST(JointLanes, Atan2IsWithinFloatRoundingInEveryOctant) {
     EXPECT_NEAR(wide_atan2(one, zero)[0], kPi / 2, 1e-6);
     EXPECT_NEAR(wide_atan2(-one, zero)[0], -kPi / 2, 1e-6);
     EXPECT_NEAR(wide_atan2(zero, -one)[0], kPi, 1e-6);
+}
+
+// The lanes' square root (wide.hpp; the friction cone's and a wide joint's length): each
+// lane the correctly rounded root, the same bits as the scalar one, over zeros, subnormals,
+// the largest float, infinity and a spread of magnitudes, so the lanes' results never depend
+// on which instruction a build has.
+TEST(JointLanes, SquareRootIsEachLanesScalarRootToTheBit) {
+    std::vector<float> values = {0.0f,
+                                 -0.0f,
+                                 std::numeric_limits<float>::denorm_min(),
+                                 std::numeric_limits<float>::min(),
+                                 std::numeric_limits<float>::max(),
+                                 std::numeric_limits<float>::infinity(),
+                                 1.0f,
+                                 2.0f,
+                                 3.0f};
+    std::mt19937 random(19);
+    std::uniform_real_distribution<float> exponent(-40.0f, 38.0f);
+    while (values.size() % kLanes != 0 || values.size() < 4096) values.push_back(std::pow(10.0f, exponent(random)));
+    int differing = 0;
+    for (std::size_t i = 0; i < values.size(); i += kLanes) {
+        Wide a;
+        for (int l = 0; l < kLanes; ++l) a[l] = values[i + l];
+        const Wide r = wide_sqrt(a);
+        for (int l = 0; l < kLanes; ++l) {
+            const float expected = std::sqrt(values[i + l]);
+            std::uint32_t got_bits, expected_bits;
+            std::memcpy(&got_bits, &r[l], sizeof(float));
+            std::memcpy(&expected_bits, &expected, sizeof(float));
+            if (got_bits != expected_bits) ++differing;
+        }
+    }
+    EXPECT_EQ(differing, 0) << "of " << values.size() << " roots";
 }
 
 // Swing-twist joints swung nearly half a turn (150-178 degrees, where the arc that undoes
