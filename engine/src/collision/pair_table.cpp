@@ -76,6 +76,17 @@ const Table& table() {
     return instance;
 }
 
+// Out's first `count` manifolds, labelled with no part where neither shape is a compound:
+// the convex pair functions leave the labels alone, and a caller reuses its slots from pair
+// to pair (the narrowphase, for a chunk of pairs), so a compound's part labels stayed on the
+// next pair's manifold, which then missed its own warm start.
+int unlabelled(const Shape& a, const Shape& b, Manifold* out, int count) {
+    if (a.type != ShapeType::Compound && b.type != ShapeType::Compound) {
+        for (int i = 0; i < count; ++i) out[i].part_a = out[i].part_b = 0;
+    }
+    return count;
+}
+
 }  // namespace
 }  // namespace detail
 
@@ -85,7 +96,7 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
     if (capacity <= 0) return 0;
     const detail::Entry fn = detail::table()[static_cast<int>(a.type)][static_cast<int>(b.type)];
     if (fn == nullptr) return 0;
-    return fn(a, xa, b, xb, speculative_distance, out, capacity, boxes, motion);
+    return detail::unlabelled(a, b, out, fn(a, xa, b, xb, speculative_distance, out, capacity, boxes, motion));
 }
 
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
@@ -115,7 +126,7 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
         if (from_mesh != mesh_a) {
             for (int i = 0; i < count; ++i) detail::flip_manifold(out[i]);
         }
-        return count;
+        return detail::unlabelled(a, b, out, count);
     }
     triangles.clear();
     if (queries) *queries = MeshQueries();
@@ -142,7 +153,7 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
     }
     if (!touching) return 0;
     if (swap) detail::flip_manifold(out[0]);
-    return 1;
+    return detail::unlabelled(a, b, out, 1);
 }
 
 }  // namespace spindle
