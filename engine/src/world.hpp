@@ -494,8 +494,12 @@ struct World {
 
     UpdateStats stats;
     WorkCounters counters;
-    std::vector<EffectCounts> scratch_counts;                    // per worker
-    std::vector<ContactCounts> contact_counts;                   // per worker (narrowphase.cpp)
+    std::vector<EffectCounts> scratch_counts;   // per worker
+    std::vector<ContactCounts> contact_counts;  // per worker (narrowphase.cpp)
+    // The narrowphase's mesh and compound pairs put aside per worker in its first pass, and
+    // all of them for its second (narrowphase.cpp).
+    std::vector<std::vector<std::uint32_t>> heavy_contacts;
+    std::vector<std::uint32_t> heavy_positions;
     std::vector<CacheLinePadded<std::uint64_t>> publish_counts;  // per worker: interpolated publishes (buffering.cpp)
     RawRoomVector<std::uint32_t> scratch_lost;                   // raw room: a first step's search writes what it keeps
     std::vector<ContactMove> scratch_contact_moves;              // remove_contacts (contact_list.cpp)

@@ -303,6 +303,63 @@ void update_narrowphase(World& world) {
         if (contact.manifold_count == 0) contact.pushed = false;  // apart: the next push is a new impact
         if (contact_event_candidate(contact)) event_candidates[worker].push_back(position);
     };
+    // Collides the pair at position k again (recycling did not keep it), by `worker` with its
+    // scratch: new manifolds, impulses carried, a new summary.
+    auto collide_pair = [&](std::uint32_t k, Contact& contact, bool recyclable, unsigned worker, ContactCounts& counts,
+                            Manifold* found, ContactManifold* fresh, TriangleFeatures& no_triangles) {
+        const std::uint32_t a = contact.body_a, bb = contact.body_b;
+        const Transform ta = b.transform(a), tb = b.transform(bb);
+        // Speculative contacts reach as far as the bodies can close in one step.
+        const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
+        const Real speculative = settings.speculative_distance + closing;
+        const Shape& shape_a = b.traits[a].shape;
+        const Shape& shape_b = b.traits[bb].shape;
+        // A compound's part boxes, where the broadphase made them this step.
+        const auto part_boxes = [&](const Shape& shape, std::uint32_t i) {
+            return shape.type == ShapeType::Compound ? world.broadphase->part_boxes.made_in(i, world.steps)
+                                                     : std::span<const Aabb>();
+        };
+        const PartBoxes boxes{part_boxes(shape_a, a), part_boxes(shape_b, bb)};
+        // Only a mesh pair keeps triangle features; the others' record has no room for them.
+        const bool mesh = shape_a.type == ShapeType::TriangleMesh || shape_b.type == ShapeType::TriangleMesh;
+        TriangleFeatures& triangles = mesh ? contact.made_extra().triangle_features : no_triangles;
+        MeshQueries* const queries = mesh ? &contact.made_extra().mesh_queries : nullptr;
+        // A compound pair with more part manifolds than room keeps those deepest a step
+        // ahead, not the deepest now: the parts about to land before those resting. Every
+        // manifold's points are put in the order the solver takes them by the same motion.
+        const bool compound = shape_a.type == ShapeType::Compound || shape_b.type == ShapeType::Compound;
+        const PairMotion motion{b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
+        const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
+                                     triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
+                                     recyclable ? recycle_distance : 0);
+        if (compound && queries) count_parts(*queries, counts);
+        for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
+        // A pair with no manifolds (every pair of a first step) has no impulses to carry:
+        // its first manifold is made in the record itself, not in `fresh` and copied.
+        const bool carries = contact.manifold_count > 0;
+        for (int m = 0; m < n; ++m) {
+            ContactManifold& made = carries || m > 0 ? fresh[m] : contact.manifold;
+            make_manifold(found[m], shape_a, shape_b, made);
+            if (carries) carry_impulses(contact, made);
+        }
+        if (n > 0 && carries) contact.manifold = fresh[0];
+        contact.manifold_count = static_cast<std::uint8_t>(n);
+        if (n > 1) contact.made_extra().manifolds.assign(fresh + 1, fresh + n);
+        remember(contact, b);
+        // New manifolds, new summary (a cached pair, above, keeps both).
+        world.contact_summaries[awake[k]] = contact_summary(contact);
+        counts.touching += n > 0 ? 1u : 0u;
+        note_events(contact, awake[k], worker, counts);
+    };
+    // A mesh's or a compound's pair costs hundreds of times a box pair's, and such pairs sit
+    // together in the contact list (a mesh is one body of each of its pairs): in chunks of
+    // 16 they were one worker's alone while the other waited. With two workers or more the
+    // first pass puts those it must collide aside, and a second collides them one to a
+    // chunk. Each pair is collided alone: which pass or worker does it changes nothing.
+    std::vector<std::vector<std::uint32_t>>& heavy = world.heavy_contacts;
+    heavy.resize(world.jobs->worker_count());
+    for (std::vector<std::uint32_t>& list : heavy) list.clear();
+    std::vector<std::uint32_t>* const put_aside = world.jobs->worker_count() > 1 ? heavy.data() : nullptr;
     // A parallel_for, not a run_phases phase: a mesh or hull pair costs a thousand times
     // a resting box pair, and parallel_for splits the busy worker's range on demand,
     // where a phase's first block (half a share) could hold all the expensive pairs.
@@ -338,50 +395,30 @@ void update_narrowphase(World& world) {
                 note_events(contact, awake[k], worker, counts);
                 continue;
             }
-            const Transform ta = b.transform(a), tb = b.transform(bb);
-            // Speculative contacts reach as far as the bodies can close in one step.
-            const Real closing = (b.v[bb] - b.v[a]).norm() * dt;
-            const Real speculative = settings.speculative_distance + closing;
-            const Shape& shape_a = b.traits[a].shape;
-            const Shape& shape_b = b.traits[bb].shape;
-            // A compound's part boxes, where the broadphase made them this step.
-            const auto part_boxes = [&](const Shape& shape, std::uint32_t i) {
-                return shape.type == ShapeType::Compound ? world.broadphase->part_boxes.made_in(i, world.steps)
-                                                         : std::span<const Aabb>();
-            };
-            const PartBoxes boxes{part_boxes(shape_a, a), part_boxes(shape_b, bb)};
-            // Only a mesh pair keeps triangle features; the others' record has no room for them.
-            const bool mesh = shape_a.type == ShapeType::TriangleMesh || shape_b.type == ShapeType::TriangleMesh;
-            TriangleFeatures& triangles = mesh ? contact.made_extra().triangle_features : no_triangles;
-            MeshQueries* const queries = mesh ? &contact.made_extra().mesh_queries : nullptr;
-            // A compound pair with more part manifolds than room keeps those deepest a step
-            // ahead, not the deepest now: the parts about to land before those resting. Every
-            // manifold's points are put in the order the solver takes them by the same motion.
-            const bool compound = shape_a.type == ShapeType::Compound || shape_b.type == ShapeType::Compound;
-            const PairMotion motion{b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
-            const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
-                                         triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
-                                         recyclable ? recycle_distance : 0);
-            if (compound && queries) count_parts(*queries, counts);
-            for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
-            // A pair with no manifolds (every pair of a first step) has no impulses to carry:
-            // its first manifold is made in the record itself, not in `fresh` and copied.
-            const bool carries = contact.manifold_count > 0;
-            for (int m = 0; m < n; ++m) {
-                ContactManifold& made = carries || m > 0 ? fresh[m] : contact.manifold;
-                make_manifold(found[m], shape_a, shape_b, made);
-                if (carries) carry_impulses(contact, made);
+            if (put_aside != nullptr && contact.extra) {  // a mesh's or compound's: the second pass
+                put_aside[worker].push_back(k);
+                continue;
             }
-            if (n > 0 && carries) contact.manifold = fresh[0];
-            contact.manifold_count = static_cast<std::uint8_t>(n);
-            if (n > 1) contact.made_extra().manifolds.assign(fresh + 1, fresh + n);
-            remember(contact, b);
-            // New manifolds, new summary (a cached pair, above, keeps both).
-            world.contact_summaries[awake[k]] = contact_summary(contact);
-            counts.touching += n > 0 ? 1u : 0u;
-            note_events(contact, awake[k], worker, counts);
+            collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
         }
     });
+    std::vector<std::uint32_t>& positions = world.heavy_positions;
+    positions.clear();
+    for (const std::vector<std::uint32_t>& list : heavy) positions.insert(positions.end(), list.begin(), list.end());
+    world.jobs->parallel_for("Narrowphase heavy", 0, static_cast<std::uint32_t>(positions.size()), 1,
+                             [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+                                 Manifold found[kMaxManifolds];
+                                 ContactManifold fresh[kMaxManifolds];
+                                 TriangleFeatures no_triangles;
+                                 ContactCounts& counts = world.contact_counts[worker];
+                                 for (std::uint32_t i = lo; i < hi; ++i) {
+                                     const std::uint32_t k = positions[i];
+                                     Contact& contact = world.contacts[awake[k]];
+                                     const bool recyclable = !any_fast ||
+                                                             (!b.is_fast(contact.body_a) && !b.is_fast(contact.body_b));
+                                     collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
+                                 }
+                             });
     std::uint32_t touching = 0, reused = 0, ruled_out = 0;
     for (const ContactCounts& c : world.contact_counts) {
         touching += c.touching;
