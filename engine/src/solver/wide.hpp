@@ -1,11 +1,12 @@
 // Wide: eight floats worked on together, the engine's one SIMD header. GCC's vector
 // extensions compile it to one AVX instruction when the build enables AVX and to two
 // SSE halves otherwise, with no intrinsics to port but the square root's (wide_sqrt);
-// every operation is IEEE lane by lane, so both give the same bits. The contact solver puts eight manifolds of one
-// colour in the lanes, so the dependent chain of one manifold's Gauss-Seidel rows
-// overlaps seven others instead of stalling on its own latency. Floats are enough for
-// what it keeps (Box2D v3 and Box3D solve in floats): anchors and separations are
-// relative to the bodies, positions stay in double in the bodies themselves.
+// every operation is IEEE lane by lane, so both give the same bits. The contact solver
+// puts eight manifolds of one colour in the lanes, so the dependent chain of one
+// manifold's Gauss-Seidel rows overlaps seven others instead of stalling on its own
+// latency. Floats are enough for what it keeps (Box2D v3 and Box3D solve in floats):
+// anchors and separations are relative to the bodies, positions stay in double in the
+// bodies themselves.
 #pragma once
 
 #include <cmath>
