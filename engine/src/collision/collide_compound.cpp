@@ -166,6 +166,17 @@ private:
     ScratchBuffer<std::uint8_t, kInlineParts> m_has_exact;
 };
 
+// Each part's reach past the centres' (PartReach) at its centre, into out[i]; returns
+// the largest.
+Real part_reaches(const PartReach& reach, PosedParts& parts, Real* out) {
+    Real most = 0;
+    for (std::uint32_t i = 0; i < parts.size(); ++i) {
+        out[i] = reach(parts.loose(i).center());
+        most = std::max(most, out[i]);
+    }
+    return most;
+}
+
 // The parts of b whose loose boxes overlap `box`, in part order; returns their count.
 std::uint32_t parts_near(PosedParts& b, const Aabb& box, std::uint32_t* out) {
     std::uint32_t n = 0;
@@ -226,11 +237,7 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
     PosedParts parts(*b.parts, xb, b_boxes);
     const PartReach reach(motion);
     ScratchBuffer<Real, kInlineParts> extra(parts.size());
-    Real most = 0;
-    for (std::uint32_t i = 0; i < parts.size(); ++i) {
-        extra[i] = reach(parts.loose(i).center());
-        most = std::max(most, extra[i]);
-    }
+    const Real most = part_reaches(reach, parts, extra.data());
     ScratchBuffer<std::uint32_t, kInlineParts> near(parts.size());
     const std::uint32_t count = parts_near(parts, most > 0 ? a_box.fattened(most) : a_box, near.data());
     collide_parts(
@@ -332,15 +339,8 @@ int collide_compound_compound(const Shape& a, const Transform& xa, const Shape& 
     // reaches the farther of its two parts', which bounds it at any point between them.
     const PartReach reach(motion);
     ScratchBuffer<Real, kInlineParts> a_extra(a_parts.size()), b_extra(b_parts.size());
-    Real a_most = 0, b_most = 0;
-    for (std::uint32_t j = 0; j < a_parts.size(); ++j) {
-        a_extra[j] = reach(a_parts.loose(j).center());
-        a_most = std::max(a_most, a_extra[j]);
-    }
-    for (std::uint32_t i = 0; i < b_parts.size(); ++i) {
-        b_extra[i] = reach(b_parts.loose(i).center());
-        b_most = std::max(b_most, b_extra[i]);
-    }
+    const Real a_most = part_reaches(reach, a_parts, a_extra.data());
+    const Real b_most = part_reaches(reach, b_parts, b_extra.data());
     const Aabb b_box = b_parts.loose_all();
     // Each of a's parts lies inside a's whole loose box (padded as each part's is), so a
     // part of b whose loose box misses that box, fattened as a part's box is, meets none of
