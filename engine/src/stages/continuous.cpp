@@ -54,6 +54,7 @@ struct SweptPart {
     Real half_size = 0;  // the farthest core point from the centre, plus the radius
     Real thinnest = 0;
     Real swing = 0;  // the most any point of the part moves as the body turns about its centre of mass
+    Real spin = 0;   // the most any point of the part moves as it turns about its own centre
 };
 
 // Part `shape` posed by `pose` in the body's frame, swept along `path`.
@@ -61,14 +62,18 @@ void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, 
     make_core(shape, pose, part.core);
     part.centre = pose.apply(shape.type == ShapeType::ConvexHull ? shape.hull->centroid() : Vec3::Zero());
     Vec3 from_com = Vec3::Zero();
+    Vec3 from_centre = Vec3::Zero();
     Real half = 0;
     for (int i = 0; i < part.core.count; ++i) {
         from_com = from_com.cwiseMax((part.core.points[i] - path.local_com).cwiseAbs());
+        from_centre = from_centre.cwiseMax((part.core.points[i] - part.centre).cwiseAbs());
         half = std::max(half, (part.core.points[i] - part.centre).squaredNorm());
     }
     part.half_size = std::sqrt(half) + part.core.radius;
     part.thinnest = thinnest_half_size(shape);
     part.swing = modified_cross(path.turn, from_com + Vec3::Constant(part.core.radius)).norm();
+    // The rounding turns onto itself about the core: a ball's spin moves none of its surface.
+    part.spin = modified_cross(path.turn, from_centre).norm();
 }
 
 void pose_core(const ConvexCore& local, const Transform& x, ConvexCore& out) {
@@ -139,13 +144,27 @@ Real gap_bound(const ConvexCore& core, const Aabb& core_box, const std::array<Ve
     return std::max(height_above(core, tri[3], tri[0]), apart.norm());
 }
 
+// Whether the part, its centre h0 in front of a plane at the start of the step and h1 at
+// its end, cannot pass through the plane: no point of it comes nearer than half its
+// thinnest half-size within the step (its centre's approach plus its turn about its
+// centre) and its centre ends farther in front than that. What it can sink into the plane
+// in a step is less than that half, and the contacts push it out; sweeping it would stop
+// a body settling onto a floor while it rolls or slides fast short of where the solver put
+// it. Box3D's early out for parallel movement (b3MeshTimeOfImpactFcn) measures the centre
+// alone, and so would let a spinning pole's end through.
+bool stays_in_front(const SweptPart& part, Real h0, Real h1) {
+    const Real shallow = Real(0.5) * part.thinnest;
+    return h1 > shallow && h0 - h1 + part.spin < shallow;
+}
+
 // The part against a triangle mesh posed by xw. The triangles are gathered once, under
 // the part's swept box: those whose plane has the part's centre behind it at the start
 // are left out (Box3D's b3CollideTriangleAndHull culls so, and collide_mesh.cpp gives a
 // shape with its centre behind no contact from a triangle it lies across), and so are
-// those whose plane it cannot reach within the step. At each pose the triangle nearest by
-// a cheap bound (its plane's distance, or its box's from the part's) is measured first; a
-// triangle whose bound is no nearer than the best gap found is not measured at all.
+// those whose plane it stays in front of (stays_in_front) or cannot reach within the step.
+// At each pose the triangle nearest by a cheap bound (its plane's distance, or its box's
+// from the part's) is measured first; a triangle whose bound is no nearer than the best
+// gap found is not measured at all.
 Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const TriangleMesh& mesh, const Transform& xw,
                         Real target, Real before, SweepScratch& scratch) {
     const Transform to_mesh = xw.inverse();
@@ -162,7 +181,9 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
         const MeshTriangle& tri = mesh.triangles()[t];
         const std::array<Vec3, 4> corners{mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]],
                                           mesh.vertices()[tri.v[2]], mesh.normal(t)};
-        if (corners[3].dot(c0 - corners[0]) < 0 || gap_bound(posed, core_box, corners) > travel) return;
+        const Real h0 = corners[3].dot(c0 - corners[0]);
+        if (h0 < 0 || stays_in_front(part, h0, corners[3].dot(c1 - corners[0]))) return;
+        if (gap_bound(posed, core_box, corners) > travel) return;
         triangles.push_back(corners);
     });
     if (triangles.empty()) return before;
@@ -203,6 +224,8 @@ Real sweep_against(const BodyPath& path, const SweptPart& part, const Shape& wal
         case ShapeType::Plane: {
             const Vec3 n = xw.rotate(wall.normal);
             const Real offset = wall.offset + n.dot(xw.p);
+            const Real h0 = n.dot(path.start.apply(part.centre)) - offset;
+            if (stays_in_front(part, h0, n.dot(path.end.apply(part.centre)) - offset)) return before;
             return time_of_impact(path, part, target, before, [&](const Transform& pose, Real, Real) {
                 Real lowest = kHuge;
                 for (int i = 0; i < part.core.count; ++i)
