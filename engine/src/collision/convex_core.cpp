@@ -60,7 +60,9 @@ void add_part(const Shape& part, const Transform& x, const Vec3& local_com, Swee
     ConvexCore core;
     make_core(part, x, core);
     for (int i = 0; i < core.count; ++i) {
-        extent.reach = extent.reach.cwiseMax((core.points[i] - local_com).cwiseAbs() + Vec3::Constant(core.radius));
+        const Vec3 from_com = (core.points[i] - local_com).cwiseAbs();
+        extent.core_reach = extent.core_reach.cwiseMax(from_com);
+        extent.reach = extent.reach.cwiseMax(from_com + Vec3::Constant(core.radius));
     }
     extent.thinnest = std::min(extent.thinnest, thinnest_half_size(part));
 }
@@ -75,7 +77,7 @@ SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com) {
         for (std::uint32_t i = 0; i < parts.size(); ++i) add_part(parts.shape(i), parts.pose(i), local_com, extent);
     } else if (shape.type == ShapeType::Box) {
         // The farthest corner along each axis, without making the corners: a box is most bodies.
-        extent.reach = local_com.cwiseAbs() + shape.half_extents;
+        extent.reach = extent.core_reach = local_com.cwiseAbs() + shape.half_extents;
         extent.thinnest = shape.half_extents.minCoeff();
     } else if (is_convex(shape)) {
         add_part(shape, Transform{}, local_com, extent);

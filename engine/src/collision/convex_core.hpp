@@ -25,9 +25,12 @@ void make_core(const Shape& shape, const Transform& x, ConvexCore& core);
 // How far a dynamic body's shape reaches from its centre of mass along each of the body's
 // own axes, and its thinnest half-size (a sphere's or capsule's radius, a box's least half
 // extent, a hull's inner radius; the least over a compound's parts): Box3D's maxExtent and
-// minExtent, which decide whether a step moves the body far enough to be swept.
+// minExtent, which decide whether a step moves the body far enough to be swept. A turn
+// moves the body's surface only as far as it moves its core: the rounding about the core (a
+// sphere's, a capsule's) turns onto itself, so `core_reach` leaves it out.
 struct SweepExtent {
     Vec3 reach = Vec3::Zero();
+    Vec3 core_reach = Vec3::Zero();
     Real thinnest = 0;
 };
 SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com);
