@@ -659,17 +659,24 @@ enum class SatResult { Apart, Touching, NormalOnly };
 // normal in A's frame) may say its points are not wanted: the answer is then NormalOnly, with
 // the cache kept as for Touching and m as it was. (A chosen axis always makes a manifold: the
 // deepest vertex stands in for a face's clip, and it lies at the face's separation, which is
-// within reach.)
+// within reach.) With `keep_face_b` (a face of B, or -1), a cache that keeps that face, past
+// the slop, has it measured over (face_of_b_over) before any whole SAT.
 template <typename NormalOnly>
 [[gnu::always_inline]] inline SatResult sat_posed(const PreparedPolyhedron& prepared, const Posed& pa, const Posed& pb,
                                                   Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop,
-                                                  NormalOnly&& normal_only) {
+                                                  NormalOnly&& normal_only, int keep_face_b = -1) {
     using Kind = FeatureCache::Kind;
     if (cache && cache->kind() != Kind::None) {
         const CachedAxis axis = cached_axis(*cache, pa, pb);
         if (axis.valid && axis.separation > speculative) return SatResult::Apart;
         if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
             cached_manifold(*cache, axis, pa, pb, speculative, m))
+            return SatResult::Touching;
+        // B's face `keep_face_b`, kept because the mesh's rule had it measured over, is measured
+        // over again past the slop: the whole SAT would mostly choose an edge or a face of A that
+        // the rule sends back to the same face.
+        if (axis.valid && cache->kind() == Kind::FaceB && static_cast<int>(cache->index_b()) == keep_face_b &&
+            face_of_b_over(pa, pb, cache->index_b(), speculative, m, cache))
             return SatResult::Touching;
     }
     const FaceQuery face_a = query_faces(pa, pb, speculative);
@@ -734,7 +741,8 @@ bool collide_polyhedron_triangle(const PreparedPolyhedron& prepared, const Trans
             m.point_count = 0;
             return measure.again(m);
         };
-        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only)) {
+        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only,
+                          measure.points_matter ? -1 : static_cast<int>(measure.face))) {
             case SatResult::Apart: return false;
             case SatResult::Touching:
                 manifold_to_world(m, xa);
