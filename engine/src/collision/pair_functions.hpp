@@ -168,7 +168,10 @@ struct FaceMeasure {
 };
 // collide_polyhedra of a against a mesh triangle (b), then, when `measure` asks it, its
 // face_of_b_manifold over the triangle's face, in one posing of the triangle: what the two
-// calls give, the same to the bit, with the same cache.
+// calls give, the same to the bit, with the same cache. But when the rule reads the normal
+// alone (!points_matter) and the cache keeps the face it measures over, that face past the
+// slop is measured over again at once (face_of_b_manifold's answer) and the whole SAT is
+// run only if nothing over it is within reach.
 bool collide_polyhedron_triangle(const PreparedPolyhedron& a, const Transform& xa, const PolyView& triangle,
                                  const RelativePose& triangle_in_a, Real speculative_distance, Manifold& out,
                                  FeatureCache* cache, Real feature_slop, const FaceMeasure& measure);

@@ -268,7 +268,8 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
     ScratchBuffer<ArcEdge, 2 * kInlineVertices> edges_b(b.view.edge_count);
     ScratchBuffer<std::uint32_t, 2 * kInlineVertices> kept_b(b.view.edge_count);
     std::uint32_t count_b = 0;
-    if (b.view.arc_edges == nullptr && b.view.edge_count <= 4) {
+    const bool triangle = b.view.arc_edges == nullptr && b.view.edge_count <= 4;
+    if (triangle) {
         // A triangle's edges, made and bounded in one group of lanes; each joins its two
         // faces, whose normals are turned once.
         const unsigned bits = lane_bits(arc_reach(own_arc_lanes(b.view), d_in_b) > needed) &
@@ -301,16 +302,22 @@ EdgeQuery query_edges(const PreparedPolyhedron& prepared_a, const Posed& a, cons
         for (std::uint32_t g = 0; g < groups; ++g) {
             if (kept_a[g] == 0) continue;
             const ArcLanes& l = lanes_a[g];
-            const Lanes b0 = (bn0x * l.dx + bn0y * l.dy) + bn0z * l.dz;
-            const Lanes b1 = (bn1x * l.dx + bn1y * l.dy) + bn1z * l.dz;
             const Lanes a0 = (l.n0x * bdx + l.n0y * bdy) + l.n0z * bdz;
             const Lanes a1 = (l.n1x * bdx + l.n1y * bdy) + l.n1z * bdz;
-            for (unsigned crossing = lane_bits((b0 * b1 <= 0) & (a0 * a1 <= 0)) & kept_a[g]; crossing != 0;
-                 crossing &= crossing - 1) {
+            unsigned crossing = lane_bits(a0 * a1 <= 0) & kept_a[g];
+            // A triangle's edge joins its two faces, n and -n: its arc is a half circle, which
+            // every great arc crosses (b0 b1 = -(n.da)^2, to the bit), so only A's arc is tested.
+            if (!triangle) {
+                const Lanes b0 = (bn0x * l.dx + bn0y * l.dy) + bn0z * l.dz;
+                const Lanes b1 = (bn1x * l.dx + bn1y * l.dy) + bn1z * l.dz;
+                crossing &= lane_bits(b0 * b1 <= 0);
+            }
+            for (; crossing != 0; crossing &= crossing - 1) {
                 const std::uint32_t ja = 4 * g + static_cast<std::uint32_t>(__builtin_ctz(crossing));
                 Vec3 unit;
                 Real s;
-                // The lanes ran edge_pair_axis's first two tests, bit for bit.
+                // The lanes ran edge_pair_axis's first two tests, bit for bit (against a
+                // triangle only the second: the first passes there whatever the edge).
                 if (!crossing_edge_pair_axis(edges_a[ja], eb, unit, s)) continue;
                 if (s > best.separation) best = {s, ja, jb, unit, true};
                 if (s > limit) return best;
@@ -659,17 +666,24 @@ enum class SatResult { Apart, Touching, NormalOnly };
 // normal in A's frame) may say its points are not wanted: the answer is then NormalOnly, with
 // the cache kept as for Touching and m as it was. (A chosen axis always makes a manifold: the
 // deepest vertex stands in for a face's clip, and it lies at the face's separation, which is
-// within reach.)
+// within reach.) With `keep_face_b` (a face of B, or -1), a cache that keeps that face, past
+// the slop, has it measured over (face_of_b_over) before any whole SAT.
 template <typename NormalOnly>
 [[gnu::always_inline]] inline SatResult sat_posed(const PreparedPolyhedron& prepared, const Posed& pa, const Posed& pb,
                                                   Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop,
-                                                  NormalOnly&& normal_only) {
+                                                  NormalOnly&& normal_only, int keep_face_b = -1) {
     using Kind = FeatureCache::Kind;
     if (cache && cache->kind() != Kind::None) {
         const CachedAxis axis = cached_axis(*cache, pa, pb);
         if (axis.valid && axis.separation > speculative) return SatResult::Apart;
         if (axis.valid && std::abs(axis.separation - cache->separation()) < feature_slop &&
             cached_manifold(*cache, axis, pa, pb, speculative, m))
+            return SatResult::Touching;
+        // B's face `keep_face_b`, kept because the mesh's rule had it measured over, is measured
+        // over again past the slop: the whole SAT would mostly choose an edge or a face of A that
+        // the rule sends back to the same face.
+        if (axis.valid && cache->kind() == Kind::FaceB && static_cast<int>(cache->index_b()) == keep_face_b &&
+            face_of_b_over(pa, pb, cache->index_b(), speculative, m, cache))
             return SatResult::Touching;
     }
     const FaceQuery face_a = query_faces(pa, pb, speculative);
@@ -734,7 +748,8 @@ bool collide_polyhedron_triangle(const PreparedPolyhedron& prepared, const Trans
             m.point_count = 0;
             return measure.again(m);
         };
-        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only)) {
+        switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only,
+                          measure.points_matter ? -1 : static_cast<int>(measure.face))) {
             case SatResult::Apart: return false;
             case SatResult::Touching:
                 manifold_to_world(m, xa);

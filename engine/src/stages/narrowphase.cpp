@@ -32,11 +32,14 @@ constexpr Real kSameFace = 0.9;
 // Contact recycling (Box3D's): a pair keeps its manifolds while B's centre has moved less
 // than the recycle distance in A's frame, counting the reach of the relative turn (a body's
 // extent times the angle), and neither body has turned more than 10 degrees (the normal
-// stays fixed in the world). The recycle distance is 8 linear slops (4 cm at the default
-// slop), never more than the speculative distance: a feature that was beyond the
-// speculative distance when collided cannot have come into touch. Box3D allows 10 slops
-// while touching; at 2 cm a 50-cube column leant and fell.
-constexpr Real kRecycleSlops = 8;
+// stays fixed in the world). As Box3D's, the recycle distance is 10 linear slops (5 cm at
+// the default slop) for a pair with manifolds and, for one without, never more than the
+// speculative distance: a feature that was beyond the speculative distance when collided
+// cannot have come into touch. A touching pair has its features within reach and its
+// solver holding them (Box3D's touching pairs move 6 slops past its speculative distance,
+// here 2). A compound's part against a mesh recycles only with manifolds: its distance is
+// the touching one. (At 2 cm a 50-cube column leant and fell.)
+constexpr Real kRecycleSlops = 10;
 
 // How far a point of the body can be from its centre of mass (0 for a static body: only
 // the other body's turn moves the contact), by its tight bounds. Out of line, with the
@@ -89,10 +92,12 @@ struct Turns {
     Quat dqa, dqb;
 };
 
-// Whether the contact's manifolds can be recycled; its bodies' turns in `turns` if so.
-// The cheap checks first: the reach of both bodies only for a pair that passes them.
-bool recycles(const Contact& contact, const Bodies& b, Real tolerance, Turns& turns) {
+// Whether the contact's manifolds can be recycled, within `touching` if it has manifolds,
+// else within `apart`; its bodies' turns in `turns` if so. The cheap checks first: the
+// reach of both bodies only for a pair that passes them.
+bool recycles(const Contact& contact, const Bodies& b, Real touching, Real apart, Turns& turns) {
     if (!contact.cached) return false;
+    const Real tolerance = contact.manifold_count > 0 ? touching : apart;
     const std::uint32_t a = contact.body_a, bb = contact.body_b;
     const Real turn_a = b.q[a].dot(contact.cached_qa), turn_b = b.q[bb].dot(contact.cached_qb);
     if (std::min(turn_a * turn_a, turn_b * turn_b) <= kRecycleCosHalfAngleSq) return false;
@@ -285,7 +290,8 @@ void update_narrowphase(World& world) {
     const Bodies& b = world.bodies;
     const SolverSettings& settings = world.settings.solver;
     const Real dt = world.settings.time_step.duration;
-    const Real recycle_distance = std::min(kRecycleSlops * settings.linear_slop, settings.speculative_distance);
+    const Real touching_recycle_distance = kRecycleSlops * settings.linear_slop;
+    const Real recycle_distance = std::min(touching_recycle_distance, settings.speculative_distance);
     const bool any_fast = world.fast_bodies > 0;
     const bool any_reporting = world.events->reporting > 0;
     const std::vector<std::uint32_t>& awake = awake_contacts(world);
@@ -331,7 +337,7 @@ void update_narrowphase(World& world) {
         const PairMotion motion{b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
         const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
                                      triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
-                                     recyclable ? recycle_distance : 0);
+                                     recyclable ? touching_recycle_distance : 0);
         if (compound && queries) count_parts(*queries, counts);
         for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
         // A pair with no manifolds (every pair of a first step) has no impulses to carry:
@@ -388,7 +394,7 @@ void update_narrowphase(World& world) {
             // the space has one: is_fast reads the cold description.
             const bool recyclable = !any_fast || (!b.is_fast(a) && !b.is_fast(bb));
             Turns turns;
-            if (recyclable && recycles(contact, b, recycle_distance, turns)) {
+            if (recyclable && recycles(contact, b, touching_recycle_distance, recycle_distance, turns)) {
                 recycle(contact, b, turns);
                 counts.reused += 1;
                 counts.touching += contact.manifold_count > 0 ? 1u : 0u;

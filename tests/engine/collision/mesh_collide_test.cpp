@@ -311,6 +311,16 @@ TEST(ConvexMesh, AFaceOverTheTriangleIsMeasuredWhenTheIncidentFaceLiesBesideIt) 
     SPINDLE_EXPECT_VEC_NEAR(m.points[0].point, Vec3(1, 0.5 * expected, 0), 1e-9);
 }
 
+bool same_bits(const Manifold& a, const Manifold& b) {
+    if (a.point_count != b.point_count || a.normal != b.normal) return false;
+    for (int k = 0; k < a.point_count; ++k) {
+        if (a.points[k].point != b.points[k].point || a.points[k].separation != b.points[k].separation ||
+            a.points[k].id != b.points[k].id)
+            return false;
+    }
+    return true;
+}
+
 void expect_same_bits(const Manifold& got, const Manifold& expected, int pose) {
     for (int i = 0; i < 3; ++i) EXPECT_EQ(got.normal[i], expected.normal[i]) << "pose " << pose;
     ASSERT_EQ(got.point_count, expected.point_count) << "pose " << pose;
@@ -326,7 +336,10 @@ void expect_same_bits(const Manifold& got, const Manifold& expected, int pose) {
 // reads the normal alone it makes no points the rule throws away. A hull and a box drift and
 // turn across a tilted triangle, each with its own cache carried from pose to pose both ways:
 // the answers, manifolds and caches must be the two calls', bit for bit, for a rule on the
-// normal (asked before any point is made) and one on the points.
+// normal (asked before any point is made) and one on the points. Under the rule on the normal,
+// a cache that keeps the face measured over may have it measured over again without the SAT
+// (AKeptTriangleFacePastTheSlopIsMeasuredOverItWithoutTheSat): there the one call may be
+// face_of_b_manifold's alone, to the bit, and both caches go on from it.
 TEST(ConvexMesh, ATriangleMeasuredAgainInOnePosingIsTheTwoCallsToTheBit) {
     std::vector<Vec3> cloud;
     for (int i = 0; i < 12; ++i)
@@ -338,7 +351,7 @@ TEST(ConvexMesh, ATriangleMeasuredAgainInOnePosingIsTheTwoCallsToTheBit) {
     const Transform xm = at(Vec3(0.1, -0.05, 0.2), about(Vec3(1, 0, 2), 0.3));
     const detail::TrianglePoly triangle(Vec3(-1, 0, -1), Vec3(-0.5, 0.2, 1.5), Vec3(1.5, -0.1, -0.5));
     const Vec3 up = xm.rotate(triangle.normal());
-    int normal_only = 0, measured = 0, touching = 0;
+    int normal_only = 0, measured = 0, touching = 0, kept_face = 0;
     for (const bool on_points : {false, true}) {
         for (const detail::PreparedPolyhedron& shape : shapes) {
             FeatureCache kept_two, kept_one;
@@ -365,8 +378,22 @@ TEST(ConvexMesh, ATriangleMeasuredAgainInOnePosingIsTheTwoCallsToTheBit) {
                     two_touch = detail::face_of_b_manifold(shape, xa, triangle.view(), triangle_in_a, face, 0.05, two,
                                                            &kept_two);
                 const detail::FaceMeasure measure{face, on_points, again};
+                // Under the rule on the normal, a kept face measured over may be measured over
+                // again without the SAT: the one call is then face_of_b_manifold's alone.
+                const bool face_kept = !on_points && kept_one.kind() == FeatureCache::Kind::FaceB &&
+                                       kept_one.index_b() == face;
+                FeatureCache kept_over = kept_one;
+                Manifold over;
+                const bool over_touch = face_kept &&
+                                        detail::face_of_b_manifold(shape, xa, triangle.view(), triangle_in_a, face,
+                                                                   0.05, over, &kept_over);
                 const bool one_touch = detail::collide_polyhedron_triangle(shape, xa, triangle.view(), triangle_in_a,
                                                                            0.05, one, &kept_one, 0.005, measure);
+                if (over_touch && one_touch && kept_one == kept_over && same_bits(one, over)) {
+                    kept_two = kept_one;
+                    ++kept_face;
+                    continue;
+                }
                 ASSERT_EQ(one_touch, two_touch) << "pose " << pose;
                 EXPECT_TRUE(kept_one == kept_two) << "pose " << pose;
                 measured += two_again;
@@ -378,6 +405,50 @@ TEST(ConvexMesh, ATriangleMeasuredAgainInOnePosingIsTheTwoCallsToTheBit) {
     EXPECT_GT(normal_only, 100);
     EXPECT_GT(measured, 100);
     EXPECT_GT(touching, 400);
+    EXPECT_GT(kept_face, 100);
+}
+
+// A triangle's face kept (the mesh's rule had the contact measured over it), whose separation
+// has moved past the slop, is measured over that face again instead of chosen anew by the whole
+// SAT, on a triangle whose rule reads the normal alone: the SAT would mostly choose an edge or a
+// face of the hull that the rule sends back to the same face. A log lies at 30 degrees, its
+// centre in front of the triangle and its lower end under it, 0.3 m and more below the face: the
+// SAT finds it apart (its top face has the triangle 0.15 m above it), yet what lies under the
+// triangle is measured over the kept face, deep, as face_of_b_manifold measures it, and the face
+// stays kept.
+TEST(ConvexMesh, AKeptTriangleFacePastTheSlopIsMeasuredOverItWithoutTheSat) {
+    const detail::BoxPoly log(Vec3(1.0, 0.1, 0.1));
+    const detail::PreparedPolyhedron prepared(log.view());
+    // Corners (0, 0, 0), (0, 0, 1), (1, 0, 0): facing +y.
+    const detail::TrianglePoly triangle(Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 0));
+    ASSERT_NEAR(triangle.normal().y(), 1.0, 1e-12);
+    const Real tilt = kPi / 6;
+    const Vec3 along(std::cos(tilt), -std::sin(tilt), 0), up(std::sin(tilt), std::cos(tilt), 0);
+    // The log's top face crosses the triangle's plane at x = -0.3, 0.3 before the triangle's
+    // edge; its centre lies 0.3 back along the log from there.
+    const Vec3 centre = Vec3(-0.3, 0, 0.3) - 0.3 * along - 0.1 * up;
+    ASSERT_GT(centre.y(), 0);
+    const Transform xa = at(centre, about(Vec3::UnitZ(), -tilt));
+    const Transform identity;
+    const detail::RelativePose triangle_in_a(xa, identity);
+    Manifold sat;
+    FeatureCache fresh;
+    ASSERT_FALSE(detail::collide_polyhedra(prepared, xa, triangle.view(), triangle_in_a, 0.05, sat, &fresh, 0.005));
+    Manifold over;
+    ASSERT_TRUE(detail::face_of_b_manifold(prepared, xa, triangle.view(), triangle_in_a, 0, 0.05, over));
+    ASSERT_GT(over.point_count, 0);
+    EXPECT_LT(deepest(over), -0.3);
+    // The mesh's rule for a triangle with no active edge: measured over the face unless the
+    // normal is the face's.
+    const auto again = [](const Manifold& m) { return std::abs(m.normal.y()) < 1 - 1e-6; };
+    const detail::FaceMeasure measure{0, false, again};
+    FeatureCache kept(FeatureCache::Kind::FaceB, 0, 0, -0.005f);  // as it lay on the face
+    Manifold m;
+    ASSERT_TRUE(detail::collide_polyhedron_triangle(prepared, xa, triangle.view(), triangle_in_a, 0.05, m, &kept, 0.005,
+                                                    measure));
+    expect_same_bits(m, over, 0);
+    EXPECT_EQ(kept.kind(), FeatureCache::Kind::FaceB);
+    EXPECT_EQ(kept.index_b(), 0u);
 }
 
 TEST(ConvexMesh, RandomPosesGiveWellFormedManifolds) {

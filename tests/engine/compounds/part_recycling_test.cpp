@@ -14,10 +14,10 @@ namespace spindle {
 namespace part_recycling {
 namespace {
 
-// A box part lying on a flat mesh and, 2.5 m along x, a box part lying there too: one body
+// A box part lying on a flat mesh and, 3.5 m along x, a box part lying there too: one body
 // resting on both on a frictionless mesh, turning about the vertical through the first
 // part's centre at 0.9 rad/s (its centre of mass moving to match). The second part slides
-// round 2.5 m out, 3.75 cm a step; the first turns about its centre, which drifts a few
+// round 3.5 m out, 5.25 cm a step; the first turns about its centre, which drifts a few
 // centimetres in 20 steps as the body turns about its centre of mass.
 BodyHandle start_turning(Space& space) {
     BodyDesc ground;
@@ -27,7 +27,7 @@ BodyHandle start_turning(Space& space) {
     space.create_body(ground);
     const Shape box = Shape::box(Vec3(0.25, 0.25, 0.25));
     std::vector<CompoundPart> parts{{box}, {box}};
-    parts[1].position = Vec3(2.5, 0, 0);
+    parts[1].position = Vec3(3.5, 0, 0);
     BodyDesc desc;
     desc.shape = Shape::compound(parts);
     desc.friction = 0;

@@ -240,11 +240,12 @@ TEST(Effects, ANewBodyMeansNewColours) {
     EXPECT_EQ(space.counters().constraint_colorings, settled + 1);
 }
 
-// A sliding contact recycles its manifold until it has slid the recycle distance (8
-// linear slops, 4 cm) from where it was collided, then collides again: at 1.8 m/s (3 cm a
-// step) every other step, at 3 m/s (5 cm a step) every step.
+// A sliding contact recycles its manifold until it has slid the recycle distance (10
+// linear slops, 5 cm, while it touches) from where it was collided, then collides again:
+// at 1.8 m/s (3 cm a step) and 2.7 m/s (4.5 cm) every other step, at 3.6 m/s (6 cm) every
+// step.
 TEST(Effects, SlidingContactsAreRecomputed) {
-    for (const double speed : {1.8, 3.0}) {
+    for (const double speed : {1.8, 2.7, 3.6}) {
         Space space(awake());
         add_ground(space, 0);
         BodyDesc d;
@@ -255,7 +256,7 @@ TEST(Effects, SlidingContactsAreRecomputed) {
         const BodyHandle box = space.create_body(d);
         for (int i = 0; i < 30; ++i) space.update();
         EXPECT_EQ(space.counters().contacts_updated, 30u);
-        EXPECT_EQ(space.counters().manifolds_reused, speed < 2 ? 15u : 0u) << speed << " m/s";
+        EXPECT_EQ(space.counters().manifolds_reused, speed < 3 ? 15u : 0u) << speed << " m/s";
         EXPECT_NEAR(space.internal_position(box).y(), 0.5, 0.01);
         EXPECT_NEAR(space.internal_linear_velocity(box).x(), speed, 1e-6);
     }
