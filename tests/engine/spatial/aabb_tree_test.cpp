@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -76,6 +77,34 @@ TEST(AabbTree, Query_MatchesBruteForce) {
     for (int q = 0; q < 200; ++q) {
         const Aabb box = rng.box(50, 8);
         ASSERT_EQ(query_sorted(tree, box), brute_sorted(tree, live, box)) << "query " << q;
+    }
+}
+
+// Boxes are closed: a query finds a box it touches on any of the six faces, and not one
+// a rounding step away on that axis alone; a NaN coordinate finds nothing (as
+// Aabb::overlaps). Each face is one of the query's six comparisons.
+TEST(AabbTree, Query_FindsABoxTouchingAnyFaceNotOneARoundingStepAway) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    const Aabb unit{Vec3::Zero(), Vec3::Ones()};
+    tree.create_proxy(unit, 7);
+    const auto finds = [&](const Aabb& box) {
+        EXPECT_EQ(query_sorted(tree, box).size() == 1, unit.overlaps(box));
+        return !query_sorted(tree, box).empty();
+    };
+    for (int axis = 0; axis < 3; ++axis) {
+        for (const Real side : {Real(-1), Real(1)}) {
+            Aabb touching = unit;
+            touching.min[axis] += side;
+            touching.max[axis] += side;
+            EXPECT_TRUE(finds(touching)) << "axis " << axis << " side " << side;
+            Aabb apart = touching;
+            Real& face = side > 0 ? apart.min[axis] : apart.max[axis];
+            face = std::nextafter(face, side * Real(2));
+            EXPECT_FALSE(finds(apart)) << "axis " << axis << " side " << side;
+        }
+        Aabb nan = unit;
+        nan.min[axis] = std::numeric_limits<Real>::quiet_NaN();
+        EXPECT_FALSE(finds(nan)) << "axis " << axis;
     }
 }
 

@@ -2,7 +2,8 @@
 // pairs' contacts are decided and filled in parallel ranges, and the lost ones found so,
 // yet the list is the one a single thread makes (the pairs' order), whatever job system
 // and however its ranges ran; every contact is a pair whose fat boxes overlap and that
-// may collide, and the pair index knows every contact's position.
+// may collide, and the pair index knows every contact's position, also after a filter,
+// the layer table, a joint, a motion type, a shape or a body made again took contacts away.
 #include <spindle/engine/space.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
 
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <numeric>
 #include <set>
 #include <vector>
@@ -103,13 +105,12 @@ struct Block {
     std::vector<bool> dynamic;
 };
 
-// Every contact is a pair the broadphase may make (fat boxes overlapping, one body
-// dynamic, not both sensors, filter and joints allowing), each such pair has one, and
-// the index holds each contact's position.
-void expect_contacts_are_the_allowed_overlaps(const World& world) {
+// The pairs the broadphase may make contacts of: fat boxes overlapping, one body dynamic,
+// not both sensors, filter and joints allowing.
+std::set<std::uint64_t> allowed_overlaps(const World& world) {
     const Bodies& b = world.bodies;
     const BroadphaseState& bp = *world.broadphase;
-    std::set<std::uint64_t> expected;
+    std::set<std::uint64_t> pairs;
     for (std::uint32_t i = 0; i < b.capacity(); ++i) {
         for (std::uint32_t j = i + 1; j < b.capacity(); ++j) {
             if (!b.alive[i] || !b.alive[j]) continue;
@@ -117,9 +118,16 @@ void expect_contacts_are_the_allowed_overlaps(const World& world) {
             if (b.traits[i].sensor && b.traits[j].sensor) continue;
             if (filter_blocks_pair(world, i, j) || joint_blocks_pair(world, i, j)) continue;
             if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) continue;
-            expected.insert(std::uint64_t{i} << 32 | j);
+            pairs.insert(std::uint64_t{i} << 32 | j);
         }
     }
+    return pairs;
+}
+
+// Every contact is a pair the broadphase may make, each such pair has one, and the index
+// holds each contact's position.
+void expect_contacts_are_the_allowed_overlaps(const World& world) {
+    const std::set<std::uint64_t> expected = allowed_overlaps(world);
     const std::set<std::uint64_t> made(world.contact_keys.begin(), world.contact_keys.end());
     ASSERT_EQ(made.size(), world.contact_keys.size()) << "a pair has two contacts";
     EXPECT_EQ(made, expected);
@@ -489,6 +497,165 @@ TEST(BroadphaseContacts, ManyContactsMadeAndLostOnThreads_AreTheListsOfOneThread
     const std::vector<std::vector<std::uint64_t>> lists = run_sphere_block(reverse);
     ASSERT_EQ(lists.size(), reference.size());
     for (std::size_t k = 0; k < lists.size(); ++k) EXPECT_TRUE(lists[k] == reference[k]) << "after step " << k + 1;
+}
+
+}  // namespace
+}  // namespace spindle
+
+namespace spindle {
+namespace {
+
+// The pair search reports a pair only when one of its proxies is new or grew: a pair whose
+// fat boxes overlap and that has no contact is found again only if a proxy is made anew
+// or touched. So every path that removes a contact while the two fat boxes may still
+// overlap (a filter, the layer table, a joint, a motion type, a shape, a body destroyed
+// and made again) must make the pair found again at the next step. Each test drifts a
+// raft of boxes, takes such a path there and back, and checks after every step that each
+// allowed overlap has its contact.
+
+std::set<std::uint64_t> contacts(const World& world) { return {world.contact_keys.begin(), world.contact_keys.end()}; }
+
+// A 6 x 6 raft of touching unit boxes without gravity or sleep, each drifting slowly its
+// own way (their fat boxes grow every few steps, mostly where they already were).
+struct Raft {
+    Raft() : space(settings(), &jobs) {
+        for (int i = 0; i < 6; ++i) {
+            for (int k = 0; k < 6; ++k) bodies.push_back(space.create_body(desc(i, k)));
+        }
+    }
+    static SpaceSettings settings() {
+        SpaceSettings s;
+        s.gravity = Vec3::Zero();
+        s.sleep.enabled = false;
+        return s;
+    }
+    BodyDesc desc(int i, int k) const {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3::Constant(0.5));
+        d.position = Vec3(i - 2.5, 0.5, k - 2.5);
+        const Real angle = 2.4 * (6 * i + k);
+        d.linear_velocity = Vec3(std::cos(angle), 0, std::sin(angle)) * 0.4;
+        return d;
+    }
+    World& world() { return SpaceInternals::world(space); }
+    BodyHandle at(int i, int k) const { return bodies[static_cast<std::size_t>(6 * i + k)]; }
+    std::uint32_t slot(int i, int k) const { return at(i, k).index; }
+    // The body at (i, k) and its four neighbours (i, k inside the raft's edge).
+    std::vector<BodyHandle> cross(int i, int k) const {
+        return {at(i, k), at(i - 1, k), at(i + 1, k), at(i, k - 1), at(i, k + 1)};
+    }
+
+    std::set<std::uint64_t> contacts_of(std::uint32_t slot) {
+        std::set<std::uint64_t> keys;
+        for (const std::uint64_t key : contacts(world())) {
+            if ((key >> 32) == slot || (key & 0xffffffffu) == slot) keys.insert(key);
+        }
+        return keys;
+    }
+    // Steps `steps` times, checking every allowed overlap has its contact after each.
+    void run(int steps) {
+        for (int s = 0; s < steps; ++s) {
+            space.update();
+            ASSERT_EQ(contacts(world()), allowed_overlaps(world())) << "step " << step;
+            ++step;
+        }
+    }
+    SingleThreadedJobSystem jobs;
+    Space space;
+    std::vector<BodyHandle> bodies;
+    int step = 0;
+};
+
+// A path away (contacts of `slot` removed while the boxes overlap) and back: the pairs
+// it gave back must be contacts after the next step. Checks that coming back made
+// contacts the body did not have (else the test would prove nothing).
+void there_and_back(Raft& raft, std::uint32_t slot, const std::function<void()>& away,
+                    const std::function<void()>& back) {
+    raft.run(6);
+    away();
+    raft.run(4);
+    const std::set<std::uint64_t> before = raft.contacts_of(slot);
+    back();
+    raft.run(1);
+    std::size_t regained = 0;
+    for (const std::uint64_t key : raft.contacts_of(slot)) regained += before.count(key) == 0 ? 1u : 0u;
+    EXPECT_GT(regained, 0u);
+    raft.run(20);
+}
+
+// there_and_back with the body at (2, 2) and its neighbours blocked from one another by
+// `block` on each, and the body given back by `allow`.
+void block_cross_then_allow(Raft& raft, const std::function<void(BodyHandle)>& block,
+                            const std::function<void(BodyHandle)>& allow) {
+    const auto block_all = [&] {
+        for (const BodyHandle n : raft.cross(2, 2)) block(n);
+    };
+    there_and_back(raft, raft.slot(2, 2), block_all, [&] { allow(raft.at(2, 2)); });
+}
+
+TEST(PairsFoundAgain, FilterBlocksThenAllows_ContactsMadeAgain) {
+    Raft raft;
+    block_cross_then_allow(
+        raft, [&](BodyHandle n) { raft.space.set_collision_filter(n, 0, 5); },  // one group
+        [&](BodyHandle n) { raft.space.set_collision_filter(n, 0, 0); });
+}
+
+TEST(PairsFoundAgain, LayerTableBlocksThenAllows_ContactsMadeAgain) {
+    Raft raft;
+    const BodyHandle x = raft.at(3, 2);
+    raft.space.set_collision_filter(x, 1, 0);
+    there_and_back(
+        raft, raft.slot(3, 2), [&] { raft.space.set_layers_collide(0, 1, false); },
+        [&] { raft.space.set_layers_collide(0, 1, true); });
+}
+
+TEST(PairsFoundAgain, JointMadeThenDestroyed_ContactMadeAgain) {
+    Raft raft;
+    JointHandle joint;
+    there_and_back(
+        raft, raft.slot(2, 3),
+        [&] {
+            const Vec3 middle =
+                (raft.space.internal_position(raft.at(2, 3)) + raft.space.internal_position(raft.at(3, 3))) * 0.5;
+            joint = raft.space.create_joint(JointDesc::ball_socket_at(raft.at(2, 3), raft.at(3, 3), middle));
+        },
+        [&] { raft.space.destroy_joint(joint); });
+}
+
+TEST(PairsFoundAgain, KinematicPairMadeDynamicAgain_ContactsMadeAgain) {
+    Raft raft;
+    block_cross_then_allow(
+        raft, [&](BodyHandle n) { raft.space.set_motion_type(n, MotionType::Kinematic); },  // no kinematic pairs
+        [&](BodyHandle n) { raft.space.set_motion_type(n, MotionType::Dynamic); });
+}
+
+// A new shape takes the body's contacts away and makes them again at once: a slightly
+// smaller box still overlaps its neighbours, and its box shrank, so only a new search of
+// its whole box finds them.
+TEST(PairsFoundAgain, ShapeChanged_ContactsMadeAgain) {
+    Raft raft;
+    const BodyHandle x = raft.at(3, 3);
+    raft.run(6);
+    raft.space.set_shape(x, Shape::box(Vec3::Constant(0.45)));
+    raft.run(1);
+    EXPECT_FALSE(raft.contacts_of(raft.slot(3, 3)).empty());
+    raft.run(5);
+    raft.space.set_shape(x, Shape::box(Vec3::Constant(0.5)));
+    raft.run(20);
+}
+
+TEST(PairsFoundAgain, BodyDestroyedAndMadeAgainInItsPlace_ContactsMadeAgain) {
+    Raft raft;
+    BodyDesc again;
+    std::uint32_t slot = raft.slot(2, 2);
+    there_and_back(
+        raft, slot,
+        [&] {
+            again = raft.desc(2, 2);
+            again.position = raft.space.internal_position(raft.at(2, 2));
+            raft.space.destroy_body(raft.at(2, 2));
+        },
+        [&] { ASSERT_EQ(raft.space.create_body(again).index, slot); });  // the slot used again
 }
 
 }  // namespace
