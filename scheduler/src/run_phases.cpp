@@ -99,12 +99,15 @@ std::uint64_t run_one_block_round(PhaseRun& run, std::uint32_t p, std::uint32_t 
     while (seen < share_end) {
         if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
         const bool tracing = self.system->trace_enabled();
+        std::int64_t traced_from = tracing ? now_nanoseconds() : 0;  // each phase's span begins where the last ended
         for (std::uint32_t q = p; q < end; ++q) {
             const Phase& phase = run.phases[q];
             if (phase.count == 0) continue;
-            const std::int64_t traced_from = tracing ? now_nanoseconds() : 0;
             run.fn(q, 0, phase.count, worker);
-            if (tracing) self.record(phase.name, run.name, traced_from, now_nanoseconds());
+            if (!tracing) continue;
+            const std::int64_t traced_to = now_nanoseconds();
+            self.record(phase.name, run.name, traced_from, traced_to);
+            traced_from = traced_to;
         }
         return 1;
     }
@@ -129,6 +132,7 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
             ++run.barriers;
         }
         std::uint64_t ran = 0;
+        std::int64_t traced_from = 0;  // when this participant claimed its first block of a split phase
         if (one_block(phase)) {
             while (end < phase_count && one_block(run.phases[end])) {
                 if (me == 0 && run.phases[end].count > 0) ++run.phases_run;
@@ -139,7 +143,6 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
             ran = run_one_block_round(run, p, end, taken_before[0], worker, self);
         } else {
             const std::uint32_t grain = std::max<std::uint32_t>(phase.grain, 1);
-            std::int64_t traced_from = 0;  // when this participant claimed its first block of the phase
             for (unsigned step = 0; step < n; ++step) {
                 const unsigned j = (me + step) % n;
                 const auto first = static_cast<std::uint32_t>(std::uint64_t{phase.count} * j / n);
@@ -160,16 +163,18 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
                 }
                 taken_before[j] = share_end;
             }
-            // One span per participant and phase, from its first block to the end of its last:
-            // between its blocks it claims the next one, which is its own work, not a wait, so
-            // only the barrier below is left out of it (and a block costs no clock reads).
-            if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         }
         // Publish this round's blocks at once (one store per round, not per block).
         if (ran > 0) {
             mine += ran;
             run.finished[me].value.store(mine, std::memory_order_release);
         }
+        // One span per participant and phase, from its first block to the end of its last:
+        // between its blocks it claims the next one, which is its own work, not a wait, so
+        // only the barrier below is left out of it (and a block costs no clock reads). Taken
+        // after the blocks are published: the clock read and the record would otherwise hold
+        // up every participant waiting for them, in a traced run only.
+        if (tracing && ran > 0 && !one_block(phase)) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         wait_for_blocks(run, me, mine, done_target);
     }
 }
