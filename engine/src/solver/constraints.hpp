@@ -405,7 +405,7 @@ struct SolverScratch {
     std::vector<std::uint32_t> lead_blocked, lead_free;
     std::vector<std::uint8_t> in_tail;  // per solver body: whether a tail colour writes it
     bool lead_made = false;
-    bool fuse_tails = true;  // false: every tail a round of its own (tests compare the two)
+    bool carry_tails = true;  // false: every tail a round of its own (tests compare the two)
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,

@@ -498,7 +498,7 @@ void split_lead(SolverScratch& scratch, int lead, int tail) {
 // colour before it, the lead's blocked contacts after the tail (the same item), and the
 // lead's free contacts share no dynamic body with the tail, so any worker may run them beside it.
 void carry_tail(SolverScratch& scratch, std::size_t first) {
-    if (!scratch.fuse_tails || first == 0 || first == scratch.phases.size() || !scratch.joints.empty() ||
+    if (!scratch.carry_tails || first == 0 || first == scratch.phases.size() || !scratch.joints.empty() ||
         scratch.wide.size() > scratch.wide_begin[kColorCount])
         return;
     const Pass pass = scratch.plan[first - 1].pass;

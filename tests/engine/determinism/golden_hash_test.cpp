@@ -185,7 +185,7 @@ struct FoldRun {
 };
 
 // The fold tests count the phases the fold saves alone: the tails stay rounds of their own
-// (SolverScratch::fuse_tails) unless `carry_tails`.
+// (SolverScratch::carry_tails) unless `carry_tails`.
 FoldRun run_folded(const SceneDesc& scene, int steps, JobSystem& jobs, bool fold, bool carry_tails = false);
 
 // The scene folded and not, on the single-threaded job system and 1 and 2 workers: the
@@ -213,7 +213,7 @@ FoldRun run_folded(const SceneDesc& scene, int steps, JobSystem& jobs, bool fold
     build(scene, space);
     SolverScratch& solver = *SpaceInternals::world(space).solver;
     solver.fold_body_passes = fold;
-    solver.fuse_tails = carry_tails;
+    solver.carry_tails = carry_tails;
     auto* stealing = dynamic_cast<WorkStealingJobSystem*>(&jobs);
     const std::uint64_t phases_before = stealing ? stealing->phases_run() : 0;
     for (int i = 0; i < steps; ++i) space.update();
