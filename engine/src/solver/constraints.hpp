@@ -281,6 +281,9 @@ enum class Pass : std::uint8_t {
 // A pass's first colour may carry the tail of the pass before it (SolverScratch::tail_plan):
 // its item 0 runs the tail's phases, then its own constraints that touch a body of the tail
 // (lead_blocked); its other items are its other constraints (lead_free), then the chunks.
+// StoreAndFinalize may carry the last pass's tail (`color` its first colour): item 0 runs it,
+// stores its contacts' impulses and finalizes its bodies; then the other contacts, then
+// chunks of the other bodies.
 struct SolverPhase {
     Pass pass = Pass::Solve;
     int color = 0;
@@ -403,7 +406,8 @@ struct SolverScratch {
     std::vector<SolverPhase> tail_plan;
     std::vector<std::uint32_t> tail_counts;
     std::vector<std::uint32_t> lead_blocked, lead_free;
-    std::vector<std::uint8_t> in_tail;  // per solver body: whether a tail colour writes it
+    std::vector<std::uint8_t> in_tail;       // per solver body: whether a tail colour writes it
+    std::vector<std::uint32_t> tail_bodies;  // those bodies, in order
     bool lead_made = false;
     bool carry_tails = true;  // false: every tail a round of its own (tests compare the two)
 };

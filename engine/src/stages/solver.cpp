@@ -466,7 +466,8 @@ bool tail_color(const SolverScratch& scratch, std::size_t p) {
 }
 
 // SolverScratch::lead_blocked and lead_free: colour `lead`'s wide contacts that share a
-// dynamic body with colours [tail, kColorCount), and the others, in colour order.
+// dynamic body with colours [tail, kColorCount), and the others, in colour order; and those
+// bodies (in_tail, tail_bodies).
 void split_lead(SolverScratch& scratch, int lead, int tail) {
     scratch.in_tail.assign(scratch.bodies.size(), 0);
     auto mark = [&](std::uint32_t k) {
@@ -478,6 +479,10 @@ void split_lead(SolverScratch& scratch, int lead, int tail) {
             mark(wc.a[l]);
             mark(wc.b[l]);
         }
+    }
+    scratch.tail_bodies.clear();
+    for (std::uint32_t k = 0; k < scratch.in_tail.size(); ++k) {
+        if (scratch.in_tail[k] != 0) scratch.tail_bodies.push_back(k);
     }
     scratch.lead_blocked.clear();
     scratch.lead_free.clear();
@@ -491,29 +496,27 @@ void split_lead(SolverScratch& scratch, int lead, int tail) {
     scratch.lead_made = true;
 }
 
-// Moves the tail of the pass planned before phase `first` (its last colours, one block each,
-// after a bigger colour of that pass) into item 0 of phase `first`, the next pass's first
-// colour (SolverScratch::tail_plan says why). Only for wide contacts alone: with joints or an
-// overflow the tail stays a round of its own. The tail runs after the barrier that ends the
-// colour before it, the lead's blocked contacts after the tail (the same item), and the
-// lead's free contacts share no dynamic body with the tail, so any worker may run them beside it.
-void carry_tail(SolverScratch& scratch, std::size_t first) {
-    if (!scratch.carry_tails || first == 0 || first == scratch.phases.size() || !scratch.joints.empty() ||
+// Where the tail of the constraint pass planned last before phase `first` begins (its last
+// colours, one block each, after a bigger colour of that pass); `first` if it has none. Only
+// for wide contacts alone: with joints or an overflow a tail stays a round of its own.
+std::size_t tail_before(const SolverScratch& scratch, std::size_t first) {
+    if (!scratch.carry_tails || first == 0 || !scratch.joints.empty() ||
         scratch.wide.size() > scratch.wide_begin[kColorCount])
-        return;
+        return first;
     const Pass pass = scratch.plan[first - 1].pass;
-    if (pass != Pass::WarmStart && pass != Pass::Solve && pass != Pass::Relax && pass != Pass::Restitution) return;
-    const int lead = scratch.plan[first].color;
-    if (lead == kColorCount || scratch.wide_begin[lead + 1] - scratch.wide_begin[lead] <= kOneBlockColor) return;
-    const std::uint32_t lead_wides = scratch.wide_begin[lead + 1] - scratch.wide_begin[lead];
+    if (pass != Pass::WarmStart && pass != Pass::Solve && pass != Pass::Relax && pass != Pass::Restitution)
+        return first;
     std::size_t from = first;
     while (from > 0 && scratch.plan[from - 1].pass == pass && tail_color(scratch, from - 1)) --from;
     // The tail follows a bigger colour of its pass: a pass of small colours only is left alone.
     if (from == first || from == 0 || scratch.plan[from - 1].pass != pass || tail_color(scratch, from - 1) ||
         scratch.plan[from - 1].color >= scratch.plan[from].color)
-        return;
-    // Every pass has the same colours (wide contacts only): one split serves them all.
-    if (!scratch.lead_made) split_lead(scratch, lead, scratch.plan[from].color);
+        return first;
+    return from;
+}
+
+// Moves plan entries [from, first) into SolverScratch::tail_plan; returns where they begin there.
+std::uint32_t move_tail(SolverScratch& scratch, std::size_t from, std::size_t first) {
     const auto tail_begin = static_cast<std::uint32_t>(scratch.tail_plan.size());
     for (std::size_t p = from; p < first; ++p) {
         scratch.tail_plan.push_back(scratch.plan[p]);
@@ -523,6 +526,24 @@ void carry_tail(SolverScratch& scratch, std::size_t first) {
                        scratch.plan.begin() + static_cast<std::ptrdiff_t>(first));
     scratch.phases.erase(scratch.phases.begin() + static_cast<std::ptrdiff_t>(from),
                          scratch.phases.begin() + static_cast<std::ptrdiff_t>(first));
+    return tail_begin;
+}
+
+// Moves the tail of the pass planned before phase `first` into item 0 of phase `first`, the
+// next pass's first colour (SolverScratch::tail_plan says why). The tail runs after the
+// barrier that ends the colour before it, the lead's blocked contacts after the tail (the same
+// item), and the lead's free contacts share no dynamic body with the tail, so any worker may
+// run them beside it.
+void carry_tail(SolverScratch& scratch, std::size_t first) {
+    if (first == scratch.phases.size()) return;
+    const int lead = scratch.plan[first].color;
+    if (lead == kColorCount || scratch.wide_begin[lead + 1] - scratch.wide_begin[lead] <= kOneBlockColor) return;
+    const std::uint32_t lead_wides = scratch.wide_begin[lead + 1] - scratch.wide_begin[lead];
+    const std::size_t from = tail_before(scratch, first);
+    if (from == first) return;
+    // Every pass has the same colours (wide contacts only): one split serves them all.
+    if (!scratch.lead_made) split_lead(scratch, lead, scratch.plan[from].color);
+    const std::uint32_t tail_begin = move_tail(scratch, from, first);
     SolverPhase& carrier = scratch.plan[from];
     Phase& carrier_phase = scratch.phases[from];
     carrier.tail_begin = tail_begin;
@@ -615,10 +636,21 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     if (scratch.fold_body_passes && scratch.joints.empty() && !scratch.wide.empty()) {
         // Storing the contacts' impulses and finalizing the bodies read and write nothing of
         // each other's: one phase, the bodies in chunks after the wide contacts.
-        const auto wide = static_cast<std::uint32_t>(scratch.wide.size());
+        auto wide = static_cast<std::uint32_t>(scratch.wide.size());
+        SolverPhase store{Pass::StoreImpulses, 0, true, wide};
+        // The last pass's tail too, in item 0, then the tail's own contacts' impulses and its
+        // bodies; the other contacts and bodies beside it (SolverScratch::tail_plan).
+        const std::size_t last = scratch.phases.size();
+        if (const std::size_t from = tail_before(scratch, last); from != last && scratch.lead_made) {
+            store.color = scratch.plan[from].color;
+            store.tail_begin = move_tail(scratch, from, last);
+            store.tail_end = static_cast<std::uint32_t>(scratch.tail_plan.size());
+            wide = 1 + scratch.wide_begin[store.color];
+            store.constraints = wide;
+        }
         scratch.phases.push_back(
             Phase{"StoreAndFinalize", wide + (n + kBodyPassGrain - 1) / kBodyPassGrain, kWideGrain});
-        scratch.plan.push_back(SolverPhase{Pass::StoreImpulses, 0, true, wide});
+        scratch.plan.push_back(store);
         return;
     }
     plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
@@ -830,13 +862,45 @@ void solve(World& world, Real dt) {
             run_items(own, own.constraints + chunks_from - carrier.constraints,
                       own.constraints + hi - carrier.constraints, worker);
     };
+    // Items [lo, hi) of StoreAndFinalize carrying the last pass's tail: item 0 the tail, its
+    // contacts' impulses and its bodies; then the other contacts, then chunks of the other bodies.
+    const std::span<const std::uint8_t> in_tail(scratch.in_tail);
+    auto run_store_carrier = [&](const SolverPhase& carrier, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+        auto finalize = [&](std::uint32_t from, std::uint32_t to) {
+            finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
+        };
+        if (lo == 0) {
+            for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
+                run_items(scratch.tail_plan[t], 0, scratch.tail_counts[t], worker);
+            store_contact_impulses(world, scratch, scratch.wide_begin[carrier.color],
+                                   static_cast<std::uint32_t>(scratch.wide.size()));
+            for (std::uint32_t k : scratch.tail_bodies) finalize(k, k + 1);
+            lo = 1;
+        }
+        if (lo < carrier.constraints)
+            store_contact_impulses(world, scratch, lo - 1, std::min(hi, carrier.constraints) - 1);
+        body_chunks(carrier, lo, hi, static_cast<std::uint32_t>(world.awake.size()),
+                    [&](std::uint32_t from, std::uint32_t to) {
+                        for (std::uint32_t k = from; k < to;) {  // runs of bodies the tail does not touch
+                            if (in_tail[k] != 0) {
+                                ++k;
+                                continue;
+                            }
+                            const std::uint32_t run = k;
+                            while (k < to && in_tail[k] == 0) ++k;
+                            finalize(run, k);
+                        }
+                    });
+    };
     world.jobs->run_phases("Solver", scratch.phases,
                            [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
                                const SolverPhase& phase = scratch.plan[p];
-                               if (phase.tail_end > phase.tail_begin) {
-                                   run_carrier(phase, lo, hi, worker);
-                               } else {
+                               if (phase.tail_end == phase.tail_begin) {
                                    run_items(phase, lo, hi, worker);
+                               } else if (phase.pass == Pass::StoreImpulses) {
+                                   run_store_carrier(phase, lo, hi, worker);
+                               } else {
+                                   run_carrier(phase, lo, hi, worker);
                                }
                            });
     for (const EffectCounts& c : world.scratch_counts) {

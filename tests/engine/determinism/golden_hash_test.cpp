@@ -306,7 +306,8 @@ TEST(GoldenHash, FoldedIntegrationWithKinematicBodiesGivesTheSameBitsAsItsOwnPas
 
 // A pass's tail (its last colours of a few wide contacts, a round of one worker) carried into
 // the first item of the next pass's first colour, before that colour's contacts that share a
-// body with it, while the colour's other contacts run beside it (SolverScratch::tail_plan):
+// body with it, while the colour's other contacts run beside it, and the last pass's into
+// StoreAndFinalize, before its own contacts' impulses and its bodies (SolverScratch::tail_plan):
 // each body meets its constraints in the same order, so the same bits as the tails as rounds
 // of their own, on the single-threaded job system and 1 and 2 workers, in fewer phases.
 // turntable's boxes have tail colours from the start (the pyramid's only once it has landed,
