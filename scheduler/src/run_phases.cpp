@@ -50,11 +50,19 @@ void share_block(std::uint32_t items, std::uint32_t grain, std::uint32_t b, std:
 bool one_block(const Phase& phase) { return phase.count <= std::max<std::uint32_t>(phase.grain, 1); }
 
 // One run_phases call, on the caller's stack. Each phase is cut into one share per
-// participant and each share into blocks. claimed[j] counts the blocks taken from share
-// j over every phase so far, finished[j] the blocks participant j has run: a phase is
-// over when the finished blocks add up to the blocks of all phases up to it. No counter
-// is reset between phases, so a participant that starts late just walks past the phases
-// that are over. A round of one-block phases is one block of share 0.
+// participant and each share into blocks. claimed[r % 2][j] counts the blocks taken from
+// share j over every other round so far (r counts the rounds with items), finished[j] the
+// blocks participant j has run: a phase is over when the finished blocks add up to the
+// blocks of all phases up to it. No counter is reset between phases, so a participant that
+// starts late just walks past the phases that are over. A round of one-block phases is one
+// block of share 0.
+//
+// Two claim counters a share, a round's and the next's: whoever finishes its own share first
+// takes the other's counter to its core, claiming what is left of it, so the owner's first
+// claim of the next round would fetch it back (one transfer between cores as every round
+// begins, on its critical path). While a round runs nobody touches the next round's
+// counters, so each participant fetches its own for writing at the start of a round
+// (a prefetch: it waits for nothing) and finds it in its cache when the next one begins.
 //
 // Each participant writes only its own finished count (a plain store), and the others
 // read it: the last to finish a phase does not first take a shared counter from the
@@ -67,7 +75,7 @@ struct PhaseRun {
     PhaseFn fn;
     const char* name;
     unsigned participants;
-    CacheLinePadded<std::atomic<std::uint32_t>> claimed[WorkStealingJobSystem::kMaxPhaseWorkers];
+    CacheLinePadded<std::atomic<std::uint32_t>> claimed[2][WorkStealingJobSystem::kMaxPhaseWorkers];
     CacheLinePadded<std::atomic<std::uint64_t>> finished[WorkStealingJobSystem::kMaxPhaseWorkers];
     std::uint64_t phases_run = 0;  // phases with items and rounds, counted by participant 0,
     std::uint64_t barriers = 0;    // which walks every round
@@ -91,20 +99,23 @@ void wait_for_blocks(PhaseRun& run, unsigned me, std::uint64_t mine, std::uint64
 }
 
 // Participant `me`'s part of a round of one-block phases [p, end): the whole round if it
-// claims it. Returns the blocks it ran (0 or 1).
+// claims it (from the round's counter of share 0). Returns the blocks it ran (0 or 1).
 std::uint64_t run_one_block_round(PhaseRun& run, std::uint32_t p, std::uint32_t end, std::uint32_t share_end,
-                                  unsigned worker, Worker& self) noexcept {
-    std::atomic<std::uint32_t>& claimed = run.claimed[0].value;
+                                  unsigned parity, unsigned worker, Worker& self) noexcept {
+    std::atomic<std::uint32_t>& claimed = run.claimed[parity][0].value;
     std::uint32_t seen = claimed.load(std::memory_order_relaxed);
     while (seen < share_end) {
         if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
         const bool tracing = self.system->trace_enabled();
+        std::int64_t traced_from = tracing ? now_nanoseconds() : 0;  // each phase's span begins where the last ended
         for (std::uint32_t q = p; q < end; ++q) {
             const Phase& phase = run.phases[q];
             if (phase.count == 0) continue;
-            const std::int64_t traced_from = tracing ? now_nanoseconds() : 0;
             run.fn(q, 0, phase.count, worker);
-            if (tracing) self.record(phase.name, run.name, traced_from, now_nanoseconds());
+            if (!tracing) continue;
+            const std::int64_t traced_to = now_nanoseconds();
+            self.record(phase.name, run.name, traced_from, traced_to);
+            traced_from = traced_to;
         }
         return 1;
     }
@@ -115,9 +126,11 @@ std::uint64_t run_one_block_round(PhaseRun& run, std::uint32_t p, std::uint32_t 
 // share first, then what is left of the others'; then the barrier.
 void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexcept {
     const unsigned n = run.participants;
-    std::uint32_t taken_before[WorkStealingJobSystem::kMaxPhaseWorkers] = {};  // claimed[j] when the phase began
-    std::uint64_t done_target = 0;                                             // blocks of the rounds so far
-    std::uint64_t mine = 0;  // blocks this participant ran, as in finished[me]
+    // claimed[r % 2][j] when round r began, and r % 2 (flipped as each round begins)
+    std::uint32_t taken_before[2][WorkStealingJobSystem::kMaxPhaseWorkers] = {};
+    unsigned parity = 1;
+    std::uint64_t done_target = 0;  // blocks of the rounds so far
+    std::uint64_t mine = 0;         // blocks this participant ran, as in finished[me]
     const bool tracing = self.system->trace_enabled();
     const auto phase_count = static_cast<std::uint32_t>(run.phases.size());
     for (std::uint32_t p = 0, end = 0; p < phase_count; p = end) {
@@ -129,47 +142,51 @@ void take_part(PhaseRun& run, unsigned me, unsigned worker, Worker& self) noexce
             ++run.barriers;
         }
         std::uint64_t ran = 0;
+        parity ^= 1;
+        __builtin_prefetch(&run.claimed[parity ^ 1][me].value, 1);  // for writing, next round
+        std::int64_t traced_from = 0;  // when this participant claimed its first block of a split phase
         if (one_block(phase)) {
             while (end < phase_count && one_block(run.phases[end])) {
                 if (me == 0 && run.phases[end].count > 0) ++run.phases_run;
                 ++end;
             }
             done_target += 1;
-            taken_before[0] += 1;
-            ran = run_one_block_round(run, p, end, taken_before[0], worker, self);
+            taken_before[parity][0] += 1;
+            ran = run_one_block_round(run, p, end, taken_before[parity][0], parity, worker, self);
         } else {
             const std::uint32_t grain = std::max<std::uint32_t>(phase.grain, 1);
-            std::int64_t traced_from = 0;  // when this participant claimed its first block of the phase
             for (unsigned step = 0; step < n; ++step) {
                 const unsigned j = (me + step) % n;
                 const auto first = static_cast<std::uint32_t>(std::uint64_t{phase.count} * j / n);
                 const auto items = static_cast<std::uint32_t>(std::uint64_t{phase.count} * (j + 1) / n) - first;
                 const std::uint32_t blocks = share_blocks(items, grain);
                 done_target += blocks;
-                const std::uint32_t share_end = taken_before[j] + blocks;
-                std::atomic<std::uint32_t>& claimed = run.claimed[j].value;
+                const std::uint32_t share_end = taken_before[parity][j] + blocks;
+                std::atomic<std::uint32_t>& claimed = run.claimed[parity][j].value;
                 std::uint32_t seen = claimed.load(std::memory_order_relaxed);
                 while (seen < share_end) {
                     if (!claimed.compare_exchange_weak(seen, seen + 1, std::memory_order_relaxed)) continue;
                     std::uint32_t lo = 0, hi = 0;
-                    share_block(items, grain, seen - taken_before[j], lo, hi);
+                    share_block(items, grain, seen - taken_before[parity][j], lo, hi);
                     if (tracing && ran == 0) traced_from = now_nanoseconds();
                     run.fn(p, first + lo, first + hi, worker);
                     ++ran;
                     ++seen;
                 }
-                taken_before[j] = share_end;
+                taken_before[parity][j] = share_end;
             }
-            // One span per participant and phase, from its first block to the end of its last:
-            // between its blocks it claims the next one, which is its own work, not a wait, so
-            // only the barrier below is left out of it (and a block costs no clock reads).
-            if (tracing && ran > 0) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         }
         // Publish this round's blocks at once (one store per round, not per block).
         if (ran > 0) {
             mine += ran;
             run.finished[me].value.store(mine, std::memory_order_release);
         }
+        // One span per participant and phase, from its first block to the end of its last:
+        // between its blocks it claims the next one, which is its own work, not a wait, so
+        // only the barrier below is left out of it (and a block costs no clock reads). Taken
+        // after the blocks are published: the clock read and the record would otherwise hold
+        // up every participant waiting for them, in a traced run only.
+        if (tracing && ran > 0 && !one_block(phase)) self.record(phase.name, run.name, traced_from, now_nanoseconds());
         wait_for_blocks(run, me, mine, done_target);
     }
 }

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <memory>
 #include <random>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -317,6 +318,24 @@ TEST(WorkStealing, TraceIsChromeJsonNamingJobsStagesWorkersAndPus) {
     EXPECT_EQ(std::system(check.c_str()), 0);
 }
 
+// A worker's chunks of one range are traced end to start: taking the next chunk is its own
+// work, so no gap between them may look like time it spent waiting (the serial fraction
+// counts such gaps), and a chunk costs one clock read, not two.
+TEST(WorkStealing, ConsecutiveChunksOfAWorkerAreTracedEndToStart) {
+    auto jobs = make(1);
+    jobs->enable_trace(true);
+    std::vector<double> sums(16, 0.0);
+    jobs->parallel_for("chunks", 0, 64, 4, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t i = lo; i < hi; ++i) sums[i / 4] += std::sqrt(static_cast<double>(i));
+    });
+    const std::vector<TraceEvent> events = jobs->trace_events();
+    ASSERT_EQ(events.size(), 16u);  // one worker: every chunk in one range, in order
+    for (std::size_t k = 1; k < events.size(); ++k) {
+        EXPECT_EQ(events[k].begin_ns, events[k - 1].end_ns) << "chunk " << k;
+        EXPECT_LE(events[k].begin_ns, events[k].end_ns);
+    }
+}
+
 namespace {
 
 // Phases whose items read the previous non-empty phase at scattered places: a phase
@@ -509,18 +528,28 @@ TEST(WorkStealing, ConsecutiveOneBlockPhases_RunBackToBackWithOneBarrier) {
     }
 }
 
+namespace {
+
+// The trace of one run_phases call, of phases that do nothing, on two workers.
+std::vector<TraceEvent> trace_of_phases(const char* name, std::span<const Phase> phases) {
+    auto jobs = make(2);
+    jobs->enable_trace(true);
+    jobs->run_phases(name, phases, [](std::uint32_t, std::uint32_t, std::uint32_t, unsigned) {});
+    return jobs->trace_events();
+}
+
+auto named(const char* name) {
+    return [name](const TraceEvent& e) { return std::strcmp(e.name, name) == 0; };
+}
+
+}  // namespace
+
 // A participant's blocks of a phase are one span (its claims between them are its own
 // work; the barrier after them is left out), named after the phase.
 TEST(WorkStealing, PhasesAreTracedOnceByEachParticipantThatRanBlocks) {
-    auto jobs = make(2);
-    jobs->enable_trace(true);
     const Phase phases[] = {{"alpha", 10, 1}, {"beta", 0, 1}, {"gamma", 3, 1}};
-    jobs->run_phases("Greek", phases, [](std::uint32_t, std::uint32_t, std::uint32_t, unsigned) {});
-    const std::vector<TraceEvent> events = jobs->trace_events();
-    auto count = [&](const char* name) {
-        return std::count_if(events.begin(), events.end(),
-                             [&](const TraceEvent& e) { return std::strcmp(e.name, name) == 0; });
-    };
+    const std::vector<TraceEvent> events = trace_of_phases("Greek", phases);
+    auto count = [&](const char* name) { return std::count_if(events.begin(), events.end(), named(name)); };
     // alpha's 10 items are 8 blocks (two shares of 5, each in blocks of 2, 1, 1, 1), gamma's 3
     // are 3: one span per participant that took any, whoever took which.
     EXPECT_GE(count("alpha"), 1);
@@ -534,4 +563,19 @@ TEST(WorkStealing, PhasesAreTracedOnceByEachParticipantThatRanBlocks) {
             EXPECT_LE(e.begin_ns, e.end_ns);
         }
     }
+}
+
+// A round of one-block phases runs on one participant, its phases traced end to start.
+TEST(WorkStealing, OneBlockRoundIsTracedPhaseAfterPhaseWithoutGaps) {
+    const Phase phases[] = {{"one", 1, 1}, {"two", 2, 2}, {"three", 1, 1}};
+    const std::vector<TraceEvent> events = trace_of_phases("Round", phases);
+    auto find = [&](const char* name) { return std::find_if(events.begin(), events.end(), named(name)); };
+    const auto one = find("one"), two = find("two"), three = find("three");
+    ASSERT_NE(one, events.end());
+    ASSERT_NE(two, events.end());
+    ASSERT_NE(three, events.end());
+    EXPECT_EQ(one->worker, two->worker);
+    EXPECT_EQ(two->worker, three->worker);
+    EXPECT_EQ(two->begin_ns, one->end_ns);
+    EXPECT_EQ(three->begin_ns, two->end_ns);
 }

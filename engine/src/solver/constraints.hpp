@@ -277,11 +277,20 @@ enum class Pass : std::uint8_t {
 // of its pass to touch (first_touch), and in its items past `constraints`, chunks of the
 // bodies no constraint touches; a StoreImpulses phase finalizes every awake body in chunks
 // past them.
+//
+// A pass's first colour may carry the tail of the pass before it (SolverScratch::tail_plan):
+// its item 0 runs the tail's phases, then its own constraints that touch a body of the tail
+// (lead_blocked); its other items are its other constraints (lead_free), then the chunks.
+// StoreAndFinalize may carry the last pass's tail (`color` its first colour): item 0 runs it,
+// stores its contacts' impulses and finalizes its bodies; then the other contacts, then
+// chunks of the other bodies.
 struct SolverPhase {
     Pass pass = Pass::Solve;
     int color = 0;
     bool integrates = false;        // carries its body pass
     std::uint32_t constraints = 0;  // items of its own pass, when it does; the chunks of bodies follow
+    std::uint32_t tail_begin = 0;   // the tail it carries: tail_plan[tail_begin, tail_end)
+    std::uint32_t tail_end = 0;
 };
 
 // Support mass scaling (support_scales.cpp): the factors a manifold's rows multiply each
@@ -386,6 +395,21 @@ struct SolverScratch {
     std::vector<std::uint8_t> supported;
     std::vector<Phase> phases;      // the step's solver loop, run by run_phases
     std::vector<SolverPhase> plan;  // what each phase does
+    // A pass's last colours of a few wide contacts each (its tail) are a round of run_phases:
+    // one worker runs them while the others wait, then a barrier. Without joints or an
+    // overflow, the tail runs instead in the first item of the next pass's first colour,
+    // before those of that colour's wide contacts that share a dynamic body with it
+    // (lead_blocked, few: the tail's bodies are few); its other wide contacts (lead_free) run
+    // beside the tail. Each body meets its constraints in the same order: the same results,
+    // a barrier fewer a pass. The tail phases (tail_plan, items in tail_counts), and the first
+    // colour's wide contacts, as indices into it, made once per colouring (lead_made).
+    std::vector<SolverPhase> tail_plan;
+    std::vector<std::uint32_t> tail_counts;
+    std::vector<std::uint32_t> lead_blocked, lead_free;
+    std::vector<std::uint8_t> in_tail;       // per solver body: whether a tail colour writes it
+    std::vector<std::uint32_t> tail_bodies;  // those bodies, in order
+    bool lead_made = false;
+    bool carry_tails = true;  // false: every tail a round of its own (tests compare the two)
 };
 
 // How contacts are solved in one pass (contact_solver.cpp): soft push-out with use_bias,

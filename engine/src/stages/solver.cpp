@@ -460,6 +460,101 @@ void integrate_first_touched(const SolverScratch& scratch, int color, std::uint3
     if (to > from) integrate(std::span<const std::uint32_t>(scratch.first_touched.data() + from, to - from));
 }
 
+// Whether plan entry p is a colour of a few wide contacts (one block: a round of run_phases).
+bool tail_color(const SolverScratch& scratch, std::size_t p) {
+    return scratch.plan[p].color < kColorCount && scratch.phases[p].count <= kOneBlockColor;
+}
+
+// SolverScratch::lead_blocked and lead_free: colour `lead`'s wide contacts that share a
+// dynamic body with colours [tail, kColorCount), and the others, in colour order; and those
+// bodies (in_tail, tail_bodies).
+void split_lead(SolverScratch& scratch, int lead, int tail) {
+    scratch.in_tail.assign(scratch.bodies.size(), 0);
+    auto mark = [&](std::uint32_t k) {
+        if (scratch.bodies[k].dynamic) scratch.in_tail[k] = 1;
+    };
+    for (std::uint32_t w = scratch.wide_begin[tail]; w < scratch.wide_begin[kColorCount]; ++w) {
+        const WideContact& wc = scratch.wide[w];
+        for (int l = 0; l < wc.lanes; ++l) {
+            mark(wc.a[l]);
+            mark(wc.b[l]);
+        }
+    }
+    scratch.tail_bodies.clear();
+    for (std::uint32_t k = 0; k < scratch.in_tail.size(); ++k) {
+        if (scratch.in_tail[k] != 0) scratch.tail_bodies.push_back(k);
+    }
+    scratch.lead_blocked.clear();
+    scratch.lead_free.clear();
+    for (std::uint32_t w = scratch.wide_begin[lead]; w < scratch.wide_begin[lead + 1]; ++w) {
+        const WideContact& wc = scratch.wide[w];
+        bool shares = false;
+        for (int l = 0; l < wc.lanes; ++l)
+            shares = shares || scratch.in_tail[wc.a[l]] != 0 || scratch.in_tail[wc.b[l]] != 0;
+        (shares ? scratch.lead_blocked : scratch.lead_free).push_back(w - scratch.wide_begin[lead]);
+    }
+    scratch.lead_made = true;
+}
+
+// Where the tail of the constraint pass planned last before phase `first` begins (its last
+// colours, one block each, after a bigger colour of that pass); `first` if it has none. Only
+// for wide contacts alone: with joints or an overflow a tail stays a round of its own.
+std::size_t tail_before(const SolverScratch& scratch, std::size_t first) {
+    if (!scratch.carry_tails || first == 0 || !scratch.joints.empty() ||
+        scratch.wide.size() > scratch.wide_begin[kColorCount])
+        return first;
+    const Pass pass = scratch.plan[first - 1].pass;
+    if (pass != Pass::WarmStart && pass != Pass::Solve && pass != Pass::Relax && pass != Pass::Restitution)
+        return first;
+    std::size_t from = first;
+    while (from > 0 && scratch.plan[from - 1].pass == pass && tail_color(scratch, from - 1)) --from;
+    // The tail follows a bigger colour of its pass: a pass of small colours only is left alone.
+    if (from == first || from == 0 || scratch.plan[from - 1].pass != pass || tail_color(scratch, from - 1) ||
+        scratch.plan[from - 1].color >= scratch.plan[from].color)
+        return first;
+    return from;
+}
+
+// Moves plan entries [from, first) into SolverScratch::tail_plan; returns where they begin there.
+std::uint32_t move_tail(SolverScratch& scratch, std::size_t from, std::size_t first) {
+    const auto tail_begin = static_cast<std::uint32_t>(scratch.tail_plan.size());
+    for (std::size_t p = from; p < first; ++p) {
+        scratch.tail_plan.push_back(scratch.plan[p]);
+        scratch.tail_counts.push_back(scratch.phases[p].count);
+    }
+    scratch.plan.erase(scratch.plan.begin() + static_cast<std::ptrdiff_t>(from),
+                       scratch.plan.begin() + static_cast<std::ptrdiff_t>(first));
+    scratch.phases.erase(scratch.phases.begin() + static_cast<std::ptrdiff_t>(from),
+                         scratch.phases.begin() + static_cast<std::ptrdiff_t>(first));
+    return tail_begin;
+}
+
+// Moves the tail of the pass planned before phase `first` into item 0 of phase `first`, the
+// next pass's first colour (SolverScratch::tail_plan says why). The tail runs after the
+// barrier that ends the colour before it, the lead's blocked contacts after the tail (the same
+// item), and the lead's free contacts share no dynamic body with the tail, so any worker may
+// run them beside it.
+void carry_tail(SolverScratch& scratch, std::size_t first) {
+    if (first == scratch.phases.size()) return;
+    const int lead = scratch.plan[first].color;
+    if (lead == kColorCount || scratch.wide_begin[lead + 1] - scratch.wide_begin[lead] <= kOneBlockColor) return;
+    const std::uint32_t lead_wides = scratch.wide_begin[lead + 1] - scratch.wide_begin[lead];
+    const std::size_t from = tail_before(scratch, first);
+    if (from == first) return;
+    // Every pass has the same colours (wide contacts only): one split serves them all.
+    if (!scratch.lead_made) split_lead(scratch, lead, scratch.plan[from].color);
+    const std::uint32_t tail_begin = move_tail(scratch, from, first);
+    SolverPhase& carrier = scratch.plan[from];
+    Phase& carrier_phase = scratch.phases[from];
+    carrier.tail_begin = tail_begin;
+    carrier.tail_end = static_cast<std::uint32_t>(scratch.tail_plan.size());
+    // Item 0, then the free contacts, then the chunks of bodies if it integrates.
+    const std::uint32_t chunks = carrier_phase.count - lead_wides;
+    carrier.constraints = 1 + static_cast<std::uint32_t>(scratch.lead_free.size());
+    carrier_phase.count = carrier.constraints + chunks;
+    carrier_phase.grain = kConstraintGrain;
+}
+
 // Adds the phases of one pass over the constraints: one per colour that has any (its
 // joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
 // With `integrates`, each of its phases integrates the bodies it touches first, and the
@@ -482,15 +577,18 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
         scratch.phases.push_back(Phase{name, 1, 1});
         scratch.plan.push_back(SolverPhase{pass, kColorCount});
     }
-    if (!integrates || first == scratch.phases.size()) return;
-    for (std::size_t p = first; p < scratch.phases.size(); ++p) {
-        scratch.plan[p].integrates = true;
-        scratch.plan[p].constraints = scratch.phases[p].count;
+    if (integrates && first != scratch.phases.size()) {
+        for (std::size_t p = first; p < scratch.phases.size(); ++p) {
+            scratch.plan[p].integrates = true;
+            scratch.plan[p].constraints = scratch.phases[p].count;
+        }
+        const auto chunks =
+            static_cast<std::uint32_t>((scratch.untouched.size() + kBodyPassGrain - 1) / kBodyPassGrain);
+        Phase& phase = scratch.phases[first];
+        phase.count += chunks;
+        phase.grain = phase.count <= kOneBlockColor ? phase.count : kConstraintGrain;
     }
-    const auto chunks = static_cast<std::uint32_t>((scratch.untouched.size() + kBodyPassGrain - 1) / kBodyPassGrain);
-    Phase& phase = scratch.phases[first];
-    phase.count += chunks;
-    phase.grain = phase.count <= kOneBlockColor ? phase.count : kConstraintGrain;
+    carry_tail(scratch, first);
 }
 
 void plan_body_pass(SolverScratch& scratch, Pass pass, const char* name, std::uint32_t bodies) {
@@ -510,6 +608,8 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     scratch.phases.clear();
     scratch.plan.clear();
+    scratch.tail_plan.clear();
+    scratch.tail_counts.clear();
     plan_wide_pass(scratch, Pass::PrepareContacts, "PrepareContacts");
     if (!scratch.wide_joints.empty()) {
         scratch.phases.push_back(
@@ -536,10 +636,21 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     if (scratch.fold_body_passes && scratch.joints.empty() && !scratch.wide.empty()) {
         // Storing the contacts' impulses and finalizing the bodies read and write nothing of
         // each other's: one phase, the bodies in chunks after the wide contacts.
-        const auto wide = static_cast<std::uint32_t>(scratch.wide.size());
+        auto wide = static_cast<std::uint32_t>(scratch.wide.size());
+        SolverPhase store{Pass::StoreImpulses, 0, true, wide};
+        // The last pass's tail too, in item 0, then the tail's own contacts' impulses and its
+        // bodies; the other contacts and bodies beside it (SolverScratch::tail_plan).
+        const std::size_t last = scratch.phases.size();
+        if (const std::size_t from = tail_before(scratch, last); from != last && scratch.lead_made) {
+            store.color = scratch.plan[from].color;
+            store.tail_begin = move_tail(scratch, from, last);
+            store.tail_end = static_cast<std::uint32_t>(scratch.tail_plan.size());
+            wide = 1 + scratch.wide_begin[store.color];
+            store.constraints = wide;
+        }
         scratch.phases.push_back(
             Phase{"StoreAndFinalize", wide + (n + kBodyPassGrain - 1) / kBodyPassGrain, kWideGrain});
-        scratch.plan.push_back(SolverPhase{Pass::StoreImpulses, 0, true, wide});
+        scratch.plan.push_back(store);
         return;
     }
     plan_wide_pass(scratch, Pass::StoreImpulses, "StoreImpulses");
@@ -597,6 +708,7 @@ void solve(World& world, Real dt) {
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
         find_first_touches(*world.jobs, scratch, static_cast<std::uint32_t>(world.awake.size()));
+        scratch.lead_made = false;
         world.counters.constraint_colorings += 1;
     }
     // Folded only where every phase that integrates has a constraint to carry it.
@@ -656,84 +768,141 @@ void solve(World& world, Real dt) {
         body_chunks(phase, lo, hi, static_cast<std::uint32_t>(untouched.size()),
                     [&](std::uint32_t from, std::uint32_t to) { integrate(untouched.subspan(from, to - from)); });
     };
-    world.jobs->run_phases(
-        "Solver", scratch.phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
-            const SolverPhase phase = scratch.plan[p];
-            EffectCounts& counts = world.scratch_counts[worker];
-            switch (phase.pass) {
-                case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
-                case Pass::PrepareJoints: prepare_joint_lanes(scratch, lo, hi); break;
-                case Pass::StoreImpulses:
-                    if (!phase.integrates) {
-                        store_contact_impulses(world, scratch, lo, hi);
-                        break;
-                    }
-                    store_contact_impulses(world, scratch, std::min(lo, phase.constraints),
-                                           std::min(hi, phase.constraints));
-                    body_chunks(phase, lo, hi, static_cast<std::uint32_t>(world.awake.size()),
-                                [&](std::uint32_t from, std::uint32_t to) {
-                                    finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
-                                });
-                    break;
-                case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
-                case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
-                case Pass::FinalizeBodies: finalize_bodies(world, scratch, dt, lo, hi, world.fast_lists[worker]); break;
-                case Pass::IntegrateVelocities:
-                    integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
-                    break;
-                case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi); break;
-                case Pass::IntegrateKinematic:
-                    integrate_positions(world, bodies, push, h,
-                                        std::span<const std::uint32_t>(scratch.kinematic).subspan(lo, hi - lo));
-                    break;
-                case Pass::WarmStart: {
-                    if (phase.integrates) {
-                        integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
-                            integrate_velocities(world, bodies, gravity_scales, h, ks, counts);
-                        });
-                    }
-                    const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
-                    if (lo >= own) break;
-                    for_colored<true>(
-                        scratch, phase.color, lo, own,
-                        [&](WideJoint& wj) { warm_start_joint_lanes(scratch, wj, bodies); },
-                        [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
-                        [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies, push); });
+    // Constraints [lo, hi) of a colour solved, with a pass's bias or without.
+    auto solve_colored = [&](int color, std::uint32_t lo, std::uint32_t hi, const JointSolveParams& joint_params,
+                             const ContactSolveParams& contact_params, EffectCounts& counts) {
+        for_colored<true>(
+            scratch, color, lo, hi,
+            [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_params, counts); },
+            [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_params, counts); },
+            [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, push, contact_params, counts); });
+    };
+    // Items [lo, hi) of a phase of the plan.
+    auto run_items = [&](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+        EffectCounts& counts = world.scratch_counts[worker];
+        switch (phase.pass) {
+            case Pass::PrepareContacts: prepare_contacts(world, scratch, solve_params, lo, hi); break;
+            case Pass::PrepareJoints: prepare_joint_lanes(scratch, lo, hi); break;
+            case Pass::StoreImpulses:
+                if (!phase.integrates) {
+                    store_contact_impulses(world, scratch, lo, hi);
                     break;
                 }
-                case Pass::Solve:
-                    for_colored<true>(
-                        scratch, phase.color, lo, hi,
-                        [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_solve, counts); },
-                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_solve, counts); },
-                        [&](WideContact& wc) {
-                            solve_contact(wc, push_anchors(wc), bodies, push, solve_params, counts);
-                        });
-                    break;
-                case Pass::Relax: {
-                    if (phase.integrates) {
-                        integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
-                            integrate_positions(world, bodies, push, h, ks);
-                        });
-                    }
-                    const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
-                    if (lo >= own) break;
-                    for_colored<true>(
-                        scratch, phase.color, lo, own,
-                        [&](WideJoint& wj) { solve_joint_lanes(scratch, wj, bodies, joint_relax, counts); },
-                        [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_relax, counts); },
-                        [&](WideContact& wc) {
-                            solve_contact(wc, push_anchors(wc), bodies, push, relax_params, counts);
-                        });
-                    break;
+                store_contact_impulses(world, scratch, std::min(lo, phase.constraints),
+                                       std::min(hi, phase.constraints));
+                body_chunks(phase, lo, hi, static_cast<std::uint32_t>(world.awake.size()),
+                            [&](std::uint32_t from, std::uint32_t to) {
+                                finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
+                            });
+                break;
+            case Pass::StoreJointLanes: store_joint_lane_impulses(scratch, lo, hi); break;
+            case Pass::StoreJoints: store_joint_impulses(world, scratch, lo, hi); break;
+            case Pass::FinalizeBodies: finalize_bodies(world, scratch, dt, lo, hi, world.fast_lists[worker]); break;
+            case Pass::IntegrateVelocities:
+                integrate_velocities(world, bodies, gravity_scales, h, lo, hi, counts);
+                break;
+            case Pass::IntegratePositions: integrate_positions(world, bodies, push, h, lo, hi); break;
+            case Pass::IntegrateKinematic:
+                integrate_positions(world, bodies, push, h,
+                                    std::span<const std::uint32_t>(scratch.kinematic).subspan(lo, hi - lo));
+                break;
+            case Pass::WarmStart: {
+                if (phase.integrates) {
+                    integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
+                        integrate_velocities(world, bodies, gravity_scales, h, ks, counts);
+                    });
                 }
-                case Pass::Restitution:
-                    for_colored<false>(
-                        scratch, phase.color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
-                        [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
-                    break;
+                const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
+                if (lo >= own) break;
+                for_colored<true>(
+                    scratch, phase.color, lo, own, [&](WideJoint& wj) { warm_start_joint_lanes(scratch, wj, bodies); },
+                    [&](JointConstraint& jc) { warm_start_joint(jc, bodies); },
+                    [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies, push); });
+                break;
             }
-        });
+            case Pass::Solve: solve_colored(phase.color, lo, hi, joint_solve, solve_params, counts); break;
+            case Pass::Relax: {
+                if (phase.integrates) {
+                    integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
+                        integrate_positions(world, bodies, push, h, ks);
+                    });
+                }
+                const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
+                if (lo < own) solve_colored(phase.color, lo, own, joint_relax, relax_params, counts);
+                break;
+            }
+            case Pass::Restitution:
+                for_colored<false>(
+                    scratch, phase.color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
+                    [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
+                break;
+        }
+    };
+    // Items [lo, hi) of a first colour that carries the tail of the pass before it: item 0 the
+    // tail and then the colour's blocked contacts, then its free ones, then chunks of bodies.
+    const std::span<const std::uint32_t> lead_free(scratch.lead_free);
+    auto run_carrier = [&](const SolverPhase& carrier, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+        SolverPhase own = carrier;  // the colour as a phase of its own: its contacts, then the chunks
+        own.constraints = scratch.wide_begin[carrier.color + 1] - scratch.wide_begin[carrier.color];
+        if (lo == 0) {
+            for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
+                run_items(scratch.tail_plan[t], 0, scratch.tail_counts[t], worker);
+            for (std::uint32_t k : scratch.lead_blocked) run_items(own, k, k + 1, worker);
+            lo = 1;
+        }
+        // Free contacts in runs of consecutive ones.
+        for (std::uint32_t i = lo; i < std::min(hi, carrier.constraints);) {
+            const std::uint32_t from = lead_free[i - 1];
+            std::uint32_t to = from + 1;
+            for (++i; i < std::min(hi, carrier.constraints) && lead_free[i - 1] == to; ++i) ++to;
+            run_items(own, from, to, worker);
+        }
+        const std::uint32_t chunks_from = std::max(lo, carrier.constraints);
+        if (chunks_from < hi)
+            run_items(own, own.constraints + chunks_from - carrier.constraints,
+                      own.constraints + hi - carrier.constraints, worker);
+    };
+    // Items [lo, hi) of StoreAndFinalize carrying the last pass's tail: item 0 the tail, its
+    // contacts' impulses and its bodies; then the other contacts, then chunks of the other bodies.
+    const std::span<const std::uint8_t> in_tail(scratch.in_tail);
+    auto run_store_carrier = [&](const SolverPhase& carrier, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+        auto finalize = [&](std::uint32_t from, std::uint32_t to) {
+            finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
+        };
+        if (lo == 0) {
+            for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
+                run_items(scratch.tail_plan[t], 0, scratch.tail_counts[t], worker);
+            store_contact_impulses(world, scratch, scratch.wide_begin[carrier.color],
+                                   static_cast<std::uint32_t>(scratch.wide.size()));
+            for (std::uint32_t k : scratch.tail_bodies) finalize(k, k + 1);
+            lo = 1;
+        }
+        if (lo < carrier.constraints)
+            store_contact_impulses(world, scratch, lo - 1, std::min(hi, carrier.constraints) - 1);
+        body_chunks(carrier, lo, hi, static_cast<std::uint32_t>(world.awake.size()),
+                    [&](std::uint32_t from, std::uint32_t to) {
+                        for (std::uint32_t k = from; k < to;) {  // runs of bodies the tail does not touch
+                            if (in_tail[k] != 0) {
+                                ++k;
+                                continue;
+                            }
+                            const std::uint32_t run = k;
+                            while (k < to && in_tail[k] == 0) ++k;
+                            finalize(run, k);
+                        }
+                    });
+    };
+    world.jobs->run_phases("Solver", scratch.phases,
+                           [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
+                               const SolverPhase& phase = scratch.plan[p];
+                               if (phase.tail_end == phase.tail_begin) {
+                                   run_items(phase, lo, hi, worker);
+                               } else if (phase.pass == Pass::StoreImpulses) {
+                                   run_store_carrier(phase, lo, hi, worker);
+                               } else {
+                                   run_carrier(phase, lo, hi, worker);
+                               }
+                           });
     for (const EffectCounts& c : world.scratch_counts) {
         world.counters.gravity_applied += c.gravity;
         world.counters.damping_applied += c.damping;
