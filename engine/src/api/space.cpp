@@ -62,7 +62,7 @@ void stock_first_step_pages(World& w, std::size_t bytes) {
     w.unstocked_bytes += bytes;
     while (w.unstocked_bytes >= kHugePageBytes && w.stocked_pages < kMostStockedPages) {
         try {
-            stock_huge_pages(*w.jobs, 1);
+            stock_huge_page();
         } catch (const std::bad_alloc&) {
             return;
         }

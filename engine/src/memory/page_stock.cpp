@@ -17,30 +17,19 @@ namespace {
 
 class PageStock {
 public:
-    void add(JobSystem& jobs, std::size_t pages) {
-        if (pages == 0) return;
-        if (pages > static_cast<std::size_t>(-1) / 2 / kHugePageBytes) throw std::bad_alloc();
+    void add() {
         {
-            // Room for the addresses first, so that a page once mapped is never lost to a
+            // Room for the address first, so that a page once mapped is never lost to a
             // failed push.
             const std::lock_guard lock(m_mutex);
-            m_pages.reserve(m_pages.size() + pages);
+            m_pages.reserve(m_pages.size() + 1);
         }
-        auto* const base = static_cast<unsigned char*>(map_huge_pages(pages * kHugePageBytes));
-        // A page per job: each job waits for its own page (the host's, on a virtual machine).
+        auto* const page = static_cast<unsigned char*>(map_huge_pages(kHugePageBytes));
+        map_pages_now(page, kHugePageBytes);
         // A byte per small page as well, for the hypervisor's first write (stages/capacity.hpp).
-        jobs.parallel_for("StockPages", 0, static_cast<std::uint32_t>(pages), 1,
-                          [base](std::uint32_t lo, std::uint32_t hi, unsigned) {
-                              for (std::uint32_t page = lo; page < hi; ++page) {
-                                  unsigned char* p = base + std::size_t{page} * kHugePageBytes;
-                                  map_pages_now(p, kHugePageBytes);
-                                  for (std::size_t b = 0; b < kHugePageBytes; b += 4096)
-                                      *reinterpret_cast<volatile unsigned char*>(p + b) = 0;
-                              }
-                          });
+        for (std::size_t b = 0; b < kHugePageBytes; b += 4096) *reinterpret_cast<volatile unsigned char*>(page + b) = 0;
         const std::lock_guard lock(m_mutex);
-        for (std::size_t page = 0; page < pages; ++page)
-            m_pages.push_back(reinterpret_cast<std::uintptr_t>(base + page * kHugePageBytes));
+        m_pages.push_back(reinterpret_cast<std::uintptr_t>(page));
     }
 
     void* take() noexcept {
@@ -79,7 +68,7 @@ PageStock& stock() {
 
 }  // namespace
 
-void stock_huge_pages(JobSystem& jobs, std::size_t pages) { stock().add(jobs, pages); }
+void stock_huge_page() { stock().add(); }
 
 void* take_stocked_huge_page() noexcept { return stock().take(); }
 

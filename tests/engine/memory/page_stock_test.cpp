@@ -1,11 +1,9 @@
 // Huge pages stocked ahead of a first step (memory/page_stock.hpp): Space::reserve_bodies
 // stocks them, the step moves them under its arrays instead of faulting fresh ones, and the
 // update after it gives back the rest.
+#include <gtest/gtest.h>
 #include <spindle/engine/space.hpp>
 #include <spindle/scene/scene.hpp>
-#include <spindle/scheduler/single_threaded.hpp>
-
-#include <gtest/gtest.h>
 
 #include <cstddef>
 #include <string>
@@ -27,9 +25,8 @@ using namespace spindle;
 // A stocked page is moved, not copied nor faulted again: the huge page it lands on is
 // resident before anything touches it, and the one beside it is not.
 TEST(PageStock, AMovedPageIsInPlaceBeforeItsFirstTouch) {
-    SingleThreadedJobSystem jobs;
     const std::size_t before = stocked_huge_pages();
-    stock_huge_pages(jobs, 1);
+    stock_huge_page();
     ASSERT_EQ(stocked_huge_pages(), before + 1);
     void* block = map_huge_pages(2 * kHugePageBytes);
     auto* second = static_cast<unsigned char*>(block) + kHugePageBytes;
