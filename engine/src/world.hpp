@@ -438,6 +438,12 @@ struct World {
     std::vector<std::uint32_t> awake_contact_list;
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
+    // Huge pages stocked for the first step of the bodies made since the last update
+    // (memory/page_stock.hpp, api/space.cpp), and the bytes that step will write that are
+    // not stocked yet (less than a page). The update gives back the pages its step did not
+    // take, and starts the count again.
+    std::size_t stocked_pages = 0;
+    std::size_t unstocked_bytes = 0;
 
     // The layer table: bit b of layer_masks[a] is set when layers a and b collide
     // (symmetric; all set by default, so filtering changes nothing until asked).

@@ -15,6 +15,7 @@
 
 #include "api/describe.hpp"
 #include "api/validation.hpp"
+#include "memory/page_stock.hpp"
 #include "solver/constraints.hpp"
 #include "solver/speed_limit.hpp"
 #include "stages/body_changes.hpp"
@@ -30,9 +31,45 @@ std::string to_string(BodyHandle handle) {
 }
 
 World::World() = default;
-World::~World() = default;
+World::~World() { give_back_stocked_huge_pages(stocked_pages); }
 
 namespace {
+
+// What a dynamic body's first step writes on huge pages, which create_body stocks ahead
+// (memory/page_stock.hpp): its solver body, push velocities, gravity scale and moved box;
+// and for kStockedContactsPerBody contacts (a resting pile's) each contact's record, its
+// lane of a wide contact and that lane's push anchors, and its pairs, keys and manifold refs
+// in the broadphase's and the solver's lists. Static bodies make no contact among
+// themselves: a level of a million of them stocks nothing.
+constexpr std::size_t kStockedContactsPerBody = 3;
+constexpr std::size_t kFirstStepBytesPerBody =
+    sizeof(SolverBody) + sizeof(PushVelocity) + sizeof(Real) + sizeof(Aabb) +
+    kStockedContactsPerBody * (sizeof(Contact) + sizeof(WideContact) / kLanes + sizeof(PushAnchors) + 2 * sizeof(Pair) +
+                               2 * sizeof(ManifoldRef) + 3 * sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t));
+// A level's first step rounds each of its arrays on whole huge pages (the contacts, the
+// solver bodies, the wide contacts, their anchors) up to a page: half a page each, counted
+// once per reserve_bodies (a level being built) and stocked with its dynamic bodies' bytes.
+constexpr std::size_t kRoundingBytesPerLevel = 4 * kHugePageBytes / 2;
+// At most this many pages are held ahead of an update: a scene of many bodies falling
+// apart (rain) takes few of them, and gives them back only at its first step.
+constexpr std::size_t kMostStockedPages = 64;
+
+// Stocks the whole pages of what the bodies made since the last update will write in
+// their first step: here, where the game builds its level, a page at a time, rather than
+// in that step. Only whole pages: a game that makes a body now and then stocks nothing.
+// A hint: without memory for a page the step maps its own.
+void stock_first_step_pages(World& w, std::size_t bytes) {
+    w.unstocked_bytes += bytes;
+    while (w.unstocked_bytes >= kHugePageBytes && w.stocked_pages < kMostStockedPages) {
+        try {
+            stock_huge_page();
+        } catch (const std::bad_alloc&) {
+            return;
+        }
+        w.stocked_pages += 1;
+        w.unstocked_bytes -= kHugePageBytes;
+    }
+}
 
 // By a quarter at a time (stages/capacity.hpp), not doubled: a scene built body by body
 // keeps its per-slot arrays near its body count.
@@ -121,6 +158,7 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
+    if (b.type[slot] == MotionType::Dynamic) stock_first_step_pages(w, kFirstStepBytesPerBody);
     return BodyHandle{slot, b.generation[slot]};
 }
 
@@ -148,6 +186,8 @@ void Space::reserve_bodies(std::size_t count) {
         // Only capacities changed: every body, handle and published state is as it was.
         throw Error("reserve_bodies: no memory for " + std::to_string(count) + " bodies");
     }
+    // Stocked with the level's dynamic bodies' pages: a level of static bodies stocks none.
+    w.unstocked_bytes += kRoundingBytesPerLevel;
 }
 
 void Space::destroy_body(BodyHandle body) {

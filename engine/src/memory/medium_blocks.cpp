@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "memory/huge_page_vector.hpp"
+#include "memory/page_stock.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/asan_interface.h>
@@ -65,9 +66,13 @@ public:
                 }
             }
         }
-        void* p = map_huge_pages(kHugePageBytes);  // throws std::bad_alloc
-        // One call maps the chunk's huge page (or its small pages where none is given).
-        map_pages_now(p, kHugePageBytes);
+        // A stocked page is mapped and written already; else one call maps the chunk's huge
+        // page (or its small pages where none is given).
+        void* p = take_stocked_huge_page();
+        if (p == nullptr) {
+            p = map_huge_pages(kHugePageBytes);  // throws std::bad_alloc
+            map_pages_now(p, kHugePageBytes);
+        }
         SPINDLE_POISON(p, kHugePageBytes);
         try {
             m_chunks.push_back(Chunk{reinterpret_cast<std::uintptr_t>(p), 0});

@@ -8,11 +8,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
+#include <type_traits>
 #include <vector>
 
 #include <spindle/scheduler/job_system.hpp>
 
 #include "memory/huge_page_vector.hpp"
+#include "memory/page_stock.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -52,14 +54,17 @@ void fit_capacity(std::vector<T, A>& v) {
 // so no two jobs fault the same page. On some virtual machines a mapped small page's first
 // write from the program is still a fault of its own (the hypervisor's, unseen by the
 // kernel), so each job also writes a byte of each of its small pages (raw room: no element
-// lives there yet). A hint: nothing for room of less than a megabyte (not worth the jobs),
-// or where the OS has no such call.
+// lives there yet). A whole huge page of the room is instead a stocked one moved there,
+// where the stock has one (memory/page_stock.hpp): written before the step, it waits for
+// nothing. A hint: nothing for room of less than a megabyte (not worth the jobs), or where
+// the OS has no such call.
 template <typename T, typename A>
 void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::uintptr_t kPage = 4096;
     constexpr std::uintptr_t kPagesPerJob = kHugePageBytes / kPage;
     constexpr std::size_t kMinBytes = std::size_t{1} << 20;
+    static_assert(kMinBytes >= kOnHugePagesBytes, "room of kMinBytes lies in a block of whole huge pages");
     if (end <= v.size() || (end - v.size()) * sizeof(T) < kMinBytes) return;
     // Whole pages inside the room only: the pages it shares with live elements are mapped.
     const auto first = (reinterpret_cast<std::uintptr_t>(v.data() + v.size()) + kPage - 1) / kPage;
@@ -67,8 +72,17 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
     if (last <= first) return;
     const std::uintptr_t first_span = first / kPagesPerJob;
     const auto spans = static_cast<std::uint32_t>((last - 1) / kPagesPerJob - first_span + 1);
-    jobs.parallel_for("MapPages", 0, spans, 1, [first, last, first_span](std::uint32_t lo, std::uint32_t hi, unsigned) {
+    // A huge page may be replaced where it holds no live element and lies inside the block,
+    // which is whole huge pages (HugePageAllocator) from room of a megabyte up.
+    constexpr bool kOnWholeHugePages = std::is_base_of_v<HugePageAllocator<T>, A>;
+    const auto live_end = reinterpret_cast<std::uintptr_t>(v.data() + v.size());
+    const auto block_end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity());
+    jobs.parallel_for("MapPages", 0, spans, 1, [=](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t span = lo; span < hi; ++span) {
+            const std::uintptr_t huge_page = (first_span + span) * kHugePageBytes;
+            if (kOnWholeHugePages && huge_page >= live_end && huge_page < block_end &&
+                move_stocked_huge_page_to(reinterpret_cast<void*>(huge_page)))
+                continue;
             const std::uintptr_t from = std::max(first, (first_span + span) * kPagesPerJob);
             const std::uintptr_t to = std::min(last, (first_span + span + 1) * kPagesPerJob);
             // Errors (an old kernel without the call) leave the pages to fault as before.

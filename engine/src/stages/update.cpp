@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "api/describe.hpp"
+#include "memory/page_stock.hpp"
 #include "stages/body_changes.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
@@ -73,6 +75,12 @@ void check_not_holding_motion_state_lock(const World& world, const char* what) {
     }
 }
 
+// The huge pages stocked for the step just taken (api/space.cpp) that it did not take.
+void give_back_stock(World& world) {
+    world.unstocked_bytes = 0;
+    if (world.stocked_pages != 0) give_back_stocked_huge_pages(std::exchange(world.stocked_pages, 0));
+}
+
 }  // namespace
 
 void Space::update(Real dt) {
@@ -105,6 +113,7 @@ void Space::update(Real dt) {
     }
     for (int i = 0; i < steps; ++i) step(w, ts.duration);
     w.stats.steps = steps;
+    if (steps > 0) give_back_stock(w);
 
     run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
 }
@@ -117,6 +126,7 @@ void Space::update() {
     run_stage(w, Stage::ApplyWrites, [&] { apply_writes(w); });
     step(w, w.settings.time_step.duration);
     w.stats.steps = 1;
+    give_back_stock(w);
     run_stage(w, Stage::FlipReadBuffers, [&] { flip_read_buffers(w); });
 }
 
