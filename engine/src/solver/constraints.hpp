@@ -401,10 +401,13 @@ struct SolverScratch {
     // before those of that colour's wide contacts that share a dynamic body with it
     // (lead_blocked, few: the tail's bodies are few); its other wide contacts (lead_free) run
     // beside the tail. Each body meets its constraints in the same order: the same results,
-    // a barrier fewer a pass. The tail phases (tail_plan, items in tail_counts), and the first
-    // colour's wide contacts, as indices into it, made once per colouring (lead_made).
-    std::vector<SolverPhase> tail_plan;
-    std::vector<std::uint32_t> tail_counts;
+    // a barrier fewer a pass. The tail phases (tail_plan), and the first colour's wide
+    // contacts, as indices into it, made once per colouring (lead_made).
+    struct TailPhase {
+        SolverPhase phase;
+        std::uint32_t items = 0;  // its Phase's count
+    };
+    std::vector<TailPhase> tail_plan;
     std::vector<std::uint32_t> lead_blocked, lead_free;
     std::vector<std::uint8_t> in_tail;       // per solver body: whether a tail colour writes it
     std::vector<std::uint32_t> tail_bodies;  // those bodies, in order

@@ -518,10 +518,7 @@ std::size_t tail_before(const SolverScratch& scratch, std::size_t first) {
 // Moves plan entries [from, first) into SolverScratch::tail_plan; returns where they begin there.
 std::uint32_t move_tail(SolverScratch& scratch, std::size_t from, std::size_t first) {
     const auto tail_begin = static_cast<std::uint32_t>(scratch.tail_plan.size());
-    for (std::size_t p = from; p < first; ++p) {
-        scratch.tail_plan.push_back(scratch.plan[p]);
-        scratch.tail_counts.push_back(scratch.phases[p].count);
-    }
+    for (std::size_t p = from; p < first; ++p) scratch.tail_plan.push_back({scratch.plan[p], scratch.phases[p].count});
     scratch.plan.erase(scratch.plan.begin() + static_cast<std::ptrdiff_t>(from),
                        scratch.plan.begin() + static_cast<std::ptrdiff_t>(first));
     scratch.phases.erase(scratch.phases.begin() + static_cast<std::ptrdiff_t>(from),
@@ -609,7 +606,6 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     scratch.phases.clear();
     scratch.plan.clear();
     scratch.tail_plan.clear();
-    scratch.tail_counts.clear();
     plan_wide_pass(scratch, Pass::PrepareContacts, "PrepareContacts");
     if (!scratch.wide_joints.empty()) {
         scratch.phases.push_back(
@@ -838,6 +834,11 @@ void solve(World& world, Real dt) {
                 break;
         }
     };
+    // The tail a carrier's item 0 runs first.
+    auto run_tail = [&](const SolverPhase& carrier, unsigned worker) {
+        for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
+            run_items(scratch.tail_plan[t].phase, 0, scratch.tail_plan[t].items, worker);
+    };
     // Items [lo, hi) of a first colour that carries the tail of the pass before it: item 0 the
     // tail and then the colour's blocked contacts, then its free ones, then chunks of bodies.
     const std::span<const std::uint32_t> lead_free(scratch.lead_free);
@@ -845,8 +846,7 @@ void solve(World& world, Real dt) {
         SolverPhase own = carrier;  // the colour as a phase of its own: its contacts, then the chunks
         own.constraints = scratch.wide_begin[carrier.color + 1] - scratch.wide_begin[carrier.color];
         if (lo == 0) {
-            for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
-                run_items(scratch.tail_plan[t], 0, scratch.tail_counts[t], worker);
+            run_tail(carrier, worker);
             for (std::uint32_t k : scratch.lead_blocked) run_items(own, k, k + 1, worker);
             lo = 1;
         }
@@ -870,8 +870,7 @@ void solve(World& world, Real dt) {
             finalize_bodies(world, scratch, dt, from, to, world.fast_lists[worker]);
         };
         if (lo == 0) {
-            for (std::uint32_t t = carrier.tail_begin; t < carrier.tail_end; ++t)
-                run_items(scratch.tail_plan[t], 0, scratch.tail_counts[t], worker);
+            run_tail(carrier, worker);
             store_contact_impulses(world, scratch, scratch.wide_begin[carrier.color],
                                    static_cast<std::uint32_t>(scratch.wide.size()));
             for (std::uint32_t k : scratch.tail_bodies) finalize(k, k + 1);
