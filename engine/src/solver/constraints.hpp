@@ -320,11 +320,13 @@ struct SolverScratch {
         std::vector<ManifoldRef> refs;
         bool restitution = false;  // any of them has restitution
         std::size_t first = 0;     // where its refs go in manifolds
+        bool same = false;         // they were in colored_manifolds where they go (join_range)
     };
     std::vector<ListedRange> listed;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
-    RawRoomVector<ManifoldRef> colored_manifolds;  // a copy of manifolds
+    RawRoomVector<ManifoldRef> colored_manifolds;  // manifolds, as join_range leaves it
+    bool same_manifolds = false;                   // this step's manifolds are the last colouring's
     std::size_t colored_bodies = 0;
     std::uint64_t colored_body_set = ~std::uint64_t{0};  // World::body_set_version then
     std::vector<JointRef> colored_joints;                // the joint list then

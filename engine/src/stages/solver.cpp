@@ -122,6 +122,19 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
     range.restitution = restitution;
 }
 
+// JoinManifolds' range: its refs into the step's list, and into the last colouring's list
+// where they differ from it (compared only where the lists are as long: else every ref moved),
+// so that list is always this step's and comparing it costs no serial pass.
+void join_range(SolverScratch& scratch, SolverScratch::ListedRange& range, bool same_count) {
+    const auto at = static_cast<std::ptrdiff_t>(range.first);
+    std::copy(range.refs.begin(), range.refs.end(), scratch.manifolds.begin() + at);
+    static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
+    range.same = same_count &&
+                 (range.refs.empty() || std::memcmp(range.refs.data(), scratch.colored_manifolds.data() + at,
+                                                    range.refs.size() * sizeof(ManifoldRef)) == 0);
+    if (!range.same) std::copy(range.refs.begin(), range.refs.end(), scratch.colored_manifolds.begin() + at);
+}
+
 // The step's solver bodies (PrepareBodies) and its list of touching manifolds of awake
 // contacts, in contact order (ListManifolds, then JoinManifolds), in one run_phases: one
 // fork and join, not three. Fixed chunks of bodies and ranges of contacts are listed in
@@ -157,8 +170,11 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     bool restitution = false;
     if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
         scratch.manifolds.clear();
+        scratch.same_manifolds = scratch.colored_manifolds.empty();
+        scratch.colored_manifolds.clear();
         return restitution;
     }
+    bool same_count = false;  // as many manifolds as the last colouring's
     world.jobs->run_phases("SolverLists", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
         if (p == 0) {
             for (std::uint32_t item = lo; item < hi; ++item) {
@@ -177,13 +193,14 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
                 restitution = restitution || range.restitution;
             }
             scratch.manifolds.resize(total);
+            same_count = scratch.colored_manifolds.size() == total;
+            scratch.colored_manifolds.resize(total);  // capacity kept: no allocation once grown
         } else {
-            for (std::uint32_t r = lo; r < hi; ++r) {
-                std::copy(listed[r].refs.begin(), listed[r].refs.end(),
-                          scratch.manifolds.begin() + static_cast<std::ptrdiff_t>(listed[r].first));
-            }
+            for (std::uint32_t r = lo; r < hi; ++r) join_range(scratch, listed[r], same_count);
         }
     });
+    scratch.same_manifolds = same_count &&
+                             std::all_of(listed.begin(), listed.end(), [](const auto& range) { return range.same; });
     // Equal least and greatest inverse mass over every chunk: no body is lighter than
     // another it carries.
     Real least = kHuge, greatest = -kHuge;
@@ -240,20 +257,18 @@ bool same_bytes(const std::vector<T, A>& x, const std::vector<T, A>& y) {
 }
 
 // Whether the colours and packing of the last colouring hold for this step's
-// constraints: the same manifolds of the same bodies, no body made or destroyed (a
-// reused slot could change from kinematic to dynamic, which the colours depend on),
-// the same awake count (the immovable body is the last) and the same joints of the same
-// bodies. A resting pile keeps its manifold list from step to step, a jointed scene its
-// joint list, and comparing them is far cheaper than colouring.
+// constraints: the same manifolds of the same bodies (compared range by range as they
+// were joined: join_range), no body made or destroyed (a reused slot could change from
+// kinematic to dynamic, which the colours depend on), the same awake count (the immovable body is the last) and the
+// same joints of the same bodies. A resting pile keeps its manifold list from step to step, a jointed scene its joint
+// list, and comparing them is far cheaper than colouring.
 bool same_constraints(const World& world, SolverScratch& scratch) {
-    static_assert(std::has_unique_object_representations_v<ManifoldRef>, "compared as bytes");
     static_assert(std::has_unique_object_representations_v<JointRef>, "compared as bytes");
-    const bool same = scratch.reuse_colors && same_bytes(scratch.colored_joints, scratch.joint_refs) &&
+    const bool same = scratch.reuse_colors && scratch.same_manifolds &&
+                      same_bytes(scratch.colored_joints, scratch.joint_refs) &&
                       scratch.colored_body_set == world.body_set_version &&
-                      scratch.colored_bodies == scratch.bodies.size() &&
-                      same_bytes(scratch.colored_manifolds, scratch.manifolds);
+                      scratch.colored_bodies == scratch.bodies.size();
     if (!same) {
-        scratch.colored_manifolds = scratch.manifolds;  // capacity kept: no allocation once grown
         scratch.colored_bodies = scratch.bodies.size();
         scratch.colored_body_set = world.body_set_version;
         scratch.colored_joints = scratch.joint_refs;

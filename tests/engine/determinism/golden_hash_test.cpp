@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <utility>
@@ -142,6 +143,46 @@ TEST(GoldenHash, ReusedJointColoursGiveTheSameBitsAsFreshColouring) {
         EXPECT_EQ(fresh_colorings, 120u);
         EXPECT_LT(reused_colorings, 60u) << "the swinging chains should reuse their colours for most steps";
         EXPECT_EQ(hex(reused), hex(fresh)) << workers << " workers";
+    }
+}
+
+// Each JoinManifolds range compares its refs with the last colouring's list and copies
+// them there where they differ (solver.cpp, join_range): a ref changed in any range, not
+// only the first, colours again, and the colouring's list is this step's list after it.
+TEST(GoldenHash, AManifoldChangedInALaterListRangeColoursAgain) {
+    for (unsigned workers : {1u, 2u}) {
+        auto jobs = jobs_for(workers);
+        SpaceSettings settings;
+        settings.sleep.enabled = false;
+        Space space(settings, jobs.get());
+        BodyDesc floor;
+        floor.type = MotionType::Static;
+        floor.shape = Shape::plane(Vec3::UnitY(), 0);
+        space.create_body(floor);
+        BodyDesc box;
+        box.shape = Shape::box(Vec3::Constant(0.5));
+        for (int x = 0; x < 30; ++x) {  // 900 boxes apart: a contact each, two list ranges
+            for (int z = 0; z < 30; ++z) {
+                box.position = Vec3(1.5 * x, 0.5, 1.5 * z);
+                space.create_body(box);
+            }
+        }
+        for (int i = 0; i < 10; ++i) space.update();
+        SolverScratch& scratch = *SpaceInternals::world(space).solver;
+        ASSERT_EQ(scratch.manifolds.size(), 900u);
+        const std::uint64_t settled = space.counters().constraint_colorings;
+        space.update();
+        ASSERT_EQ(space.counters().constraint_colorings, settled) << "a resting grid reuses its colours";
+        scratch.colored_manifolds[scratch.manifolds.size() - 1].manifold ^= 1;  // in the second range
+        space.update();
+        EXPECT_EQ(space.counters().constraint_colorings, settled + 1) << workers << " workers";
+        ASSERT_EQ(scratch.colored_manifolds.size(), scratch.manifolds.size());
+        EXPECT_EQ(std::memcmp(scratch.colored_manifolds.data(), scratch.manifolds.data(),
+                              scratch.manifolds.size() * sizeof(ManifoldRef)),
+                  0)
+            << workers << " workers";
+        space.update();
+        EXPECT_EQ(space.counters().constraint_colorings, settled + 1) << "reused again, " << workers << " workers";
     }
 }
 
