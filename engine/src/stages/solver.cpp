@@ -9,6 +9,7 @@
 #include "solver/constraints.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -161,12 +162,11 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     if (scratch.listed.size() < ranges) scratch.listed.resize(ranges);  // capacity kept from step to step
     const std::span<SolverScratch::ListedRange> listed(scratch.listed.data(), ranges);
 
-    // Items of the first phase: the chunks of bodies, then the ranges of contacts. The
-    // second (one block) places the ranges and sizes the list; the third copies them in,
-    // in jobs: a first step's list is hundreds of new pages, each a fault on its first write.
-    const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1},
-                            {"PlaceManifolds", 1, 1},
-                            {"JoinManifolds", ranges, 1}};
+    // Items of the first phase: the chunks of bodies, then the ranges of contacts; the range
+    // listed last places the ranges and sizes the list (a countdown: not a round of its own
+    // and the barrier after it). The second copies them in, in jobs: a first step's list is
+    // hundreds of new pages, each a fault on its first write.
+    const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1}, {"JoinManifolds", ranges, 1}};
     bool restitution = false;
     if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
         scratch.manifolds.clear();
@@ -175,28 +175,33 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
         return restitution;
     }
     bool same_count = false;  // as many manifolds as the last colouring's
+    auto place = [&] {
+        std::size_t total = 0;
+        for (SolverScratch::ListedRange& range : listed) {
+            range.first = total;
+            total += range.refs.size();
+            restitution = restitution || range.restitution;
+        }
+        scratch.manifolds.resize(total);
+        same_count = scratch.colored_manifolds.size() == total;
+        scratch.colored_manifolds.resize(total);  // capacity kept: no allocation once grown
+    };
+    if (ranges == 0) place();
+    std::atomic<std::uint32_t> unlisted{ranges};  // ranges not listed yet: the last to be listed places them
     world.jobs->run_phases("SolverLists", phases, [&](std::uint32_t p, std::uint32_t lo, std::uint32_t hi, unsigned) {
-        if (p == 0) {
-            for (std::uint32_t item = lo; item < hi; ++item) {
-                if (item < chunks) {
-                    prepare_body_chunk(world, scratch, item * kBodyGrain, std::min(n, (item + 1) * kBodyGrain));
-                } else {
-                    const std::uint32_t r = item - chunks;
-                    list_range(world, contacts, scratch, r * kListGrain, std::min(count, (r + 1) * kListGrain));
-                }
-            }
-        } else if (p == 1) {
-            std::size_t total = 0;
-            for (SolverScratch::ListedRange& range : listed) {
-                range.first = total;
-                total += range.refs.size();
-                restitution = restitution || range.restitution;
-            }
-            scratch.manifolds.resize(total);
-            same_count = scratch.colored_manifolds.size() == total;
-            scratch.colored_manifolds.resize(total);  // capacity kept: no allocation once grown
-        } else {
+        if (p == 1) {
             for (std::uint32_t r = lo; r < hi; ++r) join_range(scratch, listed[r], same_count);
+            return;
+        }
+        for (std::uint32_t item = lo; item < hi; ++item) {
+            if (item < chunks) {
+                prepare_body_chunk(world, scratch, item * kBodyGrain, std::min(n, (item + 1) * kBodyGrain));
+                continue;
+            }
+            const std::uint32_t r = item - chunks;
+            list_range(world, contacts, scratch, r * kListGrain, std::min(count, (r + 1) * kListGrain));
+            // Every other range's list happened before its count down, and so before this.
+            if (unlisted.fetch_sub(1, std::memory_order_acq_rel) == 1) place();
         }
     });
     scratch.same_manifolds = same_count &&
