@@ -264,9 +264,10 @@ bool same_bytes(const std::vector<T, A>& x, const std::vector<T, A>& y) {
 // Whether the colours and packing of the last colouring hold for this step's
 // constraints: the same manifolds of the same bodies (compared range by range as they
 // were joined: join_range), no body made or destroyed (a reused slot could change from
-// kinematic to dynamic, which the colours depend on), the same awake count (the immovable body is the last) and the
-// same joints of the same bodies. A resting pile keeps its manifold list from step to step, a jointed scene its joint
-// list, and comparing them is far cheaper than colouring.
+// kinematic to dynamic, which the colours depend on), the same awake count (the
+// immovable body is the last) and the same joints of the same bodies. A resting pile
+// keeps its manifold list from step to step, a jointed scene its joint list, and
+// comparing them is far cheaper than colouring.
 bool same_constraints(const World& world, SolverScratch& scratch) {
     static_assert(std::has_unique_object_representations_v<JointRef>, "compared as bytes");
     const bool same = scratch.reuse_colors && scratch.same_manifolds &&
