@@ -125,70 +125,91 @@ Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide
     return select(k > splat(0), splat(1) / k, splat(0));
 }
 
-// Central friction of one lane (Box3D's): the friction centre is the points' mean,
+// What central friction reads of the lanes' manifolds and bodies, gathered in double by
+// prepare_wide. Lanes and point slots without a manifold or point stay zero.
+struct FrictionLanes {
+    WideD3 anchor_a[kMaxManifoldPoints], anchor_b[kMaxManifoldPoints];  // each point from A's and B's centre
+    WideD separation[kMaxManifoldPoints]{};
+    WideDMask filled[kMaxManifoldPoints]{};  // lanes with a point in the slot
+    WideD3 normal, tangent[2];
+    WideD3 friction_impulse;
+    WideDMat3 inv_inertia_a, inv_inertia_b;
+    WideD inv_mass_a{}, inv_mass_b{};
+    // Per world axis, lanes whose body has its translation along it locked.
+    WideDMask locked_a[3]{}, locked_b[3]{};
+};
+
+// The free part of v (without_axes, motion_locks.hpp): a locked axis is an exact zero.
+WideD3 free_part(const WideD3& v, const WideDMask (&locked)[3]) {
+    const WideD zero{};
+    return {select(locked[0], zero, v.x), select(locked[1], zero, v.y), select(locked[2], zero, v.z)};
+}
+
+// Central friction of the lanes (Box3D's): the friction centre is the points' mean,
 // weighted down for points farther apart than friction_distance (up to twice that they
 // fade out, so the centre moves smoothly as points come and go); the two tangent rows at
-// the centre with their coupled 2x2 effective mass; the twist row about the normal.
-void prepare_friction(const SolverBody& A, const SolverBody& B, const Contact& contact, const ContactManifold& m,
-                      const Vec3 (&tangent)[2], Real friction_distance, WideContact& wc, int l) {
-    constexpr Real kMinWeight = 1e-3;
-    Vec3 center_a = Vec3::Zero(), center_b = Vec3::Zero();
-    Real total = 0;
-    for (int j = 0; j < m.point_count; ++j) {
-        const ContactPoint& p = m.points[j];
-        const Real weight = std::clamp(2 - p.separation / friction_distance, kMinWeight, Real(1));
-        center_a += weight * contact.anchor_a(p);
-        center_b += weight * contact.anchor_b(p);
-        total += weight;
+// the centre with their coupled 2x2 effective mass; the twist row about the normal. In
+// double, every lane as the scalar products would make it.
+void prepare_friction(const FrictionLanes& in, Real friction_distance, WideContact& wc) {
+    const WideD zero{}, one = splat_d(1), min_weight = splat_d(1e-3), distance = splat_d(friction_distance);
+    WideD3 center_a, center_b;
+    WideD total{};
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        WideD weight = splat_d(2) - in.separation[j] / distance;
+        weight = select(weight < min_weight, min_weight, weight);  // std::clamp's order
+        weight = select(one < weight, one, weight);
+        if (j == 0) {  // every manifold has a first point (a lane without one weighs a zero anchor)
+            center_a = WideD3{} + weight * in.anchor_a[0];
+            center_b = WideD3{} + weight * in.anchor_b[0];
+            total = zero + weight;
+            continue;
+        }
+        center_a = select(in.filled[j], center_a + weight * in.anchor_a[j], center_a);
+        center_b = select(in.filled[j], center_b + weight * in.anchor_b[j], center_b);
+        total = select(in.filled[j], total + weight, total);
     }
-    if (total > 0) {
-        center_a /= total;
-        center_b /= total;
+    const WideDMask weighed = total > zero;
+    center_a = select(weighed, center_a / total, center_a);
+    center_b = select(weighed, center_b / total, center_b);
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        const WideD3 arm = in.anchor_a[j] - center_a;
+        wc.points[j].lever_arm = narrow(select(in.filled[j], wide_sqrt(dot(arm, arm)), zero));
     }
-    for (int j = 0; j < m.point_count; ++j) {
-        wc.points[j].lever_arm[l] = static_cast<float>((contact.anchor_a(m.points[j]) - center_a).norm());
-    }
-    wc.center_a.set_lane(l, center_a);
-    wc.center_b.set_lane(l, center_b);
-    Vec3 ia[2], ib[2], ra_x[2], rb_x[2];
+    wc.center_a = narrow(center_a);
+    wc.center_b = narrow(center_b);
+    WideD3 ia[2], ib[2], ra_x[2], rb_x[2];
     for (int t = 0; t < 2; ++t) {
-        ra_x[t] = center_a.cross(tangent[t]);
-        rb_x[t] = center_b.cross(tangent[t]);
-        ia[t] = A.inv_inertia * ra_x[t];
-        ib[t] = B.inv_inertia * rb_x[t];
-        wc.friction_row[t].ia.set_lane(l, ia[t]);
-        wc.friction_row[t].ib.set_lane(l, ib[t]);
+        ra_x[t] = cross(center_a, in.tangent[t]);
+        rb_x[t] = cross(center_b, in.tangent[t]);
+        ia[t] = in.inv_inertia_a * ra_x[t];
+        ib[t] = in.inv_inertia_b * rb_x[t];
+        wc.friction_row[t] = {narrow(ia[t]), narrow(ib[t])};
     }
     // k(s, t) = ms (Ps ts).(Ps tt) summed over both bodies (P: the free axes) + the angular terms.
+    const WideD3 free_a[2] = {free_part(in.tangent[0], in.locked_a), free_part(in.tangent[1], in.locked_a)};
+    const WideD3 free_b[2] = {free_part(in.tangent[0], in.locked_b), free_part(in.tangent[1], in.locked_b)};
     auto linear = [&](int s, int t) {
-        return A.inv_mass * project_linear(tangent[s], A.locks).dot(project_linear(tangent[t], A.locks)) +
-               B.inv_mass * project_linear(tangent[s], B.locks).dot(project_linear(tangent[t], B.locks));
+        return in.inv_mass_a * dot(free_a[s], free_a[t]) + in.inv_mass_b * dot(free_b[s], free_b[t]);
     };
-    const Real k00 = linear(0, 0) + ra_x[0].dot(ia[0]) + rb_x[0].dot(ib[0]);
-    const Real k11 = linear(1, 1) + ra_x[1].dot(ia[1]) + rb_x[1].dot(ib[1]);
-    const Real k01 = linear(0, 1) + ra_x[0].dot(ia[1]) + rb_x[0].dot(ib[1]);
+    const WideD k00 = linear(0, 0) + dot(ra_x[0], ia[0]) + dot(rb_x[0], ib[0]);
+    const WideD k11 = linear(1, 1) + dot(ra_x[1], ia[1]) + dot(rb_x[1], ib[1]);
+    const WideD k01 = linear(0, 1) + dot(ra_x[0], ia[1]) + dot(rb_x[0], ib[1]);
     // The inverse; where a motion lock leaves a tangent no give (K of rank one, K = t u u^T
     // with t its trace), the pseudo-inverse u u^T / t = K / t^2, so the free tangent still rubs.
-    const Real det = k00 * k11 - k01 * k01;
-    const Real trace = k00 + k11;
-    Real m00 = 0, m01 = 0, m11 = 0;
-    if (det > Real(1e-9) * trace * trace) {
-        m00 = k11 / det, m01 = -k01 / det, m11 = k00 / det;
-    } else if (trace > 0) {
-        const Real inv_sq = 1 / (trace * trace);
-        m00 = k00 * inv_sq, m01 = k01 * inv_sq, m11 = k11 * inv_sq;
-    }
-    wc.friction_mass[0][l] = static_cast<float>(m00);
-    wc.friction_mass[1][l] = static_cast<float>(m01);
-    wc.friction_mass[2][l] = static_cast<float>(m11);
-    wc.friction_impulse[0][l] = tangent[0].dot(m.friction_impulse);
-    wc.friction_impulse[1][l] = tangent[1].dot(m.friction_impulse);
-    const Vec3 twist_a = A.inv_inertia * m.normal, twist_b = B.inv_inertia * m.normal;
-    wc.twist_row.ia.set_lane(l, twist_a);
-    wc.twist_row.ib.set_lane(l, twist_b);
-    const Real k_twist = m.normal.dot(twist_a + twist_b);
-    wc.twist_mass[l] = static_cast<float>(k_twist > 0 ? 1 / k_twist : 0);
-    wc.twist_impulse[l] = m.twist_impulse;
+    const WideD det = k00 * k11 - k01 * k01;
+    const WideD trace = k00 + k11;
+    const WideDMask invertible = det > splat_d(1e-9) * trace * trace;
+    const WideDMask pseudo = ~invertible & (trace > zero);
+    const WideD inv_sq = one / (trace * trace);
+    wc.friction_mass[0] = narrow(select(invertible, k11 / det, select(pseudo, k00 * inv_sq, zero)));
+    wc.friction_mass[1] = narrow(select(invertible, -k01 / det, select(pseudo, k01 * inv_sq, zero)));
+    wc.friction_mass[2] = narrow(select(invertible, k00 / det, select(pseudo, k11 * inv_sq, zero)));
+    wc.friction_impulse[0] = narrow(dot(in.tangent[0], in.friction_impulse));
+    wc.friction_impulse[1] = narrow(dot(in.tangent[1], in.friction_impulse));
+    const WideD3 twist_a = in.inv_inertia_a * in.normal, twist_b = in.inv_inertia_b * in.normal;
+    wc.twist_row = {narrow(twist_a), narrow(twist_b)};
+    const WideD k_twist = dot(in.normal, twist_a + twist_b);
+    wc.twist_mass = narrow(select(k_twist > zero, one / k_twist, zero));
 }
 
 // The reach of a shape's rolling resistance (Box3D's): a sphere's or capsule's radius, a
@@ -244,8 +265,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     const Vec3 g = world.settings.gravity;
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
     // far apart.
-    WideMat3 inv_inertia_a, inv_inertia_b;
-    Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
+    FrictionLanes in;
     Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
     // Inverse mass sum of both bodies along the normal: the share of the free axes for a
     // locked body, inv_mass_a + inv_mass_b otherwise.
@@ -254,14 +274,9 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     wc.locked = false;
     wc.tracks_push = false;
     wc.rolls = false;
-    wc.normal = wc.tangent[0] = wc.tangent[1] = Wide3{};
-    wc.inv_mass_a = wc.inv_mass_b = wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
+    wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
-    wc.center_a = wc.center_b = Wide3{};
-    wc.friction_row[0] = wc.friction_row[1] = wc.twist_row = WideRow{};
-    wc.friction_mass[0] = wc.friction_mass[1] = wc.friction_mass[2] = wc.twist_mass = Wide{};
-    wc.friction_impulse[0] = wc.friction_impulse[1] = wc.twist_impulse = Wide{};
-    for (WidePoint& p : wc.points) p.lever_arm = Wide{};
+    wc.twist_impulse = Wide{};
     for (std::uint8_t& points : wc.slot_points) points = 0;
     const Real friction_distance = std::max(world.settings.solver.speculative_distance, Real(1e-3));
     for (int l = 0; l < wc.lanes; ++l) {
@@ -275,16 +290,22 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         const SolverBody& B = scaled(scratch.bodies[ref.b], scale.b, scaled_b);
         Vec3 tangent[2];
         tangent_basis(m.normal, tangent[0], tangent[1]);
-        wc.normal.set_lane(l, m.normal);
-        wc.tangent[0].set_lane(l, tangent[0]);
-        wc.tangent[1].set_lane(l, tangent[1]);
-        wc.inv_mass_a[l] = A.inv_mass;
-        wc.inv_mass_b[l] = B.inv_mass;
+        in.normal.set_lane(l, m.normal);
+        in.tangent[0].set_lane(l, tangent[0]);
+        in.tangent[1].set_lane(l, tangent[1]);
+        in.inv_mass_a[l] = A.inv_mass;
+        in.inv_mass_b[l] = B.inv_mass;
+        for (int axis = 0; axis < 3; ++axis) {
+            in.locked_a[axis][l] = (A.locks & (1u << axis)) != 0 ? -1 : 0;
+            in.locked_b[axis][l] = (B.locks & (1u << axis)) != 0 ? -1 : 0;
+        }
         wc.locked = wc.locked || ((A.locks | B.locks) & kLockTranslation) != 0;
         linear_sum[l] = inverse_mass_along(A.inv_mass, A.locks, m.normal) +
                         inverse_mass_along(B.inv_mass, B.locks, m.normal);
-        inv_inertia_a.set_lane(l, A.inv_inertia);
-        inv_inertia_b.set_lane(l, B.inv_inertia);
+        in.inv_inertia_a.set_lane(l, A.inv_inertia);
+        in.inv_inertia_b.set_lane(l, B.inv_inertia);
+        in.friction_impulse.set_lane(l, m.friction_impulse);
+        wc.twist_impulse[l] = m.twist_impulse;
         wc.friction[l] = contact.friction;
         wc.against_static[l] =
             b.type[contact.body_a] == MotionType::Static || b.type[contact.body_b] == MotionType::Static ? 1 : 0;
@@ -296,14 +317,27 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
                                             project_linear(scratch.gravity_scales[ref.a] * g, A.locks));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
-            ra[j].set_lane(l, contact.anchor_a(src));
-            rb[j].set_lane(l, contact.anchor_b(src));
+            in.anchor_a[j].set_lane(l, contact.anchor_a(src));
+            in.anchor_b[j].set_lane(l, contact.anchor_b(src));
+            in.separation[j][l] = src.separation;
+            in.filled[j][l] = -1;
             separation[j][l] = src.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
-        prepare_friction(A, B, contact, m, tangent, friction_distance, wc, l);
         if (contact.rolling_resistance > 0) prepare_rolling(world, contact, m, A, B, wc, rolling, l);
+    }
+    wc.inv_mass_a = narrow(in.inv_mass_a);
+    wc.inv_mass_b = narrow(in.inv_mass_b);
+    wc.normal = narrow(in.normal);
+    wc.tangent[0] = narrow(in.tangent[0]);
+    wc.tangent[1] = narrow(in.tangent[1]);
+    prepare_friction(in, friction_distance, wc);
+    const WideMat3 inv_inertia_a = narrow(in.inv_inertia_a), inv_inertia_b = narrow(in.inv_inertia_b);
+    Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
+    for (int j = 0; j < kMaxManifoldPoints; ++j) {
+        ra[j] = narrow(in.anchor_a[j]);
+        rb[j] = narrow(in.anchor_b[j]);
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());

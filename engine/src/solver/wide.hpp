@@ -171,4 +171,78 @@ inline Wide3 rotate_inverse(const WideQuat& q, const Wide3& a) {
     return a - (two * q.w) * t + two * cross(q.v, t);
 }
 
+// Eight lanes of doubles, for preparing: the contact solver prepares its rows in double
+// lane by lane, as scalar code would, and keeps them in floats. The sums of three
+// products here are Eigen's (x0 + (x1 + x2): it unrolls a sum of three by halves), so a
+// lane gets the same bits as Eigen's scalar dot or matrix product on that lane's values.
+using WideD = double __attribute__((vector_size(kLanes * sizeof(double))));
+using WideDMask = std::int64_t __attribute__((vector_size(kLanes * sizeof(std::int64_t))));  // lanes: 0 or -1
+
+inline WideD splat_d(Real x) { return WideD{x, x, x, x, x, x, x, x}; }
+// By the bits: GCC splits `m ? a : b` on vectors wider than the target's lane by lane.
+inline WideD select(WideDMask m, WideD if_set, WideD if_clear) {
+    return reinterpret_cast<WideD>((m & reinterpret_cast<WideDMask>(if_set)) |
+                                   (~m & reinterpret_cast<WideDMask>(if_clear)));
+}
+inline Wide narrow(WideD a) { return __builtin_convertvector(a, Wide); }  // each lane rounded as a scalar cast
+inline WideD wide_sqrt(WideD a) {
+#if defined(__AVX__)
+    static_assert(kLanes == 8, "two __m256d of lanes");
+    const Double4 lo = _mm256_sqrt_pd(__builtin_shufflevector(a, a, 0, 1, 2, 3));
+    const Double4 hi = _mm256_sqrt_pd(__builtin_shufflevector(a, a, 4, 5, 6, 7));
+    return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+#else
+    WideD r;
+    for (int i = 0; i < kLanes; ++i) r[i] = __builtin_sqrt(a[i]);
+    return r;
+#endif
+}
+
+struct WideD3 {
+    WideD x{}, y{}, z{};
+
+    void set_lane(int i, const Vec3& v) {
+        x[i] = v.x();
+        y[i] = v.y();
+        z[i] = v.z();
+    }
+};
+
+inline WideD3 operator+(const WideD3& a, const WideD3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline WideD3 operator-(const WideD3& a, const WideD3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline WideD3 operator*(WideD s, const WideD3& v) { return {s * v.x, s * v.y, s * v.z}; }
+inline WideD3 operator/(const WideD3& v, WideD s) { return {v.x / s, v.y / s, v.z / s}; }
+inline WideD3 select(WideDMask m, const WideD3& if_set, const WideD3& if_clear) {
+    return {select(m, if_set.x, if_clear.x), select(m, if_set.y, if_clear.y), select(m, if_set.z, if_clear.z)};
+}
+inline WideD dot(const WideD3& a, const WideD3& b) { return a.x * b.x + (a.y * b.y + a.z * b.z); }
+inline WideD3 cross(const WideD3& a, const WideD3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline Wide3 narrow(const WideD3& v) { return {narrow(v.x), narrow(v.y), narrow(v.z)}; }
+
+// A 3x3 matrix per lane, row-major.
+struct WideDMat3 {
+    WideD m[3][3]{};
+
+    void set_lane(int i, const Mat3& a) {
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c) m[r][c][i] = a(r, c);
+        }
+    }
+};
+
+inline WideD3 operator*(const WideDMat3& a, const WideD3& v) {
+    return {a.m[0][0] * v.x + (a.m[0][1] * v.y + a.m[0][2] * v.z),
+            a.m[1][0] * v.x + (a.m[1][1] * v.y + a.m[1][2] * v.z),
+            a.m[2][0] * v.x + (a.m[2][1] * v.y + a.m[2][2] * v.z)};
+}
+inline WideMat3 narrow(const WideDMat3& a) {
+    WideMat3 n;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) n.m[r][c] = narrow(a.m[r][c]);
+    }
+    return n;
+}
+
 }  // namespace spindle
