@@ -1,6 +1,8 @@
 // Each effect is paid for only where a scene uses it (design.md section 7): the work
 // counters stay at zero for an effect no body asks for, and count exactly the bodies
 // or contact points that do.
+#include <cmath>
+
 #include <spindle/engine/space.hpp>
 
 #include <gtest/gtest.h>
@@ -288,5 +290,33 @@ TEST(Effects, ALongBodySpinningAboutItsLengthKeepsItsManifold) {
         EXPECT_NEAR(space.internal_position(capsule).y(), 0.25, 0.01);
         EXPECT_NEAR(space.internal_angular_velocity(capsule).norm(), 0.6, 1e-3);
     }
+}
+// A body's reach in the recycling test is its extent along its own axes (Box3D's
+// maxExtent), not its world bounds' corner: two cubes tilted with a diagonal upright, face
+// to face in no gravity, one spinning about their common normal at 1.2 rad/s (0.02 rad a
+// step). Their corners reach 0.87 m, so a contact recycles until the turn reaches 0.058 rad
+// (two steps of three); by the bounds' corner (1.3 m) it lasted 0.038 rad (one of two).
+TEST(Effects, ATiltedCubeSpinningAgainstAnotherRecyclesByItsOwnReach) {
+    SpaceSettings settings = awake();
+    settings.gravity = Vec3::Zero();
+    Space space(settings);
+    const Quat tilt = Quat(Eigen::AngleAxis<Real>(std::atan(1 / std::sqrt(2.0)), Vec3::UnitX())) *
+                      Quat(Eigen::AngleAxis<Real>(kPi / 4, Vec3::UnitZ()));  // a diagonal along y
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.5));
+    d.orientation = tilt;
+    d.friction = 0;
+    d.type = MotionType::Kinematic;
+    space.create_body(d);
+    const Vec3 normal = tilt * Vec3::UnitX();
+    d.type = MotionType::Dynamic;
+    d.position = normal;  // face to face
+    d.angular_velocity = 1.2 * normal;
+    const BodyHandle spinning = space.create_body(d);
+    for (int i = 0; i < 60; ++i) space.update();
+    EXPECT_EQ(space.counters().contacts_updated, 60u);
+    EXPECT_GE(space.counters().manifolds_reused, 38u);
+    EXPECT_NEAR((space.internal_position(spinning) - normal).norm(), 0, 1e-3);
+    EXPECT_NEAR(space.internal_angular_velocity(spinning).dot(normal), 1.2, 1e-3);
 }
 }  // namespace effects_test
