@@ -279,11 +279,9 @@ void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, co
     q.parts.push_back(now);
     // The kept box holds `box`, so every triangle overlapping `box` is among its triangles:
     // the same test as the mesh's leaves the same triangles in the same order.
-    const std::span<const Vec3> vertices = mesh.vertices();
-    const std::span<const MeshTriangle> triangles = mesh.triangles();
     for (std::uint32_t k = now.first; k < now.first + now.count; ++k) {
         const std::uint32_t t = q.triangles[k];
-        if (triangle_bounds(vertices, triangles[t]).overlaps(box)) visit(t);
+        if (mesh.bounds(t).overlaps(box)) visit(t);
     }
 }
 

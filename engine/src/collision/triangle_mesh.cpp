@@ -59,7 +59,11 @@ TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const std::
     mark_active_edges();
     build_tree();
     m_normals.resize(m_triangles.size());
-    for (std::uint32_t t = 0; t < m_triangles.size(); ++t) m_normals[t] = made_normal(t);
+    m_bounds.resize(m_triangles.size());
+    for (std::uint32_t t = 0; t < m_triangles.size(); ++t) {
+        m_normals[t] = made_normal(t);
+        m_bounds[t] = triangle_bounds(m_vertices, m_triangles[t]);
+    }
     m_grid = MeshGrid::build(m_vertices, m_triangles, local_bounds());
 }
 
@@ -202,7 +206,7 @@ void TriangleMesh::build_tree() {
 
 void TriangleMesh::query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const {
     if (!local_bounds().overlaps(box)) return;
-    if (m_grid && m_grid->query(box, m_vertices, m_triangles, visit)) return;
+    if (m_grid && m_grid->query(box, m_bounds, visit)) return;
     query_tree(box, visit);
 }
 
@@ -215,7 +219,7 @@ void TriangleMesh::query_tree(const Aabb& box, FunctionRef<void(std::uint32_t)> 
         if (!node.box.overlaps(box)) continue;
         if (node.count > 0) {
             for (std::uint32_t t = node.first; t < node.first + node.count; ++t) {
-                if (triangle_bounds(m_vertices, m_triangles[t]).overlaps(box)) visit(t);
+                if (m_bounds[t].overlaps(box)) visit(t);
             }
             continue;
         }
