@@ -184,7 +184,7 @@ int collide_triangles(const Shape& a, const Transform& a_in_mesh, const Prepared
     const auto visit = [&](std::uint32_t t) {
         const MeshTriangle& tri = mesh.triangles()[t];
         const Vec3 v[3] = {mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]], mesh.vertices()[tri.v[2]]};
-        const Vec3 normal = triangle_normal(v[0], v[1], v[2]);  // made once for the cull and the polyhedron
+        const Vec3& normal = mesh.normal(t);  // triangle_normal of v, for the cull and the polyhedron
         if (span.clear_of_plane(v, normal, speculative)) return;
         // Triangles are one-sided for a shape lying across their plane (Box3D culls by the
         // shape's centre too). With its centre behind, it has passed the middle and gets no
@@ -279,11 +279,9 @@ void TriangleFeatureWalk::query(std::uint32_t part, const TriangleMesh& mesh, co
     q.parts.push_back(now);
     // The kept box holds `box`, so every triangle overlapping `box` is among its triangles:
     // the same test as the mesh's leaves the same triangles in the same order.
-    const std::span<const Vec3> vertices = mesh.vertices();
-    const std::span<const MeshTriangle> triangles = mesh.triangles();
     for (std::uint32_t k = now.first; k < now.first + now.count; ++k) {
         const std::uint32_t t = q.triangles[k];
-        if (triangle_bounds(vertices, triangles[t]).overlaps(box)) visit(t);
+        if (mesh.bounds(t).overlaps(box)) visit(t);
     }
 }
 

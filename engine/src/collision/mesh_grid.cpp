@@ -107,8 +107,7 @@ MeshGrid::Range MeshGrid::query_cells(Real lo, Real hi, int axis) const {
     return {clamped(std::ceil(in_cells(lo, axis)) - 1, axis), clamped(std::floor(in_cells(hi, axis)), axis)};
 }
 
-bool MeshGrid::query(const Aabb& box, std::span<const Vec3> vertices, std::span<const MeshTriangle> triangles,
-                     FunctionRef<void(std::uint32_t)> visit) const {
+bool MeshGrid::query(const Aabb& box, std::span<const Aabb> bounds, FunctionRef<void(std::uint32_t)> visit) const {
     const Range u = query_cells(box.min[m_axis[0]], box.max[m_axis[0]], 0);
     const Range v = query_cells(box.min[m_axis[1]], box.max[m_axis[1]], 1);
     if ((u.hi - u.lo + 1) * (v.hi - v.lo + 1) > kMaxBuckets) return false;
@@ -123,7 +122,7 @@ bool MeshGrid::query(const Aabb& box, std::span<const Vec3> vertices, std::span<
                 const std::uint32_t entry = m_entries[e];
                 if (!(i == u.lo || entry & kFirstAlongU) || !(j == v.lo || entry & kFirstAlongV)) continue;
                 const std::uint32_t t = entry >> kFlagBits;
-                if (!triangle_bounds(vertices, triangles[t]).overlaps(box)) continue;
+                if (!bounds[t].overlaps(box)) continue;
                 if (n == kMaxGathered) return false;
                 found[n++] = t;
             }

@@ -27,8 +27,8 @@ public:
     // Calls visit(t) for every triangle whose bounds overlap `box`, in increasing t (the
     // order of the mesh's tree), and returns true; or calls nothing and returns false when
     // the box reaches more triangles than the grid gathers at once (the tree serves it).
-    bool query(const Aabb& box, std::span<const Vec3> vertices, std::span<const MeshTriangle> triangles,
-               FunctionRef<void(std::uint32_t)> visit) const;
+    // `bounds`: each triangle's, triangle_bounds as the mesh keeps them.
+    bool query(const Aabb& box, std::span<const Aabb> bounds, FunctionRef<void(std::uint32_t)> visit) const;
 
 private:
     MeshGrid() = default;

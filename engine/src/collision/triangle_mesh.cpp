@@ -10,6 +10,7 @@
 #include <spindle/platform/error.hpp>
 
 #include "collision/error_text.hpp"
+#include "collision/polyhedron.hpp"
 
 namespace spindle {
 namespace {
@@ -57,13 +58,18 @@ TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const std::
     if (m_triangles.empty()) throw Error("triangle mesh: has no triangle of non-zero area");
     mark_active_edges();
     build_tree();
+    m_normals.resize(m_triangles.size());
+    m_bounds.resize(m_triangles.size());
+    for (std::uint32_t t = 0; t < m_triangles.size(); ++t) {
+        m_normals[t] = made_normal(t);
+        m_bounds[t] = triangle_bounds(m_vertices, m_triangles[t]);
+    }
     m_grid = MeshGrid::build(m_vertices, m_triangles, local_bounds());
 }
 
-Vec3 TriangleMesh::normal(std::uint32_t t) const {
+Vec3 TriangleMesh::made_normal(std::uint32_t t) const {
     const MeshTriangle& tri = m_triangles[t];
-    const Vec3& a = m_vertices[tri.v[0]];
-    return (m_vertices[tri.v[1]] - a).cross(m_vertices[tri.v[2]] - a).normalized();
+    return detail::triangle_normal(m_vertices[tri.v[0]], m_vertices[tri.v[1]], m_vertices[tri.v[2]]);
 }
 
 void TriangleMesh::mark_active_edges() {
@@ -92,7 +98,7 @@ void TriangleMesh::mark_active_edges() {
             MeshTriangle& t2 = m_triangles[refs[i + 1].triangle];
             const std::uint32_t k1 = refs[i].edge, k2 = refs[i + 1].edge;
             const bool opposite_winding = t1.v[k1] == t2.v[(k2 + 1) % 3];
-            const Vec3 n1 = normal(refs[i].triangle), n2 = normal(refs[i + 1].triangle);
+            const Vec3 n1 = made_normal(refs[i].triangle), n2 = made_normal(refs[i + 1].triangle);
             const Vec3& on_edge = m_vertices[t1.v[k1]];
             const Vec3& far2 = m_vertices[t2.v[(k2 + 2) % 3]];
             const bool concave = n1.dot(far2 - on_edge) > 0;
@@ -200,7 +206,7 @@ void TriangleMesh::build_tree() {
 
 void TriangleMesh::query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const {
     if (!local_bounds().overlaps(box)) return;
-    if (m_grid && m_grid->query(box, m_vertices, m_triangles, visit)) return;
+    if (m_grid && m_grid->query(box, m_bounds, visit)) return;
     query_tree(box, visit);
 }
 
@@ -213,7 +219,7 @@ void TriangleMesh::query_tree(const Aabb& box, FunctionRef<void(std::uint32_t)> 
         if (!node.box.overlaps(box)) continue;
         if (node.count > 0) {
             for (std::uint32_t t = node.first; t < node.first + node.count; ++t) {
-                if (triangle_bounds(m_vertices, m_triangles[t]).overlaps(box)) visit(t);
+                if (m_bounds[t].overlaps(box)) visit(t);
             }
             continue;
         }

@@ -49,8 +49,11 @@ public:
     std::span<const MeshNode> nodes() const noexcept { return m_nodes; }
     const Aabb& local_bounds() const noexcept { return m_nodes.front().box; }
 
-    // Unit normal of triangle t (counter-clockwise winding).
-    Vec3 normal(std::uint32_t t) const;
+    // Unit normal of triangle t (counter-clockwise winding): triangle_normal of its corners,
+    // made once (every collide against the mesh meets it again).
+    const Vec3& normal(std::uint32_t t) const { return m_normals[t]; }
+    // Triangle t's bounds, triangle_bounds of its corners, made once: what every query tests.
+    const Aabb& bounds(std::uint32_t t) const { return m_bounds[t]; }
     // Calls visit(t) for every triangle whose bounds overlap `box` (mesh frame), in tree
     // order (increasing t); through the grid when the mesh is flat enough to have one.
     void query(const Aabb& box, FunctionRef<void(std::uint32_t)> visit) const;
@@ -61,9 +64,12 @@ public:
 private:
     void build_tree();
     void mark_active_edges();
+    Vec3 made_normal(std::uint32_t t) const;
 
     std::vector<Vec3> m_vertices;
     std::vector<MeshTriangle> m_triangles;
+    std::vector<Vec3> m_normals;  // per triangle, in triangles()' order
+    std::vector<Aabb> m_bounds;   // the same
     std::vector<MeshNode> m_nodes;
     std::optional<MeshGrid> m_grid;
 };

@@ -57,8 +57,9 @@ struct SweptPart {
     Real spin = 0;   // the most any point of the part moves as it turns about its own centre
 };
 
-// Part `shape` posed by `pose` in the body's frame, swept along `path`.
-void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, SweptPart& part) {
+// Part `shape` posed by `pose` in the body's frame, swept along `path`; `thinnest` is the
+// shape's thinnest_half_size.
+void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, Real thinnest, SweptPart& part) {
     make_core(shape, pose, part.core);
     part.centre = pose.apply(shape.type == ShapeType::ConvexHull ? shape.hull->centroid() : Vec3::Zero());
     Vec3 from_com = Vec3::Zero();
@@ -70,7 +71,7 @@ void make_part(const Shape& shape, const Transform& pose, const BodyPath& path, 
         half = std::max(half, (part.core.points[i] - part.centre).squaredNorm());
     }
     part.half_size = std::sqrt(half) + part.core.radius;
-    part.thinnest = thinnest_half_size(shape);
+    part.thinnest = thinnest;
     part.swing = modified_cross(path.turn, from_com + Vec3::Constant(part.core.radius)).norm();
     // The rounding turns onto itself about the core: a ball's spin moves none of its surface.
     part.spin = modified_cross(path.turn, from_centre).norm();
@@ -158,10 +159,11 @@ bool stays_in_front(const SweptPart& part, Real h0, Real h1) {
 }
 
 // The part against a triangle mesh posed by xw. The triangles are gathered once, under
-// the part's swept box: those whose plane has the part's centre behind it at the start
-// are left out (Box3D's b3CollideTriangleAndHull culls so, and collide_mesh.cpp gives a
-// shape with its centre behind no contact from a triangle it lies across), and so are
-// those whose plane it stays in front of (stays_in_front) or cannot reach within the step.
+// the box the part can reach from its start: those whose plane has the part's centre
+// behind it at the start are left out (Box3D's b3CollideTriangleAndHull culls so, and
+// collide_mesh.cpp gives a shape with its centre behind no contact from a triangle it lies
+// across), and so are those whose plane it stays in front of (stays_in_front) or cannot
+// reach within the step.
 // At each pose the triangle nearest by a cheap bound (its plane's distance, or its box's
 // from the part's) is measured first; a triangle whose bound is no nearer than the best
 // gap found is not measured at all.
@@ -174,7 +176,12 @@ Real sweep_against_mesh(const BodyPath& path, const SweptPart& part, const Trian
     const Vec3 c0 = to_mesh.apply(path.start.apply(part.centre));
     const Vec3 c1 = to_mesh.apply(path.end.apply(part.centre));
     const Real travel = path.moved.norm() + part.swing + target;
-    const Aabb box = segment_box(c0, c1, part.half_size + travel);
+    // gap_bound keeps no triangle whose box lies farther than `travel` from the core's, so
+    // the mesh is asked only for that box (a hair more, for the boxes' rounding) within the
+    // part's swept box about its centre: the same triangles kept, far fewer met.
+    const Real hair = Real(1e-9) * (1 + travel + core_box.min.cwiseAbs().cwiseMax(core_box.max.cwiseAbs()).maxCoeff());
+    const Aabb near = core_box.fattened(travel + hair), swept = segment_box(c0, c1, part.half_size + travel);
+    const Aabb box{near.min.cwiseMax(swept.min), near.max.cwiseMin(swept.max)};
     std::vector<std::array<Vec3, 4>>& triangles = scratch.triangles;
     triangles.clear();
     mesh.query(box, [&](std::uint32_t t) {
@@ -298,7 +305,8 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
             const Aabb& local = shape.parts->part_bounds(p);
             const Vec3 b0 = path.start.apply(local.center()), b1 = path.end.apply(local.center());
             const Real twist = modified_cross(path.turn, local.extents()).norm();
-            if ((b1 - b0).norm() + twist < Real(0.5) * thinnest_half_size(shape.parts->shape(p))) continue;
+            const Real thinnest = thinnest_half_size(shape.parts->shape(p));
+            if ((b1 - b0).norm() + twist < Real(0.5) * thinnest) continue;
             // Nor is its core made when its swept box meets no static body.
             const Vec3 lever = (local.center() - path.local_com).cwiseAbs() + local.extents();
             const Real reach = local.extents().norm() + path.moved.norm() + modified_cross(path.turn, lever).norm();
@@ -306,9 +314,9 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
             if (std::none_of(statics.begin(), statics.end(),
                              [&](std::uint32_t wall) { return box.overlaps(b.bounds[wall]); }))
                 continue;
-            make_part(shape.parts->shape(p), shape.parts->pose(p), path, part);
+            make_part(shape.parts->shape(p), shape.parts->pose(p), path, thinnest, part);
         } else {
-            make_part(shape, Transform{}, path, part);
+            make_part(shape, Transform{}, path, thinnest_half_size(shape), part);
         }
         const Vec3 c0 = path.start.apply(part.centre);
         const Vec3 c1 = path.end.apply(part.centre);

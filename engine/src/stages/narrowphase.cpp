@@ -360,6 +360,9 @@ void update_narrowphase(World& world) {
     // 16 they were one worker's alone while the other waited. With two workers or more the
     // first pass puts those it must collide aside, and a second collides them one to a
     // chunk. Each pair is collided alone: which pass or worker does it changes nothing.
+    // A pair put aside keeps in its position's top bit whether it may recycle, as the first
+    // pass found it: the second does not ask the bodies again (no space holds 2^31 contacts).
+    constexpr std::uint32_t kRecyclableBit = 1u << 31;
     std::vector<std::vector<std::uint32_t>>& heavy = world.heavy_contacts;
     heavy.resize(world.jobs->worker_count());
     for (std::vector<std::uint32_t>& list : heavy) list.clear();
@@ -400,7 +403,7 @@ void update_narrowphase(World& world) {
                 continue;
             }
             if (put_aside != nullptr && contact.extra) {  // a mesh's or compound's: the second pass
-                put_aside[worker].push_back(k);
+                put_aside[worker].push_back(k | static_cast<std::uint32_t>(recyclable) << 31);
                 continue;
             }
             collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
@@ -416,10 +419,9 @@ void update_narrowphase(World& world) {
                                  TriangleFeatures no_triangles;
                                  ContactCounts& counts = world.contact_counts[worker];
                                  for (std::uint32_t i = lo; i < hi; ++i) {
-                                     const std::uint32_t k = positions[i];
+                                     const std::uint32_t k = positions[i] & ~kRecyclableBit;
                                      Contact& contact = world.contacts[awake[k]];
-                                     const bool recyclable = !any_fast ||
-                                                             (!b.is_fast(contact.body_a) && !b.is_fast(contact.body_b));
+                                     const bool recyclable = (positions[i] & kRecyclableBit) != 0;
                                      collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
                                  }
                              });

@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <set>
 
 #include <spindle/platform/error.hpp>
 
+#include "collision/polyhedron.hpp"
 #include "collision/triangle_mesh.hpp"
 #include "collision_test_util.hpp"
 
@@ -76,6 +78,24 @@ TEST(TriangleMesh, QueryFindsExactlyTheOverlappingTriangles) {
             if (tb.overlaps(box)) expected.insert(t);
         }
         EXPECT_EQ(found, expected);
+    }
+}
+
+// The normals and bounds are made once, after the tree has put the triangles in its order:
+// each is its own triangle's, as triangle_normal and triangle_bounds make them from the
+// corners, to the bit.
+TEST(TriangleMesh, EachNormalAndBoxIsItsTrianglesOwnToTheBit) {
+    const TriangleMesh mesh = grid(12, 0.7, [](Real x, Real z) { return 0.4 * std::sin(x) * std::cos(0.6 * z); });
+    for (std::uint32_t t = 0; t < mesh.triangles().size(); ++t) {
+        const MeshTriangle& tri = mesh.triangles()[t];
+        const Vec3 made = detail::triangle_normal(mesh.vertices()[tri.v[0]], mesh.vertices()[tri.v[1]],
+                                                  mesh.vertices()[tri.v[2]]);
+        const Aabb box = triangle_bounds(mesh.vertices(), tri);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_EQ(mesh.normal(t)[i], made[i]) << "triangle " << t;
+            EXPECT_EQ(mesh.bounds(t).min[i], box.min[i]) << "triangle " << t;
+            EXPECT_EQ(mesh.bounds(t).max[i], box.max[i]) << "triangle " << t;
+        }
     }
 }
 
