@@ -217,11 +217,12 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
-    if (w.steps != 0 || w.settings.capacity.contact_count == 0) w.first_step_contacts += new_pairs_of(w, slot);
-    if (b.type[slot] == MotionType::Dynamic) {
-        w.first_step_bodies += 1;
-        stock_first_step_pages(w);
-    }
+    const std::size_t pairs = w.steps != 0 || w.settings.capacity.contact_count == 0 ? new_pairs_of(w, slot)
+                                                                                     : std::size_t{0};
+    w.first_step_contacts += pairs;
+    if (b.type[slot] == MotionType::Dynamic) w.first_step_bodies += 1;
+    // A static floor made after the bodies resting on it brings their contacts.
+    if (b.type[slot] == MotionType::Dynamic || pairs != 0) stock_first_step_pages(w);
     return BodyHandle{slot, b.generation[slot]};
 }
 
