@@ -439,11 +439,13 @@ struct World {
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
     // Huge pages stocked for the first step of the bodies made since the last update
-    // (memory/page_stock.hpp, api/space.cpp), and the bytes that step will write that are
-    // not stocked yet (less than a page). The update gives back the pages its step did not
-    // take, and starts the count again.
+    // (memory/page_stock.hpp, api/space.cpp), and what sizes them: those dynamic bodies,
+    // and the pairs of overlapping fat boxes they made as they were added (the contacts
+    // that step makes). The update gives back the pages its step did not take, and starts
+    // the counts again.
     std::size_t stocked_pages = 0;
-    std::size_t unstocked_bytes = 0;
+    std::size_t first_step_bodies = 0;
+    std::size_t first_step_contacts = 0;
 
     // The layer table: bit b of layer_masks[a] is set when layers a and b collide
     // (symmetric; all set by default, so filtering changes nothing until asked).

@@ -65,6 +65,7 @@ MemoryReport memory_report(const Space& space) {
     for (const std::shared_ptr<QueryScene>& scene : world.query_scenes) {
         if (scene) report.query_scenes += scene->heap_bytes();
     }
+    report.page_stock = world.stocked_pages * kHugePageBytes;
     return report;
 }
 

@@ -23,6 +23,10 @@ struct MemoryReport {
     std::size_t solver_other = 0;    // solver bodies, manifold lists, colours, joints, phases
     std::size_t broadphase = 0;      // AABB trees, per-slot proxies, pair lists, compounds' part boxes
     std::size_t query_scenes = 0;    // both published query scenes
+    // Not the heap, and not in total(): the huge pages mapped for the next first step of
+    // the bodies made since the last update (SpaceSettings::capacity), which that update
+    // takes under its arrays or gives back.
+    std::size_t page_stock = 0;
 
     std::size_t total() const noexcept {
         return bodies + histories + published + contacts + contact_extras + contact_lookup + wide_contacts + push_rows +

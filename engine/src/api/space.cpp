@@ -6,6 +6,7 @@
 #include <spindle/platform/error.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -35,39 +36,97 @@ World::~World() { give_back_stocked_huge_pages(stocked_pages); }
 
 namespace {
 
-// What a dynamic body's first step writes on huge pages, which create_body stocks ahead
-// (memory/page_stock.hpp): its solver body, push velocities, gravity scale and moved box;
-// and for kStockedContactsPerBody contacts (a resting pile's) each contact's record, its
-// lane of a wide contact and that lane's push anchors, and its pairs, keys and manifold refs
-// in the broadphase's and the solver's lists. Static bodies make no contact among
-// themselves: a level of a million of them stocks nothing.
-constexpr std::size_t kStockedContactsPerBody = 3;
-constexpr std::size_t kFirstStepBytesPerBody =
-    sizeof(SolverBody) + sizeof(PushVelocity) + sizeof(Real) + sizeof(Aabb) +
-    kStockedContactsPerBody * (sizeof(Contact) + sizeof(WideContact) / kLanes + sizeof(PushAnchors) + 2 * sizeof(Pair) +
-                               2 * sizeof(ManifoldRef) + 3 * sizeof(std::uint64_t) + 4 * sizeof(std::uint32_t));
-// A level's first step rounds each of its arrays on whole huge pages (the contacts, the
-// solver bodies, the wide contacts, their anchors) up to a page: half a page each, counted
-// once per reserve_bodies (a level being built) and stocked with its dynamic bodies' bytes.
-constexpr std::size_t kRoundingBytesPerLevel = 4 * kHugePageBytes / 2;
-// At most this many pages are held ahead of an update: a scene of many bodies falling
-// apart (rain) takes few of them, and gives them back only at its first step.
+// The huge pages a first step writes, counted array by array as it lays them out
+// (memory/huge_page_vector.hpp): an array map_room fills takes stocked pages under it from
+// a megabyte up (stages/capacity.hpp); any array of a medium size takes a block of the
+// medium block pool, whose new chunks are stocked pages too. Other arrays of a megabyte
+// or more fault their own pages.
+class FirstStepPages {
+public:
+    // An array map_room fills: the contact records, wide contacts, push anchors, solver bodies.
+    void mapped(std::size_t count, std::size_t element_bytes) {
+        const std::size_t pages = stocked_room_pages(count, element_bytes);
+        if (pages == 0) listed(count, element_bytes);
+        m_pages += pages;
+    }
+    void listed(std::size_t count, std::size_t element_bytes) {
+        const std::size_t bytes = count * element_bytes;
+        if (bytes >= kMediumBlockMinBytes && bytes < kMediumBlockEndBytes) m_pool_bytes += medium_block_bytes(bytes);
+    }
+    std::size_t pages() const { return m_pages + (m_pool_bytes + kHugePageBytes - 1) / kHugePageBytes; }
+
+private:
+    std::size_t m_pages = 0;
+    std::size_t m_pool_bytes = 0;
+};
+
+// What the first step of `bodies` new dynamic bodies making `contacts` contacts writes on
+// huge pages, which create_body stocks ahead (memory/page_stock.hpp). The lists a step
+// adds must be added here: PageStock.AFirstStepTakesWhatItsLevelStocked fails otherwise.
+std::size_t first_step_pages(std::size_t bodies, std::size_t contacts) {
+    FirstStepPages p;
+    const std::size_t wide = (contacts + kLanes - 1) / kLanes;
+    p.mapped(contacts, sizeof(Contact));
+    p.mapped(wide, sizeof(WideContact));
+    p.mapped(wide * kLanes, sizeof(PushAnchors));
+    p.mapped(bodies + 1, sizeof(SolverBody));
+    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(Pair));           // the broadphase's new pairs, merged
+    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(std::uint64_t));  // their keys, the contacts' keys
+    for (int k = 0; k < 3; ++k) p.listed(contacts, sizeof(std::uint32_t));  // claimed slots, summaries, awake list
+    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(ManifoldRef));    // the solver's manifold lists
+    // The contact index: a power of two of slots, at most half full (ContactIndex::reserve).
+    const std::size_t slots = std::bit_ceil(2 * contacts);
+    p.listed(slots, sizeof(std::uint64_t));
+    p.listed(slots, sizeof(std::uint32_t));
+    p.listed(bodies, sizeof(Aabb));  // the moved fat boxes
+    p.listed(bodies + 1, sizeof(PushVelocity));
+    p.listed(bodies + 1, sizeof(Real));  // gravity scales
+    return p.pages();
+}
+// At most this many pages are held ahead of an update.
 constexpr std::size_t kMostStockedPages = 64;
 
-// Stocks the whole pages of what the bodies made since the last update will write in
-// their first step: here, where the game builds its level, a page at a time, rather than
-// in that step. Only whole pages: a game that makes a body now and then stocks nothing.
+// The contacts body `slot`'s new proxy will make at the next step: the pairs its fat box
+// makes with those already in the trees, which the filter keeps, of which one body is
+// dynamic (each pair counted once, by the later of its two bodies). A static body looks
+// in the moving tree only: a level of a million static bodies makes no pair among them.
+std::size_t new_pairs_of(const World& w, std::uint32_t slot) {
+    const BroadphaseState& bp = *w.broadphase;
+    const Bodies& b = w.bodies;
+    const bool dynamic = b.type[slot] == MotionType::Dynamic;
+    std::size_t pairs = 0;
+    const auto count = [&](std::uint64_t other) {
+        const auto j = static_cast<std::uint32_t>(other);
+        if (j != slot && (dynamic || b.type[j] == MotionType::Dynamic) && !filter_blocks_pair(w, slot, j)) pairs += 1;
+        return true;
+    };
+    const Aabb& box = bp.tree.fat_aabb(bp.proxy[slot]);
+    if (b.type[slot] == MotionType::Static) {
+        const DynamicAabbTree& moving = bp.tree.moving_tree();
+        moving.query(box, [&](std::int32_t id) { return count(moving.user(id)); });
+    } else {
+        bp.tree.query(box, [&](ProxyId id) { return count(bp.tree.user(id)); });
+    }
+    return pairs;
+}
+
+// Stocks the pages the first step of the bodies made since the last update will write
+// (first_step_pages): here, where the game builds its level, a page at a time, rather
+// than in that step. The contacts are the game's count for its level's first step where
+// it gave one (SpaceSettings::capacity), else the pairs the new proxies made. A game that
+// makes a body now and then stocks nothing (its arrays are too small for whole pages).
 // A hint: without memory for a page the step maps its own.
-void stock_first_step_pages(World& w, std::size_t bytes) {
-    w.unstocked_bytes += bytes;
-    while (w.unstocked_bytes >= kHugePageBytes && w.stocked_pages < kMostStockedPages) {
+void stock_first_step_pages(World& w) {
+    const std::int64_t hint = w.steps == 0 ? w.settings.capacity.contact_count : 0;
+    const std::size_t contacts = hint > 0 ? static_cast<std::size_t>(hint) : w.first_step_contacts;
+    const std::size_t pages = std::min(first_step_pages(w.first_step_bodies, contacts), kMostStockedPages);
+    while (w.stocked_pages < pages) {
         try {
             stock_huge_page();
         } catch (const std::bad_alloc&) {
             return;
         }
         w.stocked_pages += 1;
-        w.unstocked_bytes -= kHugePageBytes;
     }
 }
 
@@ -158,7 +217,12 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
-    if (b.type[slot] == MotionType::Dynamic) stock_first_step_pages(w, kFirstStepBytesPerBody);
+    const std::size_t pairs = w.steps != 0 || w.settings.capacity.contact_count == 0 ? new_pairs_of(w, slot)
+                                                                                     : std::size_t{0};
+    w.first_step_contacts += pairs;
+    if (b.type[slot] == MotionType::Dynamic) w.first_step_bodies += 1;
+    // A static floor made after the bodies resting on it brings their contacts.
+    if (b.type[slot] == MotionType::Dynamic || pairs != 0) stock_first_step_pages(w);
     return BodyHandle{slot, b.generation[slot]};
 }
 
@@ -186,8 +250,6 @@ void Space::reserve_bodies(std::size_t count) {
         // Only capacities changed: every body, handle and published state is as it was.
         throw Error("reserve_bodies: no memory for " + std::to_string(count) + " bodies");
     }
-    // Stocked with the level's dynamic bodies' pages: a level of static bodies stocks none.
-    w.unstocked_bytes += kRoundingBytesPerLevel;
 }
 
 void Space::destroy_body(BodyHandle body) {

@@ -111,6 +111,14 @@ void validate(const EventSettings& s) {
     }
 }
 
+void validate(const CapacitySettings& s) {
+    if (s.contact_count < 0 || s.contact_count > CapacitySettings::kMaxContactCount) {
+        reject_field("capacity", "contact_count",
+                     ("must be >= 0 and <= " + std::to_string(CapacitySettings::kMaxContactCount)).c_str(),
+                     std::to_string(s.contact_count));
+    }
+}
+
 void validate_gravity(const Vec3& gravity) {
     if (!is_finite(gravity)) throw Error("gravity must be finite, got " + vec(gravity));
 }
@@ -121,6 +129,7 @@ void validate(const SpaceSettings& s) {
     validate(s.solver);
     validate(s.sleep);
     validate(s.events);
+    validate(s.capacity);
 }
 
 // ---- shapes and bodies ----

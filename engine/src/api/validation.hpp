@@ -37,6 +37,7 @@ void validate(const TimeStepSettings& settings);
 void validate(const SolverSettings& settings);
 void validate(const SleepSettings& settings);
 void validate(const EventSettings& settings);
+void validate(const CapacitySettings& settings);
 void validate_gravity(const Vec3& gravity);
 void validate(const SpaceSettings& settings);
 

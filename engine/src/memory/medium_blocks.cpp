@@ -46,7 +46,7 @@ void unmap_chunk(void* p) noexcept {
 
 // The units of a block of `bytes`: a power of two, under kUnits.
 std::uint32_t units_of(std::size_t bytes) {
-    return static_cast<std::uint32_t>(std::bit_ceil(bytes) / kMediumBlockMinBytes);
+    return static_cast<std::uint32_t>(medium_block_bytes(bytes) / kMediumBlockMinBytes);
 }
 
 class MediumBlockPool {

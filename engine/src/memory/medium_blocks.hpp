@@ -8,6 +8,7 @@
 // written. Process-wide, under a lock: such blocks come and go a few times a step.
 #pragma once
 
+#include <bit>
 #include <cstddef>
 
 namespace spindle {
@@ -21,6 +22,9 @@ inline constexpr std::size_t kMediumBlockEndBytes = std::size_t{1} << 20;
 // Empty chunks kept for the next blocks beyond those in use: a scene whose contacts come
 // and go moves its arrays between sizes, and a kept chunk is memory already written.
 inline constexpr std::size_t kKeptEmptyMediumChunks = 2;
+
+// The room a block of `bytes` takes in a chunk: its power-of-two size.
+constexpr std::size_t medium_block_bytes(std::size_t bytes) { return std::bit_ceil(bytes); }
 
 // A block of at least `bytes` (kMediumBlockMinBytes <= bytes < kMediumBlockEndBytes),
 // aligned to its power-of-two size, its pages mapped. Throws std::bad_alloc when the system

@@ -18,18 +18,18 @@ namespace {
 class PageStock {
 public:
     void add() {
-        {
-            // Room for the address first, so that a page once mapped is never lost to a
-            // failed push.
-            const std::lock_guard lock(m_mutex);
-            m_pages.reserve(m_pages.size() + 1);
-        }
         auto* const page = static_cast<unsigned char*>(map_huge_pages(kHugePageBytes));
         map_pages_now(page, kHugePageBytes);
         // A byte per small page as well, for the hypervisor's first write (stages/capacity.hpp).
         for (std::size_t b = 0; b < kHugePageBytes; b += 4096) *reinterpret_cast<volatile unsigned char*>(page + b) = 0;
-        const std::lock_guard lock(m_mutex);
-        m_pages.push_back(reinterpret_cast<std::uintptr_t>(page));
+        // A page that finds no room in the list is unmapped, never lost.
+        try {
+            const std::lock_guard lock(m_mutex);
+            m_pages.push_back(reinterpret_cast<std::uintptr_t>(page));
+        } catch (...) {
+            unmap_huge_pages(page, kHugePageBytes);
+            throw;
+        }
     }
 
     void* take() noexcept {

@@ -6,7 +6,10 @@
 // a time, where the game builds its level; the step then moves stocked pages under its
 // arrays (page tables only, no copy) instead of faulting fresh ones, and the update gives
 // back what the step did not take (api/space.cpp, stages/update.cpp).
-// Process-wide, under a lock, as the medium block pool: the allocators hold no state.
+// Process-wide, under a lock, as the medium block pool: the allocators hold no state. So a
+// page taken is nobody's: map_room and the pool take pages without knowing for which space.
+// Each space gives back as many as it stocked, which may be pages another space stocked
+// for its own first step (that step then maps its own: slower, never wrong).
 #pragma once
 
 #include <cstddef>
@@ -14,7 +17,8 @@
 namespace spindle {
 
 // Adds a huge page to the stock, mapped and written once. Throws std::bad_alloc when the
-// system has no memory for it (the stock is then as it was).
+// system has no memory for it or for its place in the stock (the stock is then as it was,
+// and the page unmapped). Any thread.
 void stock_huge_page();
 
 // A stocked page where it lies, or nullptr when the stock is empty: for a new block of

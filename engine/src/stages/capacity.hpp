@@ -46,6 +46,11 @@ void fit_capacity(std::vector<T, A>& v) {
     v.swap(fitted);
 }
 
+// map_room maps room from a megabyte up: less is not worth the jobs.
+inline constexpr std::size_t kMappedRoomMinBytes = std::size_t{1} << 20;
+static_assert(kMappedRoomMinBytes >= kOnHugePagesBytes,
+              "room of kMappedRoomMinBytes lies in a block of whole huge pages");
+
 // Has the OS map the pages of v's room for elements [v.size(), end) (end <= capacity) now,
 // split over jobs, before one thread constructs them there. A first step fills tens of
 // megabytes of new arrays, and a page's first touch (a fault, the kernel zeroing it) costs
@@ -63,9 +68,7 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 #if defined(__linux__) && defined(MADV_POPULATE_WRITE)
     constexpr std::uintptr_t kPage = 4096;
     constexpr std::uintptr_t kPagesPerJob = kHugePageBytes / kPage;
-    constexpr std::size_t kMinBytes = std::size_t{1} << 20;
-    static_assert(kMinBytes >= kOnHugePagesBytes, "room of kMinBytes lies in a block of whole huge pages");
-    if (end <= v.size() || (end - v.size()) * sizeof(T) < kMinBytes) return;
+    if (end <= v.size() || (end - v.size()) * sizeof(T) < kMappedRoomMinBytes) return;
     // Whole pages inside the room only: the pages it shares with live elements are mapped.
     const auto first = (reinterpret_cast<std::uintptr_t>(v.data() + v.size()) + kPage - 1) / kPage;
     const auto last = reinterpret_cast<std::uintptr_t>(v.data() + end) / kPage;
@@ -94,6 +97,14 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 #else
     (void)jobs, (void)v, (void)end;
 #endif
+}
+
+// The stocked pages map_room moves under an empty array on whole huge pages given room for
+// `count` elements of `element_bytes`: each huge page the room reaches, none under
+// kMappedRoomMinBytes (map_room maps nothing there).
+constexpr std::size_t stocked_room_pages(std::size_t count, std::size_t element_bytes) {
+    const std::size_t bytes = count * element_bytes;
+    return bytes < kMappedRoomMinBytes ? 0 : (bytes + kHugePageBytes - 1) / kHugePageBytes;
 }
 
 }  // namespace spindle

@@ -2,6 +2,9 @@
 // the Space constructor, with NaN, infinities, a negative value and zero. A rejection
 // names the field, the constructor and the setter say the same, and the space is unchanged.
 #include <climits>
+#include <cstdint>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "invalid_input.hpp"
@@ -163,5 +166,23 @@ TEST(InvalidSettings, UpdateRejectsNonFiniteAndNegativeDt) {
                 expect_rejected(*scene.space, *twin.space, change, "dt", t.name);
             }
         }
+    }
+}
+
+// The contact count hint has no setter (it sizes a level's build): the constructor checks
+// it, naming the struct, the field, the bounds and the value.
+TEST(InvalidSettings, CapacityContactCountIsCheckedByTheConstructor) {
+    constexpr std::int64_t kMost = CapacitySettings::kMaxContactCount;
+    for (const std::int64_t bad : {std::numeric_limits<std::int64_t>::min(), std::int64_t{-1}, kMost + 1,
+                                   std::numeric_limits<std::int64_t>::max()}) {
+        SpaceSettings all;
+        all.capacity.contact_count = bad;
+        EXPECT_EQ(error_of([&] { Space space(all); }),
+                  "capacity: contact_count must be >= 0 and <= 4294967295, got " + std::to_string(bad));
+    }
+    for (const std::int64_t good : {std::int64_t{0}, std::int64_t{60000}, kMost}) {
+        SpaceSettings all;
+        all.capacity.contact_count = good;
+        expect_accepted([&] { Space space(all); }, "contact_count", std::to_string(good));
     }
 }

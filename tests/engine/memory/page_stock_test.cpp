@@ -1,18 +1,24 @@
-// Huge pages stocked ahead of a first step (memory/page_stock.hpp): Space::reserve_bodies
-// stocks them, the step moves them under its arrays instead of faulting fresh ones, and the
-// update after it gives back the rest.
+// Huge pages stocked ahead of a first step (memory/page_stock.hpp): Space::create_body
+// stocks what the new bodies' first step will write, by the pairs their fat boxes make or the
+// game's count of contacts, the step moves them under its arrays instead of faulting fresh
+// ones, and the update after it gives back the rest.
 #include <gtest/gtest.h>
 #include <spindle/engine/space.hpp>
 #include <spindle/scene/scene.hpp>
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
 #include "memory/huge_page_vector.hpp"
 #include "memory/medium_blocks.hpp"
 #include "memory/page_stock.hpp"
+#include "solver/solver_body.hpp"
 #include "stages/stages.hpp"
 
 #if defined(__linux__)
@@ -49,7 +55,7 @@ TEST(PageStock, AMovedPageIsInPlaceBeforeItsFirstTouch) {
 #endif
 
 // Jolt's pyramid (1240 boxes): the first step's contact records fill whole huge pages, and
-// those come from the stock reserve_bodies made; the update gives back what is left.
+// those come from the stock its bodies made; the update gives back what is left.
 TEST(PageStock, AFirstStepTakesItsPagesFromTheStockItsBodiesReserved) {
     const std::size_t before = stocked_huge_pages();
     const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
@@ -76,4 +82,130 @@ TEST(PageStock, AFirstStepTakesItsPagesFromTheStockItsBodiesReserved) {
     space.update();
     EXPECT_EQ(world.stocked_pages, 0u);
     EXPECT_EQ(stocked_huge_pages(), before) << "the pages the step did not take were not given back";
+}
+
+namespace {
+
+// A level of `count` boxes in a grid, `spacing` apart (2 m: none touches), above a floor.
+void make_grid(Space& space, int count, Real spacing) {
+    space.reserve_bodies(static_cast<std::size_t>(count) + 1);
+    BodyDesc floor;
+    floor.type = MotionType::Static;
+    floor.shape = Shape::box(Vec3(1000, 1, 1000));
+    floor.position = Vec3(0, -1, 0);
+    space.create_body(floor);
+    for (int i = 0; i < count; ++i) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        d.position = Vec3(spacing * (i % 100), 5.0 + spacing * (i / 10000), spacing * ((i / 100) % 100));
+        space.create_body(d);
+    }
+}
+
+// Runs `level`'s first step in a process of its own (a death test's, re-run from the
+// start: the medium block pool, process-wide, holds no chunk yet) with one page stocked
+// beyond the level's, and exits 0 when the step took exactly the level's stock: the one
+// page left shows it needed no more, none of the level's left that it needed no less.
+// Else it says what it took on stderr and exits 1.
+template <typename Level>
+void expect_first_step_takes_its_stock(const SpaceSettings& settings, Level&& level) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(
+        {
+            Space space{settings};
+            level(space);
+            World& world = SpaceInternals::world(space);
+            space.flush();
+            const std::size_t stocked = world.stocked_pages;
+            stock_huge_page();
+            const std::size_t ready = stocked_huge_pages();
+            step(world, space.settings().time_step.duration);
+            const std::size_t taken = ready - stocked_huge_pages();
+            std::fprintf(stderr, "stocked %zu, taken %zu with a page to spare\n", stocked, taken);
+            std::exit(stocked > 0 && taken == stocked ? 0 : 1);
+        },
+        ::testing::ExitedWithCode(0), "");
+}
+
+}  // namespace
+
+// A falling level (Box3D's rain, junkyard: bodies apart) makes few contacts in its first
+// step: it stocks only the pages that step writes (its solver bodies', and the pool's
+// chunk for its per-body lists), not pages for contacts it does not make.
+TEST(PageStock, AFallingLevelStocksOnlyThePagesItsFirstStepTakes) {
+    Space space;
+    make_grid(space, 8000, 2);
+    const World& world = SpaceInternals::world(space);
+    EXPECT_EQ(world.first_step_contacts, 0u) << "boxes 1 m apart were counted as pairs";
+    EXPECT_LE(world.stocked_pages, 2u) << "a level of boxes apart stocked pages for contacts it does not make";
+    expect_first_step_takes_its_stock({}, [](Space& s) { make_grid(s, 8000, 2); });
+}
+
+// A floor made after the boxes resting on it brings their contacts: they are stocked for
+// with it (8,000 contact records, 3.6 MB).
+TEST(PageStock, AFloorMadeAfterItsBoxesStocksTheirContacts) {
+    expect_first_step_takes_its_stock({}, [](Space& space) {
+        for (int i = 0; i < 8000; ++i) {
+            BodyDesc d;
+            d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+            d.position = Vec3(2.0 * (i % 100), 0.5, 2.0 * (i / 100));
+            space.create_body(d);
+        }
+        BodyDesc floor;
+        floor.type = MotionType::Static;
+        floor.shape = Shape::box(Vec3(1000, 1, 1000));
+        floor.position = Vec3(0, -1, 0);
+        space.create_body(floor);
+    });
+}
+
+// What a level stocks is what its first step takes, no more and no less: a resting pyramid
+// (Jolt's: contact records, wide contacts and pool chunks), many_pyramids by its counted
+// pairs and by the game's count of its contacts (28,420). A list the first step adds on
+// huge pages that first_step_pages (api/space.cpp) does not count fails here.
+TEST(PageStock, AFirstStepTakesWhatItsLevelStocked) {
+    const SceneDesc pyramid = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
+    expect_first_step_takes_its_stock(pyramid.settings, [&](Space& space) { build(pyramid, space); });
+    const SceneDesc many = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/many_pyramids.toml");
+    expect_first_step_takes_its_stock(many.settings, [&](Space& space) { build(many, space); });
+    SpaceSettings told = many.settings;
+    told.capacity.contact_count = 28420;
+    expect_first_step_takes_its_stock(told, [&](Space& space) { build(many, space); });
+}
+
+// The pairs counted as the bodies are made are the contacts their first step makes: Jolt's
+// pyramid, boxes resting on each other.
+TEST(PageStock, ThePairsCountedAsBodiesAreMadeAreTheFirstStepsContacts) {
+    const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
+    Space space{scene.settings};
+    build(scene, space);
+    World& world = SpaceInternals::world(space);
+    const std::size_t counted = world.first_step_contacts;
+    ASSERT_GT(counted, 0u);
+    space.update();
+    EXPECT_EQ(world.contacts.size(), counted);
+}
+
+// The game's count of its level's first contacts (SpaceSettings::capacity) sizes the
+// stock instead of the pairs counted, before the space's first step only: a body made
+// after it stocks by its own pairs again. memory_report shows the stock.
+TEST(PageStock, TheGamesContactCountSizesTheFirstStepsStockOnly) {
+    const std::size_t before = stocked_huge_pages();
+    SpaceSettings settings;
+    settings.capacity.contact_count = 60000;
+    Space space{settings};
+    make_grid(space, 100, 2);
+    World& world = SpaceInternals::world(space);
+    EXPECT_GT(world.stocked_pages, 20u) << "the game's 60,000 contacts were not stocked for";
+    EXPECT_EQ(memory_report(space).page_stock, world.stocked_pages * kHugePageBytes);
+    EXPECT_EQ(stocked_huge_pages(), before + world.stocked_pages);
+    space.update();
+    EXPECT_EQ(memory_report(space).page_stock, 0u);
+    EXPECT_EQ(stocked_huge_pages(), before);
+    make_grid(space, 100, 2);
+    EXPECT_EQ(world.stocked_pages, 0u) << "the game's count was stocked for again after the first step";
+
+    Space counted;  // the same level without the game's count
+    make_grid(counted, 100, 2);
+    EXPECT_EQ(SpaceInternals::world(counted).stocked_pages, 0u);
 }

@@ -77,12 +77,25 @@ struct EventSettings {
     std::uint32_t max_contact_points = 1u << 16;
 };
 
+// What the game expects its level to hold (Box3D's b3Capacity). A hint: nothing is
+// limited by it.
+struct CapacitySettings {
+    // The contacts the level's first step will make (Box3D's contactCount). The huge pages
+    // that step writes are mapped as the level's dynamic bodies are made, for this many
+    // contacts, and given back after it when it did not take them. 0: the space counts the
+    // pairs of overlapping boxes its new bodies make as they are made (a tree query each).
+    // At most kMaxContactCount (a contact's place is 32 bits).
+    std::int64_t contact_count = 0;
+    static constexpr std::int64_t kMaxContactCount = (std::int64_t{1} << 32) - 1;
+};
+
 struct SpaceSettings {
     Vec3 gravity{0, -9.81, 0};
     TimeStepSettings time_step;
     SolverSettings solver;
     SleepSettings sleep;
     EventSettings events;
+    CapacitySettings capacity;
 };
 
 }  // namespace spindle

@@ -48,9 +48,11 @@ public:
 
     // ---- structure (update thread, or any thread while no update runs) ----
     // Validates everything first; a rejected body leaves the space unchanged and the
-    // spindle::Error names the field and value. A dynamic body also has the memory its first
-    // step will write mapped here (a huge page each few hundred bodies) rather than in that
-    // step; the next update gives back what its step did not take.
+    // spindle::Error names the field and value. A body's fat box is looked up among the
+    // others' for the contacts it will make, and the huge pages a level's first step will
+    // write for its new dynamic bodies and their contacts are mapped here, as they add up
+    // to whole pages, rather than in that step (SpaceSettings::capacity); the next update
+    // gives back what its step did not take.
     BodyHandle create_body(const BodyDesc& desc);
     void destroy_body(BodyHandle body);
     bool contains(BodyHandle body) const noexcept;  // any thread: as published
