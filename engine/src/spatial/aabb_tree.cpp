@@ -46,6 +46,7 @@ std::int32_t DynamicAabbTree::allocate_node() {
     node.parent_or_next = kNull;
     node.height = 0;
     node.payload.children = {kNull, kNull};
+    m_child_boxes_current = false;
     return id;
 }
 
@@ -53,6 +54,7 @@ void DynamicAabbTree::free_node(std::int32_t id) {
     Node& node = m_nodes[static_cast<std::size_t>(id)];
     node.height = kFreeHeight;
     node.parent_or_next = m_free_list;
+    m_child_boxes_current = false;
     if (m_enlarged[static_cast<std::size_t>(id)] != 0) {
         m_enlarged[static_cast<std::size_t>(id)] = 0;
         --m_enlarged_nodes;
@@ -164,6 +166,7 @@ bool DynamicAabbTree::move_proxy(std::int32_t id, const Aabb& tight, const Vec3&
     SPINDLE_ASSERT(margin >= 0 && is_finite(margin), "DynamicAabbTree::move_proxy: margin must be finite and >= 0");
     if (!needs_move(id, tight, displacement, margin)) return false;
     m_nodes[static_cast<std::size_t>(id)].box = fatten(tight, displacement, margin);
+    m_child_boxes_current = false;
     enlarge_ancestors(id);
     validate_if_enabled();
     return true;
@@ -173,6 +176,7 @@ void DynamicAabbTree::set_fat_box(std::int32_t id, const Aabb& fat) {
     check_proxy(id);
     SPINDLE_ASSERT(is_finite_box(fat), "DynamicAabbTree::set_fat_box: box must be finite with min <= max");
     m_nodes[static_cast<std::size_t>(id)].box = fat;
+    m_child_boxes_current = false;
     flag_ancestors(id);
     m_stale_boxes = m_stale_boxes || id != m_root;  // a lone leaf has no ancestor to go stale
     validate_if_enabled();
@@ -199,6 +203,7 @@ std::int32_t DynamicAabbTree::set_fat_box_shared(std::int32_t id, const Aabb& fa
 
 void DynamicAabbTree::end_shared_fat_boxes(std::int32_t flagged, std::int32_t boxes_set) {
     m_enlarged_nodes += flagged;
+    if (boxes_set > 0) m_child_boxes_current = false;
     // As set_fat_box: only a lone leaf (the root) has no ancestor to go stale.
     if (boxes_set > 0 && m_nodes[static_cast<std::size_t>(m_root)].height > 0) m_stale_boxes = true;
     validate_if_enabled();
@@ -288,6 +293,7 @@ std::int32_t DynamicAabbTree::find_best_sibling(const Aabb& box) const {
 }
 
 void DynamicAabbTree::insert_leaf(std::int32_t leaf) {
+    m_child_boxes_current = false;
     if (m_root == kNull) {
         m_root = leaf;
         m_nodes[static_cast<std::size_t>(leaf)].parent_or_next = kNull;
@@ -321,6 +327,7 @@ void DynamicAabbTree::insert_leaf(std::int32_t leaf) {
 }
 
 void DynamicAabbTree::remove_leaf(std::int32_t leaf) {
+    m_child_boxes_current = false;
     if (leaf == m_root) {
         m_root = kNull;
         return;
@@ -443,13 +450,46 @@ bool DynamicAabbTree::rotate(std::int32_t a) {
 }
 
 std::size_t DynamicAabbTree::heap_bytes() const noexcept {
-    std::size_t bytes = m_nodes.capacity() * sizeof(Node) + m_enlarged.capacity() * sizeof(std::uint8_t) +
+    std::size_t bytes = m_nodes.capacity() * sizeof(Node) + m_child_boxes.capacity() * sizeof(ChildBoxes) +
+                        m_enlarged.capacity() * sizeof(std::uint8_t) +
                         m_build_leaves.capacity() * sizeof(std::int32_t) +
                         (m_build_tasks.capacity() + m_build_subtrees.capacity()) * sizeof(BuildTask) +
                         (m_build_order.capacity() + m_build_pool.capacity()) * sizeof(std::int32_t) +
                         m_build_stacks.capacity() * sizeof(std::vector<BuildTask>);
     for (const std::vector<BuildTask>& stack : m_build_stacks) bytes += stack.capacity() * sizeof(BuildTask);
     return bytes;
+}
+
+void DynamicAabbTree::make_child_boxes(JobSystem* jobs) {
+    SPINDLE_ASSERT(!m_stale_boxes, "DynamicAabbTree::make_child_boxes: rebuild_enlarged has not run");
+    m_child_boxes.resize(m_nodes.size());
+    const auto make = [this](std::uint32_t begin, std::uint32_t end, unsigned) {
+        for (std::uint32_t id = begin; id < end; ++id) {
+            const Node& node = m_nodes[id];
+            if (node.height <= 0) continue;  // leaves and free nodes have none
+            ChildBoxes& children = m_child_boxes[id];
+            const std::int32_t c[2] = {node.payload.children.first, node.payload.children.second};
+            for (int k = 0; k < 2; ++k) {
+                const Node& child = m_nodes[static_cast<std::size_t>(c[k])];
+                for (int axis = 0; axis < 3; ++axis) {
+                    children.min[3 * k + axis] = static_cast<float>(child.box.min[axis]);
+                    children.max[3 * k + axis] = static_cast<float>(child.box.max[axis]);
+                }
+                children.entry[k] = child.height == 0 ? ~c[k] : c[k];
+            }
+            children.unused[0] = children.unused[1] = 0;
+        }
+    };
+    const auto count = static_cast<std::uint32_t>(m_nodes.size());
+    // Nodes per job: a few per worker on a washer-sized tree.
+    constexpr std::uint32_t kGrain = 2048;
+    if (jobs != nullptr && count > kGrain) {
+        jobs->parallel_for("broadphase.child_boxes", 0, count, kGrain, make);
+    } else {
+        make(0, count, 0);
+    }
+    m_child_boxes_current = true;
+    validate_if_enabled();
 }
 
 Real DynamicAabbTree::area_cost() const {
@@ -501,6 +541,19 @@ void DynamicAabbTree::validate() const {
                 stack.push(child);
             }
             SPINDLE_TREE_CHECK(c[0] != c[1], "tree: both children are the same node");
+            if (m_child_boxes_current) {
+                const ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(id)];
+                for (int k = 0; k < 2; ++k) {
+                    const Node& cn = m_nodes[static_cast<std::size_t>(c[k])];
+                    SPINDLE_TREE_CHECK(children.entry[k] == (cn.height == 0 ? ~c[k] : c[k]),
+                                       "tree: a child box's entry is not its child");
+                    for (int axis = 0; axis < 3; ++axis) {
+                        SPINDLE_TREE_CHECK(children.min[3 * k + axis] == static_cast<float>(cn.box.min[axis]) &&
+                                               children.max[3 * k + axis] == static_cast<float>(cn.box.max[axis]),
+                                           "tree: a child's float box is not its box");
+                    }
+                }
+            }
             const int expected = 1 + std::max(m_nodes[static_cast<std::size_t>(c[0])].height,
                                               m_nodes[static_cast<std::size_t>(c[1])].height);
             SPINDLE_TREE_CHECK(node.height == expected, "tree: height is not 1 + the taller child");

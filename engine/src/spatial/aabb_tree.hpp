@@ -95,8 +95,15 @@ public:
     void end_shared_fat_boxes(std::int32_t flagged, std::int32_t boxes_set);
 
     // Calls callback(id) -> bool for every proxy whose fat box overlaps `box`; false stops.
+    // While the child boxes are current (make_child_boxes), the walk tests a node's two
+    // children at once on their float boxes; the same proxies in the same order either way.
     template <typename Callback>
     void query(const Aabb& box, Callback&& callback) const;
+    // Makes every internal node's children's boxes in float, for query()'s walk, until the
+    // next change to the tree. Worth it when many queries follow (a pair search of many
+    // moved proxies): it reads every node. With `jobs`, in parallel (the caller waits).
+    void make_child_boxes(JobSystem* jobs = nullptr);
+    bool child_boxes_current() const noexcept { return m_child_boxes_current; }
 
     // Casts the segment origin + t * translation, t in [0, max_fraction], against fat
     // boxes. callback(id, max_fraction) -> Real returns: a negative value to ignore the
@@ -188,6 +195,35 @@ private:
         Aabb m_box;
 #endif
     };
+    // An internal node's two children for query()'s walk, in one cache line: their fat
+    // boxes in float (lanes: first child's x, y, z, second's x, y, z) and what the walk
+    // pushes for each (its id; ~id for a leaf, whose double box the walk tests at the pop).
+    // Converted to float as the query's box is, by the same rounding, which keeps order:
+    // a float box overlaps the query's wherever the double boxes overlap, so the float test
+    // only lets through some nodes the double one would not, never the reverse.
+    struct alignas(64) ChildBoxes {
+        float min[6];
+        std::int32_t entry[2];  // in the lanes the compares of min ignore
+        float max[6];
+        float unused[2];
+    };
+    static_assert(sizeof(ChildBoxes) == 64, "a node's child boxes should fill one cache line");
+    // Which of a node's two children's float boxes overlap one box (bit 0 the first, bit 1
+    // the second): with AVX, the twelve comparisons in two.
+    class ChildTest {
+    public:
+        explicit ChildTest(const Aabb& box);
+        unsigned operator()(const ChildBoxes& children) const;
+
+    private:
+#if defined(__AVX__)
+        __m256 m_max;  // box max x, y, z, x, y, z, then lanes left out of the mask
+        __m256 m_min;  // box min x, y, z, x, y, z, likewise
+#else
+        float m_max[3];
+        float m_min[3];
+#endif
+    };
     // Same as Aabb::overlaps, but exits at the first separating axis: most nodes a
     // query visits are rejected on x alone.
     static bool overlaps(const Aabb& a, const Aabb& b) noexcept {
@@ -245,6 +281,10 @@ private:
 
     AabbTreeSettings m_settings;
     std::vector<Node> m_nodes;
+    // Per node, its children's boxes in float (make_child_boxes); read only while
+    // m_child_boxes_current, which every change to a node's box or children clears.
+    std::vector<ChildBoxes> m_child_boxes;
+    bool m_child_boxes_current = false;
     std::int32_t m_root = kNull;
     std::int32_t m_free_list = kNull;
     std::int32_t m_proxy_count = 0;
@@ -370,12 +410,72 @@ inline DynamicAabbTree::OverlapTest::OverlapTest(const Aabb& box) : m_box(box) {
 inline bool DynamicAabbTree::OverlapTest::operator()(const Aabb& node) const { return overlaps(node, m_box); }
 #endif
 
+#if defined(__AVX__)
+inline DynamicAabbTree::ChildTest::ChildTest(const Aabb& box) {
+    const auto x = static_cast<float>(box.max.x()), y = static_cast<float>(box.max.y()),
+               z = static_cast<float>(box.max.z());
+    m_max = _mm256_setr_ps(x, y, z, x, y, z, 0, 0);
+    const auto u = static_cast<float>(box.min.x()), v = static_cast<float>(box.min.y()),
+               w = static_cast<float>(box.min.z());
+    m_min = _mm256_setr_ps(u, v, w, u, v, w, 0, 0);
+}
+
+inline unsigned DynamicAabbTree::ChildTest::operator()(const ChildBoxes& children) const {
+    const __m256 low = _mm256_load_ps(children.min);  // lanes 6 and 7: the entries, left out
+    const __m256 high = _mm256_load_ps(children.max);
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(low, m_max, _CMP_LE_OQ), _mm256_cmp_ps(high, m_min, _CMP_GE_OQ));
+    const auto lanes = static_cast<unsigned>(_mm256_movemask_ps(inside));
+    return ((lanes & 0x7u) == 0x7u ? 1u : 0u) | ((lanes & 0x38u) == 0x38u ? 2u : 0u);
+}
+#else
+inline DynamicAabbTree::ChildTest::ChildTest(const Aabb& box) {
+    for (int k = 0; k < 3; ++k) {
+        m_max[k] = static_cast<float>(box.max[k]);
+        m_min[k] = static_cast<float>(box.min[k]);
+    }
+}
+
+inline unsigned DynamicAabbTree::ChildTest::operator()(const ChildBoxes& children) const {
+    unsigned found = 0;
+    for (int c = 0; c < 2; ++c) {
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) {
+            inside = inside && children.min[3 * c + k] <= m_max[k] && children.max[3 * c + k] >= m_min[k];
+        }
+        found |= inside ? 1u << c : 0u;
+    }
+    return found;
+}
+#endif
+
 template <typename Callback>
 void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
     SPINDLE_ASSERT(!m_stale_boxes,
                    "DynamicAabbTree::query: set_fat_box moved proxies and rebuild_enlarged has not run");
     const OverlapTest overlaps_box(box);
-    traverse(overlaps_box, callback);
+    if (!m_child_boxes_current || m_root == kNull || m_nodes[static_cast<std::size_t>(m_root)].height == 0) {
+        traverse(overlaps_box, callback);
+        return;
+    }
+    // traverse()'s walk, the same nodes entered in the same order, but a node's children
+    // tested together on their float boxes before they are pushed, so an internal node's
+    // own line is never read; a leaf let through is tested on its double box when popped.
+    if (!overlaps_box(m_nodes[static_cast<std::size_t>(m_root)].box)) return;
+    const ChildTest children_overlap(box);
+    TraversalStack stack;
+    stack.push(m_root);
+    while (!stack.empty()) {
+        const std::int32_t entry = stack.pop();
+        if (entry < 0) {
+            const std::int32_t leaf = ~entry;
+            if (overlaps_box(m_nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
+            continue;
+        }
+        const ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(entry)];
+        const unsigned found = children_overlap(children);
+        if ((found & 1u) != 0) stack.push(children.entry[0]);
+        if ((found & 2u) != 0) stack.push(children.entry[1]);
+    }
 }
 
 template <typename Callback>

@@ -30,6 +30,7 @@ void DynamicAabbTree::rebuild() {
     }
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
+    m_child_boxes_current = false;
     build_from_leaves(nullptr);
     m_built_cost = build_cost();
     validate_if_enabled();
@@ -114,6 +115,7 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     // Flagged nodes form a tree from the root down (a flagged node's parent is flagged):
     // they are built again, and what hangs off them (a leaf or an unflagged subtree) is
     // kept whole.
+    m_child_boxes_current = false;
     m_build_leaves.clear();
     m_build_pool.clear();
     const bool in_jobs = jobs != nullptr && collect_flagged_in_jobs(*jobs);

@@ -179,6 +179,14 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair kn
     m_trees[1].rebuild_enlarged(&jobs);
     const auto count = static_cast<std::uint32_t>(m_enlarged.size());
     if (count == 0) return;
+    // A search visits some hundred nodes; the float boxes cost one pass over a tree's
+    // nodes, paid back once the searches are a fair share of its proxies.
+    for (DynamicAabbTree& tree : m_trees) {
+        if (!tree.child_boxes_current() &&
+            count >= static_cast<std::uint32_t>(tree.proxy_count()) / kSearchesPerChildBoxes) {
+            tree.make_child_boxes(&jobs);
+        }
+    }
 
     const std::uint32_t grain = m_settings.grain;
     const std::uint32_t chunks = (count + grain - 1) / grain;

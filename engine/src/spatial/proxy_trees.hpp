@@ -172,6 +172,9 @@ private:
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
     void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;
+    // A tree's children's float boxes are made for a pair search of at least its proxy
+    // count over this many enlarged proxies (DynamicAabbTree::make_child_boxes).
+    static constexpr std::uint32_t kSearchesPerChildBoxes = 8;
     void merge_runs(JobSystem& jobs, PairList& pairs);
     void validate_enlarged() const;
     // The trees check themselves (amortised); this adds the enlarged list, after each change.

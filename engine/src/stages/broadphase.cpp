@@ -301,17 +301,19 @@ void update_broadphase(World& world, Real dt) {
                 b.bounds[i] = shape.bounds(b.transform(i));
             }
             const Vec3 d = b.v[i] * dt;
-            const Aabb swept = reach_box(bp, swept_bounds(b, i, d), bp.proxy[i].is_static());
-            bp.refit_marked[k] = 0;
-            bp.moved_ids[k] = ProxyId{};
-            // The displacement the fat box stretches along (times the rule's stretch): a fast
-            // body's in free flight, else none. Only a fast body's flight is asked about.
+            const Real margin = bp.tree.margin(bp.proxy[i]);
             const Vec3 velocity_change = b.v[i] - bp.last_velocity[i];
             bp.last_velocity[i] = b.v[i];
-            const bool stretches = FatBoxRule::fast(d, bp.tree.margin(bp.proxy[i])) &&
-                                   b.type[i] == MotionType::Dynamic &&
-                                   bp.rule.in_free_flight(velocity_change, gravity_change);
-            const Vec3 stretch = stretches ? d : Vec3::Zero();
+            // A body carried by what touches it gets its bounds, unswept, as in Box3D; a
+            // body in free flight, thrown or hit hard, and a kinematic one, its bounds swept
+            // over the step, and a fast one in free flight a stretch ahead too.
+            const bool dynamic = b.type[i] == MotionType::Dynamic;
+            const bool free = dynamic && bp.rule.in_free_flight(velocity_change, gravity_change);
+            const bool carried = dynamic && !free && FatBoxRule::carried(velocity_change, dt, margin);
+            const Aabb swept = reach_box(bp, carried ? b.bounds[i] : swept_bounds(b, i, d), bp.proxy[i].is_static());
+            bp.refit_marked[k] = 0;
+            bp.moved_ids[k] = ProxyId{};
+            const Vec3 stretch = free && FatBoxRule::fast(d, margin) ? d : Vec3::Zero();
             if (!bp.tree.needs_move(bp.proxy[i], swept, stretch)) continue;
             const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, stretch);
             bp.moved_ids[k] = bp.proxy[i];

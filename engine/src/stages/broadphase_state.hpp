@@ -61,19 +61,21 @@ private:
 };
 
 // Box3D's fat box rule (its shape.c b3UpdateShapeAABBs and b3ComputeShapeMargin, body.c's
-// finalize): a moving body's proxy must hold its bounds swept over the step's motion and
-// grown by `speculative`; when they leave it, its new fat box is those grown by the body's
-// margin, margin_fraction x its shape's radius (fat_box_radius), at most max_margin. A small
-// body gets a small box, so fewer pairs wait in the narrowphase. Static proxies hold their
-// bounds. The bounds are swept over the step already, so two bodies that would meet within
-// the step have their pair (and speculative contact) first. A slow body's box has no stretch
-// along the motion (Box3D has none); a fast one's, moving more than its margin a step, would
-// then leave its box every step and be re-inserted and searched again each time, so the box
-// of a fast body in free flight reaches `stretch` displacements ahead and lasts a few steps.
-// A body its contacts or joints moved last step (its velocity changed by more than gravity's
-// share, within `free_tolerance` of it) gets no stretch, as in Box3D: it moves with what
-// touches it, whose pairs it has, and a box reaching past them makes and loses contacts
-// with the bodies beyond at every new box (a tumbling pile's churn).
+// finalize): a moving body's proxy must hold its bounds grown by `speculative`; when they
+// leave it, its new fat box is those grown by the body's margin, margin_fraction x its
+// shape's radius (fat_box_radius), at most max_margin. A small body gets a small box, so
+// fewer pairs wait in the narrowphase. Static proxies hold their bounds. A body in free
+// flight (its velocity changed over the last step by gravity's share, within
+// `free_tolerance` of it), a kinematic one, and one thrown or hit hard (its velocity changed
+// by more than its margin a step) holds its bounds swept over the step, so that it has its
+// pair (and speculative contact) with what it would meet within the step first; a fast one
+// in free flight, moving more than its margin a step, would then leave its box every step
+// and be re-inserted and searched again each time, so its box reaches `stretch`
+// displacements ahead and lasts a few steps. A body carried by what touches it (its
+// contacts or joints changed its velocity last step, by less than its margin a step) gets
+// Box3D's box, neither swept nor stretched: it moves with what touches it, whose pairs it
+// has, and a box reaching ahead of it meets the bodies beyond, moving with it too, at every
+// new box, contacts made and lost for nothing (a tumbling pile's churn).
 struct FatBoxRule {
     Real speculative = Real(0.02);       // m: Box3D's speculative distance, 4 linear slops
     Real max_margin = Real(0.05);        // m
@@ -88,6 +90,11 @@ struct FatBoxRule {
     bool in_free_flight(const Vec3& velocity_change, const Vec3& gravity_change) const {
         return (velocity_change - gravity_change).squaredNorm() <=
                free_tolerance * free_tolerance * gravity_change.squaredNorm();
+    }
+    // Whether a dynamic body not in free flight is carried by what touches it: its velocity
+    // changed over the last step by less than `body_margin` a step (`dt`) along every axis.
+    static bool carried(const Vec3& velocity_change, Real dt, Real body_margin) {
+        return (velocity_change * dt).cwiseAbs().maxCoeff() <= body_margin;
     }
     // Whether a body moving `displacement` a step is fast for its margin: a stretch, if it
     // is in free flight.

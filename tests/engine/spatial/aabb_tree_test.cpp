@@ -108,6 +108,92 @@ TEST(AabbTree, Query_FindsABoxTouchingAnyFaceNotOneARoundingStepAway) {
     }
 }
 
+// Every proxy `box` overlaps, in the order the query meets them.
+std::vector<std::int32_t> query_in_order(const DynamicAabbTree& tree, const Aabb& box) {
+    std::vector<std::int32_t> ids;
+    tree.query(box, [&](std::int32_t id) {
+        ids.push_back(id);
+        return true;
+    });
+    return ids;
+}
+
+// With the children's float boxes made, a query meets the same proxies in the same order
+// as the walk on the double boxes (a copy of the tree without them), and brute force;
+// including boxes whose faces a float cannot tell apart (a micrometre apart at 50 m).
+TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
+    Rng rng(5);
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    std::vector<std::int32_t> live;
+    const int n = 500 * kScale;
+    for (int i = 0; i < n; ++i) live.push_back(tree.create_proxy(rng.box(50, 2), std::uint64_t(i)));
+    const DynamicAabbTree doubles = tree;
+    tree.make_child_boxes();
+    ASSERT_TRUE(tree.child_boxes_current());
+    ASSERT_FALSE(doubles.child_boxes_current());
+    tree.validate();  // checks the float boxes too
+    for (int q = 0; q < 800; ++q) {
+        Aabb box = rng.box(50, 8);
+        if (q % 4 != 0) {  // a face on, or a few micrometres past or short of, a proxy's opposite face
+            const Aabb& other = tree.fat_aabb(live[static_cast<std::size_t>(rng.index(n))]);
+            const int axis = rng.index(3);
+            const Real offset = q % 4 == 1 ? 0 : rng.uniform(-4e-6, 4e-6);
+            const Real width = box.max[axis] - box.min[axis];
+            if (q % 8 < 4) {
+                box.min[axis] = other.max[axis] + offset;
+                box.max[axis] = box.min[axis] + width;
+            } else {
+                box.max[axis] = other.min[axis] + offset;
+                box.min[axis] = box.max[axis] - width;
+            }
+        }
+        const std::vector<std::int32_t> found = query_in_order(tree, box);
+        ASSERT_EQ(found, query_in_order(doubles, box)) << "query " << q;
+        std::vector<std::int32_t> sorted = found;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(sorted, brute_sorted(tree, live, box)) << "query " << q;
+    }
+}
+
+// Each change to the tree leaves the float boxes out of date, and the query walks the
+// double boxes until they are made again: a proxy moved, given a box, made or destroyed
+// after make_child_boxes is found where it is now.
+TEST(AabbTree, QueryAfterAChange_DoesNotReadOutOfDateChildBoxes) {
+    Rng rng(9);
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0, .displacement_multiplier = 0});
+    std::vector<std::int32_t> live;
+    for (int i = 0; i < 64; ++i) live.push_back(tree.create_proxy(rng.box(50, 2), std::uint64_t(i)));
+    const Aabb far = Aabb::from_center_extents(Vec3(500, 0, 0), Vec3::Ones());
+    const auto finds_only = [&](std::int32_t id, const char* change) {
+        EXPECT_FALSE(tree.child_boxes_current()) << change;
+        EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{id}) << change;
+        tree.make_child_boxes();
+        EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{id}) << change << ", boxes made again";
+    };
+    tree.make_child_boxes();
+    ASSERT_TRUE(query_sorted(tree, far).empty());
+    tree.move_proxy(live[3], far, Vec3::Zero());
+    finds_only(live[3], "moved");
+    tree.move_proxy(live[3], rng.box(50, 2), Vec3::Zero());
+    tree.make_child_boxes();
+    tree.set_fat_box(live[5], far);
+    tree.rebuild_enlarged();
+    finds_only(live[5], "given a box");
+    tree.destroy_proxy(live[5]);
+    EXPECT_FALSE(tree.child_boxes_current()) << "destroyed";
+    EXPECT_TRUE(query_sorted(tree, far).empty());
+    tree.make_child_boxes();
+    const std::int32_t made = tree.create_proxy(far, 99);
+    finds_only(made, "made");
+    tree.destroy_proxy(made);
+    tree.make_child_boxes();
+    tree.end_shared_fat_boxes(tree.set_fat_box_shared(live[7], far), 1);
+    tree.rebuild_enlarged();
+    finds_only(live[7], "given a box by a job");
+    tree.rebuild();
+    finds_only(live[7], "rebuilt");
+}
+
 TEST(AabbTree, Query_CallbackFalseStops) {
     DynamicAabbTree tree;
     for (int i = 0; i < 10; ++i)
