@@ -61,17 +61,13 @@ Real reach(const Bodies& b, std::uint32_t i) { return b.extents[i].reach.norm();
 // a guard against the rounding of the bounds and of the pair test's distance.
 constexpr Real kReachGuard = 1e-6;
 
-bool is_round(const Shape& s) { return s.type == ShapeType::Sphere || s.type == ShapeType::Capsule; }
-
 // Whether contact c, which has no manifold, is still out of reach: its bodies' tight
-// bounds (this step's) are further apart along an axis than the speculative reach, and
-// one of its shapes is a sphere or capsule. Such a pair's points come from the distance
-// between the cores, which is never less than the gap between the bounds, so the pair
-// test would find nothing; two polyhedra's speculative points come from their SAT
-// separation, which can be less, so they are always tested. Reads the packed key and the
-// bodies' bounds, not the contact record: a grid of spheres keeps a contact for every pair
-// whose fat boxes touch, most of them never near, and reading their records was most of
-// the narrowphase.
+// bounds (this step's) are further apart along an axis than the speculative reach (the
+// speculative distance and the step's closing, as the pair test keeps points within). The
+// shapes are at least that far apart, whatever they are. Reads the
+// packed key and the bodies' bounds, not the contact record: a tumbling pile keeps a
+// contact for every pair whose fat boxes touch, most of them never near, and reading
+// their records was most of the narrowphase.
 bool out_of_reach(const World& world, std::uint32_t c, Real speculative_distance, Real dt) {
     const Bodies& b = world.bodies;
     const std::uint64_t key = world.contact_keys[c];
@@ -82,7 +78,7 @@ bool out_of_reach(const World& world, std::uint32_t c, Real speculative_distance
     const Real gap = (box_b.min - box_a.max).cwiseMax(box_a.min - box_b.max).maxCoeff();
     if (!(gap > speculative_distance + kReachGuard)) return false;  // cheap before the closing speed
     const Real reach = speculative_distance + (b.v[bb] - b.v[a]).norm() * dt + kReachGuard;
-    return gap > reach && (is_round(b.traits[a].shape) || is_round(b.traits[bb].shape));
+    return gap > reach;
 }
 
 // How each body has turned since the manifolds were collided.

@@ -1,6 +1,6 @@
 // Pairs whose fat boxes overlap but whose shapes are too far apart for any contact point
 // are ruled out from their bounds (narrowphase.cpp, out_of_reach): no collision test and
-// no read of the contact record. Only where the bounds can tell: one shape round.
+// no read of the contact record.
 #include <spindle/engine/space.hpp>
 
 #include <gtest/gtest.h>
@@ -45,15 +45,27 @@ TEST(OutOfReach, FarPairsWithARoundShapeAreNotCollided) {
     EXPECT_EQ(space.last_update().contacts, 0u);
 }
 
-// Two polyhedra make speculative points from their SAT separation, which can be less
-// than the gap between their bounds: they are always tested.
-TEST(OutOfReach, PolyhedraAreAlwaysTested) {
+// Two polyhedra too, lined up or turned: their bounds' gap is a distance no point of theirs
+// comes within.
+TEST(OutOfReach, FarPolyhedraAreNotCollided) {
     Space space(weightless());
     add(space, Shape::box(Vec3::Constant(0.4)), Vec3(0, 0, 0));
     add(space, Shape::box(Vec3::Constant(0.4)), Vec3(0.8 + kGap, 0, 0));
+    const Quat tilt = Quat(Eigen::AngleAxis<Real>(0.6, Vec3::UnitZ())) *
+                      Quat(Eigen::AngleAxis<Real>(0.7, Vec3::UnitY()));
+    BodyDesc d;
+    d.shape = Shape::box(Vec3::Constant(0.4));
+    d.orientation = tilt;
+    d.position = Vec3(0, 5, 0);
+    space.create_body(d);
+    d.orientation = tilt.conjugate();
+    d.position = Vec3(0, 5, 0) + Vec3(1.474, 0, 0);  // bounds 0.1 m apart along x
+    space.create_body(d);
     for (int i = 0; i < 10; ++i) space.update();
-    EXPECT_EQ(space.counters().contacts_updated, 10u);
-    EXPECT_EQ(space.counters().contacts_out_of_reach, 0u);
+    EXPECT_EQ(space.counters().contacts_updated, 20u);
+    EXPECT_EQ(space.counters().contacts_out_of_reach, 20u);
+    EXPECT_EQ(space.counters().manifolds_reused, 0u);
+    EXPECT_EQ(space.last_update().contacts, 0u);
 }
 
 // The reach counts how far the pair closes in one step: spheres kGap apart, out of reach
