@@ -64,10 +64,10 @@ constexpr Real kReachGuard = 1e-6;
 // Whether contact c, which has no manifold, is still out of reach: its bodies' tight
 // bounds (this step's) are further apart along an axis than the speculative reach (the
 // speculative distance and the step's closing, as the pair test keeps points within). The
-// shapes are at least that far apart, whatever they are. Reads the
-// packed key and the bodies' bounds, not the contact record: a tumbling pile keeps a
-// contact for every pair whose fat boxes touch, most of them never near, and reading
-// their records was most of the narrowphase.
+// shapes are at least that far apart, whatever they are. Reads the packed key and the
+// bodies' bounds, not the contact record: a tumbling pile keeps a contact for every pair
+// whose fat boxes touch, most of them never near, and reading their records was most of
+// the narrowphase.
 bool out_of_reach(const World& world, std::uint32_t c, Real speculative_distance, Real dt) {
     const Bodies& b = world.bodies;
     const std::uint64_t key = world.contact_keys[c];
@@ -399,7 +399,7 @@ void update_narrowphase(World& world) {
                 continue;
             }
             if (put_aside != nullptr && contact.extra) {  // a mesh's or compound's: the second pass
-                put_aside[worker].push_back(k | static_cast<std::uint32_t>(recyclable) << 31);
+                put_aside[worker].push_back(k | static_cast<std::uint32_t>(recyclable) * kRecyclableBit);
                 continue;
             }
             collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
