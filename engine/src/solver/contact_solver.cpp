@@ -295,11 +295,13 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         in.tangent[1].set_lane(l, tangent[1]);
         in.inv_mass_a[l] = A.inv_mass;
         in.inv_mass_b[l] = B.inv_mass;
-        for (int axis = 0; axis < 3; ++axis) {
-            in.locked_a[axis][l] = (A.locks & (1u << axis)) != 0 ? -1 : 0;
-            in.locked_b[axis][l] = (B.locks & (1u << axis)) != 0 ? -1 : 0;
+        if (((A.locks | B.locks) & kLockTranslation) != 0) {  // else the lane's masks stay clear
+            wc.locked = true;
+            for (int axis = 0; axis < 3; ++axis) {
+                in.locked_a[axis][l] = (A.locks & (1u << axis)) != 0 ? -1 : 0;
+                in.locked_b[axis][l] = (B.locks & (1u << axis)) != 0 ? -1 : 0;
+            }
         }
-        wc.locked = wc.locked || ((A.locks | B.locks) & kLockTranslation) != 0;
         linear_sum[l] = inverse_mass_along(A.inv_mass, A.locks, m.normal) +
                         inverse_mass_along(B.inv_mass, B.locks, m.normal);
         in.inv_inertia_a.set_lane(l, A.inv_inertia);
