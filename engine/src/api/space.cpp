@@ -6,7 +6,6 @@
 #include <spindle/platform/error.hpp>
 #include <spindle/scheduler/single_threaded.hpp>
 
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -36,53 +35,6 @@ World::~World() { give_back_stocked_huge_pages(stocked_pages); }
 
 namespace {
 
-// The huge pages a first step writes, counted array by array as it lays them out
-// (memory/huge_page_vector.hpp): an array map_room fills takes stocked pages under it from
-// a megabyte up (stages/capacity.hpp); any array of a medium size takes a block of the
-// medium block pool, whose new chunks are stocked pages too. Other arrays of a megabyte
-// or more fault their own pages.
-class FirstStepPages {
-public:
-    // An array map_room fills: the contact records, wide contacts, push anchors, solver bodies.
-    void mapped(std::size_t count, std::size_t element_bytes) {
-        const std::size_t pages = stocked_room_pages(count, element_bytes);
-        if (pages == 0) listed(count, element_bytes);
-        m_pages += pages;
-    }
-    void listed(std::size_t count, std::size_t element_bytes) {
-        const std::size_t bytes = count * element_bytes;
-        if (bytes >= kMediumBlockMinBytes && bytes < kMediumBlockEndBytes) m_pool_bytes += medium_block_bytes(bytes);
-    }
-    std::size_t pages() const { return m_pages + (m_pool_bytes + kHugePageBytes - 1) / kHugePageBytes; }
-
-private:
-    std::size_t m_pages = 0;
-    std::size_t m_pool_bytes = 0;
-};
-
-// What the first step of `bodies` new dynamic bodies making `contacts` contacts writes on
-// huge pages, which create_body stocks ahead (memory/page_stock.hpp). The lists a step
-// adds must be added here: PageStock.AFirstStepTakesWhatItsLevelStocked fails otherwise.
-std::size_t first_step_pages(std::size_t bodies, std::size_t contacts) {
-    FirstStepPages p;
-    const std::size_t wide = (contacts + kLanes - 1) / kLanes;
-    p.mapped(contacts, sizeof(Contact));
-    p.mapped(wide, sizeof(WideContact));
-    p.mapped(wide * kLanes, sizeof(PushAnchors));
-    p.mapped(bodies + 1, sizeof(SolverBody));
-    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(Pair));           // the broadphase's new pairs, merged
-    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(std::uint64_t));  // their keys, the contacts' keys
-    for (int k = 0; k < 3; ++k) p.listed(contacts, sizeof(std::uint32_t));  // claimed slots, summaries, awake list
-    for (int k = 0; k < 2; ++k) p.listed(contacts, sizeof(ManifoldRef));    // the solver's manifold lists
-    // The contact index: a power of two of slots, at most half full (ContactIndex::reserve).
-    const std::size_t slots = std::bit_ceil(2 * contacts);
-    p.listed(slots, sizeof(std::uint64_t));
-    p.listed(slots, sizeof(std::uint32_t));
-    p.listed(bodies, sizeof(Aabb));  // the moved fat boxes
-    p.listed(bodies + 1, sizeof(PushVelocity));
-    p.listed(bodies + 1, sizeof(Real));  // gravity scales
-    return p.pages();
-}
 // At most this many pages are held ahead of an update.
 constexpr std::size_t kMostStockedPages = 64;
 

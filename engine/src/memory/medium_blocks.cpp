@@ -1,5 +1,6 @@
 #include "memory/medium_blocks.hpp"
 
+#include <array>
 #include <bit>
 #include <cstdint>
 #include <mutex>
@@ -93,6 +94,7 @@ public:
             Chunk& chunk = m_chunks[i];
             if (chunk.base != base) continue;
             chunk.used &= ~(mask << ((address - base) / kMediumBlockMinBytes));
+            m_blocks[std::countr_zero(units)] -= 1;
             SPINDLE_POISON(p, std::size_t{units} * kMediumBlockMinBytes);
             if (chunk.used != 0 || ++m_empty <= kKeptEmptyMediumChunks) return;
             unmap_chunk(reinterpret_cast<void*>(chunk.base));
@@ -105,12 +107,13 @@ public:
 
     MediumBlockCounts counts() {
         const std::lock_guard lock(m_mutex);
-        return MediumBlockCounts{m_chunks.size(), m_empty};
+        return MediumBlockCounts{m_chunks.size(), m_empty, m_blocks};
     }
 
 private:
-    static void* take(Chunk& chunk, std::uint32_t unit, std::uint32_t mask, std::size_t bytes) {
+    void* take(Chunk& chunk, std::uint32_t unit, std::uint32_t mask, std::size_t bytes) {
         chunk.used |= mask << unit;
+        m_blocks[std::countr_zero(units_of(bytes))] += 1;
         void* p = reinterpret_cast<void*>(chunk.base + std::size_t{unit} * kMediumBlockMinBytes);
         SPINDLE_UNPOISON(p, bytes);  // the block's tail past `bytes` stays poisoned
         return p;
@@ -118,7 +121,8 @@ private:
 
     std::mutex m_mutex;
     std::vector<Chunk> m_chunks;
-    std::size_t m_empty = 0;  // chunks with no block in use
+    std::size_t m_empty = 0;                                // chunks with no block in use
+    std::array<std::size_t, kMediumBlockSizes> m_blocks{};  // blocks in use, by size
 };
 
 // Never destroyed: arrays of objects destroyed at exit may give their blocks back after

@@ -8,6 +8,7 @@
 // written. Process-wide, under a lock: such blocks come and go a few times a step.
 #pragma once
 
+#include <array>
 #include <bit>
 #include <cstddef>
 
@@ -34,11 +35,16 @@ void* allocate_medium_block(std::size_t bytes);
 // Gives back a block from allocate_medium_block(bytes), the same `bytes`.
 void free_medium_block(void* p, std::size_t bytes) noexcept;
 
-// Chunks the pool holds (in use or kept empty for the next blocks) and how many of them are
-// empty: for tests and the memory report.
+// The block sizes served: kMediumBlockMinBytes << k for k below this.
+inline constexpr int kMediumBlockSizes = std::countr_zero(kMediumBlockEndBytes / kMediumBlockMinBytes) + 1;
+
+// Chunks the pool holds (in use or kept empty for the next blocks), how many of them are
+// empty, and the blocks in use of each size (blocks[k]: kMediumBlockMinBytes << k): for
+// tests and the memory report.
 struct MediumBlockCounts {
     std::size_t chunks = 0;
     std::size_t empty_chunks = 0;
+    std::array<std::size_t, kMediumBlockSizes> blocks{};
 };
 MediumBlockCounts medium_block_counts();
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
@@ -15,6 +16,9 @@
 
 #include "memory/huge_page_vector.hpp"
 #include "memory/page_stock.hpp"
+#include "solver/constraints.hpp"
+#include "spatial/proxy_trees.hpp"
+#include "stages/contact_index.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -105,6 +109,68 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 constexpr std::size_t stocked_room_pages(std::size_t count, std::size_t element_bytes) {
     const std::size_t bytes = count * element_bytes;
     return bytes < kMappedRoomMinBytes ? 0 : (bytes + kHugePageBytes - 1) / kHugePageBytes;
+}
+
+// An array a first step lays out on huge pages (memory/huge_page_vector.hpp), for the stock
+// that create_body fills ahead of it (memory/page_stock.hpp).
+struct FirstStepArray {
+    const char* name;
+    std::size_t count;
+    std::size_t element_bytes;
+    bool mapped;  // filled by map_room: stocked pages move under it from kMappedRoomMinBytes up
+
+    // The stocked pages map_room moves under it.
+    constexpr std::size_t pages() const { return mapped ? stocked_room_pages(count, element_bytes) : 0; }
+    // The medium block it takes, or 0 (an array of the heap's size, or one whose pages are
+    // moved under it, or a list of a megabyte or more, which faults its own huge pages).
+    constexpr std::size_t block_bytes() const {
+        const std::size_t bytes = count * element_bytes;
+        if (pages() != 0 || bytes < kMediumBlockMinBytes || bytes >= kMediumBlockEndBytes) return 0;
+        return medium_block_bytes(bytes);
+    }
+};
+
+// The arrays of the first step of `bodies` new dynamic bodies making `contacts` contacts that
+// take huge pages, as the stages lay them out. The wide contacts are counted as if the
+// colours were full (the solver rounds each colour up to whole lanes). A list a step adds
+// on huge pages must be added here: PageStock.AFirstStepLaysOutTheArraysItsStockCounted
+// fails otherwise.
+constexpr std::array<FirstStepArray, 19> first_step_arrays(std::size_t bodies, std::size_t contacts) {
+    const std::size_t wide = (contacts + kLanes - 1) / kLanes;
+    const std::size_t slots = ContactIndex::slots_for(contacts);
+    return {{
+        {"contact records", contacts, sizeof(Contact), true},
+        {"wide contacts", wide, sizeof(WideContact), true},
+        {"push anchors", wide * kLanes, sizeof(PushAnchors), true},
+        {"rolling rows", wide, sizeof(WideRolling), false},
+        {"solver bodies", bodies + 1, sizeof(SolverBody), true},
+        {"pairs found", contacts, sizeof(Pair), false},
+        {"pairs merged", contacts, sizeof(Pair), false},
+        {"new pair keys", contacts, sizeof(std::uint64_t), false},
+        {"contact keys", contacts, sizeof(std::uint64_t), false},
+        {"claimed slots", contacts, sizeof(std::uint32_t), false},
+        {"contact summaries", contacts, sizeof(std::uint32_t), false},
+        {"pairs kept by the filter", contacts, sizeof(std::uint32_t), false},
+        {"manifolds", contacts, sizeof(ManifoldRef), false},
+        {"coloured manifolds", contacts, sizeof(ManifoldRef), false},
+        {"contact index keys", slots, sizeof(std::uint64_t), false},
+        {"contact index positions", slots, sizeof(std::uint32_t), false},
+        {"moved fat boxes", bodies, sizeof(Aabb), false},
+        {"push velocities", bodies + 1, sizeof(PushVelocity), false},
+        {"gravity scales", bodies + 1, sizeof(Real), false},
+    }};
+}
+
+// The huge pages those arrays take: the pages moved under the mapped ones, and the chunks
+// (whole pages) of the medium block pool their blocks fill.
+constexpr std::size_t first_step_pages(std::size_t bodies, std::size_t contacts) {
+    std::size_t pages = 0;
+    std::size_t pool_bytes = 0;
+    for (const FirstStepArray& array : first_step_arrays(bodies, contacts)) {
+        pages += array.pages();
+        pool_bytes += array.block_bytes();
+    }
+    return pages + (pool_bytes + kHugePageBytes - 1) / kHugePageBytes;
 }
 
 }  // namespace spindle

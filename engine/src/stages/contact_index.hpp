@@ -55,9 +55,14 @@ public:
     // Room for `count` keys without growing (at most half the slots full). With `jobs`, a
     // rehash fills the new slots and moves the keys in jobs.
     void reserve(std::size_t count, JobSystem* jobs = nullptr) {
-        std::size_t slots = m_keys.empty() ? kMinSlots : m_keys.size();
-        while (slots < 2 * count) slots *= 2;
+        const std::size_t slots = slots_for(count);
         if (slots > m_keys.size()) rehash(slots, jobs);
+    }
+    // The slots an empty index reserves for `count` keys (a first step's: stages/capacity.hpp).
+    static constexpr std::size_t slots_for(std::size_t count) {
+        std::size_t slots = kMinSlots;
+        while (slots < 2 * count) slots *= 2;
+        return slots;
     }
 
     // Many distinct keys from jobs: reserve() room for them first; then claim() each, from
