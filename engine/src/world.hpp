@@ -438,11 +438,13 @@ struct World {
     std::vector<std::uint32_t> awake_contact_list;
     bool awake_contacts_dirty = true;
     std::unique_ptr<SolverScratch> solver;
-    // Huge pages stocked for the first step of the bodies made since the last update
+    // Huge pages stocked for the first step of the level's bodies made since the last update
     // (memory/page_stock.hpp, api/space.cpp), and what sizes them: those dynamic bodies,
     // and the pairs of overlapping fat boxes they made as they were added (the contacts
-    // that step makes). The update gives back the pages its step did not take, and starts
+    // that step makes). A level is built before the first step, or after reserve_bodies
+    // (building_level). The update gives back the pages its step did not take, and starts
     // the counts again.
+    bool building_level = false;
     std::size_t stocked_pages = 0;
     std::size_t first_step_bodies = 0;
     std::size_t first_step_contacts = 0;

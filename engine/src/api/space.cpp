@@ -63,11 +63,10 @@ std::size_t new_pairs_of(const World& w, std::uint32_t slot) {
 }
 
 // Stocks the pages the first step of the bodies made since the last update will write
-// (first_step_pages): here, where the game builds its level, a page at a time, rather
+// (first_step_pages, stages/capacity.hpp): here, where the game builds its level, a page at a time, rather
 // than in that step. The contacts are the game's count for its level's first step where
-// it gave one (SpaceSettings::capacity), else the pairs the new proxies made. A game that
-// makes a body now and then stocks nothing (its arrays are too small for whole pages).
-// A hint: without memory for a page the step maps its own.
+// it gave one (SpaceSettings::capacity), else the pairs the new proxies made. A hint: without memory for a page the
+// step maps its own.
 void stock_first_step_pages(World& w) {
     const std::int64_t hint = w.steps == 0 ? w.settings.capacity.contact_count : 0;
     const std::size_t contacts = hint > 0 ? static_cast<std::size_t>(hint) : w.first_step_contacts;
@@ -80,6 +79,18 @@ void stock_first_step_pages(World& w) {
         }
         w.stocked_pages += 1;
     }
+}
+
+// Counts a level's new body `slot` into its first step and stocks that step's pages.
+// The game's count of contacts, where it gave one, stands for the level's first: no query.
+void count_first_step(World& w, std::uint32_t slot) {
+    const bool told = w.steps == 0 && w.settings.capacity.contact_count > 0;
+    const std::size_t pairs = told ? 0 : new_pairs_of(w, slot);
+    w.first_step_contacts += pairs;
+    const bool dynamic = w.bodies.type[slot] == MotionType::Dynamic;
+    if (dynamic) w.first_step_bodies += 1;
+    // A static floor made after the bodies resting on it brings their contacts.
+    if (dynamic || pairs != 0) stock_first_step_pages(w);
 }
 
 // By a quarter at a time (stages/capacity.hpp), not doubled: a scene built body by body
@@ -169,12 +180,7 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
-    const std::size_t pairs = w.steps != 0 || w.settings.capacity.contact_count == 0 ? new_pairs_of(w, slot)
-                                                                                     : std::size_t{0};
-    w.first_step_contacts += pairs;
-    if (b.type[slot] == MotionType::Dynamic) w.first_step_bodies += 1;
-    // A static floor made after the bodies resting on it brings their contacts.
-    if (b.type[slot] == MotionType::Dynamic || pairs != 0) stock_first_step_pages(w);
+    if (w.steps == 0 || w.building_level) count_first_step(w, slot);
     return BodyHandle{slot, b.generation[slot]};
 }
 
@@ -202,6 +208,7 @@ void Space::reserve_bodies(std::size_t count) {
         // Only capacities changed: every body, handle and published state is as it was.
         throw Error("reserve_bodies: no memory for " + std::to_string(count) + " bodies");
     }
+    w.building_level = true;
 }
 
 void Space::destroy_body(BodyHandle body) {

@@ -77,6 +77,7 @@ void check_not_holding_motion_state_lock(const World& world, const char* what) {
 
 // The huge pages stocked for the step just taken (api/space.cpp) that it did not take.
 void give_back_stock(World& world) {
+    world.building_level = false;
     world.first_step_bodies = 0;
     world.first_step_contacts = 0;
     if (world.stocked_pages != 0) give_back_stocked_huge_pages(std::exchange(world.stocked_pages, 0));

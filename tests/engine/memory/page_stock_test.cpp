@@ -249,6 +249,50 @@ TEST(PageStock, ThePairsCountedAsBodiesAreMadeAreTheFirstStepsContacts) {
     EXPECT_EQ(world.contacts.size(), counted);
 }
 
+namespace {
+
+// `count` boxes resting on make_grid's floor, 2 m apart from x = `x` on, made one by one as
+// a game spawns them (no reserve_bodies): each makes one contact, with the floor.
+void spawn_resting_boxes(Space& space, int count, Real x) {
+    for (int i = 0; i < count; ++i) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        d.position = Vec3(x + 2.0 * (i % 100), 0.5, 2.0 * (i / 100));
+        space.create_body(d);
+    }
+}
+
+}  // namespace
+
+// A body spawned in a running game is not looked up in the trees, nor stocked for: its
+// step grows its arrays as the game goes. Bodies made as a level (before the first update,
+// or after reserve_bodies until the next) are.
+TEST(PageStock, ABodySpawnedInARunningGameIsNotCounted) {
+    Space space;
+    make_grid(space, 0, 2);  // the floor
+    space.update();
+    World& world = SpaceInternals::world(space);
+    spawn_resting_boxes(space, 8000, 0);
+    EXPECT_EQ(world.first_step_contacts, 0u) << "a body spawned in a running game was looked up";
+    EXPECT_EQ(world.first_step_bodies, 0u);
+    EXPECT_EQ(world.stocked_pages, 0u);
+    space.update();
+
+    space.reserve_bodies(space.body_count() + 8000);  // a level's room: its bodies are counted
+    spawn_resting_boxes(space, 8000, 300);
+    EXPECT_EQ(world.first_step_contacts, 8000u);
+    EXPECT_EQ(world.first_step_bodies, 8000u);
+    EXPECT_GT(world.stocked_pages, 0u);
+    space.update();
+    EXPECT_EQ(world.stocked_pages, 0u);
+
+    Space level;  // before the first update, without reserve_bodies
+    make_grid(level, 0, 2);
+    spawn_resting_boxes(level, 8000, 0);
+    EXPECT_EQ(SpaceInternals::world(level).first_step_contacts, 8000u);
+    EXPECT_GT(SpaceInternals::world(level).stocked_pages, 0u);
+}
+
 // The game's count of its level's first contacts (SpaceSettings::capacity) sizes the
 // stock instead of the pairs counted, before the space's first step only: a body made
 // after it stocks by its own pairs again. memory_report shows the stock.

@@ -48,18 +48,21 @@ public:
 
     // ---- structure (update thread, or any thread while no update runs) ----
     // Validates everything first; a rejected body leaves the space unchanged and the
-    // spindle::Error names the field and value. A body's fat box is looked up among the
-    // others' for the contacts it will make, and the huge pages a level's first step will
-    // write for its new dynamic bodies and their contacts are mapped here, as they add up
-    // to whole pages, rather than in that step (SpaceSettings::capacity); the next update
-    // gives back what its step did not take.
+    // spindle::Error names the field and value. While a level is built (before the first
+    // update, or after reserve_bodies until the next update) a body's fat box is looked up
+    // among the others' for the contacts it will make, and the huge pages the level's first
+    // step will write for its new dynamic bodies and their contacts are mapped here, as they
+    // add up to whole pages, rather than in that step (SpaceSettings::capacity); the next
+    // update gives back what its step did not take. A body made otherwise (one spawned in a
+    // running game) is not looked up: its step grows its arrays as it always did.
     BodyHandle create_body(const BodyDesc& desc);
     void destroy_body(BodyHandle body);
     bool contains(BodyHandle body) const noexcept;  // any thread: as published
     std::size_t body_count() const noexcept;        // any thread
     // Room for `count` bodies alive at once, for a level about to be made: creating bodies
     // up to that many then moves none of the space's per-body arrays (scene build() asks
-    // for its bodies). Never shrinks. A count past the body handles' 32-bit index, or one
+    // for its bodies), and the bodies made until the next update stock their first step's
+    // pages as a level's (create_body). Never shrinks. A count past the body handles' 32-bit index, or one
     // the memory cannot hold, throws spindle::Error naming it and changes nothing else.
     void reserve_bodies(std::size_t count);
 
