@@ -58,7 +58,8 @@ void parse_settings(const TomlReader& r, const toml::node& node, SceneDesc& scen
                   "time_to_sleep",
                   "sleep_linear_threshold",
                   "sleep_angular_threshold",
-                  "ignore_layers"});
+                  "ignore_layers",
+                  "capacity"});
     SpaceSettings& s = scene.settings;
     TimeStepSettings& ts = s.time_step;
     SolverSettings& solver = s.solver;
@@ -101,6 +102,14 @@ void parse_settings(const TomlReader& r, const toml::node& node, SceneDesc& scen
     non_negative("sleep_angular_threshold", s.sleep.angular_threshold);
     if (const toml::node* n = t.get("ignore_layers"))
         scene.ignore_layers = parse_layer_pairs(r, *n, name("ignore_layers"));
+    if (const toml::node* n = t.get("capacity")) {
+        const toml::table& capacity = r.table(*n, name("capacity"), "({ contact_count = ... })");
+        r.check_keys(capacity, name("capacity"), {"contact_count"});
+        if (const toml::node* c = capacity.get("contact_count")) {
+            s.capacity.contact_count = r.integer(*c, name("capacity.contact_count"), 0,
+                                                 CapacitySettings::kMaxContactCount);
+        }
+    }
 }
 
 MotionType parse_type(const TomlReader& r, const toml::node& node, const std::string& what) {

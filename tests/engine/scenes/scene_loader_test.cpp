@@ -439,6 +439,7 @@ sleep = false
 time_to_sleep = 2
 sleep_linear_threshold = 0.01
 sleep_angular_threshold = 0.02
+capacity.contact_count = 60000
 )",
                                         "x.toml");
     EXPECT_EQ(scene.name, "tuned");
@@ -464,6 +465,7 @@ sleep_angular_threshold = 0.02
     EXPECT_EQ(s.sleep.time_to_sleep, 2);
     EXPECT_EQ(s.sleep.linear_threshold, 0.01);
     EXPECT_EQ(s.sleep.angular_threshold, 0.02);
+    EXPECT_EQ(s.capacity.contact_count, 60000);
     EXPECT_TRUE(scene.bodies.empty());
 }
 
@@ -522,6 +524,18 @@ TEST(SceneParse, BrokenScenes_AreRejectedAtTheLineAndColumn) {
     EXPECT_REJECTED("[settings]\nsubsteps = 0\n", "2:12", "settings.substeps: expected an integer in [1, 1000], got 0");
     EXPECT_REJECTED("[settings]\ntime_step = -0.01\n", "2:13", "settings.time_step: expected a number > 0");
     EXPECT_REJECTED("[settings]\nsleep = 1\n", "2:9", "settings.sleep: expected true or false");
+    EXPECT_REJECTED("[settings]\ncapacity.contact_count = -1\n", "2:26",
+                    "settings.capacity.contact_count: expected an integer in [0, 4294967295], got -1");
+    EXPECT_REJECTED("[settings]\ncapacity.contact_count = 4294967296\n", "2:26",
+                    "settings.capacity.contact_count: expected an integer in [0, 4294967295], got 4294967296");
+    EXPECT_REJECTED("[settings]\ncapacity.contact_count = nan\n", "2:26",
+                    "settings.capacity.contact_count: expected an integer, got the number nan");
+    EXPECT_REJECTED("[settings]\ncapacity.contact_count = 6e4\n", "2:26",
+                    "settings.capacity.contact_count: expected an integer, got the number 60000");
+    EXPECT_REJECTED("[settings]\ncapacity.contact_count = \"many\"\n", "2:26",
+                    "settings.capacity.contact_count: expected an integer, got a string");
+    EXPECT_REJECTED("[settings]\ncapacity = 60000\n", "2:12", "settings.capacity: expected a table");
+    EXPECT_REJECTED("[settings]\ncapacity.contacts = 60000\n", "2:10", "unknown key 'contacts' in settings.capacity");
     EXPECT_REJECTED("[settings]\nmax_steps_per_frame = 2\nmin_steps_per_frame = 3\n", "3:23",
                     "expected at most max_steps_per_frame (2)");
     EXPECT_REJECTED("[[body]]\nshape = { sphere = 1 }\nposition = [0, 1, 0\n", "3:21", "");  // TOML syntax
