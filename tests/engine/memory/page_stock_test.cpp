@@ -294,8 +294,8 @@ TEST(PageStock, ABodySpawnedInARunningGameIsNotCounted) {
 }
 
 // The game's count of its level's first contacts (SpaceSettings::capacity) sizes the
-// stock instead of the pairs counted, before the space's first step only: a body made
-// after it stocks by its own pairs again. memory_report shows the stock.
+// stock instead of the pairs counted, before the space's first step only: a level made
+// after it (reserve_bodies) stocks by its own pairs again. memory_report shows the stock.
 TEST(PageStock, TheGamesContactCountSizesTheFirstStepsStockOnly) {
     const std::size_t before = stocked_huge_pages();
     SpaceSettings settings;
