@@ -45,7 +45,7 @@ constexpr Real kRecycleSlops = 10;
 // the other body's turn moves the contact): the length of its reach along its own axes
 // (Box3D's maxExtent), the same however the body lies. (Its world bounds' corner, used
 // before, reached up to 3 half sizes for a tilted cube where its corners reach 1.73.)
-Real reach(const Bodies& b, std::uint32_t i) { return b.extents[i].reach.norm(); }
+Real reach(const Bodies& b, std::uint32_t i) { return b.extents[i].reach_length; }
 
 // |v x r| over the points r of body i, v its turn since it was at `then` (sin(angle / 2)
 // times the axis), bounded axis by axis by its reach along its own axes (Box3D's modified
