@@ -84,6 +84,7 @@ SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com) {
     } else {
         extent.thinnest = 0;  // a plane or mesh: static only, never swept
     }
+    extent.reach_length = extent.reach.norm();
     return extent;
 }
 

@@ -32,6 +32,9 @@ struct SweepExtent {
     Vec3 reach = Vec3::Zero();
     Vec3 core_reach = Vec3::Zero();
     Real thinnest = 0;
+    // reach's length (Box3D's maxExtent), made once: the narrowphase's recycling test asks
+    // it of both bodies of every pair it tests.
+    Real reach_length = 0;
 };
 SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com);
 // One convex shape's thinnest half-size, as above.

@@ -266,11 +266,10 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
     // far apart.
     FrictionLanes in;
-    Wide separation[kMaxManifoldPoints], normal_impulse[kMaxManifoldPoints]{};
+    Wide normal_impulse[kMaxManifoldPoints]{};
     // Inverse mass sum of both bodies along the normal: the share of the free axes for a
     // locked body, inv_mass_a + inv_mass_b otherwise.
     Wide linear_sum{};
-    for (Wide& s : separation) s = splat(kEmptySeparation);
     wc.locked = false;
     wc.tracks_push = false;
     wc.rolls = false;
@@ -323,7 +322,6 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             in.anchor_b[j].set_lane(l, contact.anchor_b(src));
             in.separation[j][l] = src.separation;
             in.filled[j][l] = -1;
-            separation[j][l] = src.separation;
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
@@ -337,9 +335,12 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     prepare_friction(in, friction_distance, wc);
     const WideMat3 inv_inertia_a = narrow(in.inv_inertia_a), inv_inertia_b = narrow(in.inv_inertia_b);
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
+    Wide separation[kMaxManifoldPoints];  // the gathered doubles rounded as a float cast rounds each
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         ra[j] = narrow(in.anchor_a[j]);
         rb[j] = narrow(in.anchor_b[j]);
+        separation[j] = select(__builtin_convertvector(in.filled[j], WideMask), narrow(in.separation[j]),
+                               splat(kEmptySeparation));
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());

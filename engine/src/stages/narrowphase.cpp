@@ -45,7 +45,7 @@ constexpr Real kRecycleSlops = 10;
 // the other body's turn moves the contact): the length of its reach along its own axes
 // (Box3D's maxExtent), the same however the body lies. (Its world bounds' corner, used
 // before, reached up to 3 half sizes for a tilted cube where its corners reach 1.73.)
-Real reach(const Bodies& b, std::uint32_t i) { return b.extents[i].reach.norm(); }
+Real reach(const Bodies& b, std::uint32_t i) { return b.extents[i].reach_length; }
 
 // |v x r| over the points r of body i, v its turn since it was at `then` (sin(angle / 2)
 // times the axis), bounded axis by axis by its reach along its own axes (Box3D's modified
@@ -278,6 +278,20 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     counts.parts_recycled += queries.parts_recycled;
 }
 
+// Where a worker's pairs are collided: the manifolds found and those made from them. One a
+// thread, kept from range to range (a range is 16 pairs, most recycled or ruled out, and
+// making the room, every field set, cost more than the ranges' own loop control). Nothing
+// is read that the pair collided now did not write (make_manifold).
+struct CollideRoom {
+    Manifold found[kMaxManifolds];
+    ContactManifold fresh[kMaxManifolds];
+};
+
+CollideRoom& collide_room() {
+    thread_local CollideRoom room;
+    return room;
+}
+
 }  // namespace
 
 void update_narrowphase(World& world) {
@@ -367,10 +381,9 @@ void update_narrowphase(World& world) {
     // a resting box pair, and parallel_for splits the busy worker's range on demand,
     // where a phase's first block (half a share) could hold all the expensive pairs.
     world.jobs->parallel_for("Narrowphase", 0, count, 16, [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
-        Manifold found[kMaxManifolds];
-        // Per range, not per pair: make_manifold writes every field a manifold is read by,
-        // so a convex pair's one manifold costs nothing for the kMaxManifolds a compound may need.
-        ContactManifold fresh[kMaxManifolds];
+        CollideRoom& room = collide_room();
+        Manifold* const found = room.found;
+        ContactManifold* const fresh = room.fresh;
         TriangleFeatures no_triangles;  // what a pair of no mesh is given (it only clears them)
         ContactCounts& counts = world.contact_counts[worker];
         for (std::uint32_t k = lo; k < hi; ++k) {
@@ -410,15 +423,15 @@ void update_narrowphase(World& world) {
     for (const std::vector<std::uint32_t>& list : heavy) positions.insert(positions.end(), list.begin(), list.end());
     world.jobs->parallel_for("Narrowphase heavy", 0, static_cast<std::uint32_t>(positions.size()), 1,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned worker) {
-                                 Manifold found[kMaxManifolds];
-                                 ContactManifold fresh[kMaxManifolds];
+                                 CollideRoom& room = collide_room();
                                  TriangleFeatures no_triangles;
                                  ContactCounts& counts = world.contact_counts[worker];
                                  for (std::uint32_t i = lo; i < hi; ++i) {
                                      const std::uint32_t k = positions[i] & ~kRecyclableBit;
                                      Contact& contact = world.contacts[awake[k]];
                                      const bool recyclable = (positions[i] & kRecyclableBit) != 0;
-                                     collide_pair(k, contact, recyclable, worker, counts, found, fresh, no_triangles);
+                                     collide_pair(k, contact, recyclable, worker, counts, room.found, room.fresh,
+                                                  no_triangles);
                                  }
                              });
     std::uint32_t touching = 0, reused = 0, ruled_out = 0;
