@@ -124,7 +124,8 @@ std::vector<std::int32_t> query_in_order(const DynamicAabbTree& tree, const Aabb
 
 // With the children's float boxes made, a query meets the same proxies in the same order
 // as the walk on the double boxes (a copy of the tree without them), and brute force;
-// including boxes whose faces a float cannot tell apart (a micrometre apart at 50 m).
+// including boxes over a proxy with a face on its opposite face, or a few micrometres past
+// or short of it, which a float cannot tell apart at 50 m.
 TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
     Rng rng(5);
     DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
@@ -143,6 +144,11 @@ TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
             const int axis = rng.index(3);
             const Real offset = q % 4 == 1 ? 0 : rng.uniform(-4e-6, 4e-6);
             const Real width = box.max[axis] - box.min[axis];
+            for (int k = 0; k < 3; ++k) {  // over the proxy on the other axes, so the face is what decides
+                const Real shift = other.center()[k] - box.center()[k];
+                box.min[k] += shift;
+                box.max[k] += shift;
+            }
             if (q % 8 < 4) {
                 box.min[axis] = other.max[axis] + offset;
                 box.max[axis] = box.min[axis] + width;
