@@ -460,6 +460,22 @@ inline unsigned DynamicAabbTree::ChildTest::operator()(const ChildBoxes& childre
 }
 #endif
 
+// Inline: make_child_boxes calls it for every node of a tree.
+inline void DynamicAabbTree::make_child_boxes_of(std::int32_t id) {
+    const Node& node = m_nodes[static_cast<std::size_t>(id)];
+    ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(id)];
+    const std::int32_t c[2] = {node.payload.children.first, node.payload.children.second};
+    for (int k = 0; k < 2; ++k) {
+        const Node& child = m_nodes[static_cast<std::size_t>(c[k])];
+        for (int axis = 0; axis < 3; ++axis) {
+            children.min[3 * k + axis] = static_cast<float>(child.box.min[axis]);
+            children.max[3 * k + axis] = static_cast<float>(child.box.max[axis]);
+        }
+        children.entry[k] = child.height == 0 ? ~c[k] : c[k];
+    }
+    children.unused[0] = children.unused[1] = 0;
+}
+
 template <typename Callback>
 void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
     SPINDLE_ASSERT(!m_stale_boxes,
