@@ -46,7 +46,7 @@ std::int32_t DynamicAabbTree::allocate_node() {
     node.parent_or_next = kNull;
     node.height = 0;
     node.payload.children = {kNull, kNull};
-    m_child_boxes_current = false;
+    forget_child_boxes();
     return id;
 }
 
@@ -54,7 +54,7 @@ void DynamicAabbTree::free_node(std::int32_t id) {
     Node& node = m_nodes[static_cast<std::size_t>(id)];
     node.height = kFreeHeight;
     node.parent_or_next = m_free_list;
-    m_child_boxes_current = false;
+    forget_child_boxes();
     if (m_enlarged[static_cast<std::size_t>(id)] != 0) {
         m_enlarged[static_cast<std::size_t>(id)] = 0;
         --m_enlarged_nodes;
@@ -293,7 +293,7 @@ std::int32_t DynamicAabbTree::find_best_sibling(const Aabb& box) const {
 }
 
 void DynamicAabbTree::insert_leaf(std::int32_t leaf) {
-    m_child_boxes_current = false;
+    forget_child_boxes();
     if (m_root == kNull) {
         m_root = leaf;
         m_nodes[static_cast<std::size_t>(leaf)].parent_or_next = kNull;
@@ -327,7 +327,7 @@ void DynamicAabbTree::insert_leaf(std::int32_t leaf) {
 }
 
 void DynamicAabbTree::remove_leaf(std::int32_t leaf) {
-    m_child_boxes_current = false;
+    forget_child_boxes();
     if (leaf == m_root) {
         m_root = kNull;
         return;
@@ -465,30 +465,17 @@ void DynamicAabbTree::make_child_boxes(JobSystem* jobs) {
     m_child_boxes.resize(m_nodes.size());
     const auto make = [this](std::uint32_t begin, std::uint32_t end, unsigned) {
         for (std::uint32_t id = begin; id < end; ++id) {
-            const Node& node = m_nodes[id];
-            if (node.height <= 0) continue;  // leaves and free nodes have none
-            ChildBoxes& children = m_child_boxes[id];
-            const std::int32_t c[2] = {node.payload.children.first, node.payload.children.second};
-            for (int k = 0; k < 2; ++k) {
-                const Node& child = m_nodes[static_cast<std::size_t>(c[k])];
-                for (int axis = 0; axis < 3; ++axis) {
-                    children.min[3 * k + axis] = static_cast<float>(child.box.min[axis]);
-                    children.max[3 * k + axis] = static_cast<float>(child.box.max[axis]);
-                }
-                children.entry[k] = child.height == 0 ? ~c[k] : c[k];
-            }
-            children.unused[0] = children.unused[1] = 0;
+            // Leaves and free nodes have none.
+            if (m_nodes[id].height > 0) make_child_boxes_of(static_cast<std::int32_t>(id));
         }
     };
     const auto count = static_cast<std::uint32_t>(m_nodes.size());
-    // Nodes per job: a few per worker on a washer-sized tree.
-    constexpr std::uint32_t kGrain = 2048;
-    if (jobs != nullptr && count > kGrain) {
-        jobs->parallel_for("broadphase.child_boxes", 0, count, kGrain, make);
+    if (jobs != nullptr && count > kChildBoxesGrain) {
+        jobs->parallel_for("broadphase.child_boxes", 0, count, kChildBoxesGrain, make);
     } else {
         make(0, count, 0);
     }
-    m_child_boxes_current = true;
+    m_child_boxes_kept = m_child_boxes_current = true;
     validate_if_enabled();
 }
 
@@ -541,7 +528,8 @@ void DynamicAabbTree::validate() const {
                 stack.push(child);
             }
             SPINDLE_TREE_CHECK(c[0] != c[1], "tree: both children are the same node");
-            if (m_child_boxes_current) {
+            // Kept boxes are right but for the flagged nodes, which the next rebuild makes again.
+            if (m_child_boxes_current || (m_child_boxes_kept && m_enlarged[static_cast<std::size_t>(id)] == 0)) {
                 const ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(id)];
                 for (int k = 0; k < 2; ++k) {
                     const Node& cn = m_nodes[static_cast<std::size_t>(c[k])];

@@ -99,9 +99,12 @@ public:
     // children at once on their float boxes; the same proxies in the same order either way.
     template <typename Callback>
     void query(const Aabb& box, Callback&& callback) const;
-    // Makes every internal node's children's boxes in float, for query()'s walk, until the
-    // next change to the tree. Worth it when many queries follow (a pair search of many
-    // moved proxies): it reads every node. With `jobs`, in parallel (the caller waits).
+    // Makes every internal node's children's boxes in float, for query()'s walk. Worth it
+    // when many queries follow (a pair search of many moved proxies): it reads every node.
+    // With `jobs`, in parallel (the caller waits). They are kept from then on through moves
+    // (move_proxy, set_fat_box): rebuild_enlarged() makes again only the nodes it rebuilds,
+    // and query() walks the double boxes from a move until that rebuild. A proxy made or
+    // destroyed, or rebuild(), drops them until the next make_child_boxes().
     void make_child_boxes(JobSystem* jobs = nullptr);
     bool child_boxes_current() const noexcept { return m_child_boxes_current; }
 
@@ -230,6 +233,10 @@ private:
         return a.min.x() <= b.max.x() && b.min.x() <= a.max.x() && a.min.y() <= b.max.y() && b.min.y() <= a.max.y() &&
                a.min.z() <= b.max.z() && b.min.z() <= a.max.z();
     }
+    void make_child_boxes_of(std::int32_t id);
+    void remake_built_child_boxes(JobSystem* jobs);
+    // For a change that is not a move: the float boxes are no longer kept.
+    void forget_child_boxes() noexcept { m_child_boxes_current = m_child_boxes_kept = false; }
     void check_proxy(std::int32_t id) const {
         SPINDLE_ASSERT(is_proxy(id), "DynamicAabbTree: not a live proxy id");
         (void)id;
@@ -281,9 +288,12 @@ private:
 
     AabbTreeSettings m_settings;
     std::vector<Node> m_nodes;
-    // Per node, its children's boxes in float (make_child_boxes); read only while
-    // m_child_boxes_current, which every change to a node's box or children clears.
+    // Per node, its children's boxes in float (make_child_boxes). Kept: right for every
+    // node but the flagged ones (a move changes only a leaf's box and flags its
+    // ancestors), so rebuild_enlarged() need make only the nodes it builds. Current: right
+    // for every node, so query() may read them.
     std::vector<ChildBoxes> m_child_boxes;
+    bool m_child_boxes_kept = false;
     bool m_child_boxes_current = false;
     std::int32_t m_root = kNull;
     std::int32_t m_free_list = kNull;
@@ -325,6 +335,8 @@ private:
     // Ranges this small are built as one job each (a few per worker on a washer-sized
     // tree; far more than its leaves would not pay for the job).
     static constexpr std::uint32_t kSubtreeLeaves = 256;
+    // Nodes per job making float child boxes: a few per worker on a washer-sized tree.
+    static constexpr std::uint32_t kChildBoxesGrain = 2048;
     std::vector<std::int32_t> m_build_leaves;  // proxies, or kept subtrees in rebuild_enlarged()
     std::vector<std::int32_t> m_build_pool;    // the internal nodes a build fills, in creation order
     std::vector<BuildTask> m_build_tasks;
@@ -447,6 +459,22 @@ inline unsigned DynamicAabbTree::ChildTest::operator()(const ChildBoxes& childre
     return found;
 }
 #endif
+
+// Inline: make_child_boxes calls it for every node of a tree.
+inline void DynamicAabbTree::make_child_boxes_of(std::int32_t id) {
+    const Node& node = m_nodes[static_cast<std::size_t>(id)];
+    ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(id)];
+    const std::int32_t c[2] = {node.payload.children.first, node.payload.children.second};
+    for (int k = 0; k < 2; ++k) {
+        const Node& child = m_nodes[static_cast<std::size_t>(c[k])];
+        for (int axis = 0; axis < 3; ++axis) {
+            children.min[3 * k + axis] = static_cast<float>(child.box.min[axis]);
+            children.max[3 * k + axis] = static_cast<float>(child.box.max[axis]);
+        }
+        children.entry[k] = child.height == 0 ? ~c[k] : c[k];
+    }
+    children.unused[0] = children.unused[1] = 0;
+}
 
 template <typename Callback>
 void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {

@@ -30,7 +30,7 @@ void DynamicAabbTree::rebuild() {
     }
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
-    m_child_boxes_current = false;
+    forget_child_boxes();
     build_from_leaves(nullptr);
     m_built_cost = build_cost();
     validate_if_enabled();
@@ -110,6 +110,7 @@ bool DynamicAabbTree::collect_flagged_in_jobs(JobSystem& jobs) {
 void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     if (m_enlarged_nodes == 0) {
         m_stale_boxes = false;  // only flagged nodes go stale
+        m_child_boxes_current = m_child_boxes_kept;
         return;
     }
     // Flagged nodes form a tree from the root down (a flagged node's parent is flagged):
@@ -123,20 +124,39 @@ void DynamicAabbTree::rebuild_enlarged(JobSystem* jobs) {
     m_enlarged_nodes = 0;
     m_stale_boxes = false;
     const bool most = builds_most_of_tree();
+    bool refitted = false;
     if (most && m_built_cost.leaves > 0) {
         // The pool is in pre-order: walking it backwards fits children first (the jobs' own
         // subtrees are fitted already).
         const std::vector<std::int32_t>& unfitted = in_jobs ? m_walk_top : m_build_pool;
         for (auto it = unfitted.rbegin(); it != unfitted.rend(); ++it) refit(*it);
-        if (refit_holds(build_cost())) {
-            ++m_refit_count;
-            validate_if_enabled();
-            return;
-        }
+        refitted = refit_holds(build_cost());
     }
-    build_from_leaves(jobs);
-    if (most) m_built_cost = build_cost();
+    if (refitted) {
+        ++m_refit_count;
+    } else {
+        build_from_leaves(jobs);
+        if (most) m_built_cost = build_cost();
+    }
+    if (m_child_boxes_kept) remake_built_child_boxes(jobs);
     validate_if_enabled();
+}
+
+// After rebuild_enlarged's build or refit: the nodes it made (m_build_pool) are the only
+// ones whose children or children's boxes changed since the moves (a kept subtree keeps
+// its nodes, and a moved leaf's parent was flagged), so the kept float boxes are made
+// again for those alone.
+void DynamicAabbTree::remake_built_child_boxes(JobSystem* jobs) {
+    const auto make = [this](std::uint32_t begin, std::uint32_t end, unsigned) {
+        for (std::uint32_t k = begin; k < end; ++k) make_child_boxes_of(m_build_pool[k]);
+    };
+    const auto count = static_cast<std::uint32_t>(m_build_pool.size());
+    if (jobs != nullptr && count > kChildBoxesGrain) {
+        jobs->parallel_for("broadphase.child_boxes", 0, count, kChildBoxesGrain, make);
+    } else {
+        make(0, count, 0);
+    }
+    m_child_boxes_current = true;
 }
 
 // Whether the build in m_build_pool makes at least half of the internal nodes: only such

@@ -180,7 +180,8 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair kn
     const auto count = static_cast<std::uint32_t>(m_enlarged.size());
     if (count == 0) return;
     // A search visits some hundred nodes; the float boxes cost one pass over a tree's
-    // nodes, paid back once the searches are a fair share of its proxies.
+    // nodes, paid back once the searches are a fair share of its proxies. Once made, the
+    // tree keeps them through moves (rebuild_enlarged makes again only what it builds).
     for (DynamicAabbTree& tree : m_trees) {
         if (!tree.child_boxes_current() &&
             count >= static_cast<std::uint32_t>(tree.proxy_count()) / kSearchesPerChildBoxes) {

@@ -108,6 +108,10 @@ TEST(AabbTree, Query_FindsABoxTouchingAnyFaceNotOneARoundingStepAway) {
     }
 }
 
+[[noreturn]] void throwing_handler(const char*, const char* message, const char*, int) {
+    throw std::logic_error(message);
+}
+
 // Every proxy `box` overlaps, in the order the query meets them.
 std::vector<std::int32_t> query_in_order(const DynamicAabbTree& tree, const Aabb& box) {
     std::vector<std::int32_t> ids;
@@ -120,7 +124,8 @@ std::vector<std::int32_t> query_in_order(const DynamicAabbTree& tree, const Aabb
 
 // With the children's float boxes made, a query meets the same proxies in the same order
 // as the walk on the double boxes (a copy of the tree without them), and brute force;
-// including boxes whose faces a float cannot tell apart (a micrometre apart at 50 m).
+// including boxes over a proxy with a face on its opposite face, or a few micrometres past
+// or short of it, which a float cannot tell apart at 50 m.
 TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
     Rng rng(5);
     DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
@@ -139,6 +144,11 @@ TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
             const int axis = rng.index(3);
             const Real offset = q % 4 == 1 ? 0 : rng.uniform(-4e-6, 4e-6);
             const Real width = box.max[axis] - box.min[axis];
+            for (int k = 0; k < 3; ++k) {  // over the proxy on the other axes, so the face is what decides
+                const Real shift = other.center()[k] - box.center()[k];
+                box.min[k] += shift;
+                box.max[k] += shift;
+            }
             if (q % 8 < 4) {
                 box.min[axis] = other.max[axis] + offset;
                 box.max[axis] = box.min[axis] + width;
@@ -155,43 +165,108 @@ TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
     }
 }
 
-// Each change to the tree leaves the float boxes out of date, and the query walks the
-// double boxes until they are made again: a proxy moved, given a box, made or destroyed
-// after make_child_boxes is found where it is now.
+// A move leaves the float boxes out of date until rebuild_enlarged makes the moved
+// paths' again, and a proxy made or destroyed, or a rebuild, until make_child_boxes: the
+// query walks the double boxes meanwhile, and a proxy changed after make_child_boxes is
+// found where it is now.
 TEST(AabbTree, QueryAfterAChange_DoesNotReadOutOfDateChildBoxes) {
     Rng rng(9);
     DynamicAabbTree tree(AabbTreeSettings{.margin = 0, .displacement_multiplier = 0});
     std::vector<std::int32_t> live;
     for (int i = 0; i < 64; ++i) live.push_back(tree.create_proxy(rng.box(50, 2), std::uint64_t(i)));
     const Aabb far = Aabb::from_center_extents(Vec3(500, 0, 0), Vec3::Ones());
-    const auto finds_only = [&](std::int32_t id, const char* change) {
+    // `remake` brings the float boxes back: the rebuild of the moved paths, or all of them.
+    const auto finds_only = [&](std::int32_t id, const char* change, auto remake) {
         EXPECT_FALSE(tree.child_boxes_current()) << change;
         EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{id}) << change;
-        tree.make_child_boxes();
+        remake();
+        EXPECT_TRUE(tree.child_boxes_current()) << change;
         EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{id}) << change << ", boxes made again";
+        tree.validate();  // the float boxes too, node by node
     };
+    const auto rebuild_moved = [&] { tree.rebuild_enlarged(); };
+    const auto make_all = [&] { tree.make_child_boxes(); };
     tree.make_child_boxes();
     ASSERT_TRUE(query_sorted(tree, far).empty());
     tree.move_proxy(live[3], far, Vec3::Zero());
-    finds_only(live[3], "moved");
+    finds_only(live[3], "moved", rebuild_moved);
     tree.move_proxy(live[3], rng.box(50, 2), Vec3::Zero());
-    tree.make_child_boxes();
+    tree.rebuild_enlarged();
     tree.set_fat_box(live[5], far);
     tree.rebuild_enlarged();
-    finds_only(live[5], "given a box");
+    EXPECT_TRUE(tree.child_boxes_current()) << "given a box";
+    EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{live[5]}) << "given a box";
     tree.destroy_proxy(live[5]);
     EXPECT_FALSE(tree.child_boxes_current()) << "destroyed";
     EXPECT_TRUE(query_sorted(tree, far).empty());
+    tree.rebuild_enlarged();
+    EXPECT_FALSE(tree.child_boxes_current()) << "destroyed, then the moved paths rebuilt";
     tree.make_child_boxes();
     const std::int32_t made = tree.create_proxy(far, 99);
-    finds_only(made, "made");
+    finds_only(made, "made", make_all);
     tree.destroy_proxy(made);
     tree.make_child_boxes();
     tree.end_shared_fat_boxes(tree.set_fat_box_shared(live[7], far), 1);
+    EXPECT_FALSE(tree.child_boxes_current()) << "given a box by a job";
     tree.rebuild_enlarged();
-    finds_only(live[7], "given a box by a job");
+    EXPECT_TRUE(tree.child_boxes_current()) << "given a box by a job";
+    EXPECT_EQ(query_sorted(tree, far), std::vector<std::int32_t>{live[7]}) << "given a box by a job";
     tree.rebuild();
-    finds_only(live[7], "rebuilt");
+    finds_only(live[7], "rebuilt", make_all);
+}
+
+// Moves in one corner of a tree with float boxes made: each rebuild_enlarged makes again
+// only the nodes it built, and every node's float boxes are still its children's double
+// boxes as make_child_boxes converts them (validate() checks node by node); queries meet
+// what a copy without float boxes meets, in the same order, and brute force.
+TEST(AabbTree, MovesInACorner_RebuildKeepsEveryNodesFloatBoxes) {
+    const AssertHandler previous = set_assert_handler(&throwing_handler);
+    Rng rng(17);
+    // `doubles` is given the same changes and never float boxes: the same tree, walked on doubles.
+    DynamicAabbTree tree(AabbTreeSettings{.margin = Real(0.05)});
+    DynamicAabbTree doubles(tree.settings());
+    std::vector<std::int32_t> live;
+    const int n = 300 * kScale;
+    for (int i = 0; i < n; ++i) {
+        const Aabb box = rng.box(50, 2);
+        live.push_back(tree.create_proxy(box, std::uint64_t(i)));
+        ASSERT_EQ(doubles.create_proxy(box, std::uint64_t(i)), live.back());
+    }
+    tree.make_child_boxes();
+    const Aabb corner = Aabb::from_center_extents(Vec3::Constant(35), Vec3::Constant(15));
+    for (int round = 0; round < 20; ++round) {
+        int moved = 0;
+        for (const std::int32_t id : live) {
+            const Aabb fat = tree.fat_aabb(id);
+            if (!corner.contains(Aabb::from_center_extents(fat.center(), Vec3::Zero()))) continue;
+            const Vec3 d = rng.vec(-1, 1);
+            const Aabb tight = Aabb::from_center_extents(fat.center() + d, Vec3::Constant(0.5));
+            if (round % 2 == 0) {
+                moved += tree.move_proxy(id, tight, d) ? 1 : 0;
+                doubles.move_proxy(id, tight, d);
+            } else {
+                tree.set_fat_box(id, tree.fat_box(tight, d));
+                doubles.set_fat_box(id, tree.fat_box(tight, d));
+                ++moved;
+            }
+        }
+        ASSERT_GT(moved, 0) << "round " << round;
+        ASSERT_LT(tree.enlarged_node_count(), n / 2) << "round " << round << ": the moves should stay in the corner";
+        tree.rebuild_enlarged();
+        doubles.rebuild_enlarged();
+        ASSERT_TRUE(tree.child_boxes_current()) << "round " << round;
+        ASSERT_FALSE(doubles.child_boxes_current());
+        ASSERT_NO_THROW(tree.validate()) << "round " << round;
+        for (int q = 0; q < 40; ++q) {
+            const Aabb box = q % 2 == 0 ? rng.box(50, 8) : Aabb::from_center_extents(rng.vec(20, 50), rng.vec(1, 6));
+            const std::vector<std::int32_t> found = query_in_order(tree, box);
+            ASSERT_EQ(found, query_in_order(doubles, box)) << "round " << round << ", query " << q;
+            std::vector<std::int32_t> sorted = found;
+            std::sort(sorted.begin(), sorted.end());
+            ASSERT_EQ(sorted, brute_sorted(tree, live, box)) << "round " << round << ", query " << q;
+        }
+    }
+    set_assert_handler(previous);
 }
 
 TEST(AabbTree, Query_CallbackFalseStops) {
@@ -431,10 +506,6 @@ TEST(AabbTree, RayCast_MatchesBruteForceAndStops) {
 }
 
 #ifndef NDEBUG
-[[noreturn]] void throwing_handler(const char*, const char* message, const char*, int) {
-    throw std::logic_error(message);
-}
-
 TEST(AabbTree, StaleProxyId_Asserts) {
     const AssertHandler previous = set_assert_handler(&throwing_handler);
     DynamicAabbTree tree;
