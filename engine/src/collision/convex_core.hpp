@@ -33,7 +33,7 @@ struct SweepExtent {
     Vec3 core_reach = Vec3::Zero();
     Real thinnest = 0;
     // reach's length (Box3D's maxExtent), made once: the narrowphase's recycling test asks
-    // it of both bodies of every pair it tests.
+    // it of both bodies of every pair it tests, the continuous stage of every fast body.
     Real reach_length = 0;
 };
 SweepExtent sweep_extent(const Shape& shape, const Vec3& local_com);

@@ -271,7 +271,7 @@ Real sweep_body(World& world, const FastStart& start, SweepScratch& scratch) {
     const Real target = world.settings.solver.linear_slop;
     // The static bodies near the centre of mass's path, within its farthest reach: no
     // shape bounds, no slerp, for a body with no static body near.
-    const Aabb swept = segment_box(start.x0, b.x[i], b.extents[i].reach.norm() + target);
+    const Aabb swept = segment_box(start.x0, b.x[i], b.extents[i].reach_length + target);
     std::vector<std::uint32_t>& statics = scratch.statics;
     statics.clear();
     const BroadphaseState& bp = *world.broadphase;
