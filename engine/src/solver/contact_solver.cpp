@@ -335,12 +335,11 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     prepare_friction(in, friction_distance, wc);
     const WideMat3 inv_inertia_a = narrow(in.inv_inertia_a), inv_inertia_b = narrow(in.inv_inertia_b);
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
-    Wide separation[kMaxManifoldPoints];  // the gathered doubles rounded as a float cast rounds each
+    Wide separation[kMaxManifoldPoints];  // the gathered doubles, each rounded as a float cast rounds it
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         ra[j] = narrow(in.anchor_a[j]);
         rb[j] = narrow(in.anchor_b[j]);
-        separation[j] = select(__builtin_convertvector(in.filled[j], WideMask), narrow(in.separation[j]),
-                               splat(kEmptySeparation));
+        separation[j] = narrow(select(in.filled[j], in.separation[j], splat_d(kEmptySeparation)));
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());
