@@ -469,14 +469,17 @@ void DynamicAabbTree::make_child_boxes(JobSystem* jobs) {
             if (m_nodes[id].height > 0) make_child_boxes_of(static_cast<std::int32_t>(id));
         }
     };
-    const auto count = static_cast<std::uint32_t>(m_nodes.size());
+    run_child_box_pass(jobs, static_cast<std::uint32_t>(m_nodes.size()), make);
+    m_child_boxes_kept = m_child_boxes_current = true;
+    validate_if_enabled();
+}
+
+void DynamicAabbTree::run_child_box_pass(JobSystem* jobs, std::uint32_t count, RangeFn make) {
     if (jobs != nullptr && count > kChildBoxesGrain) {
         jobs->parallel_for("broadphase.child_boxes", 0, count, kChildBoxesGrain, make);
     } else {
         make(0, count, 0);
     }
-    m_child_boxes_kept = m_child_boxes_current = true;
-    validate_if_enabled();
 }
 
 Real DynamicAabbTree::area_cost() const {

@@ -235,6 +235,9 @@ private:
     }
     void make_child_boxes_of(std::int32_t id);
     void remake_built_child_boxes(JobSystem* jobs);
+    // Runs make over the items [0, count) of a child box pass: in jobs with `jobs` where
+    // there are more than kChildBoxesGrain, else here.
+    static void run_child_box_pass(JobSystem* jobs, std::uint32_t count, RangeFn make);
     // For a change that is not a move: the float boxes are no longer kept.
     void forget_child_boxes() noexcept { m_child_boxes_current = m_child_boxes_kept = false; }
     void check_proxy(std::int32_t id) const {

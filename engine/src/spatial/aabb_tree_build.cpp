@@ -150,12 +150,7 @@ void DynamicAabbTree::remake_built_child_boxes(JobSystem* jobs) {
     const auto make = [this](std::uint32_t begin, std::uint32_t end, unsigned) {
         for (std::uint32_t k = begin; k < end; ++k) make_child_boxes_of(m_build_pool[k]);
     };
-    const auto count = static_cast<std::uint32_t>(m_build_pool.size());
-    if (jobs != nullptr && count > kChildBoxesGrain) {
-        jobs->parallel_for("broadphase.child_boxes", 0, count, kChildBoxesGrain, make);
-    } else {
-        make(0, count, 0);
-    }
+    run_child_box_pass(jobs, static_cast<std::uint32_t>(m_build_pool.size()), make);
     m_child_boxes_current = true;
 }
 
