@@ -442,9 +442,9 @@ struct World {
     // (memory/page_stock.hpp, api/space.cpp), and what sizes them: those dynamic bodies,
     // and the pairs of overlapping fat boxes they made as they were added (the contacts
     // that step makes). A level is built before the first step, or after reserve_bodies
-    // (building_level). The update gives back the pages its step did not take, and starts
-    // the counts again.
-    bool building_level = false;
+    // until the next (building_level). The update gives back the pages its step did not
+    // take, and starts the counts again.
+    bool building_level = true;
     std::size_t stocked_pages = 0;
     std::size_t first_step_bodies = 0;
     std::size_t first_step_contacts = 0;

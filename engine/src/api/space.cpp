@@ -62,14 +62,20 @@ std::size_t new_pairs_of(const World& w, std::uint32_t slot) {
     return pairs;
 }
 
+// The game's count of its level's first contacts (SpaceSettings::capacity), before the
+// space's first step; else 0.
+std::size_t told_contacts(const World& w) {
+    return w.steps == 0 ? static_cast<std::size_t>(w.settings.capacity.contact_count) : 0;
+}
+
 // Stocks the pages the first step of the bodies made since the last update will write
 // (first_step_pages, stages/capacity.hpp): here, where the game builds its level, a page at a time, rather
 // than in that step. The contacts are the game's count for its level's first step where
 // it gave one (SpaceSettings::capacity), else the pairs the new proxies made. A hint: without memory for a page the
 // step maps its own.
 void stock_first_step_pages(World& w) {
-    const std::int64_t hint = w.steps == 0 ? w.settings.capacity.contact_count : 0;
-    const std::size_t contacts = hint > 0 ? static_cast<std::size_t>(hint) : w.first_step_contacts;
+    const std::size_t told = told_contacts(w);
+    const std::size_t contacts = told > 0 ? told : w.first_step_contacts;
     const std::size_t pages = std::min(first_step_pages(w.first_step_bodies, contacts), kMostStockedPages);
     while (w.stocked_pages < pages) {
         try {
@@ -84,8 +90,7 @@ void stock_first_step_pages(World& w) {
 // Counts a level's new body `slot` into its first step and stocks that step's pages.
 // The game's count of contacts, where it gave one, stands for the level's first: no query.
 void count_first_step(World& w, std::uint32_t slot) {
-    const bool told = w.steps == 0 && w.settings.capacity.contact_count > 0;
-    const std::size_t pairs = told ? 0 : new_pairs_of(w, slot);
+    const std::size_t pairs = told_contacts(w) > 0 ? 0 : new_pairs_of(w, slot);
     w.first_step_contacts += pairs;
     const bool dynamic = w.bodies.type[slot] == MotionType::Dynamic;
     if (dynamic) w.first_step_bodies += 1;
@@ -180,7 +185,7 @@ BodyHandle Space::create_body(const BodyDesc& desc) {
     w.body_set_version += 1;
     w.body_count.store(b.live, std::memory_order_release);
     publish_now(w, slot);
-    if (w.steps == 0 || w.building_level) count_first_step(w, slot);
+    if (w.building_level) count_first_step(w, slot);
     return BodyHandle{slot, b.generation[slot]};
 }
 

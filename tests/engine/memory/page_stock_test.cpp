@@ -91,13 +91,18 @@ TEST(PageStock, AFirstStepTakesItsPagesFromTheStockItsBodiesReserved) {
 namespace {
 
 // A level of `count` boxes in a grid, `spacing` apart (2 m: none touches), above a floor.
-void make_grid(Space& space, int count, Real spacing) {
-    space.reserve_bodies(static_cast<std::size_t>(count) + 1);
+// make_grid's floor: a static slab whose top is y = 0.
+void make_floor(Space& space) {
     BodyDesc floor;
     floor.type = MotionType::Static;
     floor.shape = Shape::box(Vec3(1000, 1, 1000));
     floor.position = Vec3(0, -1, 0);
     space.create_body(floor);
+}
+
+void make_grid(Space& space, int count, Real spacing) {
+    space.reserve_bodies(static_cast<std::size_t>(count) + 1);
+    make_floor(space);
     for (int i = 0; i < count; ++i) {
         BodyDesc d;
         d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
@@ -287,7 +292,7 @@ TEST(PageStock, ABodySpawnedInARunningGameIsNotCounted) {
     EXPECT_EQ(world.stocked_pages, 0u);
 
     Space level;  // before the first update, without reserve_bodies
-    make_grid(level, 0, 2);
+    make_floor(level);
     spawn_resting_boxes(level, 8000, 0);
     EXPECT_EQ(SpaceInternals::world(level).first_step_contacts, 8000u);
     EXPECT_GT(SpaceInternals::world(level).stocked_pages, 0u);
