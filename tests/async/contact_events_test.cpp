@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "async_util.hpp"
+#include "static_bodies.hpp"
 
 #include <chrono>
 #include <thread>
@@ -27,11 +28,7 @@ SpaceSettings bouncing_settings() {
 }
 
 void add_bouncing_balls(Space& space) {
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::box(Vec3(10, 0.5, 10));
-    ground.position = Vec3(0, -0.5, 0);
-    space.create_body(ground);
+    test::add_static_box(space, Vec3(10, 0.5, 10), Vec3(0, -0.5, 0));
     for (int i = 0; i < 24; ++i) {
         BodyDesc d;
         d.shape = Shape::sphere(0.5);

@@ -38,17 +38,6 @@ std::unique_ptr<JobSystem> two_workers() {
     return std::make_unique<WorkStealingJobSystem>(options);
 }
 
-BodyHandle add_static_box(Space& space, const Vec3& half_extents, const Vec3& position, const Quat& orientation,
-                          double friction) {
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::box(half_extents);
-    d.position = position;
-    d.orientation = orientation;
-    d.friction = friction;
-    return space.create_body(d);
-}
-
 BodyHandle add_box(Space& space, const Vec3& half_extents, const Vec3& position, double mass, double friction) {
     BodyDesc d;
     d.shape = Shape::box(half_extents);

@@ -1,10 +1,12 @@
 // Scene building and measuring helpers shared by the hard-case stability tests:
-// static floors and walls, stacks, energies, and the worst-of-many measurements the
-// pass criteria are written in.
+// stacks, energies, and the worst-of-many measurements the pass criteria are written
+// in. The static floors and walls are tests/support's, shared with the engine suites.
 #pragma once
 
 #include <spindle/engine/space.hpp>
 #include <spindle/scheduler/job_system.hpp>
+
+#include "static_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,8 +23,7 @@ std::unique_ptr<Space> make_space(const SpaceSettings& settings = {}, JobSystem*
 // A job system with two workers (the suite's budget machine has two cores).
 std::unique_ptr<JobSystem> two_workers();
 
-BodyHandle add_static_box(Space& space, const Vec3& half_extents, const Vec3& position,
-                          const Quat& orientation = Quat::Identity(), double friction = 0.6);
+using test::add_static_box;  // the floors and walls, shared with the engine suites
 BodyHandle add_box(Space& space, const Vec3& half_extents, const Vec3& position, double mass = 0,
                    double friction = 0.6);
 // Unit cubes (half extent 0.5) stacked on a floor whose top is at base.y(), exactly

@@ -14,6 +14,7 @@
 
 #include "collision/triangle_mesh.hpp"
 #include "collision_test_util.hpp"
+#include "static_bodies.hpp"
 
 namespace spindle {
 namespace {
@@ -224,11 +225,7 @@ TEST(FeatureCache, NoSlopGivesTheSATsManifolds) {
 // sleep, deep in no contact.
 TEST(FeatureCache, HullPileComesToRestAndSleeps) {
     Space space;
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(20, 1, 20));
-    floor.position = Vec3(0, -1, 0);
-    space.create_body(floor);
+    test::add_static_box(space, Vec3(20, 1, 20), Vec3(0, -1, 0));
     std::vector<BodyHandle> hulls;
     for (int layer = 0; layer < 4; ++layer) {
         for (int i = 0; i < 9; ++i) {

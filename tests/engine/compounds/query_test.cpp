@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "compound_test_util.hpp"
+#include "static_bodies.hpp"
 
 namespace spindle {
 namespace {
@@ -88,11 +89,7 @@ TEST(CompoundQuery, CompoundCastStopsWhereItsLowestPartTouches) {
     // The dumbbell itself swept down onto a box floor: it stops with its bells on it.
     SpaceSettings settings = DumbbellScene::weightless();
     Space space(settings);
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(5, 0.5, 5));
-    floor.position = Vec3(0, -0.5, 0);
-    space.create_body(floor);
+    test::add_static_box(space, Vec3(5, 0.5, 5), Vec3(0, -0.5, 0));
     space.update();
     const auto hit = space.cast_shape(dumbbell(), {Vec3(0, 2, 0), Quat::Identity()}, Vec3(0, -4, 0));
     ASSERT_TRUE(hit.has_value());

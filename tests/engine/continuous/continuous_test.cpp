@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace continuous_test {
@@ -28,11 +30,7 @@ struct BarRun {
 // Added to `space` (gravity turned off) after whatever it holds; returns the bar.
 BodyDesc bar_at_wall(Space& space) {
     space.set_gravity(Vec3::Zero());
-    BodyDesc wall;
-    wall.type = MotionType::Static;
-    wall.shape = Shape::box(Vec3(0.02, 5, 5));
-    wall.position = Vec3(0.5, 0, 0);
-    space.create_body(wall);
+    test::add_static_box(space, Vec3(0.02, 5, 5), Vec3(0.5, 0, 0));
     BodyDesc bar;
     bar.shape = Shape::box(Vec3(2, 0.05, 0.05));
     bar.position = Vec3(-1, 0, 0);
@@ -84,11 +82,7 @@ BodyHandle add_ball(Space& space, const Vec3& position, bool fast) {
 
 // A static box whose top is y = 0, half_x by half_z about the origin.
 void add_ground(Space& space, Real half_x, Real half_z) {
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::box(Vec3(half_x, 0.5, half_z));
-    ground.position = Vec3(0, -0.5, 0);
-    space.create_body(ground);
+    test::add_static_box(space, Vec3(half_x, 0.5, half_z), Vec3(0, -0.5, 0));
 }
 
 // Stages named "Continuous" in a job system's trace.

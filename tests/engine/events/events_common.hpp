@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "static_bodies.hpp"
+
 namespace spindle::test {
 
 inline void run(Space& space, int steps) {
@@ -16,10 +18,7 @@ inline void run(Space& space, int steps) {
 }
 
 inline BodyHandle add_ground(Space& space, bool contact_events = false) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::box(Vec3(10, 0.5, 10));
-    g.position = Vec3(0, -0.5, 0);
+    BodyDesc g = static_box(Vec3(10, 0.5, 10), Vec3(0, -0.5, 0));
     g.contact_events = contact_events;
     return space.create_body(g);
 }

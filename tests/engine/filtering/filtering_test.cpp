@@ -8,6 +8,8 @@
 
 #include <string>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace filtering_test {
@@ -18,10 +20,7 @@ constexpr std::uint32_t kGroundLayer = 1;
 constexpr std::uint32_t kGhostLayer = 2;  // ignores the ground in these tests
 
 BodyHandle add_ground(Space& space) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::box(Vec3(10, 0.5, 10));
-    g.position = Vec3(0, -0.5, 0);
+    BodyDesc g = test::static_box(Vec3(10, 0.5, 10), Vec3(0, -0.5, 0));
     g.layer = kGroundLayer;
     return space.create_body(g);
 }

@@ -14,6 +14,8 @@
 #include <memory>
 #include <string>
 
+#include "static_bodies.hpp"
+
 namespace spindle::test {
 
 inline constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
@@ -64,11 +66,7 @@ struct Scene {
 inline Scene make_scene(const SpaceSettings& settings = {}) {
     Scene s;
     s.space = std::make_unique<Space>(settings);
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::box(Vec3(10, 0.5, 10));
-    ground.position = Vec3(0, -0.5, 0);
-    s.ground = s.space->create_body(ground);
+    s.ground = test::add_static_box(*s.space, Vec3(10, 0.5, 10), Vec3(0, -0.5, 0));
     BodyDesc sphere;
     sphere.shape = Shape::sphere(0.5);
     sphere.position = Vec3(0, 0.5, 0);

@@ -7,6 +7,8 @@
 
 #include <vector>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace islands_test {
@@ -92,13 +94,7 @@ private:
 TEST(Islands, AWorldAtRestHandsTheSchedulerNoWork) {
     CountingJobs jobs;
     Space space(SpaceSettings{}, &jobs);
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
-    for (int i = 0; i < 100; ++i) {
-        floor.position = Vec3(i, -0.5, 0);
-        space.create_body(floor);
-    }
+    for (int i = 0; i < 100; ++i) test::add_static_box(space, Vec3(0.5, 0.5, 0.5), Vec3(i, -0.5, 0));
     BodyDesc ball;
     ball.shape = Shape::sphere(0.25);
     ball.position = Vec3(10, 0.25, 0);

@@ -7,6 +7,8 @@
 
 #include <vector>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace waking_test {
@@ -14,14 +16,6 @@ namespace waking_test {
 namespace {
 
 constexpr int kMaxSettleSteps = 600;
-
-BodyDesc static_box(const Vec3& position, const Vec3& half_extents) {
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::box(half_extents);
-    d.position = position;
-    return d;
-}
 
 BodyDesc ground_plane() {
     BodyDesc d;
@@ -95,7 +89,7 @@ TEST_F(Waking, DestroyingTheFloorDropsTheStackWithinASecond) {
 
 // On main the stack stayed asleep at y = 2.5 (top box) while its floor was 49 m lower.
 TEST_F(Waking, MovingTheFloorBySetPositionDropsTheStack) {
-    build_stack(static_box(Vec3(0, -0.5, 0), Vec3(5, 0.5, 5)), 0.5, 3);
+    build_stack(test::static_box(Vec3(5, 0.5, 5), Vec3(0, -0.5, 0)), 0.5, 3);
     settle();
     space.set_position(support, Vec3(0, -49.5, 0));
     for (int i = 0; i < 60; ++i) space.update();
@@ -105,7 +99,7 @@ TEST_F(Waking, MovingTheFloorBySetPositionDropsTheStack) {
 // On main the box stayed asleep on nothing at y = 2.5, a metre above the ground.
 TEST_F(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
     space.create_body(ground_plane());
-    build_stack(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)), 2.5, 1);
+    build_stack(test::static_box(Vec3(1, 1, 1), Vec3(0, 1, 0)), 2.5, 1);
     settle();
     space.destroy_body(support);
     for (int i = 0; i < 120; ++i) space.update();
@@ -115,7 +109,7 @@ TEST_F(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
 // A static body teleported into a sleeping one makes a new contact that wakes it. On main
 // the box slept on, overlapped by the wall, at x = 0.
 TEST_F(Waking, MovingAStaticBodyIntoASleepingBodyWakesIt) {
-    const BodyHandle wall = space.create_body(static_box(Vec3(10, 1, 0), Vec3(0.5, 1, 2)));
+    const BodyHandle wall = space.create_body(test::static_box(Vec3(0.5, 1, 2), Vec3(10, 1, 0)));
     build_stack(ground_plane(), 0.5, 1);
     settle();
     space.set_position(wall, Vec3(0.9, 1, 0));  // 0.1 m into the box
@@ -126,7 +120,7 @@ TEST_F(Waking, MovingAStaticBodyIntoASleepingBodyWakesIt) {
 
 // On main the top box stayed asleep at y = 2.5 with the pedestal moved 0.5 m lower.
 TEST_F(Waking, SetInternalMotionStateOfATouchingStaticBodyWakesTheIsland) {
-    build_stack(static_box(Vec3(0, 1, 0), Vec3(1, 1, 1)), 2.5, 2);
+    build_stack(test::static_box(Vec3(1, 1, 1), Vec3(0, 1, 0)), 2.5, 2);
     settle();
     MotionState lowered = space.internal_motion_state(support);
     lowered.position.y() -= 0.5;

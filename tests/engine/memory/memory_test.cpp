@@ -13,6 +13,7 @@
 #include "api/space_internals.hpp"
 #include "solver/constraints.hpp"
 #include "stages/broadphase_state.hpp"
+#include "static_bodies.hpp"
 
 using namespace spindle;
 
@@ -72,11 +73,7 @@ TEST(Memory, ContactArraysAreGivenBackWhenThePileComesApart) {
 // use, so they were moved to new memory on 99 of 100 steps (washer: 40 % of its step).
 TEST(Memory, ContactArraysStayPutWhileAPaddleStirsAHeap) {
     Space space;
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(20, 1, 20));
-    floor.position = Vec3(0, -1, 0);
-    space.create_body(floor);
+    test::add_static_box(space, Vec3(20, 1, 20), Vec3(0, -1, 0));
     BodyDesc paddle;
     paddle.type = MotionType::Kinematic;
     paddle.shape = Shape::box(Vec3(4, 0.3, 0.3));
@@ -153,13 +150,8 @@ TEST(Memory, StaticBodiesKeepNoInterpolationHistory) {
     settings.time_step.use_internal_time_stepping = true;
     Space space(settings);
     space.reserve_bodies(kLevelBodies);
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
-    for (int i = 0; i < kLevelBodies; ++i) {
-        d.position = Vec3(2.0 * (i % 40), 0.5, 2.0 * (i / 40));
-        space.create_body(d);
-    }
+    for (int i = 0; i < kLevelBodies; ++i)
+        test::add_static_box(space, Vec3(0.5, 0.5, 0.5), Vec3(2.0 * (i % 40), 0.5, 2.0 * (i / 40)));
     space.update(settings.time_step.duration);
     const MemoryReport report = memory_report(space);
     EXPECT_EQ(report.histories, 0u);

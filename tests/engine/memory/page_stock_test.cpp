@@ -24,6 +24,7 @@
 #include "solver/solver_body.hpp"
 #include "stages/capacity.hpp"
 #include "stages/stages.hpp"
+#include "static_bodies.hpp"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -92,13 +93,7 @@ namespace {
 
 // A level of `count` boxes in a grid, `spacing` apart (2 m: none touches), above a floor.
 // make_grid's floor: a static slab whose top is y = 0.
-void make_floor(Space& space) {
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(1000, 1, 1000));
-    floor.position = Vec3(0, -1, 0);
-    space.create_body(floor);
-}
+void make_floor(Space& space) { test::add_static_box(space, Vec3(1000, 1, 1000), Vec3(0, -1, 0)); }
 
 void make_grid(Space& space, int count, Real spacing) {
     space.reserve_bodies(static_cast<std::size_t>(count) + 1);
@@ -207,11 +202,7 @@ TEST(PageStock, AFloorMadeAfterItsBoxesStocksTheirContacts) {
             d.position = Vec3(2.0 * (i % 100), 0.5, 2.0 * (i / 100));
             space.create_body(d);
         }
-        BodyDesc floor;
-        floor.type = MotionType::Static;
-        floor.shape = Shape::box(Vec3(1000, 1, 1000));
-        floor.position = Vec3(0, -1, 0);
-        space.create_body(floor);
+        test::add_static_box(space, Vec3(1000, 1, 1000), Vec3(0, -1, 0));
     });
 }
 

@@ -12,6 +12,7 @@
 #include "api/space_internals.hpp"
 #include "memory/huge_page_vector.hpp"
 #include "solver/constraints.hpp"
+#include "static_bodies.hpp"
 
 using namespace spindle;
 
@@ -42,11 +43,7 @@ struct RoomScene {
     Space space;
 
     RoomScene() {
-        BodyDesc floor;
-        floor.type = MotionType::Static;
-        floor.shape = Shape::box(Vec3(10, 1, 10));
-        floor.position = Vec3(0, -1, 0);
-        space.create_body(floor);
+        test::add_static_box(space, Vec3(10, 1, 10), Vec3(0, -1, 0));
         for (int x = 0; x < 4; ++x) {
             for (int z = 0; z < 4; ++z) add_cube(Vec3(-2 + 1.1 * x, 0.5, -2 + 1.1 * z));
         }

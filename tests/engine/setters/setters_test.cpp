@@ -17,19 +17,15 @@
 #include <string>
 #include <thread>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace setters_test {
 
 namespace {
 
-BodyHandle add_ground(Space& space) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::box(Vec3(10, 0.5, 10));
-    g.position = Vec3(0, -0.5, 0);
-    return space.create_body(g);
-}
+BodyHandle add_ground(Space& space) { return test::add_static_box(space, Vec3(10, 0.5, 10), Vec3(0, -0.5, 0)); }
 
 BodyDesc ball(const Vec3& p) {
     BodyDesc d;
@@ -77,12 +73,7 @@ Quat about_y(Real angle) { return Quat(Eigen::AngleAxis<Real>(angle, Vec3::UnitY
 TEST(Setters, FrictionLoweredOnARamp_RestingBoxStartsSliding) {
     Space space;
     const Real slope = 20 * std::numbers::pi / 180;
-    BodyDesc ramp;
-    ramp.type = MotionType::Static;
-    ramp.shape = Shape::box(Vec3(10, 0.5, 4));
-    ramp.orientation = about_z(slope);
-    ramp.friction = 1;
-    space.create_body(ramp);
+    test::add_static_box(space, Vec3(10, 0.5, 4), Vec3::Zero(), about_z(slope), 1);
     BodyDesc d = box(Vec3::Zero());
     d.orientation = about_z(slope);
     d.position = about_z(slope) * Vec3(0, 1.0, 0);
@@ -501,10 +492,7 @@ TEST(Setters, DynamicBoxMadeStatic_StopsMidairAndHoldsABoxDroppedOnIt) {
 
 TEST(Setters, SleepingStack_WakesAndFallsWhenItsFloorIsMadeDynamic) {
     Space space;
-    BodyDesc floor = box(Vec3(0, -0.5, 0));
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(3, 0.5, 3));
-    const BodyHandle f = space.create_body(floor);
+    const BodyHandle f = test::add_static_box(space, Vec3(3, 0.5, 3), Vec3(0, -0.5, 0));
     BodyHandle stack[3];
     for (int i = 0; i < 3; ++i) stack[i] = space.create_body(box(Vec3(0, 0.5 + i, 0)));
     run(space, 240);
@@ -547,16 +535,8 @@ TEST(Setters, RestingBoxMadeKinematic_LosesItsContactWithTheGround) {
 // it): a bar spinning at 60 rad/s stops at a 4 cm wall (tests/engine/continuous).
 TEST(Setters, FastStaticBarMadeDynamic_IsSweptAndStopsAtAThinWall) {
     Space space(weightless());
-    BodyDesc wall;
-    wall.type = MotionType::Static;
-    wall.shape = Shape::box(Vec3(0.02, 5, 5));
-    wall.position = Vec3(0.5, 0, 0);
-    space.create_body(wall);
-    BodyDesc bar;
-    bar.type = MotionType::Static;
-    bar.shape = Shape::box(Vec3(2, 0.05, 0.05));
-    bar.position = Vec3(-1, 0, 0);
-    bar.orientation = about_z(2.0);
+    test::add_static_box(space, Vec3(0.02, 5, 5), Vec3(0.5, 0, 0));
+    BodyDesc bar = test::static_box(Vec3(2, 0.05, 0.05), Vec3(-1, 0, 0), about_z(2.0));
     bar.fast = true;
     const BodyHandle b = space.create_body(bar);
     space.set_motion_type(b, MotionType::Dynamic);

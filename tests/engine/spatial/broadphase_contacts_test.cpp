@@ -21,6 +21,7 @@
 #include "stages/broadphase_state.hpp"
 #include "stages/contact_events.hpp"
 #include "stages/stages.hpp"
+#include "static_bodies.hpp"
 #include "test_job_systems.hpp"
 #include "world.hpp"
 
@@ -65,11 +66,7 @@ ContactList contact_list(const World& world) {
 struct Block {
     explicit Block(JobSystem& jobs) : space(settings(), &jobs) {
         space.set_layers_collide(1, 2, false);
-        BodyDesc floor;
-        floor.type = MotionType::Static;
-        floor.shape = Shape::box(Vec3(30, 1, 30));
-        floor.position = Vec3(0, -1, 0);
-        space.create_body(floor);
+        test::add_static_box(space, Vec3(30, 1, 30), Vec3(0, -1, 0));
         int n = 0;
         for (int y = 0; y < 2; ++y) {
             for (int i = 0; i < 24; ++i) {

@@ -7,6 +7,7 @@
 
 #include "api/space_internals.hpp"
 #include "stages/stages.hpp"
+#include "static_bodies.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -16,11 +17,7 @@ TEST(ContactRecord, ManifoldMadeWhereNoneWas_KeepsNothingOfAnEarlierTouch) {
     SpaceSettings settings;
     settings.sleep.enabled = false;
     Space space(settings);
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(5, 0.5, 5));
-    floor.position = Vec3(0, -0.5, 0);
-    space.create_body(floor);
+    test::add_static_box(space, Vec3(5, 0.5, 5), Vec3(0, -0.5, 0));
     BodyDesc box;
     box.shape = Shape::box(Vec3::Constant(0.5));
     box.position = Vec3(0, 0.5, 0);

@@ -16,6 +16,7 @@
 
 #include "api/space_internals.hpp"
 #include "stages/broadphase_state.hpp"
+#include "static_bodies.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -149,12 +150,7 @@ TEST(FatBoxRule, SlowBodysBoxIsTight_FastBodysIsStretchedAndLastsSteps) {
 // beyond, moving with it, at every new box).
 TEST(FatBoxRule, FastBodyInFreeFlightIsStretched_OneItsContactsMoveIsNot) {
     Space space;  // gravity (0, -9.81, 0)
-    BodyDesc floor;
-    floor.type = MotionType::Static;
-    floor.shape = Shape::box(Vec3(200, 0.5, 5));
-    floor.position = Vec3(0, -0.5, 0);
-    floor.friction = 0;
-    space.create_body(floor);
+    test::add_static_box(space, Vec3(200, 0.5, 5), Vec3(0, -0.5, 0), Quat::Identity(), 0);
     BodyDesc slider;
     slider.shape = Shape::box(Vec3::Constant(0.5));
     slider.position = Vec3(-100, 0.5, 0);  // resting on the floor
@@ -238,11 +234,7 @@ TEST(FatBoxRule, FastCubeClosingOnAnother_GetsItsContactBeforeTheyMeet) {
 TEST(FatBoxRule, CubeThrownFromRest_GetsItsContactBeforeItMeetsAnother) {
     for (const Real gap : {0.3, 0.25, 0.35}) {
         Space space;
-        BodyDesc floor;
-        floor.type = MotionType::Static;
-        floor.shape = Shape::box(Vec3(20, 0.5, 20));
-        floor.position = Vec3(0, -0.5, 0);
-        space.create_body(floor);
+        test::add_static_box(space, Vec3(20, 0.5, 20), Vec3(0, -0.5, 0));
         BodyDesc target;
         target.shape = Shape::box(Vec3::Constant(0.25));
         target.position = Vec3(0, 0.25, 0);
