@@ -134,11 +134,11 @@ struct FirstStepArray {
 // take huge pages, as the stages lay them out. The wide contacts are counted as if the
 // colours were full (the solver rounds each colour up to whole lanes). A list a step adds
 // on huge pages must be added here: PageStock.AFirstStepLaysOutTheArraysItsStockCounted
-// fails otherwise.
-constexpr std::array<FirstStepArray, 19> first_step_arrays(std::size_t bodies, std::size_t contacts) {
+// fails otherwise. The array's length is the rows': a row added or removed needs no count.
+constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts) {
     const std::size_t wide = (contacts + kLanes - 1) / kLanes;
     const std::size_t slots = ContactIndex::slots_for(contacts);
-    return {{
+    return std::to_array<FirstStepArray>({
         {"contact records", contacts, sizeof(Contact), true},
         {"wide contacts", wide, sizeof(WideContact), true},
         {"push anchors", wide * kLanes, sizeof(PushAnchors), true},
@@ -158,7 +158,7 @@ constexpr std::array<FirstStepArray, 19> first_step_arrays(std::size_t bodies, s
         {"moved fat boxes", bodies, sizeof(Aabb), false},
         {"push velocities", bodies + 1, sizeof(PushVelocity), false},
         {"gravity scales", bodies + 1, sizeof(Real), false},
-    }};
+    });
 }
 
 // The huge pages those arrays take: the pages moved under the mapped ones, and the chunks
