@@ -3,19 +3,14 @@
 #pragma once
 
 #include <spindle/engine/space.hpp>
-#include <spindle/platform/error.hpp>
 
 #include <algorithm>
-#include <string>
 #include <vector>
 
+#include "space_calls.hpp"
 #include "static_bodies.hpp"
 
 namespace spindle::test {
-
-inline void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
 
 inline BodyHandle add_ground(Space& space, bool contact_events = false) {
     BodyDesc g = static_box(Vec3(10, 0.5, 10), Vec3(0, -0.5, 0));
@@ -51,15 +46,6 @@ inline bool same_event(const ContactEvent& x, const ContactEvent& y) {
 
 inline bool same_events(const std::vector<ContactEvent>& x, const std::vector<ContactEvent>& y) {
     return x.size() == y.size() && std::equal(x.begin(), x.end(), y.begin(), same_event);
-}
-
-std::string error_of(auto&& call) {
-    try {
-        call();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
 }
 
 }  // namespace spindle::test

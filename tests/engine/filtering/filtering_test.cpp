@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "space_calls.hpp"
 #include "static_bodies.hpp"
 
 using namespace spindle;
@@ -42,24 +43,9 @@ BodyDesc box(const Vec3& p, std::uint32_t group) {
     return d;
 }
 
-SpaceSettings weightless() {
-    SpaceSettings s;
-    s.gravity = Vec3::Zero();
-    return s;
-}
-
-void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
-
-std::string error_of(auto&& call) {
-    try {
-        call();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using test::error_of;
+using test::run;
+using test::weightless;
 
 }  // namespace
 

@@ -17,6 +17,7 @@
 #include "api/space_internals.hpp"
 #include "collision/cast.hpp"
 #include "query/query_scene.hpp"
+#include "space_calls.hpp"
 #include "world.hpp"
 
 namespace spindle {
@@ -37,14 +38,7 @@ BodyDesc body(const Shape& shape, const Vec3& position, MotionType type = Motion
     return d;
 }
 
-std::string message_of(const std::function<void()>& call) {
-    try {
-        call();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using test::error_of;
 
 TEST(SceneQueries, RayHitsTheNearestBodyOnItsSurface) {
     Space space(weightless());
@@ -277,27 +271,24 @@ TEST(SceneQueries, BadArgumentsAreNamed) {
     const Real nan = std::nan("");
     std::vector<QueryHit> hits;
     std::vector<BodyHandle> bodies;
-    EXPECT_NE(message_of([&] { space.cast_ray({nan, 0, 0}, {1, 0, 0}); }).find("cast_ray: from"), std::string::npos);
-    EXPECT_NE(message_of([&] {
+    EXPECT_NE(error_of([&] { space.cast_ray({nan, 0, 0}, {1, 0, 0}); }).find("cast_ray: from"), std::string::npos);
+    EXPECT_NE(error_of([&] {
                   space.cast_ray_all({0, 0, 0}, {1, INFINITY, 0}, hits);
               }).find("cast_ray_all: to"),
               std::string::npos);
-    EXPECT_NE(message_of([&] {
+    EXPECT_NE(error_of([&] {
                   space.cast_shape(Shape::plane({0, 1, 0}, 0), {}, {1, 0, 0});
               }).find("shape must be a sphere, capsule, box or convex hull, got plane"),
               std::string::npos);
-    EXPECT_NE(message_of([&] {
+    EXPECT_NE(error_of([&] {
                   space.cast_shape(Shape::sphere(1), {}, {nan, 0, 0});
               }).find("translation"),
               std::string::npos);
-    EXPECT_NE(message_of([&] {
+    EXPECT_NE(error_of([&] {
                   space.overlap_shape(Shape::sphere(1), {{0, 0, 0}, Quat(0, 0, 0, 0)}, bodies);
               }).find("pose.q"),
               std::string::npos);
-    EXPECT_NE(message_of([&] {
-                  space.overlap_box({{1, 0, 0}, {0, 1, 1}}, bodies);
-              }).find("box.min"),
-              std::string::npos);
+    EXPECT_NE(error_of([&] { space.overlap_box({{1, 0, 0}, {0, 1, 1}}, bodies); }).find("box.min"), std::string::npos);
 }
 
 // What compare_with_brute_force saw: rays that met a body other than the first (the

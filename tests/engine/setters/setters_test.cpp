@@ -17,6 +17,7 @@
 #include <string>
 #include <thread>
 
+#include "space_calls.hpp"
 #include "static_bodies.hpp"
 
 using namespace spindle;
@@ -41,24 +42,9 @@ BodyDesc box(const Vec3& p, Real half = 0.5) {
     return d;
 }
 
-SpaceSettings weightless() {
-    SpaceSettings s;
-    s.gravity = Vec3::Zero();
-    return s;
-}
-
-void run(Space& space, int steps) {
-    for (int i = 0; i < steps; ++i) space.update();
-}
-
-std::string error_of(auto&& call) {
-    try {
-        call();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using test::error_of;
+using test::run;
+using test::weightless;
 
 Quat about_z(Real angle) { return Quat(Eigen::AngleAxis<Real>(angle, Vec3::UnitZ())); }
 Quat about_y(Real angle) { return Quat(Eigen::AngleAxis<Real>(angle, Vec3::UnitY())); }
