@@ -18,6 +18,7 @@
 
 #include "async_util.hpp"
 #include "collision/cast.hpp"
+#include "static_bodies.hpp"
 
 namespace spindle {
 namespace {
@@ -34,10 +35,7 @@ TEST(AsyncQueries, FourThreadsQueryTheStepTheyReadWhileTheRunnerSteps) {
     SpaceSettings settings = test::async_settings();
     settings.gravity = {0, -9.81, 0};
     Space space(settings);
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane({0, 1, 0}, 0);
-    space.create_body(ground);
+    test::add_ground_plane(space);
     constexpr int kColumns = 16;
     constexpr Real kRadius = 0.25;
     std::vector<BodyHandle> balls;

@@ -14,13 +14,6 @@ namespace spindle::stability {
 
 namespace {
 
-BodyHandle add_ground_plane(Space& space) {
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::plane(Vec3::UnitY(), 0);
-    return space.create_body(d);
-}
-
 int awake_count(const Space& space, const std::vector<BodyHandle>& bodies) {
     int n = 0;
     for (BodyHandle b : bodies) n += space.internal_is_awake(b) ? 1 : 0;

@@ -23,7 +23,9 @@ std::unique_ptr<Space> make_space(const SpaceSettings& settings = {}, JobSystem*
 // A job system with two workers (the suite's budget machine has two cores).
 std::unique_ptr<JobSystem> two_workers();
 
-using test::add_static_box;  // the floors and walls, shared with the engine suites
+// The ground planes, floors and walls, shared with the engine suites.
+using test::add_ground_plane;
+using test::add_static_box;
 BodyHandle add_box(Space& space, const Vec3& half_extents, const Vec3& position, double mass = 0,
                    double friction = 0.6);
 // Unit cubes (half extent 0.5) stacked on a floor whose top is at base.y(), exactly

@@ -1,9 +1,14 @@
-// Static boxes for tests: the floors, walls and ramps the suites stand their bodies on.
+// Static bodies for tests: the ground planes, floors, walls and ramps the suites stand
+// their bodies on.
 #pragma once
 
 #include <spindle/engine/space.hpp>
 
 namespace spindle::test {
+
+// The ground: a static plane through the origin facing +y, the rest BodyDesc's defaults.
+BodyDesc ground_plane();
+BodyHandle add_ground_plane(Space& space);
 
 // A static box's description, the rest BodyDesc's defaults: for a floor that also sets
 // its layer, its events or its friction before it is made.

@@ -14,6 +14,8 @@
 #include <new>
 #include <string>
 
+#include "static_bodies.hpp"
+
 namespace {
 std::atomic<long> g_allocations{0};
 std::atomic<long> g_bytes{0};
@@ -87,10 +89,7 @@ long resting_scene_allocations(JobSystem* jobs) {
     settings.sleep.enabled = false;  // resting but awake: the full pipeline runs every step
     settings.time_step.use_internal_time_stepping = true;
     Space space(settings, jobs);
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(ground);
+    test::add_ground_plane(space);
     for (int i = 0; i < 10; ++i) {
         for (int k = 0; k < 10; ++k) {
             BodyDesc d;

@@ -9,6 +9,7 @@
 // its axis: 5/7 c g for a solid ball). The row stops the spin outright when it can, so it
 // brakes at that cap until the body stops at v0 / a.
 #include "scene_util.hpp"
+#include "static_bodies.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,9 +25,7 @@ namespace {
 constexpr double kSpeed = 2;  // m/s, the rolling start
 
 void add_ground(Space& space, double rolling_resistance = 0) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::plane(Vec3::UnitY(), 0);
+    BodyDesc g = test::ground_plane();
     g.rolling_resistance = rolling_resistance;
     space.create_body(g);
 }

@@ -12,6 +12,7 @@
 #include "collision/collide.hpp"
 #include "compound_test_util.hpp"
 #include "stages/stages.hpp"
+#include "static_bodies.hpp"
 
 namespace spindle {
 namespace {
@@ -129,10 +130,7 @@ std::unique_ptr<Space> space_on_plane() {
     SpaceSettings settings;
     settings.sleep.enabled = false;
     auto space = std::make_unique<Space>(settings);
-    BodyDesc plane;
-    plane.type = MotionType::Static;
-    plane.shape = Shape::plane(Vec3::UnitY(), 0);
-    space->create_body(plane);
+    test::add_ground_plane(*space);
     return space;
 }
 

@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace analytic_test {
@@ -22,12 +24,7 @@ BodyDesc sphere_at(const Vec3& p, double radius = 0.5) {
     return d;
 }
 
-BodyHandle add_ground(Space& space) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::plane(Vec3::UnitY(), 0);
-    return space.create_body(g);
-}
+BodyHandle add_ground(Space& space) { return test::add_ground_plane(space); }
 
 }  // namespace
 

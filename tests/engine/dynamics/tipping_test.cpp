@@ -9,6 +9,8 @@
 #include <array>
 #include <cmath>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace tipping_test {
@@ -50,9 +52,7 @@ double rod_pivot_time(double length, double w0) {
 // rad/s) and the pole stalls on its way down.
 TEST(Tipping, ThinPoleFallsInItsPivotTimeWithoutSpinningAboutItsAxis) {
     Space space;
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
+    BodyDesc ground = test::ground_plane();
     ground.friction = 0.9;
     space.create_body(ground);
 

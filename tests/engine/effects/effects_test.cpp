@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace effects_test {
@@ -21,9 +23,7 @@ BodyDesc ball(const Vec3& p) {
 }
 
 void add_ground(Space& space, Real friction = 0.6, Real restitution = 0) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::plane(Vec3::UnitY(), 0);
+    BodyDesc g = test::ground_plane();
     g.friction = friction;
     g.restitution = restitution;
     space.create_body(g);

@@ -22,10 +22,7 @@ struct Row {
 
 // Five balls in a touching row on the ground, and one far away.
 void build(Row& row) {
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    row.space.create_body(ground);
+    test::add_ground_plane(row.space);
     for (int i = 0; i < 5; ++i) {
         BodyDesc d;
         d.shape = Shape::sphere(0.5);

@@ -17,13 +17,6 @@ namespace {
 
 constexpr int kMaxSettleSteps = 600;
 
-BodyDesc ground_plane() {
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::plane(Vec3::UnitY(), 0);
-    return d;
-}
-
 // A kinematic platform, its top at y = 0.25.
 BodyDesc platform(const Vec3& velocity) {
     BodyDesc d;
@@ -80,7 +73,7 @@ protected:
 
 // On main the stack stayed asleep at y = 2.5 (top box) two seconds after its floor went.
 TEST_F(Waking, DestroyingTheFloorDropsTheStackWithinASecond) {
-    build_stack(ground_plane(), 0.5, 3);
+    build_stack(test::ground_plane(), 0.5, 3);
     settle();
     space.destroy_body(support);
     for (int i = 0; i < 60; ++i) space.update();
@@ -98,7 +91,7 @@ TEST_F(Waking, MovingTheFloorBySetPositionDropsTheStack) {
 
 // On main the box stayed asleep on nothing at y = 2.5, a metre above the ground.
 TEST_F(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
-    space.create_body(ground_plane());
+    space.create_body(test::ground_plane());
     build_stack(test::static_box(Vec3(1, 1, 1), Vec3(0, 1, 0)), 2.5, 1);
     settle();
     space.destroy_body(support);
@@ -110,7 +103,7 @@ TEST_F(Waking, DestroyingAStaticBoxUnderASleepingBodyDropsIt) {
 // the box slept on, overlapped by the wall, at x = 0.
 TEST_F(Waking, MovingAStaticBodyIntoASleepingBodyWakesIt) {
     const BodyHandle wall = space.create_body(test::static_box(Vec3(0.5, 1, 2), Vec3(10, 1, 0)));
-    build_stack(ground_plane(), 0.5, 1);
+    build_stack(test::ground_plane(), 0.5, 1);
     settle();
     space.set_position(wall, Vec3(0.9, 1, 0));  // 0.1 m into the box
     space.update();

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "joint_scenes.hpp"
+#include "static_bodies.hpp"
 
 using namespace spindle;
 using namespace spindle::test;
@@ -253,10 +254,7 @@ TEST(Collision, CreatingAJointDropsTheContactAndDestroyingItRestoresIt) {
 
 TEST(Counters, ASceneWithoutJointsSolvesNone) {
     Space space;
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(ground);
+    test::add_ground_plane(space);
     for (int i = 0; i < 4; ++i) add_sphere(space, Vec3(1.2 * i, 0.5, 0), 0.5, 1);
     for (int i = 0; i < 60; ++i) space.update();
     EXPECT_GT(space.counters().contact_points_solved, 0u);
@@ -314,10 +312,7 @@ TEST(Sleeping, AMovingBodyWakesASleeperJointedToIt) {
 TEST(Sleeping, CreatingAJointWakesBothBodies) {
     Space space;
     const BodyHandle a = add_static(space, Vec3(0, 5, 0));
-    BodyDesc ground;
-    ground.type = MotionType::Static;
-    ground.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(ground);
+    test::add_ground_plane(space);
     const BodyHandle ball = add_sphere(space, Vec3(0, 0.5, 0), 0.5, 1);
     for (int i = 0; i < 90; ++i) space.update();
     ASSERT_FALSE(space.internal_is_awake(ball));

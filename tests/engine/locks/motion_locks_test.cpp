@@ -8,6 +8,8 @@
 #include <cmath>
 #include <vector>
 
+#include "static_bodies.hpp"
+
 using namespace spindle;
 
 namespace motion_locks_test {
@@ -20,12 +22,7 @@ SpaceSettings awake() {
     return s;
 }
 
-void add_ground(Space& space) {
-    BodyDesc g;
-    g.type = MotionType::Static;
-    g.shape = Shape::plane(Vec3::UnitY(), 0);
-    space.create_body(g);
-}
+void add_ground(Space& space) { test::add_ground_plane(space); }
 
 // The rotation of q0 to q, as a rotation vector (world).
 Vec3 turned(const Quat& q0, const Quat& q) {

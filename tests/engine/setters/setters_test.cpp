@@ -642,10 +642,7 @@ TEST(Setters, BadValuesAndStaleHandles_ThrowNamingThemAndChangeNothing) {
 
 TEST(Setters, PlaneBodyMadeDynamic_Throws) {
     Space space;
-    BodyDesc d;
-    d.type = MotionType::Static;
-    d.shape = Shape::plane(Vec3::UnitY(), 0);
-    const BodyHandle p = space.create_body(d);
+    const BodyHandle p = test::add_ground_plane(space);
     const std::string e = error_of([&] { space.set_motion_type(p, MotionType::Dynamic); });
     EXPECT_NE(e.find("set_motion_type: body 0 (generation 1) has a plane or triangle mesh shape"), std::string::npos)
         << e;
