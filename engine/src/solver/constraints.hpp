@@ -333,6 +333,7 @@ struct SolverScratch {
     bool reuse_colors = true;                            // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
     std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
+    bool sort_colors = true;  // each colour's refs by their lower dynamic body (solver.cpp); false: as coloured
     // The colours' manifolds kLanes at a time, then the overflow one by one (pack_contacts
     // writes their lanes, prepare_wide every other field).
     RawRoomVector<WideContact> wide;

@@ -235,6 +235,32 @@ int assign_color(SolverScratch& scratch, std::uint32_t a, std::uint32_t b) {
     return c;
 }
 
+// Colour refs per block of sort_colors.
+constexpr std::uint32_t kSortColorGrain = 1;
+
+// Each colour's manifolds in the order of their lower dynamic body (then their ref), so a
+// share of a colour's wide contacts (run_phases cuts a phase's items into one share per
+// worker, in order) touches the bodies of about the same part of the body order in every
+// colour: a worker meets again the bodies it wrote in the last colour, still in its own
+// cache. A colour's manifolds share no dynamic body, so their order within it changes no
+// result.
+void sort_colors(JobSystem& jobs, SolverScratch& scratch) {
+    const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size());
+    auto lower_dynamic = [&](std::uint32_t ref) {
+        const ManifoldRef& m = scratch.manifolds[ref];
+        return std::min(scratch.bodies[m.a].dynamic ? m.a : immovable, scratch.bodies[m.b].dynamic ? m.b : immovable);
+    };
+    jobs.parallel_for("SortColors", 0, kColorCount, kSortColorGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
+        for (std::uint32_t c = lo; c < hi; ++c) {
+            std::vector<std::uint32_t>& refs = scratch.colors[c];
+            std::sort(refs.begin(), refs.end(), [&](std::uint32_t x, std::uint32_t y) {
+                const std::uint32_t bx = lower_dynamic(x), by = lower_dynamic(y);
+                return bx != by ? bx < by : x < y;
+            });
+        }
+    });
+}
+
 // Joints first, then contacts, in list order (deterministic), sharing the colours'
 // body sets: a colour's joints and contacts together touch each dynamic body once.
 void color(SolverScratch& scratch) {
@@ -722,6 +748,7 @@ void solve(World& world, Real dt) {
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
+        if (scratch.sort_colors) sort_colors(*world.jobs, scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
         find_first_touches(*world.jobs, scratch, static_cast<std::uint32_t>(world.awake.size()));
