@@ -751,7 +751,8 @@ void solve(World& world, Real dt) {
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
-        if (scratch.sort_colors) sort_colors(scratch);
+        // One worker meets every body in its own cache: nothing to keep apart.
+        if (scratch.sort_colors && world.jobs->worker_count() > 1) sort_colors(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
         find_first_touches(*world.jobs, scratch, static_cast<std::uint32_t>(world.awake.size()));

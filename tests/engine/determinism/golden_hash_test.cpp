@@ -405,7 +405,8 @@ SortRun run_sorted(const std::string& name, int steps, JobSystem& jobs, bool sor
 
 // A colour's manifolds sorted by their lower dynamic body, so that a worker's share of every colour meets
 // the same part of the bodies: they share no dynamic body, so the results are those of the colouring's
-// order. The pyramid's colours are not in body order as coloured, the chains' hold joints besides.
+// order. The pyramid's colours are not in body order as coloured, the chains' hold joints besides. One worker
+// does not sort.
 TEST(GoldenHash, ColoursSortedByBodyGiveTheSameBitsAsColouringOrder) {
     for (const auto& [scene, steps] : {std::pair{"pyramid", 30}, {"chains", 120}}) {
         SingleThreadedJobSystem single;
@@ -414,7 +415,7 @@ TEST(GoldenHash, ColoursSortedByBodyGiveTheSameBitsAsColouringOrder) {
         for (unsigned workers : {1u, 2u}) {
             auto jobs = jobs_for(workers);
             const SortRun sorted = run_sorted(scene, steps, *jobs, true);
-            EXPECT_TRUE(sorted.sorted) << scene << ", " << workers << " workers";
+            EXPECT_EQ(sorted.sorted, workers > 1 || reference.sorted) << scene << ", " << workers << " workers";
             EXPECT_EQ(hex(sorted.hash), hex(reference.hash)) << scene << ", " << workers << " workers";
         }
     }
