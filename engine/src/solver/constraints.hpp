@@ -333,6 +333,12 @@ struct SolverScratch {
     bool reuse_colors = true;                            // false colours every step (tests compare the two)
     std::vector<std::uint32_t> colors[kColorCount];      // manifold refs per colour
     std::vector<std::uint32_t> overflow;                 // refs that fit no colour, solved serially
+    bool sort_colors = true;  // each colour's refs by their lower dynamic body (solver.cpp); false: as coloured
+    // sort_colors' working lists, kept for their capacity: each manifold ref's colour (-1: the overflow), per
+    // solver body where its manifolds start in the sorted list, and the coloured refs sorted.
+    std::vector<std::int8_t> manifold_colors;
+    std::vector<std::uint32_t> body_starts;
+    std::vector<std::uint32_t> sorted_refs;
     // The colours' manifolds kLanes at a time, then the overflow one by one (pack_contacts
     // writes their lanes, prepare_wide every other field).
     RawRoomVector<WideContact> wide;

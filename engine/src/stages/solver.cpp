@@ -235,6 +235,33 @@ int assign_color(SolverScratch& scratch, std::uint32_t a, std::uint32_t b) {
     return c;
 }
 
+// Each colour's manifolds in the order of their lower dynamic body (then their ref), so a
+// share of a colour's wide contacts (run_phases cuts a phase's items into one share per
+// worker, in order) touches the bodies of about the same part of the body order in every
+// colour: a worker meets again the bodies it wrote in the last colour, still in its own
+// cache. A colour's manifolds share no dynamic body, so their order within it changes no
+// result. One counting sort of every coloured manifold by that body (stable: refs in
+// order within a body), dealt back to the colours (SolverScratch::manifold_colors).
+void sort_colors(SolverScratch& scratch) {
+    const auto none = static_cast<std::uint32_t>(scratch.bodies.size());  // a manifold without a dynamic body
+    auto lower_dynamic = [&](const ManifoldRef& m) {
+        return std::min(scratch.bodies[m.a].dynamic ? m.a : none, scratch.bodies[m.b].dynamic ? m.b : none);
+    };
+    std::vector<std::uint32_t>& starts = scratch.body_starts;
+    starts.assign(std::size_t{none} + 2, 0);
+    const auto count = static_cast<std::uint32_t>(scratch.manifolds.size());
+    for (std::uint32_t k = 0; k < count; ++k) {
+        if (scratch.manifold_colors[k] >= 0) ++starts[lower_dynamic(scratch.manifolds[k]) + 1];
+    }
+    for (std::size_t i = 1; i < starts.size(); ++i) starts[i] += starts[i - 1];
+    scratch.sorted_refs.resize(starts.back());
+    for (std::uint32_t k = 0; k < count; ++k) {
+        if (scratch.manifold_colors[k] >= 0) scratch.sorted_refs[starts[lower_dynamic(scratch.manifolds[k])]++] = k;
+    }
+    for (std::vector<std::uint32_t>& refs : scratch.colors) refs.clear();
+    for (std::uint32_t k : scratch.sorted_refs) scratch.colors[scratch.manifold_colors[k]].push_back(k);
+}
+
 // Joints first, then contacts, in list order (deterministic), sharing the colours'
 // body sets: a colour's joints and contacts together touch each dynamic body once.
 void color(SolverScratch& scratch) {
@@ -249,9 +276,11 @@ void color(SolverScratch& scratch) {
         const int c = assign_color(scratch, scratch.joints[k].a, scratch.joints[k].b);
         (c >= 0 ? scratch.joint_colors[c] : scratch.joint_overflow).push_back(k);
     }
+    scratch.manifold_colors.resize(scratch.manifolds.size());
     for (std::uint32_t k = 0; k < scratch.manifolds.size(); ++k) {
         const int c = assign_color(scratch, scratch.manifolds[k].a, scratch.manifolds[k].b);
         (c >= 0 ? scratch.colors[c] : scratch.overflow).push_back(k);
+        scratch.manifold_colors[k] = static_cast<std::int8_t>(c);
     }
 }
 
@@ -722,6 +751,8 @@ void solve(World& world, Real dt) {
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
         color(scratch);
+        // One worker meets every body in its own cache: nothing to keep apart.
+        if (scratch.sort_colors && world.jobs->worker_count() > 1) sort_colors(scratch);
         pack_joint_lanes(scratch);  // nothing to do in a scene without joints
         pack_contacts(*world.jobs, scratch);
         find_first_touches(*world.jobs, scratch, static_cast<std::uint32_t>(world.awake.size()));
