@@ -356,6 +356,10 @@ private:
     std::vector<std::vector<std::int32_t>> m_walk_pools, m_walk_leaves;
     std::vector<std::int32_t> m_walk_spliced;
 
+    // query()'s float walk keeps its stack in a fixed array of this many entries, room for
+    // a tree of height kWalkDepth - 1; taller trees (a pathological rebuild()) walk the doubles.
+    static constexpr int kWalkDepth = 64;
+
     // A traversal stack that lives on the C++ stack and spills to the heap only for
     // trees deeper than any balanced tree gets (a pathological rebuild()).
     class TraversalStack {
@@ -484,29 +488,34 @@ void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
     SPINDLE_ASSERT(!m_stale_boxes,
                    "DynamicAabbTree::query: set_fat_box moved proxies and rebuild_enlarged has not run");
     const OverlapTest overlaps_box(box);
-    if (!m_child_boxes_current || m_root == kNull || m_nodes[static_cast<std::size_t>(m_root)].height == 0) {
+    if (!m_child_boxes_current || height() == 0 || height() >= kWalkDepth) {
         traverse(overlaps_box, callback);
         return;
     }
     // traverse()'s walk, the same nodes entered in the same order, but a node's children
     // tested together on their float boxes before they are pushed, so an internal node's
     // own line is never read; a leaf let through is tested on its double box when popped.
+    // Depth first, the stack holds at most one waiting sibling a level and the two children
+    // just pushed: height + 1 entries, so a fixed array with no check for room.
     if (!overlaps_box(m_nodes[static_cast<std::size_t>(m_root)].box)) return;
     const ChildTest children_overlap(box);
-    TraversalStack stack;
-    stack.push(m_root);
-    while (!stack.empty()) {
-        const std::int32_t entry = stack.pop();
+    const ChildBoxes* const lines = m_child_boxes.data();
+    const Node* const nodes = m_nodes.data();
+    std::int32_t stack[kWalkDepth];
+    std::int32_t* top = stack;
+    *top++ = m_root;
+    do {
+        const std::int32_t entry = *--top;
         if (entry < 0) {
             const std::int32_t leaf = ~entry;
-            if (overlaps_box(m_nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
+            if (overlaps_box(nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
             continue;
         }
-        const ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(entry)];
+        const ChildBoxes& children = lines[static_cast<std::size_t>(entry)];
         const unsigned found = children_overlap(children);
-        if ((found & 1u) != 0) stack.push(children.entry[0]);
-        if ((found & 2u) != 0) stack.push(children.entry[1]);
-    }
+        if ((found & 1u) != 0) *top++ = children.entry[0];
+        if ((found & 2u) != 0) *top++ = children.entry[1];
+    } while (top != stack);
 }
 
 template <typename Callback>
