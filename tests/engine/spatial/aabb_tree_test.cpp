@@ -299,6 +299,34 @@ TEST(AabbTree, MovesInACorner_RebuildKeepsEveryNodesFloatBoxes) {
     set_assert_handler(previous);
 }
 
+// query() with a skip: the proxies skip accepts are passed over and the rest met in the
+// plain query's order, on the float walk and on the doubles' (a copy without float boxes).
+TEST(AabbTree, QueryWithSkip_PassesOverWhatItSkipsAndMeetsTheRestInOrder) {
+    Rng rng(7);
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    const int n = 300 * kScale;
+    for (int i = 0; i < n; ++i) tree.create_proxy(rng.box(50, 2), std::uint64_t(i));
+    const DynamicAabbTree doubles = tree;
+    tree.make_child_boxes();
+    ASSERT_TRUE(tree.child_boxes_current());
+    const auto skipped = [](std::int32_t id) { return id % 3 == 0; };
+    for (int q = 0; q < 200; ++q) {
+        const Aabb box = rng.box(50, 8);
+        for (const DynamicAabbTree* walked : {static_cast<const DynamicAabbTree*>(&tree), &doubles}) {
+            std::vector<std::int32_t> expected;
+            for (const std::int32_t id : query_in_order(*walked, box)) {
+                if (!skipped(id)) expected.push_back(id);
+            }
+            std::vector<std::int32_t> met;
+            walked->query(box, skipped, [&](std::int32_t id) {
+                met.push_back(id);
+                return true;
+            });
+            ASSERT_EQ(met, expected) << "query " << q << (walked == &tree ? ", float walk" : ", doubles");
+        }
+    }
+}
+
 TEST(AabbTree, Query_CallbackFalseStops) {
     DynamicAabbTree tree;
     for (int i = 0; i < 10; ++i)
