@@ -99,6 +99,10 @@ public:
     // children at once on their float boxes; the same proxies in the same order either way.
     template <typename Callback>
     void query(const Aabb& box, Callback&& callback) const;
+    // As above, but skip(id) -> bool is asked first of each proxy the walk reaches, and one
+    // it accepts is passed over without its box being read (a caller's own cheaper test).
+    template <typename Skip, typename Callback>
+    void query(const Aabb& box, Skip&& skip, Callback&& callback) const;
     // Makes every internal node's children's boxes in float, for query()'s walk. Worth it
     // when many queries follow (a pair search of many moved proxies): it reads every node.
     // With `jobs`, in parallel (the caller waits). They are kept from then on through moves
@@ -356,6 +360,10 @@ private:
     std::vector<std::vector<std::int32_t>> m_walk_pools, m_walk_leaves;
     std::vector<std::int32_t> m_walk_spliced;
 
+    // query()'s float walk keeps its stack in a fixed array of this many entries, room for
+    // a tree of height kWalkDepth - 1; taller trees (a pathological rebuild()) walk the doubles.
+    static constexpr int kWalkDepth = 64;
+
     // A traversal stack that lives on the C++ stack and spills to the heap only for
     // trees deeper than any balanced tree gets (a pathological rebuild()).
     class TraversalStack {
@@ -481,32 +489,44 @@ inline void DynamicAabbTree::make_child_boxes_of(std::int32_t id) {
 
 template <typename Callback>
 void DynamicAabbTree::query(const Aabb& box, Callback&& callback) const {
+    const auto skip_none = [](std::int32_t) { return false; };
+    query(box, skip_none, callback);
+}
+
+template <typename Skip, typename Callback>
+void DynamicAabbTree::query(const Aabb& box, Skip&& skip, Callback&& callback) const {
     SPINDLE_ASSERT(!m_stale_boxes,
                    "DynamicAabbTree::query: set_fat_box moved proxies and rebuild_enlarged has not run");
     const OverlapTest overlaps_box(box);
-    if (!m_child_boxes_current || m_root == kNull || m_nodes[static_cast<std::size_t>(m_root)].height == 0) {
-        traverse(overlaps_box, callback);
+    if (!m_child_boxes_current || height() == 0 || height() >= kWalkDepth) {
+        traverse(overlaps_box, [&](std::int32_t id) { return skip(id) || callback(id); });
         return;
     }
     // traverse()'s walk, the same nodes entered in the same order, but a node's children
     // tested together on their float boxes before they are pushed, so an internal node's
-    // own line is never read; a leaf let through is tested on its double box when popped.
+    // own line is never read; a leaf let through is tested on its double box when popped,
+    // unless skip passes it over. Depth first, the stack holds at most one waiting sibling
+    // a level and the two children just pushed: height + 1 entries, so a fixed array with
+    // no check for room.
     if (!overlaps_box(m_nodes[static_cast<std::size_t>(m_root)].box)) return;
     const ChildTest children_overlap(box);
-    TraversalStack stack;
-    stack.push(m_root);
-    while (!stack.empty()) {
-        const std::int32_t entry = stack.pop();
+    const ChildBoxes* const lines = m_child_boxes.data();
+    const Node* const nodes = m_nodes.data();
+    std::int32_t stack[kWalkDepth];
+    std::int32_t* top = stack;
+    *top++ = m_root;
+    do {
+        const std::int32_t entry = *--top;
         if (entry < 0) {
             const std::int32_t leaf = ~entry;
-            if (overlaps_box(m_nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
+            if (!skip(leaf) && overlaps_box(nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
             continue;
         }
-        const ChildBoxes& children = m_child_boxes[static_cast<std::size_t>(entry)];
+        const ChildBoxes& children = lines[static_cast<std::size_t>(entry)];
         const unsigned found = children_overlap(children);
-        if ((found & 1u) != 0) stack.push(children.entry[0]);
-        if ((found & 2u) != 0) stack.push(children.entry[1]);
-    }
+        if ((found & 1u) != 0) *top++ = children.entry[0];
+        if ((found & 2u) != 0) *top++ = children.entry[1];
+    } while (top != stack);
 }
 
 template <typename Callback>

@@ -15,11 +15,6 @@ AabbTreeSettings static_tree_settings(const BroadphaseSettings& s) {
     return {Real(0), Real(0), s.validate_after_changes};
 }
 
-Pair make_pair(ProxyId p, std::uint64_t user_p, ProxyId q, std::uint64_t user_q) {
-    if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
-    return {p, q, user_p, user_q};
-}
-
 bool canonical_less(const Pair& a, const Pair& b) {
     return std::make_tuple(a.user_a, a.user_b, a.proxy_a.key(), a.proxy_b.key()) <
            std::make_tuple(b.user_a, b.user_b, b.proxy_a.key(), b.proxy_b.key());
@@ -124,12 +119,6 @@ void ProxyTrees::set_fat_boxes(JobSystem& jobs, std::span<const ProxyId> ids, st
     validate_if_enabled();
 }
 
-bool ProxyTrees::is_enlarged(ProxyId id) const {
-    const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
-    const auto i = static_cast<std::size_t>(id.tree_id());
-    return i < slots.size() && slots[i] >= 0;
-}
-
 void ProxyTrees::mark_enlarged(ProxyId id) {
     std::int32_t& slot = slots_of(id)[static_cast<std::size_t>(id.tree_id())];
     if (slot >= 0) return;
@@ -148,37 +137,16 @@ void ProxyTrees::unmark_enlarged(ProxyId id) {
     slot = -1;
 }
 
-// Pairs of one enlarged proxy: moving proxies look in both trees, static ones only in
-// the moving tree. When both proxies are enlarged, both searches meet the pair; only
-// the proxy with the smaller key reports it, unless the caller knows it.
-void ProxyTrees::find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const {
-    const Aabb& box = fat_aabb(proxy);
-    const std::uint64_t user_p = user(proxy);
-    for (int t = proxy.is_static() ? 0 : 1; t >= 0; --t) {
-        const DynamicAabbTree& tree = m_trees[t];
-        tree.query(box, [&](std::int32_t tree_id) {
-            const ProxyId other = ProxyId::make(tree_id, t == 1);
-            if (other == proxy) return true;
-            if (other.key() < proxy.key() && is_enlarged(other)) return true;
-            const Pair pair = make_pair(proxy, user_p, other, tree.user(tree_id));
-            if (!known(pair.user_a, pair.user_b)) out.push_back(pair);
-            return true;
-        });
-    }
-}
+void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) { std::sort(pairs.begin(), pairs.end(), canonical_less); }
 
-void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs) {
-    update_pairs(jobs, new_pairs, [](std::uint64_t, std::uint64_t) { return false; });
-}
-
-void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair known) {
+std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs) {
     new_pairs.clear();
     // The moves since the last call left the trees valid but loose where proxies went:
     // one rebuild of those parts, before the searches walk them.
     m_trees[0].rebuild_enlarged(&jobs);
     m_trees[1].rebuild_enlarged(&jobs);
     const auto count = static_cast<std::uint32_t>(m_enlarged.size());
-    if (count == 0) return;
+    if (count == 0) return 0;
     // A search visits some hundred nodes; the float boxes cost one pass over a tree's
     // nodes, paid back once the searches are a fair share of its proxies. Once made, the
     // tree keeps them through moves (rebuild_enlarged makes again only what it builds).
@@ -188,20 +156,14 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair kn
             tree.make_child_boxes(&jobs);
         }
     }
-
-    const std::uint32_t grain = m_settings.grain;
-    const std::uint32_t chunks = (count + grain - 1) / grain;
+    const std::uint32_t chunks = pair_chunks();
     if (m_chunk_pairs.size() < chunks) m_chunk_pairs.resize(chunks);
     for (std::uint32_t c = 0; c < chunks; ++c) m_chunk_pairs[c].clear();
+    return count;
+}
 
-    // Jobs only read the trees and the enlarged marks and write their own chunk's list,
-    // sorted there: the merge below puts the sorted runs together.
-    jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
-        std::vector<Pair>& out = m_chunk_pairs[begin / grain];
-        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, out);
-        std::sort(out.begin(), out.end(), canonical_less);
-    });
-
+void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs) {
+    const std::uint32_t chunks = pair_chunks();
     m_run_starts.assign(chunks + 1, 0);
     for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
     // Raw room: each chunk's run is first written by its copy, in jobs where there are

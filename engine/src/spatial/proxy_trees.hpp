@@ -9,7 +9,6 @@
 #include <vector>
 
 #include <spindle/engine/math.hpp>
-#include <spindle/scheduler/function_ref.hpp>
 #include <spindle/scheduler/job_system.hpp>
 
 #include "memory/huge_page_vector.hpp"
@@ -111,24 +110,26 @@ public:
     // the thread that owns the broadphase, as for set_fat_box; it waits for the jobs.
     void set_fat_boxes(JobSystem& jobs, std::span<const ProxyId> ids, std::span<const Aabb> boxes);
 
-    // Whether the caller already has the pair of these user values (user_a <= user_b).
-    // Called from the pair jobs, many at once: it may only read.
-    using KnownPair = FunctionRef<bool(std::uint64_t user_a, std::uint64_t user_b)>;
-
     // Replaces new_pairs with every pair of proxies whose fat boxes overlap and of which at
     // least one was enlarged (created or grown) since the last call; never static with
     // static, each pair once, sorted by (user_a, user_b, proxy_a.key, proxy_b.key), so
     // the result does not depend on the worker count or on which job ran first. Pairs
-    // found before are found again if one of them grew; those `known` accepts are left
-    // out where they are found (Box2D's pair set), so a step where many proxies grow
-    // around pairs they have does not collect, sort and merge them only to drop them.
+    // found before are found again if one of them grew; those known(user_a, user_b) -> bool
+    // accepts (the caller already has the pair; user_a <= user_b) are left out where they
+    // are found (Box2D's pair set), so a step where many proxies grow around pairs they
+    // have does not collect, sort and merge them only to drop them. `known` is called from
+    // the pair jobs, many at once: it may only read. A template, so that it inlines into
+    // the search: a search asks it of most proxies it meets.
     // Clears the enlarged marks, and first rebuilds the parts of the trees that moves
     // enlarged (DynamicAabbTree::rebuild_enlarged). Who may call: the thread that owns the broadphase; it
     // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
     // meanwhile). Safe from inside a job: parallel_for may nest.
-    void update_pairs(JobSystem& jobs, PairList& new_pairs, KnownPair known);
+    template <typename Known>
+    void update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known);
     // As above, every pair reported.
-    void update_pairs(JobSystem& jobs, PairList& new_pairs);
+    void update_pairs(JobSystem& jobs, PairList& new_pairs) {
+        update_pairs(jobs, new_pairs, [](std::uint64_t, std::uint64_t) { return false; });
+    }
 
     // Whether the fat boxes of a and b overlap (the engine drops a contact when not).
     bool test_overlap(ProxyId a, ProxyId b) const { return fat_aabb(a).overlaps(fat_aabb(b)); }
@@ -143,7 +144,11 @@ public:
 
     const Aabb& fat_aabb(ProxyId id) const { return tree_of(id).fat_aabb(id.tree_id()); }
     std::uint64_t user(ProxyId id) const { return tree_of(id).user(id.tree_id()); }
-    bool is_enlarged(ProxyId id) const;
+    bool is_enlarged(ProxyId id) const {
+        const std::vector<std::int32_t>& slots = m_enlarged_slot[id.is_static() ? 1 : 0];
+        const auto i = static_cast<std::size_t>(id.tree_id());
+        return i < slots.size() && slots[i] >= 0;
+    }
     std::int32_t proxy_count() const noexcept { return m_trees[0].proxy_count() + m_trees[1].proxy_count(); }
     std::size_t enlarged_count() const noexcept { return m_enlarged.size(); }
     // The proxies enlarged since the last update_pairs, in marking order (for checks).
@@ -171,7 +176,21 @@ private:
     std::vector<Real> m_margins;
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
-    void find_pairs_of(ProxyId proxy, KnownPair known, std::vector<Pair>& out) const;
+    template <typename Known>
+    void find_pairs_of(ProxyId proxy, const Known& known, std::vector<Pair>& out) const;
+    // update_pairs' parts around its search: the rebuild and the float boxes before (returns
+    // the searches to make), and the runs put together and the marks cleared after.
+    std::uint32_t begin_pair_search(JobSystem& jobs, PairList& new_pairs);
+    void end_pair_search(JobSystem& jobs, PairList& new_pairs);
+    static Pair make_pair(ProxyId p, std::uint64_t user_p, ProxyId q, std::uint64_t user_q) {
+        if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
+        return {p, q, user_p, user_q};
+    }
+    static void sort_pairs(std::vector<Pair>& pairs);
+    // The pair search's chunks: one job's enlarged proxies and one output list each.
+    std::uint32_t pair_chunks() const noexcept {
+        return (static_cast<std::uint32_t>(m_enlarged.size()) + m_settings.grain - 1) / m_settings.grain;
+    }
     // A tree's children's float boxes are made for a pair search of at least its proxy
     // count over this many enlarged proxies (DynamicAabbTree::make_child_boxes).
     static constexpr std::uint32_t kSearchesPerChildBoxes = 8;
@@ -218,6 +237,43 @@ void ProxyTrees::query(const Aabb& box, Callback&& callback) const {
             return go_on;
         });
     }
+}
+
+// Pairs of one enlarged proxy: moving proxies look in both trees, static ones only in
+// the moving tree. When both proxies are enlarged, both searches meet the pair; only
+// the proxy with the smaller key reports it, unless the caller knows it. Those two rules
+// read neither box, so the walk asks them before it reads the other's.
+template <typename Known>
+void ProxyTrees::find_pairs_of(ProxyId proxy, const Known& known, std::vector<Pair>& out) const {
+    const Aabb& box = fat_aabb(proxy);
+    const std::uint64_t user_p = user(proxy);
+    for (int t = proxy.is_static() ? 0 : 1; t >= 0; --t) {
+        const DynamicAabbTree& tree = m_trees[t];
+        const auto passed_over = [&](std::int32_t tree_id) {
+            const ProxyId other = ProxyId::make(tree_id, t == 1);
+            return other == proxy || (other.key() < proxy.key() && is_enlarged(other));
+        };
+        tree.query(box, passed_over, [&](std::int32_t tree_id) {
+            const Pair pair = make_pair(proxy, user_p, ProxyId::make(tree_id, t == 1), tree.user(tree_id));
+            if (!known(pair.user_a, pair.user_b)) out.push_back(pair);
+            return true;
+        });
+    }
+}
+
+template <typename Known>
+void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known) {
+    const std::uint32_t count = begin_pair_search(jobs, new_pairs);
+    if (count == 0) return;
+    // Jobs only read the trees and the enlarged marks and write their own chunk's list,
+    // sorted there: end_pair_search puts the sorted runs together.
+    const std::uint32_t grain = m_settings.grain;
+    jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
+        std::vector<Pair>& out = m_chunk_pairs[begin / grain];
+        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, out);
+        sort_pairs(out);
+    });
+    end_pair_search(jobs, new_pairs);
 }
 
 }  // namespace spindle

@@ -165,6 +165,36 @@ TEST(AabbTree, QueryOnChildBoxes_MeetsTheSameProxiesInTheSameOrder) {
     }
 }
 
+// A tree far taller than any balanced one: boxes reaching twice as far each, from which
+// the binned build splits off the few farthest, a level at a time, as the first child, so
+// a walk leaves one of them waiting on its stack for each level. query()'s float walk keeps
+// its stack in a fixed array sized by a height bound: this tree must walk the doubles.
+TEST(AabbTree, TallTreeOnChildBoxes_MeetsWhatTheDoublesMeet) {
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    std::vector<std::int32_t> live;
+    const int n = 600;
+    for (int i = 0; i < n; ++i) {
+        const Real reach = std::ldexp(Real(1), i);  // past float's range from i = 128 on: +-inf there
+        live.push_back(tree.create_proxy(Aabb{Vec3(-reach, 0, 0), Vec3(0, 1, 1)}, std::uint64_t(i)));
+    }
+    tree.rebuild();
+    const DynamicAabbTree doubles = tree;
+    tree.make_child_boxes();
+    ASSERT_TRUE(tree.child_boxes_current());
+    tree.validate();
+    ASSERT_GE(tree.height(), 100) << "the tree is not tall: the test would not test the deep walk";
+    Rng rng(11);
+    for (int q = 0; q < 100; ++q) {
+        const Real reach = std::ldexp(Real(1), 6 * q);
+        const Aabb box = Aabb::from_center_extents(Vec3(-reach, 0.5, 0.5), Vec3(rng.uniform(0.1, 2) * reach, 1, 1));
+        const std::vector<std::int32_t> found = query_in_order(tree, box);
+        ASSERT_EQ(found, query_in_order(doubles, box)) << "query " << q;
+        std::vector<std::int32_t> sorted = found;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(sorted, brute_sorted(tree, live, box)) << "query " << q;
+    }
+}
+
 // A move leaves the float boxes out of date until rebuild_enlarged makes the moved
 // paths' again, and a proxy made or destroyed, or a rebuild, until make_child_boxes: the
 // query walks the double boxes meanwhile, and a proxy changed after make_child_boxes is
@@ -267,6 +297,34 @@ TEST(AabbTree, MovesInACorner_RebuildKeepsEveryNodesFloatBoxes) {
         }
     }
     set_assert_handler(previous);
+}
+
+// query() with a skip: the proxies skip accepts are passed over and the rest met in the
+// plain query's order, on the float walk and on the doubles' (a copy without float boxes).
+TEST(AabbTree, QueryWithSkip_PassesOverWhatItSkipsAndMeetsTheRestInOrder) {
+    Rng rng(7);
+    DynamicAabbTree tree(AabbTreeSettings{.margin = 0});
+    const int n = 300 * kScale;
+    for (int i = 0; i < n; ++i) tree.create_proxy(rng.box(50, 2), std::uint64_t(i));
+    const DynamicAabbTree doubles = tree;
+    tree.make_child_boxes();
+    ASSERT_TRUE(tree.child_boxes_current());
+    const auto skipped = [](std::int32_t id) { return id % 3 == 0; };
+    for (int q = 0; q < 200; ++q) {
+        const Aabb box = rng.box(50, 8);
+        for (const DynamicAabbTree* walked : {static_cast<const DynamicAabbTree*>(&tree), &doubles}) {
+            std::vector<std::int32_t> expected;
+            for (const std::int32_t id : query_in_order(*walked, box)) {
+                if (!skipped(id)) expected.push_back(id);
+            }
+            std::vector<std::int32_t> met;
+            walked->query(box, skipped, [&](std::int32_t id) {
+                met.push_back(id);
+                return true;
+            });
+            ASSERT_EQ(met, expected) << "query " << q << (walked == &tree ? ", float walk" : ", doubles");
+        }
+    }
 }
 
 TEST(AabbTree, Query_CallbackFalseStops) {
