@@ -4,10 +4,12 @@
 // (api/memory_report.hpp counts capacities, so the numbers are the same on every run).
 #include <spindle/engine/space.hpp>
 #include <spindle/scene/scene.hpp>
+#include <spindle/scheduler/work_stealing.hpp>
 
 #include <gtest/gtest.h>
 
 #include <string>
+#include <type_traits>
 
 #include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
@@ -180,4 +182,39 @@ TEST(Memory, ReservingMoreBodiesThanAHandleCanIndexThrowsNamingTheCount) {
     space.create_body(d);
     space.update();
     EXPECT_EQ(space.body_count(), 2u);
+}
+
+// Every list the solver keeps between steps is in memory_report's solver_other: the
+// pyramid on two workers (the colours sorted, the first touches listed) gives its bytes
+// back as each list is emptied, byte for byte.
+TEST(Memory, EveryListTheSolverKeepsIsCounted) {
+    const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
+    WorkStealingJobSystem::Options two_workers;
+    two_workers.worker_pus = {0, 0};
+    two_workers.pin = false;
+    WorkStealingJobSystem jobs(two_workers);
+    Space space(scene.settings, &jobs);
+    build(scene, space);
+    for (int i = 0; i < 10; ++i) space.update();
+    SolverScratch& solver = *SpaceInternals::world(space).solver;
+    std::size_t before = memory_report(space).solver_other;
+    auto gives_back = [&](auto& list, const char* name) {
+        const std::size_t bytes = list.capacity() * sizeof(list[0]);
+        EXPECT_GT(bytes, 0u) << name << " holds nothing: the test does not reach it";
+        std::remove_reference_t<decltype(list)>().swap(list);
+        const std::size_t after = memory_report(space).solver_other;
+        EXPECT_EQ(before - after, bytes) << name;
+        before = after;
+    };
+    gives_back(solver.manifold_colors, "manifold_colors");
+    gives_back(solver.body_starts, "body_starts");
+    gives_back(solver.sorted_refs, "sorted_refs");
+    gives_back(solver.push_velocities, "push_velocities");
+    gives_back(solver.gravity_scales, "gravity_scales");
+    gives_back(solver.rolling, "rolling");
+    gives_back(solver.body_chunks, "body_chunks");
+    gives_back(solver.first_touch, "first_touch");
+    gives_back(solver.first_touched, "first_touched");
+    gives_back(solver.untouched, "untouched");
+    gives_back(solver.touch_counts, "touch_counts");
 }
