@@ -56,10 +56,14 @@ TEST(ContactEventsAsync, GameThreadReadsEveryEventOnceWhileTheRunnerSteps) {
         runner.start();
         const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
         // Reads at once, and after pauses spanning none to several flips (a step is 4 ms),
-        // for 600 ms and until the loop published 20 steps: a loaded machine only takes
-        // longer (finishes_in_time bounds a hang).
+        // for 600 ms, until the loop published 20 steps and until two reads found events:
+        // stacked balls touch from the first step and land at about the 48th (0.2 m to fall),
+        // so a runner slowed by load may publish 20 steps with one burst of events. A loaded
+        // machine only takes longer (finishes_in_time bounds a hang).
         constexpr int kPauseMicroseconds[] = {0, 300, 1000, 5000, 12000};
-        for (int i = 0; std::chrono::steady_clock::now() < end || space.motion_states().published_steps() <= 20; ++i) {
+        for (int i = 0;
+             std::chrono::steady_clock::now() < end || space.motion_states().published_steps() <= 20 || reads < 2;
+             ++i) {
             batch.clear();
             reads += space.read_contact_events(batch) > 0 ? 1 : 0;
             seen.insert(seen.end(), batch.begin(), batch.end());
