@@ -27,6 +27,7 @@
 #include "common/scenes.hpp"
 #include "common/timing.hpp"
 #include "heap_counter.hpp"
+#include "memory/huge_page_vector.hpp"
 
 namespace spindle::bench {
 namespace {
@@ -90,12 +91,15 @@ struct Built {
     std::vector<JointHandle> joints;  // scenes from files: their joints
     bool asleep = true;               // GridSleeping: did every body fall asleep before timing
     std::int64_t heap_before = 0;     // live heap before the space was made
+    std::int64_t arrays_before = 0;   // and arrays on huge pages (huge_array_bytes)
 
-    // The heap the space holds now (bodies, shapes, broadphase, contacts, solver scratch)
-    // per dynamic body; taken after the timed steps, so every scene counts the same things.
+    // The memory the space holds now (bodies, shapes, broadphase, contacts, solver scratch)
+    // per dynamic body: the heap, and the arrays on huge pages and medium blocks, which the
+    // heap's count does not see; taken after the timed steps, so every scene counts the same.
     double bytes_per_body() const {
         const auto handle_bytes = static_cast<std::int64_t>(bodies.capacity() * sizeof(BodyHandle));
-        return static_cast<double>(live_heap_bytes() - heap_before - handle_bytes) / static_cast<double>(bodies.size());
+        const std::int64_t held = live_heap_bytes() - heap_before + huge_array_bytes() - arrays_before;
+        return static_cast<double>(held - handle_bytes) / static_cast<double>(bodies.size());
     }
 };
 
@@ -118,6 +122,7 @@ Built build(const EngineScene& scene_entry, unsigned threads) {
         case SceneKind::SceneFile: break;
     }
     built.heap_before = live_heap_bytes();
+    built.arrays_before = huge_array_bytes();
     built.space = std::make_unique<Space>(settings, built.jobs.get());
     Space& space = *built.space;
     if (kind == SceneKind::MixedPileOnMesh) {

@@ -10,6 +10,7 @@
 // (medium_blocks.hpp). Smaller blocks are ordinary ones.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -81,6 +82,12 @@ inline void unmap_huge_pages(void* p, std::size_t bytes) noexcept {
 #endif
 }
 
+// The bytes of the arrays HugePageAllocator holds on huge pages and medium blocks (each at
+// the size it takes there), process-wide: memory a count of the heap does not see. The
+// chunks and stocked pages not under an array are not in it.
+inline std::atomic<std::int64_t> g_huge_array_bytes{0};
+inline std::int64_t huge_array_bytes() noexcept { return g_huge_array_bytes.load(std::memory_order_relaxed); }
+
 template <typename T>
 struct HugePageAllocator {
     using value_type = T;
@@ -99,6 +106,8 @@ struct HugePageAllocator {
     static std::size_t rounded_bytes(std::size_t bytes) {
         return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
+    static void count(std::int64_t bytes) noexcept { g_huge_array_bytes.fetch_add(bytes, std::memory_order_relaxed); }
+    static void count(std::size_t bytes) noexcept { count(static_cast<std::int64_t>(bytes)); }
 
     // The count is checked before it is turned into bytes, for every kind of block: a count
     // whose bytes wrap would otherwise ask for a small block.
@@ -108,8 +117,16 @@ struct HugePageAllocator {
         const std::size_t bytes = n * sizeof(T);
         switch (tier(bytes)) {
             case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
-            case Tier::kMedium: return static_cast<T*>(allocate_medium_block(bytes));
-            case Tier::kHugePages: return static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
+            case Tier::kMedium: {
+                T* p = static_cast<T*>(allocate_medium_block(bytes));
+                count(medium_block_bytes(bytes));
+                return p;
+            }
+            case Tier::kHugePages: {
+                T* p = static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
+                count(rounded_bytes(bytes));
+                return p;
+            }
         }
         return nullptr;
     }
@@ -117,8 +134,14 @@ struct HugePageAllocator {
         const std::size_t bytes = n * sizeof(T);
         switch (tier(bytes)) {
             case Tier::kHeap: ::operator delete (p, std::align_val_t{alignof(T)}); return;
-            case Tier::kMedium: free_medium_block(p, bytes); return;
-            case Tier::kHugePages: unmap_huge_pages(p, rounded_bytes(bytes)); return;
+            case Tier::kMedium:
+                count(-static_cast<std::int64_t>(medium_block_bytes(bytes)));
+                free_medium_block(p, bytes);
+                return;
+            case Tier::kHugePages:
+                count(-static_cast<std::int64_t>(rounded_bytes(bytes)));
+                unmap_huge_pages(p, rounded_bytes(bytes));
+                return;
         }
     }
 

@@ -130,6 +130,24 @@ TEST(HugePageVector, SmallBlocksAreOrdinaryOnes) {
     EXPECT_EQ(v.size(), 10u);
 }
 
+// huge_array_bytes counts the arrays on medium blocks and huge pages, at the size each takes
+// there, while they live (bench_engine adds it to the heap's count for its bytes a body); a
+// small array is the heap's.
+TEST(HugePageVector, ArraysBeyondTheHeapAreCountedWhileTheyLive) {
+    const std::int64_t start = huge_array_bytes();
+    const auto held = [&] { return huge_array_bytes() - start; };
+    {
+        HugePageVector<double> v(1000);
+        EXPECT_EQ(held(), 0) << "a heap block counted";
+        v.resize(kMediumBlockMinBytes / sizeof(double) + 1);
+        EXPECT_EQ(held(), static_cast<std::int64_t>(medium_block_bytes(v.capacity() * sizeof(double))));
+        v.resize(kHugePageBytes / sizeof(double) + 1);
+        EXPECT_EQ(held(), static_cast<std::int64_t>(2 * kHugePageBytes))
+            << "the medium block given back is still counted";
+    }
+    EXPECT_EQ(held(), 0) << "a huge-page array freed is still counted";
+}
+
 TEST(HugePageVector, ACountWhoseBytesWouldWrapIsRefusedForEveryKindOfBlock) {
     // 2^61 + k doubles are 8k bytes once multiplied out in 64 bits: a heap block and a
     // medium block's size if the count were not checked first.
