@@ -139,27 +139,30 @@ void ProxyTrees::unmark_enlarged(ProxyId id) {
     slot = -1;
 }
 
-void ProxyTrees::sort_own_pairs(std::vector<Pair>& pairs, std::size_t from) {
-    // A proxy meets a few others: an insertion sort, in place; a floor meets thousands.
-    constexpr std::size_t kFew = 16;
-    if (pairs.size() - from > kFew) {
-        std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(from), pairs.end(), canonical_less);
+void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) {
+    // A first step's chunk: its proxies searched in user order, each reporting its pairs
+    // from its own user on, so the pairs' first users ascend already and only each user's
+    // run (one proxy's pairs, in the order its search met them) is sorted. Else all of it.
+    const auto first_user_less = [](const Pair& a, const Pair& b) { return a.user_a < b.user_a; };
+    if (!std::is_sorted(pairs.begin(), pairs.end(), first_user_less)) {
+        std::sort(pairs.begin(), pairs.end(), canonical_less);
         return;
     }
-    for (std::size_t i = from + 1; i < pairs.size(); ++i) {
-        const Pair pair = pairs[i];
-        std::size_t j = i;
-        for (; j > from && canonical_less(pair, pairs[j - 1]); --j) pairs[j] = pairs[j - 1];
-        pairs[j] = pair;
-    }
-}
-
-void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) {
-    // Each proxy's own pairs are in order already (sort_own_pairs); where the chunk's proxies
-    // come in user order and report pairs from their own user on (a first step's), so are
-    // the chunk's.
-    if (!std::is_sorted(pairs.begin(), pairs.end(), canonical_less)) {
-        std::sort(pairs.begin(), pairs.end(), canonical_less);
+    constexpr std::ptrdiff_t kFew = 16;  // a box meets a few others: an insertion sort; a floor thousands
+    for (auto run = pairs.begin(); run != pairs.end();) {
+        const std::uint64_t user = run->user_a;
+        const auto end = std::find_if(run, pairs.end(), [user](const Pair& p) { return p.user_a != user; });
+        if (end - run > kFew) {
+            std::sort(run, end, canonical_less);
+        } else {
+            for (auto i = run + 1; i < end; ++i) {
+                const Pair pair = *i;
+                auto j = i;
+                for (; j > run && canonical_less(pair, *(j - 1)); --j) *j = *(j - 1);
+                *j = pair;
+            }
+        }
+        run = end;
     }
 }
 

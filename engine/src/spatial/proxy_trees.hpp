@@ -186,9 +186,7 @@ private:
         if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
         return {p, q, user_p, user_q};
     }
-    // Sorts the pairs from `from` on (one proxy's, found by one search) in canonical order.
-    static void sort_own_pairs(std::vector<Pair>& pairs, std::size_t from);
-    // Sorts a chunk's pairs, whose proxies' own pairs are sorted, in canonical order.
+    // Sorts a chunk's pairs in canonical order.
     static void sort_pairs(std::vector<Pair>& pairs);
     // The pair search's chunks: one job's enlarged proxies and one output list each.
     std::uint32_t pair_chunks() const noexcept {
@@ -273,11 +271,7 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known&
     const std::uint32_t grain = m_settings.grain;
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
-        for (std::uint32_t i = begin; i < end; ++i) {
-            const std::size_t from = out.size();
-            find_pairs_of(m_enlarged[i], known, out);
-            sort_own_pairs(out, from);
-        }
+        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, out);
         sort_pairs(out);
     });
     end_pair_search(jobs, new_pairs);
