@@ -3,7 +3,6 @@
 #include "spatial/proxy_trees.hpp"
 
 #include <algorithm>
-#include <tuple>
 
 namespace spindle {
 namespace {
@@ -15,10 +14,13 @@ AabbTreeSettings static_tree_settings(const BroadphaseSettings& s) {
     return {Real(0), Real(0), s.validate_after_changes};
 }
 
-bool canonical_less(const Pair& a, const Pair& b) {
-    return std::make_tuple(a.user_a, a.user_b, a.proxy_a.key(), a.proxy_b.key()) <
-           std::make_tuple(b.user_a, b.user_b, b.proxy_a.key(), b.proxy_b.key());
-}
+// The pairs' canonical order, a function object so that the sorts and merges inline it.
+constexpr auto canonical_less = [](const Pair& a, const Pair& b) {
+    if (a.user_a != b.user_a) return a.user_a < b.user_a;
+    if (a.user_b != b.user_b) return a.user_b < b.user_b;
+    if (a.proxy_a.key() != b.proxy_a.key()) return a.proxy_a.key() < b.proxy_a.key();
+    return a.proxy_b.key() < b.proxy_b.key();
+};
 
 }  // namespace
 
@@ -137,7 +139,32 @@ void ProxyTrees::unmark_enlarged(ProxyId id) {
     slot = -1;
 }
 
-void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) { std::sort(pairs.begin(), pairs.end(), canonical_less); }
+void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) {
+    // A first step's chunk: its proxies searched in user order, each reporting its pairs
+    // from its own user on, so the pairs' first users ascend already and only each user's
+    // run (one proxy's pairs, in the order its search met them) is sorted. Else all of it.
+    const auto first_user_less = [](const Pair& a, const Pair& b) { return a.user_a < b.user_a; };
+    if (!std::is_sorted(pairs.begin(), pairs.end(), first_user_less)) {
+        std::sort(pairs.begin(), pairs.end(), canonical_less);
+        return;
+    }
+    constexpr std::ptrdiff_t kFew = 16;  // a box meets a few others: an insertion sort; a floor thousands
+    for (auto run = pairs.begin(); run != pairs.end();) {
+        const std::uint64_t user = run->user_a;
+        const auto end = std::find_if(run, pairs.end(), [user](const Pair& p) { return p.user_a != user; });
+        if (end - run > kFew) {
+            std::sort(run, end, canonical_less);
+        } else {
+            for (auto i = run + 1; i < end; ++i) {
+                const Pair pair = *i;
+                auto j = i;
+                for (; j > run && canonical_less(pair, *(j - 1)); --j) *j = *(j - 1);
+                *j = pair;
+            }
+        }
+        run = end;
+    }
+}
 
 std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs) {
     new_pairs.clear();
@@ -193,7 +220,17 @@ void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs) {
 // sorted order is unique: the result does not depend on how the rounds ran.
 void ProxyTrees::merge_runs(JobSystem& jobs, PairList& pairs) {
     std::vector<std::size_t>& starts = m_run_starts;
+    // The scratch is laid out whether the rounds run or not (raw room: nothing is written),
+    // so that a first step's arrays are those stages/capacity.hpp counts for its stock.
     m_merged_pairs.resize(pairs.size());
+    // Runs that already follow each other in order (a first step's chunks, each of proxies
+    // in user order) are the sorted list as they lie: no round copies them.
+    bool in_order = true;
+    for (std::size_t r = 1; r + 1 < starts.size() && in_order; ++r) {
+        const std::size_t at = starts[r];  // the pair before it ends an earlier run (empty runs pass)
+        if (at != 0 && at != pairs.size()) in_order = canonical_less(pairs[at - 1], pairs[at]);
+    }
+    if (in_order) return;
     for (auto runs = static_cast<std::uint32_t>(starts.size() - 1); runs > 1;) {
         const std::uint32_t merges = (runs + 1) / 2;
         jobs.parallel_for("broadphase.merge_pairs", 0, merges, 1,

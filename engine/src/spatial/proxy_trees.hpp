@@ -186,6 +186,7 @@ private:
         if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
         return {p, q, user_p, user_q};
     }
+    // Sorts a chunk's pairs in canonical order.
     static void sort_pairs(std::vector<Pair>& pairs);
     // The pair search's chunks: one job's enlarged proxies and one output list each.
     std::uint32_t pair_chunks() const noexcept {

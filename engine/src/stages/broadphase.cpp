@@ -251,11 +251,15 @@ void make_contacts(World& world, BroadphaseState& bp) {
 }
 
 // The awake contacts (positions ascending) whose fat boxes stopped overlapping; only a
-// refitted box can have.
-void find_lost_contacts(World& world, BroadphaseState& bp, RawRoomVector<std::uint32_t>& lost) {
+// refitted box can have. Those from `made_from` on were made this stage from pairs whose
+// fat boxes overlap as they are now: not read (a first step's are all of them).
+void find_lost_contacts(World& world, BroadphaseState& bp, std::uint32_t made_from,
+                        RawRoomVector<std::uint32_t>& lost) {
     const std::vector<std::uint32_t>& awake = awake_contacts(world);
-    select_in_order(*world.jobs, "LostPairs", static_cast<std::uint32_t>(awake.size()), kContactGrain, bp.range_counts,
-                    lost, [&](std::uint32_t k, std::uint32_t& position) {
+    const auto older =
+        static_cast<std::uint32_t>(std::lower_bound(awake.begin(), awake.end(), made_from) - awake.begin());
+    select_in_order(*world.jobs, "LostPairs", older, kContactGrain, bp.range_counts, lost,
+                    [&](std::uint32_t k, std::uint32_t& position) {
                         const std::uint64_t key = world.contact_keys[awake[k]];  // packed: no Contact is read
                         const auto i = static_cast<std::uint32_t>(key >> 32);
                         const auto j = static_cast<std::uint32_t>(key & 0xffffffffu);
@@ -340,6 +344,7 @@ void update_broadphase(World& world, Real dt) {
     next_part("BroadphasePairs");
     bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact);  // sorted: the same order for any worker count
     next_part("BroadphaseNewContacts");
+    const auto made_from = static_cast<std::uint32_t>(world.contacts.size());
     make_contacts(world, bp);
     next_part("BroadphaseLostContacts");
 
@@ -348,7 +353,7 @@ void update_broadphase(World& world, Real dt) {
     RawRoomVector<std::uint32_t>& lost = world.scratch_lost;
     lost.clear();
     const bool moves_marked = marked.load(std::memory_order_relaxed) != 0;
-    if (!bp.refit_slots.empty() || moves_marked) find_lost_contacts(world, bp, lost);
+    if (!bp.refit_slots.empty() || moves_marked) find_lost_contacts(world, bp, made_from, lost);
     remove_contacts(world, lost);
     fit_contacts(world);
     // Only the marked slots are cleared: a sleeping pile's slots are not touched.

@@ -150,7 +150,6 @@ constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts) {
         {"contact keys", contacts, sizeof(std::uint64_t), false},
         {"claimed slots", contacts, sizeof(std::uint32_t), false},
         {"contact summaries", contacts, sizeof(std::uint32_t), false},
-        {"pairs kept by the filter", contacts, sizeof(std::uint32_t), false},
         {"manifolds", contacts, sizeof(ManifoldRef), false},
         {"coloured manifolds", contacts, sizeof(ManifoldRef), false},
         {"contact index keys", slots, sizeof(std::uint64_t), false},

@@ -226,6 +226,36 @@ TEST(BroadphaseContacts, PairsFoundAgainAroundAGrownBox_AreNotNewPairs) {
     expect_contacts_are_the_allowed_overlaps(world);
 }
 
+// Bodies of the top layer moved away into a row of their own lose their contacts (made
+// in the first step) in the same stage as they make new ones with each other: the lost
+// ones are looked for among the contacts made before the stage only, the new ones
+// overlapping as they were found, and every lost one is still found.
+TEST(BroadphaseContacts, ContactsLostAndMadeInOneStage_TheListIsTheAllowedOverlaps) {
+    SingleThreadedJobSystem jobs;
+    Block block(jobs);
+    World& world = SpaceInternals::world(block.space);
+    block.space.update();
+    const std::set<std::uint64_t> before(world.contact_keys.begin(), world.contact_keys.end());
+    std::set<std::uint32_t> moved;
+    for (std::size_t k = block.bodies.size() / 2; k < block.bodies.size() && moved.size() < 40; k += 3) {
+        if (!block.dynamic[k]) continue;
+        block.space.set_position(block.bodies[k], Vec3(Real(0.95) * Real(moved.size()), 30, 0));
+        moved.insert(block.bodies[k].index);
+    }
+    block.space.update();
+    const std::set<std::uint64_t> after(world.contact_keys.begin(), world.contact_keys.end());
+    const auto among_moved = [&](std::uint64_t key) {
+        return moved.count(static_cast<std::uint32_t>(key >> 32)) != 0 ||
+               moved.count(static_cast<std::uint32_t>(key & 0xffffffffu)) != 0;
+    };
+    std::size_t lost = 0, made = 0;
+    for (const std::uint64_t key : before) lost += among_moved(key) && after.count(key) == 0 ? 1u : 0u;
+    for (const std::uint64_t key : after) made += among_moved(key) && before.count(key) == 0 ? 1u : 0u;
+    EXPECT_GT(lost, 40u);
+    EXPECT_GT(made, 10u);
+    expect_contacts_are_the_allowed_overlaps(world);
+}
+
 }  // namespace
 }  // namespace spindle
 

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <random>
 #include <set>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -473,6 +475,73 @@ TEST(ProxyTrees, UpdatePairs_ListsGrownIntoFilledRoomAsIntoZeros) {
         total += a.size();
     }
     EXPECT_GT(total, 0u);
+}
+
+// A first step's search: every proxy new, so the chunks' runs (and each proxy's own pairs)
+// may already lie in order and are then neither sorted nor merged. The list is the brute
+// force's in canonical order, proxies included, however the proxies were made: users in
+// order (runs in order), in reverse (runs to merge), shuffled (chunks to sort), and with
+// users shared by neighbouring proxies (ties broken by the proxy keys), on one and on
+// three threads taking the chunks last to first.
+TEST(ProxyTrees, FirstSearch_AnyMakingOrder_PairsInCanonicalOrder) {
+    const auto canonical = [](const Pair& a, const Pair& b) {
+        return std::make_tuple(a.user_a, a.user_b, a.proxy_a.key(), a.proxy_b.key()) <
+               std::make_tuple(b.user_a, b.user_b, b.proxy_a.key(), b.proxy_b.key());
+    };
+    constexpr int kSide = 12;  // a 12 x 12 x 3 block of touching cubes on a static floor
+    std::vector<Vec3> centres;
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < kSide; ++x) {
+            for (int z = 0; z < kSide; ++z) centres.emplace_back(x * Real(0.95), y * Real(0.95) + 1, z * Real(0.95));
+        }
+    }
+    std::vector<std::size_t> order(centres.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::vector<std::vector<std::size_t>> orders{order, std::vector<std::size_t>(order.rbegin(), order.rend())};
+    std::shuffle(order.begin(), order.end(), std::mt19937_64(3));
+    orders.push_back(order);
+    for (const bool shared_users : {false, true}) {
+        for (std::size_t o = 0; o < orders.size(); ++o) {
+            for (const bool threaded : {false, true}) {
+                ProxyTrees bp(BroadphaseSettings{.grain = 5});
+                std::vector<ProxyId> ids;
+                std::vector<std::uint64_t> users;
+                const ProxyId floor = bp.create_proxy(cube(Vec3(6, 0, 6), 7), 0, true);
+                for (const std::size_t k : orders[o]) {
+                    users.push_back(shared_users ? 1 + k / 2 : 1 + k);
+                    ids.push_back(bp.create_proxy(cube(centres[k], 0.5), users.back(), false));
+                }
+                std::vector<Pair> expected;
+                for (std::size_t i = 0; i < ids.size(); ++i) {
+                    if (bp.test_overlap(ids[i], floor)) expected.push_back(Pair{floor, ids[i], 0, users[i]});
+                    for (std::size_t j = 0; j < ids.size(); ++j) {
+                        const bool first = users[i] < users[j] || (users[i] == users[j] && ids[i].key() < ids[j].key());
+                        if (j != i && first && bp.test_overlap(ids[i], ids[j])) {
+                            expected.push_back(Pair{ids[i], ids[j], users[i], users[j]});
+                        }
+                    }
+                }
+                std::sort(expected.begin(), expected.end(), canonical);
+                PairList pairs;
+                if (threaded) {
+                    test::ReverseThreadedJobSystem jobs(3);
+                    bp.update_pairs(jobs, pairs);
+                } else {
+                    SingleThreadedJobSystem jobs;
+                    bp.update_pairs(jobs, pairs);
+                }
+                ASSERT_GT(expected.size(), 3 * centres.size());  // many chunks' worth, and the floor's hundreds
+                ASSERT_EQ(pairs.size(), expected.size()) << "order " << o << " shared " << shared_users;
+                for (std::size_t i = 0; i < pairs.size(); ++i) {
+                    ASSERT_EQ(pairs[i].proxy_a, expected[i].proxy_a)
+                        << "order " << o << " shared " << shared_users << " threaded " << threaded << " at " << i;
+                    ASSERT_EQ(pairs[i].proxy_b, expected[i].proxy_b);
+                    ASSERT_EQ(pairs[i].user_a, expected[i].user_a);
+                    ASSERT_EQ(pairs[i].user_b, expected[i].user_b);
+                }
+            }
+        }
+    }
 }
 
 TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
