@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision/clipping.hpp"
+#include "collision/lanes.hpp"
 #include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
@@ -157,24 +158,31 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         if (s > speculative) return 0;
         if (s > face_b.separation) face_b = {s, j};
     }
-    // Edge axes e_i x r_j. The cross product's i-th coordinate is zero, and the products
-    // with it add nothing: each sum below is the same two terms, in the same order, that
-    // the whole vectors' dot products add (the bits are those of Vec3::cross and dot).
+    // Edge axes e_i x r_j, the three of an i in lanes (lane j; the fourth lane's axis is
+    // zero, left out as parallel edges are). The cross product's i-th coordinate is zero,
+    // and the products with it add nothing: each sum below is the same two terms, in the
+    // same order, that the whole vectors' dot products add (the bits are those of
+    // Vec3::cross and dot, which sums three terms as x + (y + z)).
+    const Lanes rows[3] = {Lanes{r(0, 0), r(0, 1), r(0, 2), 0}, Lanes{r(1, 0), r(1, 1), r(1, 2), 0},
+                           Lanes{r(2, 0), r(2, 1), r(2, 2), 0}};
     for (int i = 0; i < 3; ++i) {
         const int p = i == 0 ? 1 : 0, q = i == 2 ? 1 : 2;  // the other two coordinates, ascending
+        // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
+        const Lanes ap = i == 1 ? rows[2] : -rows[i == 0 ? 2 : 1];
+        const Lanes aq = i == 1 ? -rows[0] : rows[i == 0 ? 1 : 0];
+        const Lanes length = lane_sqrt(ap * ap + aq * aq);
+        const Lanes ra = ha[p] * lane_abs(ap) + ha[q] * lane_abs(aq);
+        // |r' axis|, B's three axes.
+        const Lanes on_b0 = lane_abs(r(p, 0) * ap + r(q, 0) * aq);
+        const Lanes on_b1 = lane_abs(r(p, 1) * ap + r(q, 1) * aq);
+        const Lanes on_b2 = lane_abs(r(p, 2) * ap + r(q, 2) * aq);
+        const Lanes rb = hb[0] * on_b0 + (hb[1] * on_b1 + hb[2] * on_b2);
+        const Lanes s = (lane_abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
+        // Parallel edges (and the fourth lane): the face axes cover them.
+        const unsigned axes = lane_bits(!(length < Real(1e-6))) & 7u;
+        if ((lane_bits(s > speculative) & axes) != 0) return 0;
         for (int j = 0; j < 3; ++j) {
-            // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
-            const Real ap = i == 1 ? r(2, j) : -r(i == 0 ? 2 : 1, j);
-            const Real aq = i == 1 ? -r(0, j) : r(i == 0 ? 1 : 0, j);
-            const Real length = std::sqrt(ap * ap + aq * aq);
-            if (length < Real(1e-6)) continue;  // parallel edges: the face axes cover them
-            const Real ra = ha[p] * std::abs(ap) + ha[q] * std::abs(aq);
-            const Vec3 on_b(std::abs(r(p, 0) * ap + r(q, 0) * aq), std::abs(r(p, 1) * ap + r(q, 1) * aq),
-                            std::abs(r(p, 2) * ap + r(q, 2) * aq));  // |r' axis|
-            const Real rb = hb.dot(on_b);
-            const Real s = (std::abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
-            if (s > speculative) return 0;
-            if (s > edge.separation) edge = {s, 3 * i + j};
+            if ((axes >> j & 1u) != 0 && s[j] > edge.separation) edge = {s[j], 3 * i + j};
         }
     }
 
