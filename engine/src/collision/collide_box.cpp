@@ -28,22 +28,29 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     n[axis] = sign;
     const auto reference_face = static_cast<std::uint32_t>(2 * axis + (sign < 0 ? 1 : 0));
 
-    // Incident face: the face of i whose normal is most against n (ri' n is a row of ri:
-    // n has one non-zero coordinate).
-    const Vec3 along = ri.transpose() * n;
+    // Incident face: the face of i whose normal is most against n (ri' n, a row of ri: n has
+    // one non-zero coordinate).
+    const Vec3 along = sign * ri.row(axis).transpose();
     int j = 0;
     for (int k = 1; k < 3; ++k) {
         if (std::abs(along[k]) > std::abs(along[j])) j = k;
     }
     const auto incident_face = static_cast<std::uint32_t>(2 * j + (along[j] > 0 ? 1 : 0));
     // Its corners in BoxPoly's loop order (the clip keys name them by place in the loop),
-    // made in r's frame as BoxPoly would make them.
-    ClipVertex buffer_a[8], buffer_b[8];
+    // made in r's frame as BoxPoly would make them: four at a time in lanes, lane k corner k,
+    // each coordinate the sums of ri * corner + ti (x + (y + z), then ti).
     const std::uint32_t* loop = kBoxLoops + 4 * incident_face;
-    for (std::uint32_t k = 0; k < 4; ++k) {
+    Lanes cx, cy, cz;
+    for (int k = 0; k < 4; ++k) {
         const std::uint32_t v = loop[k];
-        const Vec3 corner(v & 1 ? hi.x() : -hi.x(), v & 2 ? hi.y() : -hi.y(), v & 4 ? hi.z() : -hi.z());
-        buffer_a[k] = {ri * corner + ti, clip_key(0, k, 0), static_cast<std::uint16_t>(k)};
+        cx[k] = v & 1 ? hi.x() : -hi.x(), cy[k] = v & 2 ? hi.y() : -hi.y(), cz[k] = v & 4 ? hi.z() : -hi.z();
+    }
+    const auto coordinate = [&](int i) { return (ri(i, 0) * cx + (ri(i, 1) * cy + ri(i, 2) * cz)) + ti[i]; };
+    const Lanes corners[3] = {coordinate(0), coordinate(1), coordinate(2)};
+    ClipVertex buffer_a[8], buffer_b[8];
+    for (std::uint32_t k = 0; k < 4; ++k) {
+        buffer_a[k] = {Vec3(corners[0][k], corners[1][k], corners[2][k]), clip_key(0, k, 0),
+                       static_cast<std::uint16_t>(k)};
     }
     // The reference face's four side planes lie along r's other two axes: a point's
     // distance past one is a coordinate (the same bits a general plane's dot product gives).
@@ -61,7 +68,14 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
         }
         ++side;
     };
+    // Where no corner reaches past any side plane (a box standing square on a larger face, or
+    // beside one of its size), none is clipped against: the four tests at once, in lanes.
+    LaneMask past = {};
     for (int k = 1; k <= 2; ++k) {
+        const int u = (axis + k) % 3;
+        past |= ~(corners[u] - hr[u] <= 0) | ~(-corners[u] - hr[u] <= 0);  // NaN too, as the clip
+    }
+    for (int k = 1; k <= 2 && lane_bits(past) != 0; ++k) {
         const int u = (axis + k) % 3;
         const Real reach = hr[u];
         clip([u, reach](const Vec3& p) { return p[u] - reach; });
@@ -69,7 +83,7 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     }
     int n_out = 0;
     for (int k = 0; k < count; ++k) {
-        const Real separation = n.dot(in[k].p) - hr[axis];
+        const Real separation = sign * in[k].p[axis] - hr[axis];  // n . p: n has one non-zero coordinate
         if (separation > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
                         face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
