@@ -159,26 +159,32 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
     // Everything in A's frame: r's columns are B's axes, t is B's centre.
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
-    const Mat3 abs_r = r.cwiseAbs();
+    // r's rows and columns in lanes, lane 3 a copy of lane 2 (never read: every test below
+    // masks it off; a zero there was a register vmovq that valgrind cannot decode).
+    const Lanes rows[3] = {Lanes{r(0, 0), r(0, 1), r(0, 2), r(0, 2)}, Lanes{r(1, 0), r(1, 1), r(1, 2), r(1, 2)},
+                           Lanes{r(2, 0), r(2, 1), r(2, 2), r(2, 2)}};
+    const Lanes columns[3] = {Lanes{r(0, 0), r(1, 0), r(2, 0), r(2, 0)}, Lanes{r(0, 1), r(1, 1), r(2, 1), r(2, 1)},
+                              Lanes{r(0, 2), r(1, 2), r(2, 2), r(2, 2)}};
+    const Lanes t_lanes{t.x(), t.y(), t.z(), t.z()};
 
     BoxAxis face_a, face_b, edge;
+    // A's axis i: |t_i| - ha_i - |r|.row(i) . hb; B's axis j: |r.col(j) . t| - hb_j - |r|.col(j) . ha
+    // (a dot product sums x + (y + z)).
+    const Lanes faces_a =
+        lane_abs(t_lanes) - Lanes{ha.x(), ha.y(), ha.z(), ha.z()} -
+        (lane_abs(columns[0]) * hb[0] + (lane_abs(columns[1]) * hb[1] + lane_abs(columns[2]) * hb[2]));
+    const Lanes faces_b = lane_abs(rows[0] * t[0] + (rows[1] * t[1] + rows[2] * t[2])) -
+                          Lanes{hb.x(), hb.y(), hb.z(), hb.z()} -
+                          (lane_abs(rows[0]) * ha[0] + (lane_abs(rows[1]) * ha[1] + lane_abs(rows[2]) * ha[2]));
+    if ((lane_bits(faces_a > speculative) & 7u) != 0 || (lane_bits(faces_b > speculative) & 7u) != 0) return 0;
     for (int i = 0; i < 3; ++i) {
-        const Real s = std::abs(t[i]) - ha[i] - abs_r.row(i).dot(hb);
-        if (s > speculative) return 0;
-        if (s > face_a.separation) face_a = {s, i};
+        if (faces_a[i] > face_a.separation) face_a = {faces_a[i], i};
+        if (faces_b[i] > face_b.separation) face_b = {faces_b[i], i};
     }
-    for (int j = 0; j < 3; ++j) {
-        const Real s = std::abs(r.col(j).dot(t)) - hb[j] - abs_r.col(j).dot(ha);
-        if (s > speculative) return 0;
-        if (s > face_b.separation) face_b = {s, j};
-    }
-    // Edge axes e_i x r_j, the three of an i in lanes (lane j; the fourth lane's axis is
-    // zero, left out as parallel edges are). The cross product's i-th coordinate is zero,
-    // and the products with it add nothing: each sum below is the same two terms, in the
-    // same order, that the whole vectors' dot products add (the bits are those of
-    // Vec3::cross and dot, which sums three terms as x + (y + z)).
-    const Lanes rows[3] = {Lanes{r(0, 0), r(0, 1), r(0, 2), 0}, Lanes{r(1, 0), r(1, 1), r(1, 2), 0},
-                           Lanes{r(2, 0), r(2, 1), r(2, 2), 0}};
+    // Edge axes e_i x r_j, the three of an i in lanes (lane j; the fourth left out). The
+    // cross product's i-th coordinate is zero, and the products with it add nothing: each
+    // sum below is the same two terms, in the same order, that the whole vectors' dot
+    // products add (the bits are those of Vec3::cross and dot).
     for (int i = 0; i < 3; ++i) {
         const int p = i == 0 ? 1 : 0, q = i == 2 ? 1 : 2;  // the other two coordinates, ascending
         // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
@@ -192,7 +198,7 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         const Lanes on_b2 = lane_abs(r(p, 2) * ap + r(q, 2) * aq);
         const Lanes rb = hb[0] * on_b0 + (hb[1] * on_b1 + hb[2] * on_b2);
         const Lanes s = (lane_abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
-        // Parallel edges (and the fourth lane): the face axes cover them.
+        // Parallel edges: the face axes cover them (and `& 7u` leaves the fourth lane out).
         const unsigned axes = lane_bits(!(length < Real(1e-6))) & 7u;
         if ((lane_bits(s > speculative) & axes) != 0) return 0;
         for (int j = 0; j < 3; ++j) {
