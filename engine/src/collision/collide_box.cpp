@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "collision/clipping.hpp"
+#include "collision/lanes.hpp"
 #include "collision/pair_functions.hpp"
 
 namespace spindle::detail {
@@ -27,22 +28,29 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     n[axis] = sign;
     const auto reference_face = static_cast<std::uint32_t>(2 * axis + (sign < 0 ? 1 : 0));
 
-    // Incident face: the face of i whose normal is most against n (ri' n is a row of ri:
-    // n has one non-zero coordinate).
-    const Vec3 along = ri.transpose() * n;
+    // Incident face: the face of i whose normal is most against n (ri' n, a row of ri: n has
+    // one non-zero coordinate).
+    const Vec3 along = sign * ri.row(axis).transpose();
     int j = 0;
     for (int k = 1; k < 3; ++k) {
         if (std::abs(along[k]) > std::abs(along[j])) j = k;
     }
     const auto incident_face = static_cast<std::uint32_t>(2 * j + (along[j] > 0 ? 1 : 0));
     // Its corners in BoxPoly's loop order (the clip keys name them by place in the loop),
-    // made in r's frame as BoxPoly would make them.
-    ClipVertex buffer_a[8], buffer_b[8];
+    // made in r's frame as BoxPoly would make them: four at a time in lanes, lane k corner k,
+    // each coordinate the sums of ri * corner + ti (x + (y + z), then ti).
     const std::uint32_t* loop = kBoxLoops + 4 * incident_face;
-    for (std::uint32_t k = 0; k < 4; ++k) {
+    Lanes cx, cy, cz;
+    for (int k = 0; k < 4; ++k) {
         const std::uint32_t v = loop[k];
-        const Vec3 corner(v & 1 ? hi.x() : -hi.x(), v & 2 ? hi.y() : -hi.y(), v & 4 ? hi.z() : -hi.z());
-        buffer_a[k] = {ri * corner + ti, clip_key(0, k, 0), static_cast<std::uint16_t>(k)};
+        cx[k] = v & 1 ? hi.x() : -hi.x(), cy[k] = v & 2 ? hi.y() : -hi.y(), cz[k] = v & 4 ? hi.z() : -hi.z();
+    }
+    const auto coordinate = [&](int i) { return (ri(i, 0) * cx + (ri(i, 1) * cy + ri(i, 2) * cz)) + ti[i]; };
+    const Lanes corners[3] = {coordinate(0), coordinate(1), coordinate(2)};
+    ClipVertex buffer_a[8], buffer_b[8];
+    for (std::uint32_t k = 0; k < 4; ++k) {
+        buffer_a[k] = {Vec3(corners[0][k], corners[1][k], corners[2][k]), clip_key(0, k, 0),
+                       static_cast<std::uint16_t>(k)};
     }
     // The reference face's four side planes lie along r's other two axes: a point's
     // distance past one is a coordinate (the same bits a general plane's dot product gives).
@@ -60,7 +68,14 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
         }
         ++side;
     };
+    // Where no corner reaches past any side plane (a box standing square on a larger face, or
+    // beside one of its size), none is clipped against: the four tests at once, in lanes.
+    LaneMask past = {};
     for (int k = 1; k <= 2; ++k) {
+        const int u = (axis + k) % 3;
+        past |= ~(corners[u] - hr[u] <= 0) | ~(-corners[u] - hr[u] <= 0);  // NaN too, as the clip
+    }
+    for (int k = 1; k <= 2 && lane_bits(past) != 0; ++k) {
         const int u = (axis + k) % 3;
         const Real reach = hr[u];
         clip([u, reach](const Vec3& p) { return p[u] - reach; });
@@ -68,7 +83,7 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     }
     int n_out = 0;
     for (int k = 0; k < count; ++k) {
-        const Real separation = n.dot(in[k].p) - hr[axis];
+        const Real separation = sign * in[k].p[axis] - hr[axis];  // n . p: n has one non-zero coordinate
         if (separation > speculative) continue;
         out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
                         face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
@@ -144,37 +159,50 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
     // Everything in A's frame: r's columns are B's axes, t is B's centre.
     const Mat3 r = (xa.q.conjugate() * xb.q).toRotationMatrix();
     const Vec3 t = xa.apply_inverse(xb.p);
-    const Mat3 abs_r = r.cwiseAbs();
+    // r's rows and columns in lanes, lane 3 a copy of lane 2 (never read: every test below
+    // masks it off; a zero there was a register vmovq that valgrind cannot decode).
+    const Lanes rows[3] = {Lanes{r(0, 0), r(0, 1), r(0, 2), r(0, 2)}, Lanes{r(1, 0), r(1, 1), r(1, 2), r(1, 2)},
+                           Lanes{r(2, 0), r(2, 1), r(2, 2), r(2, 2)}};
+    const Lanes columns[3] = {Lanes{r(0, 0), r(1, 0), r(2, 0), r(2, 0)}, Lanes{r(0, 1), r(1, 1), r(2, 1), r(2, 1)},
+                              Lanes{r(0, 2), r(1, 2), r(2, 2), r(2, 2)}};
+    const Lanes t_lanes{t.x(), t.y(), t.z(), t.z()};
 
     BoxAxis face_a, face_b, edge;
+    // A's axis i: |t_i| - ha_i - |r|.row(i) . hb; B's axis j: |r.col(j) . t| - hb_j - |r|.col(j) . ha
+    // (a dot product sums x + (y + z)).
+    const Lanes faces_a =
+        lane_abs(t_lanes) - Lanes{ha.x(), ha.y(), ha.z(), ha.z()} -
+        (lane_abs(columns[0]) * hb[0] + (lane_abs(columns[1]) * hb[1] + lane_abs(columns[2]) * hb[2]));
+    const Lanes faces_b = lane_abs(rows[0] * t[0] + (rows[1] * t[1] + rows[2] * t[2])) -
+                          Lanes{hb.x(), hb.y(), hb.z(), hb.z()} -
+                          (lane_abs(rows[0]) * ha[0] + (lane_abs(rows[1]) * ha[1] + lane_abs(rows[2]) * ha[2]));
+    if ((lane_bits(faces_a > speculative) & 7u) != 0 || (lane_bits(faces_b > speculative) & 7u) != 0) return 0;
     for (int i = 0; i < 3; ++i) {
-        const Real s = std::abs(t[i]) - ha[i] - abs_r.row(i).dot(hb);
-        if (s > speculative) return 0;
-        if (s > face_a.separation) face_a = {s, i};
+        if (faces_a[i] > face_a.separation) face_a = {faces_a[i], i};
+        if (faces_b[i] > face_b.separation) face_b = {faces_b[i], i};
     }
-    for (int j = 0; j < 3; ++j) {
-        const Real s = std::abs(r.col(j).dot(t)) - hb[j] - abs_r.col(j).dot(ha);
-        if (s > speculative) return 0;
-        if (s > face_b.separation) face_b = {s, j};
-    }
-    // Edge axes e_i x r_j. The cross product's i-th coordinate is zero, and the products
-    // with it add nothing: each sum below is the same two terms, in the same order, that
-    // the whole vectors' dot products add (the bits are those of Vec3::cross and dot).
+    // Edge axes e_i x r_j, the three of an i in lanes (lane j; the fourth left out). The
+    // cross product's i-th coordinate is zero, and the products with it add nothing: each
+    // sum below is the same two terms, in the same order, that the whole vectors' dot
+    // products add (the bits are those of Vec3::cross and dot).
     for (int i = 0; i < 3; ++i) {
         const int p = i == 0 ? 1 : 0, q = i == 2 ? 1 : 2;  // the other two coordinates, ascending
+        // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
+        const Lanes ap = i == 1 ? rows[2] : -rows[i == 0 ? 2 : 1];
+        const Lanes aq = i == 1 ? -rows[0] : rows[i == 0 ? 1 : 0];
+        const Lanes length = lane_sqrt(ap * ap + aq * aq);
+        const Lanes ra = ha[p] * lane_abs(ap) + ha[q] * lane_abs(aq);
+        // |r' axis|, B's three axes.
+        const Lanes on_b0 = lane_abs(r(p, 0) * ap + r(q, 0) * aq);
+        const Lanes on_b1 = lane_abs(r(p, 1) * ap + r(q, 1) * aq);
+        const Lanes on_b2 = lane_abs(r(p, 2) * ap + r(q, 2) * aq);
+        const Lanes rb = hb[0] * on_b0 + (hb[1] * on_b1 + hb[2] * on_b2);
+        const Lanes s = (lane_abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
+        // Parallel edges: the face axes cover them (and `& 7u` leaves the fourth lane out).
+        const unsigned axes = lane_bits(!(length < Real(1e-6))) & 7u;
+        if ((lane_bits(s > speculative) & axes) != 0) return 0;
         for (int j = 0; j < 3; ++j) {
-            // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
-            const Real ap = i == 1 ? r(2, j) : -r(i == 0 ? 2 : 1, j);
-            const Real aq = i == 1 ? -r(0, j) : r(i == 0 ? 1 : 0, j);
-            const Real length = std::sqrt(ap * ap + aq * aq);
-            if (length < Real(1e-6)) continue;  // parallel edges: the face axes cover them
-            const Real ra = ha[p] * std::abs(ap) + ha[q] * std::abs(aq);
-            const Vec3 on_b(std::abs(r(p, 0) * ap + r(q, 0) * aq), std::abs(r(p, 1) * ap + r(q, 1) * aq),
-                            std::abs(r(p, 2) * ap + r(q, 2) * aq));  // |r' axis|
-            const Real rb = hb.dot(on_b);
-            const Real s = (std::abs(ap * t[p] + aq * t[q]) - ra - rb) / length;
-            if (s > speculative) return 0;
-            if (s > edge.separation) edge = {s, 3 * i + j};
+            if ((axes >> j & 1u) != 0 && s[j] > edge.separation) edge = {s[j], 3 * i + j};
         }
     }
 

@@ -31,6 +31,12 @@ inline Lanes lane_sqrt(Lanes x) {
 #endif
 }
 
+// The magnitude of each lane (its sign bit cleared, as std::abs does).
+inline Lanes lane_abs(Lanes x) {
+    constexpr std::int64_t kMagnitude = 0x7fffffffffffffff;
+    return reinterpret_cast<Lanes>(reinterpret_cast<LaneMask>(x) & kMagnitude);
+}
+
 // Vertices in lanes: lane k of group i holds vertex 4i + k; lanes past the last vertex
 // repeat vertex 0, which never wins a support query over it (ties go to the lower index)
 // and leaves a minimum or maximum as it is.

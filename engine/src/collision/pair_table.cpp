@@ -102,6 +102,15 @@ int collide(const Shape& a, const Transform& xa, const Shape& b, const Transform
 int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Transform& xb, Real speculative_distance,
                    Manifold* out, int capacity, FeatureCache& cache, TriangleFeatures& triangles, Real feature_slop,
                    const PartBoxes& boxes, const PairMotion* motion, MeshQueries* queries, Real recycle_distance) {
+    // Box-box, most pairs of a pile, called straight (as collide() would call it): nothing of
+    // a mesh or a feature kept, and no table.
+    if (a.type == ShapeType::Box && b.type == ShapeType::Box && capacity > 0) {
+        triangles.clear();
+        if (queries) *queries = MeshQueries();
+        cache = FeatureCache();
+        return detail::unlabelled(a, b, out,
+                                  detail::collide_box_box(a, xa, b, xb, speculative_distance, out, capacity));
+    }
     const auto polyhedron = [](const Shape& s) { return s.type == ShapeType::Box || s.type == ShapeType::ConvexHull; };
     const bool mesh_a = a.type == ShapeType::TriangleMesh;
     const bool mesh_b = b.type == ShapeType::TriangleMesh;

@@ -342,12 +342,17 @@ void update_narrowphase(World& world) {
         // ahead, not the deepest now: the parts about to land before those resting. Every
         // manifold's points are put in the order the solver takes them by the same motion.
         const bool compound = shape_a.type == ShapeType::Compound || shape_b.type == ShapeType::Compound;
-        const PairMotion motion{b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
+        // Where neither body turns, every point approaches at the relative velocity: no spread,
+        // the collide's order stays, and neither the motion nor the speeds are worked out (every
+        // pair of a first step from rest, where gravity has given speed and no turn).
+        const bool turning = !(b.w[a] == Vec3::Zero() && b.w[bb] == Vec3::Zero());
+        PairMotion motion;
+        if (compound || turning) motion = {b.x[a], b.v[a], b.w[a], b.x[bb], b.v[bb], b.w[bb], dt};
         const int n = collide_cached(shape_a, ta, shape_b, tb, speculative, found, kMaxManifolds, contact.feature,
                                      triangles, settings.linear_slop, boxes, compound ? &motion : nullptr, queries,
                                      recyclable ? touching_recycle_distance : 0);
         if (compound && queries) count_parts(*queries, counts);
-        for (int m = 0; m < n; ++m) order_by_approach(found[m], motion);
+        for (int m = 0; m < n && turning; ++m) order_by_approach(found[m], motion);
         // A pair with no manifolds (every pair of a first step) has no impulses to carry:
         // its first manifold is made in the record itself, not in `fresh` and copied.
         const bool carries = contact.manifold_count > 0;
