@@ -106,8 +106,13 @@ struct HugePageAllocator {
     static std::size_t rounded_bytes(std::size_t bytes) {
         return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
     }
-    static void count(std::int64_t bytes) noexcept { g_huge_array_bytes.fetch_add(bytes, std::memory_order_relaxed); }
-    static void count(std::size_t bytes) noexcept { count(static_cast<std::int64_t>(bytes)); }
+    // What a block of `bytes` takes beyond the heap: its medium block or its huge pages.
+    static std::int64_t held_bytes(std::size_t bytes) {
+        const Tier t = tier(bytes);
+        return static_cast<std::int64_t>(t == Tier::kHeap     ? 0
+                                         : t == Tier::kMedium ? medium_block_bytes(bytes)
+                                                              : rounded_bytes(bytes));
+    }
 
     // The count is checked before it is turned into bytes, for every kind of block: a count
     // whose bytes wrap would otherwise ask for a small block.
@@ -115,33 +120,22 @@ struct HugePageAllocator {
     T* allocate(std::size_t n) {
         if (n > max_size()) throw std::bad_array_new_length();
         const std::size_t bytes = n * sizeof(T);
+        void* p = nullptr;
         switch (tier(bytes)) {
             case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
-            case Tier::kMedium: {
-                T* p = static_cast<T*>(allocate_medium_block(bytes));
-                count(medium_block_bytes(bytes));
-                return p;
-            }
-            case Tier::kHugePages: {
-                T* p = static_cast<T*>(map_huge_pages(rounded_bytes(bytes)));
-                count(rounded_bytes(bytes));
-                return p;
-            }
+            case Tier::kMedium: p = allocate_medium_block(bytes); break;
+            case Tier::kHugePages: p = map_huge_pages(rounded_bytes(bytes)); break;
         }
-        return nullptr;
+        g_huge_array_bytes.fetch_add(held_bytes(bytes), std::memory_order_relaxed);  // once it is held
+        return static_cast<T*>(p);
     }
     void deallocate(T* p, std::size_t n) noexcept {
         const std::size_t bytes = n * sizeof(T);
+        g_huge_array_bytes.fetch_sub(held_bytes(bytes), std::memory_order_relaxed);
         switch (tier(bytes)) {
             case Tier::kHeap: ::operator delete (p, std::align_val_t{alignof(T)}); return;
-            case Tier::kMedium:
-                count(-static_cast<std::int64_t>(medium_block_bytes(bytes)));
-                free_medium_block(p, bytes);
-                return;
-            case Tier::kHugePages:
-                count(-static_cast<std::int64_t>(rounded_bytes(bytes)));
-                unmap_huge_pages(p, rounded_bytes(bytes));
-                return;
+            case Tier::kMedium: free_medium_block(p, bytes); return;
+            case Tier::kHugePages: unmap_huge_pages(p, rounded_bytes(bytes)); return;
         }
     }
 
