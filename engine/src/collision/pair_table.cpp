@@ -139,8 +139,8 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
     }
     triangles.clear();
     if (queries) *queries = MeshQueries();
-    // Box-box has its own 15-axis test; a compound's walk takes its part boxes.
-    if (capacity <= 0 || !polyhedron(a) || !polyhedron(b) || (a.type == ShapeType::Box && b.type == ShapeType::Box)) {
+    // A compound's walk takes its part boxes (box-box went straight to its own test above).
+    if (capacity <= 0 || !polyhedron(a) || !polyhedron(b)) {
         cache = FeatureCache();
         return collide(a, xa, b, xb, speculative_distance, out, capacity, boxes, motion);
     }
