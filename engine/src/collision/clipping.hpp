@@ -148,10 +148,21 @@ void closest_segment_parameters(const Vec3& p1, const Vec3& d1, const Vec3& p2, 
 // A unit vector perpendicular to v (v need not be unit; any non-zero length).
 Vec3 any_perpendicular(const Vec3& v);
 
-// Maps a manifold computed in frame x into the world. Its points are turned four at a time
-// in lanes (every slot: those past the count are left as they were), each lane the sums
+// Points p in frame x turned into the world four at a time, in lanes, each lane the sums
 // Transform::apply makes, in its order: Eigen's q v is v + w uv + q.vec x uv, with uv twice
 // q.vec x v.
+inline void lanes_to_world(Lanes& px, Lanes& py, Lanes& pz, const Transform& x) {
+    const Real qx = x.q.x(), qy = x.q.y(), qz = x.q.z(), qw = x.q.w();
+    Lanes ux = qy * pz - qz * py, uy = qz * px - qx * pz, uz = qx * py - qy * px;
+    ux += ux, uy += uy, uz += uz;
+    const Lanes wx = x.p.x() + ((px + qw * ux) + (qy * uz - qz * uy));
+    const Lanes wy = x.p.y() + ((py + qw * uy) + (qz * ux - qx * uz));
+    const Lanes wz = x.p.z() + ((pz + qw * uz) + (qx * uy - qy * ux));
+    px = wx, py = wy, pz = wz;
+}
+
+// Maps a manifold computed in frame x into the world, its points turned in lanes (every
+// slot: those past the count are left as they were).
 inline void manifold_to_world(Manifold& m, const Transform& x) {
     static_assert(kMaxManifoldPoints == 4, "a manifold's points fill one group of lanes");
     m.normal = x.rotate(m.normal);
@@ -160,13 +171,20 @@ inline void manifold_to_world(Manifold& m, const Transform& x) {
         const Vec3& p = m.points[i].point;
         px[i] = p.x(), py[i] = p.y(), pz[i] = p.z();
     }
-    const Real qx = x.q.x(), qy = x.q.y(), qz = x.q.z(), qw = x.q.w();
-    Lanes ux = qy * pz - qz * py, uy = qz * px - qx * pz, uz = qx * py - qy * px;
-    ux += ux, uy += uy, uz += uz;
-    const Lanes wx = x.p.x() + ((px + qw * ux) + (qy * uz - qz * uy));
-    const Lanes wy = x.p.y() + ((py + qw * uy) + (qz * ux - qx * uz));
-    const Lanes wz = x.p.z() + ((pz + qw * uz) + (qx * uy - qy * ux));
-    for (int i = 0; i < m.point_count; ++i) m.points[i].point = Vec3(wx[i], wy[i], wz[i]);
+    lanes_to_world(px, py, pz, x);
+    for (int i = 0; i < m.point_count; ++i) m.points[i].point = Vec3(px[i], py[i], pz[i]);
+}
+
+// reduce_to_manifold and then manifold_to_world for at most four candidates (all kept, in
+// their order): each point written once, already in the world. m.normal must be set, in x.
+inline void candidates_to_world(const ContactCandidate* c, int count, Manifold& m, const Transform& x) {
+    static_assert(kMaxManifoldPoints == 4, "a manifold's points fill one group of lanes");
+    m.normal = x.rotate(m.normal);
+    Lanes px = {}, py = {}, pz = {};
+    for (int i = 0; i < count; ++i) px[i] = c[i].point.x(), py[i] = c[i].point.y(), pz[i] = c[i].point.z();
+    lanes_to_world(px, py, pz, x);
+    for (int i = 0; i < count; ++i) m.points[i] = {Vec3(px[i], py[i], pz[i]), c[i].separation, c[i].id};
+    m.point_count = count;
 }
 
 inline void flip_manifold(Manifold& m) {

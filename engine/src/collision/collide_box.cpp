@@ -3,6 +3,7 @@
 // single point between the two closest edges.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "collision/clipping.hpp"
 #include "collision/lanes.hpp"
@@ -47,46 +48,107 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     }
     const auto coordinate = [&](int i) { return (ri(i, 0) * cx + (ri(i, 1) * cy + ri(i, 2) * cz)) + ti[i]; };
     const Lanes corners[3] = {coordinate(0), coordinate(1), coordinate(2)};
-    ClipVertex buffer_a[8], buffer_b[8];
-    for (std::uint32_t k = 0; k < 4; ++k) {
-        buffer_a[k] = {Vec3(corners[0][k], corners[1][k], corners[2][k]), clip_key(0, k, 0),
-                       static_cast<std::uint16_t>(k)};
-    }
     // The reference face's four side planes lie along r's other two axes: a point's
     // distance past one is a coordinate (the same bits a general plane's dot product gives).
-    // A plane with every point on its inner side would give the polygon back as it is, so
-    // it is not clipped against: a box on a box of its size reaches past one side at most.
-    int count = 4;
-    ClipVertex* in = buffer_a;
-    ClipVertex* next = buffer_b;
-    std::uint32_t side = 0;
-    const auto clip = [&](const auto& distance) {
-        const auto past = [&](const ClipVertex& v) { return !(distance(v.p) <= 0); };  // NaN too, as clipping drops it
-        if (std::any_of(in, in + count, past)) {
-            count = clip_polygon_by(in, count, distance, side, next);
-            std::swap(in, next);
-        }
-        ++side;
+    // Side s is +u, -u, +v, -v for s = 0..3 (u, v the axes after `axis`), in the order
+    // they are clipped against.
+    const auto side_distance = [&](int s, const auto& p) {
+        const int u = (axis + 1 + s / 2) % 3;
+        return (s % 2 == 0 ? p[u] : -p[u]) - hr[u];
     };
-    // Where no corner reaches past any side plane (a box standing square on a larger face, or
-    // beside one of its size), none is clipped against: the four tests at once, in lanes.
-    LaneMask past = {};
-    for (int k = 1; k <= 2; ++k) {
-        const int u = (axis + k) % 3;
-        past |= ~(corners[u] - hr[u] <= 0) | ~(-corners[u] - hr[u] <= 0);  // NaN too, as the clip
-    }
-    for (int k = 1; k <= 2 && lane_bits(past) != 0; ++k) {
-        const int u = (axis + k) % 3;
-        const Real reach = hr[u];
-        clip([u, reach](const Vec3& p) { return p[u] - reach; });
-        clip([u, reach](const Vec3& p) { return -p[u] - reach; });
-    }
+    unsigned past_sides = 0;  // side s set when a corner lies past it (NaN too, as the clip)
+    for (int s = 0; s < 4; ++s) past_sides |= (lane_bits(~(side_distance(s, corners) <= 0)) != 0 ? 1u : 0u) << s;
     int n_out = 0;
-    for (int k = 0; k < count; ++k) {
-        const Real separation = sign * in[k].p[axis] - hr[axis];  // n . p: n has one non-zero coordinate
-        if (separation > speculative) continue;
-        out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
-                        face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
+    // Where no corner lies past a side (a box standing square on a larger face, or beside one
+    // of its size) the face is its four corners; where they lie past one side only (a box on
+    // two) the face is cut by one line, its cuts made four at a time in lanes. Either way the
+    // points are those the clip below gives, in its order, with its keys.
+    if ((past_sides & (past_sides - 1)) == 0) {
+        const int cut_side = past_sides == 0 ? -1 : __builtin_ctz(past_sides);
+        // Lanes 0-3 the corners, 4-7 where the edge from corner k - 1 to corner k crosses the
+        // side (Sutherland-Hodgman's cut, prev + t (cur - prev)); `order` the clip's output.
+        Lanes points[2][3];
+        std::uint16_t keys[8];
+        unsigned order[8];
+        int count = 0;
+        for (int c = 0; c < 3; ++c) points[0][c] = corners[c];
+        for (std::uint32_t k = 0; k < 4; ++k) keys[k] = clip_key(0, k, 0);
+        if (cut_side < 0) {
+            for (unsigned k = 0; k < 4; ++k) order[count++] = k;
+        } else {
+            const Lanes d = side_distance(cut_side, corners);
+            const Lanes d_prev = __builtin_shufflevector(d, d, 3, 0, 1, 2);
+            const Lanes t = d_prev / (d_prev - d);
+            for (int c = 0; c < 3; ++c) {
+                const Lanes prev = __builtin_shufflevector(corners[c], corners[c], 3, 0, 1, 2);
+                points[1][c] = prev + t * (corners[c] - prev);
+            }
+            const unsigned inside = lane_bits(d <= 0);
+            for (std::uint32_t k = 0; k < 4; ++k) {
+                const std::uint32_t prev = (k + 3) % 4;
+                if ((inside >> prev & 1u) != (inside >> k & 1u)) {
+                    keys[4 + k] = clip_key(1, prev, static_cast<std::uint32_t>(cut_side));
+                    order[count++] = 4 + k;
+                }
+                if ((inside >> k & 1u) != 0) order[count++] = k;
+            }
+            // A cut rounded past a later side (its corners on that side, to the last bit) is
+            // clipped there too: the general clip below.
+            unsigned cuts = 0;
+            for (int i = 0; i < count; ++i) cuts |= order[i] >= 4 ? 1u << (order[i] - 4) : 0u;
+            for (int s = cut_side + 1; s < 4; ++s) {
+                if ((lane_bits(~(side_distance(s, points[1]) <= 0)) & cuts) != 0) count = -1;
+            }
+        }
+        if (count >= 0) {
+            // n . p and p - n s / 2 in lanes (n has one non-zero coordinate), each point then
+            // read at its place in `order`.
+            Real separation[8], surface[3][8];
+            for (int g = 0; g < (cut_side < 0 ? 1 : 2); ++g) {
+                const Lanes along_n = sign * points[g][axis] - hr[axis];
+                const Lanes half = Real(0.5) * along_n;
+                std::memcpy(separation + 4 * g, &along_n, sizeof along_n);
+                for (int c = 0; c < 3; ++c) {
+                    const Lanes on_surface = points[g][c] - n[c] * half;
+                    std::memcpy(surface[c] + 4 * g, &on_surface, sizeof on_surface);
+                }
+            }
+            for (int i = 0; i < count; ++i) {
+                const unsigned k = order[i];
+                if (separation[k] > speculative) continue;
+                out[n_out++] = {Vec3(surface[0][k], surface[1][k], surface[2][k]), separation[k],
+                                face_contact_id(reference_is_b, reference_face, incident_face, keys[k])};
+            }
+            if (n_out > 0) return n_out;
+            past_sides = 0;  // nothing within reach: the deepest corner below
+        }
+    }
+    // Cut by two sides or more (a box at a corner, or turned): the general clip, each side
+    // with a corner past it in turn. A side every point is inside of would give the polygon
+    // back as it is, so it is not clipped against.
+    if (past_sides != 0) {
+        ClipVertex buffer_a[8], buffer_b[8];
+        for (std::uint32_t k = 0; k < 4; ++k) {
+            buffer_a[k] = {Vec3(corners[0][k], corners[1][k], corners[2][k]), clip_key(0, k, 0),
+                           static_cast<std::uint16_t>(k)};
+        }
+        int count = 4;
+        ClipVertex* in = buffer_a;
+        ClipVertex* next = buffer_b;
+        for (std::uint32_t s = 0; s < 4; ++s) {
+            const auto distance = [&](const Vec3& p) { return side_distance(static_cast<int>(s), p); };
+            const auto past = [&](const ClipVertex& v) { return !(distance(v.p) <= 0); };  // NaN too
+            if (std::any_of(in, in + count, past)) {
+                count = clip_polygon_by(in, count, distance, s, next);
+                std::swap(in, next);
+            }
+        }
+        for (int k = 0; k < count; ++k) {
+            const Real separation = sign * in[k].p[axis] - hr[axis];  // n . p: n has one non-zero coordinate
+            if (separation > speculative) continue;
+            out[n_out++] = {in[k].p - n * (Real(0.5) * separation), separation,
+                            face_contact_id(reference_is_b, reference_face, incident_face, in[k].key)};
+        }
     }
     if (n_out > 0) return n_out;
     // Nothing over the reference face is within reach, yet the face axis says the boxes
@@ -256,8 +318,12 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
     }
     if (count == 0) return 0;
     wedge_normal(ha, hb, r, t, face_a, face_b, on_b, m.normal, candidates, count);
-    reduce_to_manifold(candidates, count, m);
-    manifold_to_world(m, xa);
+    if (count <= kMaxManifoldPoints) {
+        candidates_to_world(candidates, count, m, xa);
+    } else {
+        reduce_to_manifold(candidates, count, m);
+        manifold_to_world(m, xa);
+    }
     return 1;
 }
 
