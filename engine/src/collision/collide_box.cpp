@@ -12,6 +12,29 @@
 namespace spindle::detail {
 namespace {
 
+// Each face's corners in kBoxLoops' order, the signs of their coordinates four at a time
+// (kLoopSigns[f][c][k]: corner k's coordinate c).
+struct LoopSigns {
+    alignas(sizeof(Lanes)) Real signs[6][3][4];
+};
+constexpr LoopSigns loop_signs() {
+    LoopSigns table{};
+    for (int f = 0; f < 6; ++f) {
+        for (int k = 0; k < 4; ++k) {
+            for (int c = 0; c < 3; ++c) table.signs[f][c][k] = (kBoxLoops[4 * f + k] >> c & 1u) != 0 ? 1 : -1;
+        }
+    }
+    return table;
+}
+constexpr LoopSigns kLoopSigns = loop_signs();
+
+// Lanes from four doubles in a row.
+Lanes load_lanes(const Real* x) {
+    Lanes lanes;
+    std::memcpy(&lanes, x, sizeof lanes);
+    return lanes;
+}
+
 struct BoxAxis {
     Real separation = -kHuge;
     int index = -1;  // face axis 0..2, or edge pair 3 * i + j
@@ -40,12 +63,10 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     // Its corners in BoxPoly's loop order (the clip keys name them by place in the loop),
     // made in r's frame as BoxPoly would make them: four at a time in lanes, lane k corner k,
     // each coordinate the sums of ri * corner + ti (x + (y + z), then ti).
-    const std::uint32_t* loop = kBoxLoops + 4 * incident_face;
-    Lanes cx, cy, cz;
-    for (int k = 0; k < 4; ++k) {
-        const std::uint32_t v = loop[k];
-        cx[k] = v & 1 ? hi.x() : -hi.x(), cy[k] = v & 2 ? hi.y() : -hi.y(), cz[k] = v & 4 ? hi.z() : -hi.z();
-    }
+    // (A half extent times its corner's sign: the same bits as the half extent or its negation.)
+    const auto& signs = kLoopSigns.signs[incident_face];
+    const Lanes cx = hi.x() * load_lanes(signs[0]), cy = hi.y() * load_lanes(signs[1]),
+                cz = hi.z() * load_lanes(signs[2]);
     const auto coordinate = [&](int i) { return (ri(i, 0) * cx + (ri(i, 1) * cy + ri(i, 2) * cz)) + ti[i]; };
     const Lanes corners[3] = {coordinate(0), coordinate(1), coordinate(2)};
     // The reference face's four side planes lie along r's other two axes: a point's
