@@ -272,7 +272,8 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
     // each other, as every pair of a pile is before anything turns), axis e_i x e_j is A's face
     // axis k and its separation is faces_a[k] to the bit (each sum adds only zeros to it): no
     // edge is past the speculative distance nor clearly deeper than a face, so none is asked.
-    const bool square = r == Mat3::Identity();
+    const bool square = r(0, 0) == 1 && r(1, 1) == 1 && r(2, 2) == 1 && r(0, 1) == 0 && r(0, 2) == 0 && r(1, 0) == 0 &&
+                        r(1, 2) == 0 && r(2, 0) == 0 && r(2, 1) == 0;
     for (int i = 0; i < 3 && !square; ++i) {
         const int p = i == 0 ? 1 : 0, q = i == 2 ? 1 : 2;  // the other two coordinates, ascending
         // (e_i x c)[p], [q]: (-c2, c1), (c2, -c0), (-c1, c0) for i = 0, 1, 2.
@@ -343,7 +344,8 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         count = box_face_contact(ha, hb, r, t, face_a.index, speculative, false, m.normal, candidates);
     }
     if (count == 0) return 0;
-    wedge_normal(ha, hb, r, t, face_a, face_b, on_b, m.normal, candidates, count);
+    // (Square boxes meet in no wedge: B's face normal is one of A's, parallel or at right angles.)
+    if (!square) wedge_normal(ha, hb, r, t, face_a, face_b, on_b, m.normal, candidates, count);
     if (count <= kMaxManifoldPoints) {
         candidates_to_world(candidates, count, m, xa);
     } else {
