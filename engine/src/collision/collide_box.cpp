@@ -44,9 +44,9 @@ struct BoxAxis {
 // r's frame). Writes the clipped points in r's frame; n is r's face normal pointing at i.
 // A corner that clipping drops lies beside the reference face, outside r: it touches
 // nothing, and is not kept (as a point it would prop the box up past r's edge), unless
-// no point survives at all.
+// no point survives at all. `square`: ri is the identity, up to the signs of its zeros.
 int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3& ti, int axis, Real speculative,
-                     bool reference_is_b, Vec3& n, ContactCandidate* out) {
+                     bool reference_is_b, bool square, Vec3& n, ContactCandidate* out) {
     const Real sign = ti[axis] < 0 ? -1 : 1;
     n = Vec3::Zero();
     n[axis] = sign;
@@ -68,7 +68,9 @@ int box_face_contact(const Vec3& hr, const Vec3& hi, const Mat3& ri, const Vec3&
     const Lanes cx = hi.x() * load_lanes(signs[0]), cy = hi.y() * load_lanes(signs[1]),
                 cz = hi.z() * load_lanes(signs[2]);
     const auto coordinate = [&](int i) { return (ri(i, 0) * cx + (ri(i, 1) * cy + ri(i, 2) * cz)) + ti[i]; };
-    const Lanes corners[3] = {coordinate(0), coordinate(1), coordinate(2)};
+    // Square, each sum is a half extent (never zero) plus products with zeros: the extent.
+    const Lanes corners[3] = {square ? cx + ti[0] : coordinate(0), square ? cy + ti[1] : coordinate(1),
+                              square ? cz + ti[2] : coordinate(2)};
     // The reference face's four side planes lie along r's other two axes: a point's
     // distance past one is a coordinate (the same bits a general plane's dot product gives).
     // Side s is +u, -u, +v, -v for s = 0..3 (u, v the axes after `axis`), in the order
@@ -337,11 +339,11 @@ int collide_box_box(const Shape& a, const Transform& xa, const Shape& b, const T
         // Reference face on B: clip in B's frame, then bring the points back to A's.
         const Mat3 rt = r.transpose();
         Vec3 normal_b;
-        count = box_face_contact(hb, ha, rt, -(rt * t), face_b.index, speculative, true, normal_b, candidates);
+        count = box_face_contact(hb, ha, rt, -(rt * t), face_b.index, speculative, true, square, normal_b, candidates);
         for (int k = 0; k < count; ++k) candidates[k].point = r * candidates[k].point + t;
         m.normal = -(r * normal_b);
     } else {
-        count = box_face_contact(ha, hb, r, t, face_a.index, speculative, false, m.normal, candidates);
+        count = box_face_contact(ha, hb, r, t, face_a.index, speculative, false, square, m.normal, candidates);
     }
     if (count == 0) return 0;
     // (Square boxes meet in no wedge: B's face normal is one of A's, parallel or at right angles.)
