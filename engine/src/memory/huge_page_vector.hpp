@@ -4,10 +4,11 @@
 // page's first touch costs microseconds (the guest's fault and the hypervisor's): 512 of
 // them per 2 MB where a huge page takes one, and mapping the small pages at once in one
 // madvise still leaves each first write the hypervisor's fault (docs/benchmarks.md).
-// Blocks of half a huge page or more are allocated aligned to it and rounded up to whole
-// huge pages, so no small page is left at either end, and the whole block is asked for as
-// transparent huge pages. Blocks of a few pages up to that share huge pages
-// (medium_blocks.hpp). Smaller blocks are ordinary ones.
+// Blocks of half a huge page or more are allocated aligned to it, on whole huge pages; a
+// tail of less than half a huge page past the last whole one is small pages instead (a
+// few hundred faults rather than up to 2 MB held for nothing), so a block holds at most
+// half a huge page more than its bytes, or twice them. Blocks of a few pages up to that
+// share huge pages (medium_blocks.hpp). Smaller blocks are ordinary ones.
 #pragma once
 
 #include <cstddef>
@@ -47,9 +48,15 @@ inline void map_pages_now(void* p, std::size_t bytes) {
 #endif
 }
 
-// The bytes a block of `bytes` (kOnHugePagesBytes or more) is mapped as: whole huge pages.
+// The bytes a block of `bytes` (kOnHugePagesBytes or more) is mapped as: its whole huge
+// pages, and a tail of less than half a huge page as whole small pages, or one more huge
+// page for a longer tail.
 constexpr std::size_t huge_block_bytes(std::size_t bytes) {
-    return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
+    constexpr std::size_t kSmallPage = 4096;
+    const std::size_t whole = bytes / kHugePageBytes * kHugePageBytes;
+    const std::size_t tail = bytes - whole;
+    if (tail >= kHugePageBytes / 2) return whole + kHugePageBytes;
+    return whole + (tail + kSmallPage - 1) / kSmallPage * kSmallPage;
 }
 
 // The whole huge pages of a block of `bytes` mapped as huge_block_bytes(bytes).
