@@ -161,7 +161,7 @@ TEST(HugePageVector, BlocksBeyondTheHeapAreCountedAsTheProcessHoldsThem) {
         const std::int64_t taken = resident_bytes() - resident_start;
         EXPECT_LT(std::abs(taken - held()), kNoise) << what << ": the process took " << taken;
 #else
-        (void)what;
+        (void)what, (void)resident_start;
 #endif
     };
     {
