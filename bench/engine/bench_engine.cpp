@@ -91,14 +91,16 @@ struct Built {
     std::vector<JointHandle> joints;  // scenes from files: their joints
     bool asleep = true;               // GridSleeping: did every body fall asleep before timing
     std::int64_t heap_before = 0;     // live heap before the space was made
-    std::int64_t arrays_before = 0;   // and arrays on huge pages (huge_array_bytes)
+    std::int64_t mapped_before = 0;   // and held in the blocks mapped for huge pages (mapped_bytes_held)
 
     // The memory the space holds now (bodies, shapes, broadphase, contacts, solver scratch)
-    // per dynamic body: the heap, and the arrays on huge pages and medium blocks, which the
-    // heap's count does not see; taken after the timed steps, so every scene counts the same.
+    // per dynamic body: the heap, and the pages held in the blocks mapped for huge pages (the
+    // arrays on them, the medium block pool's chunks whole), which the heap's count does not
+    // see; taken after the timed steps, so every scene counts the same.
     double bytes_per_body() const {
         const auto handle_bytes = static_cast<std::int64_t>(bodies.capacity() * sizeof(BodyHandle));
-        const std::int64_t held = live_heap_bytes() - heap_before + huge_array_bytes() - arrays_before;
+        const auto mapped = static_cast<std::int64_t>(mapped_bytes_held());
+        const std::int64_t held = live_heap_bytes() - heap_before + mapped - mapped_before;
         return static_cast<double>(held - handle_bytes) / static_cast<double>(bodies.size());
     }
 };
@@ -122,7 +124,7 @@ Built build(const EngineScene& scene_entry, unsigned threads) {
         case SceneKind::SceneFile: break;
     }
     built.heap_before = live_heap_bytes();
-    built.arrays_before = huge_array_bytes();
+    built.mapped_before = static_cast<std::int64_t>(mapped_bytes_held());
     built.space = std::make_unique<Space>(settings, built.jobs.get());
     Space& space = *built.space;
     if (kind == SceneKind::MixedPileOnMesh) {
@@ -176,18 +178,22 @@ WorstJointError worst_joint_error(const Space& space, const std::vector<JointHan
     return worst;
 }
 
-// Where bytes_per_body goes: each structure's share, and the rest the heap counter sees
-// (published buffers, write buffer, events, joints, shapes' shared data, job arenas).
+// Where bytes_per_body goes: each structure's share at its capacity, and the rest: what the
+// heap counter sees besides (published buffers, write buffer, events, joints, shapes'
+// shared data, job arenas) and the pages held beyond the arrays' bytes (a huge page's
+// unused part, the medium block pool's chunks whole). `mapped` is the pages held in the
+// blocks mapped for huge pages, of bytes_per_body.
 void print_memory(const char* name, unsigned threads, const Built& built) {
     const MemoryReport report = memory_report(*built.space);
     const double per_body = 1.0 / static_cast<double>(built.bodies.size());
     const auto at = [&](std::size_t bytes) { return static_cast<double>(bytes) * per_body; };
     std::printf("memory %s/threads:%u bytes_per_body=%.0f bodies=%.0f contacts=%.0f extras=%.0f lookup=%.0f wide=%.0f "
-                "push_rows=%.0f solver_other=%.0f broadphase=%.0f query_scenes=%.0f rest=%.0f\n",
+                "push_rows=%.0f solver_other=%.0f broadphase=%.0f query_scenes=%.0f rest=%.0f mapped=%.0f\n",
                 name, threads, built.bytes_per_body(), at(report.bodies), at(report.contacts),
                 at(report.contact_extras), at(report.contact_lookup), at(report.wide_contacts), at(report.push_rows),
                 at(report.solver_other), at(report.broadphase), at(report.query_scenes),
-                built.bytes_per_body() - at(report.total()));
+                built.bytes_per_body() - at(report.total()),
+                static_cast<double>(static_cast<std::int64_t>(mapped_bytes_held()) - built.mapped_before) * per_body);
     std::fflush(stdout);
 }
 

@@ -4,16 +4,15 @@
 // page's first touch costs microseconds (the guest's fault and the hypervisor's): 512 of
 // them per 2 MB where a huge page takes one, and mapping the small pages at once in one
 // madvise still leaves each first write the hypervisor's fault (docs/benchmarks.md).
-// Blocks of half a huge page or more are allocated aligned to it and rounded up to whole
-// huge pages, so no small page is left at either end, and the whole block is asked for as
-// transparent huge pages. Blocks of a few pages up to that share huge pages
-// (medium_blocks.hpp). Smaller blocks are ordinary ones.
+// Blocks of half a huge page or more are allocated aligned to it, on whole huge pages; a
+// tail of less than half a huge page past the last whole one is small pages instead (a
+// few hundred faults rather than up to 2 MB held for nothing), so a block holds at most
+// half a huge page more than its bytes, or twice them. Blocks of a few pages up to that
+// share huge pages (medium_blocks.hpp). Smaller blocks are ordinary ones.
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -28,9 +27,9 @@
 namespace spindle {
 
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
-// From here a block goes on whole huge pages. Rounding up to them holds at most twice
-// the block's bytes, while its small pages would each cost a first write's fault: a
-// block just under a huge page (a 10k-body scene's solver bodies) paid 500 of them.
+// From here a block goes on huge pages (huge_block_bytes). Rounding up to them holds at
+// most twice the block's bytes, while its small pages would each cost a first write's
+// fault: a block just under a huge page (a 10k-body scene's solver bodies) paid 500 of them.
 inline constexpr std::size_t kOnHugePagesBytes = kHugePageBytes / 2;
 // Blocks from kMediumBlockMinBytes up to this share huge pages; smaller ones mostly come
 // from heap memory already mapped.
@@ -49,44 +48,44 @@ inline void map_pages_now(void* p, std::size_t bytes) {
 #endif
 }
 
-// A block of `bytes` (whole huge pages) starting on a huge page. On Linux a mapping of
-// its own, not the heap's: heap memory a program freed before keeps the small pages it
-// was written on, and asking for huge pages does not replace those, so a block from it
-// paid the small pages' faults again wherever the heap had been used. A hint: where the
-// system gives no huge pages on request, the block stays small pages.
-inline void* map_huge_pages(std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    // Over-map by a huge page, then give back the ends outside the aligned block.
-    void* raw = mmap(nullptr, bytes + kHugePageBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (raw == MAP_FAILED) throw std::bad_alloc();
-    const auto begin = reinterpret_cast<std::uintptr_t>(raw);
-    const std::uintptr_t aligned = (begin + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-    if (aligned > begin) munmap(raw, aligned - begin);
-    if (const std::uintptr_t tail = begin + kHugePageBytes - aligned; tail > 0)
-        munmap(reinterpret_cast<void*>(aligned + bytes), tail);
-    madvise(reinterpret_cast<void*>(aligned), bytes, MADV_HUGEPAGE);
-    return reinterpret_cast<void*>(aligned);
-#else
-    void* p = std::aligned_alloc(kHugePageBytes, bytes);
-    if (p == nullptr) throw std::bad_alloc();
-    return p;
-#endif
+// The bytes a block of `bytes` (kOnHugePagesBytes or more) is mapped as: its whole huge
+// pages, and a tail of less than half a huge page as whole small pages, or one more huge
+// page for a longer tail.
+constexpr std::size_t huge_block_bytes(std::size_t bytes) {
+    constexpr std::size_t kSmallPage = 4096;
+    const std::size_t whole = bytes / kHugePageBytes * kHugePageBytes;
+    const std::size_t tail = bytes - whole;
+    if (tail >= kHugePageBytes / 2) return whole + kHugePageBytes;
+    return whole + (tail + kSmallPage - 1) / kSmallPage * kSmallPage;
 }
 
-inline void unmap_huge_pages(void* p, std::size_t bytes) noexcept {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    munmap(p, bytes);
-#else
-    (void)bytes;
-    std::free(p);
-#endif
-}
+// The whole huge pages of a block of `bytes` mapped as huge_block_bytes(bytes).
+constexpr std::size_t whole_huge_pages(std::size_t bytes) { return huge_block_bytes(bytes) / kHugePageBytes; }
 
-// The bytes of the arrays HugePageAllocator holds on huge pages and medium blocks (each at
-// the size it takes there), process-wide: memory a count of the heap does not see. The
-// chunks and stocked pages not under an array are not in it.
-inline std::atomic<std::int64_t> g_huge_array_bytes{0};
-inline std::int64_t huge_array_bytes() noexcept { return g_huge_array_bytes.load(std::memory_order_relaxed); }
+// A block of `bytes` (huge_block_bytes: whole huge pages, then whole small pages) starting
+// on a huge page, its whole huge pages asked for as transparent huge pages. On Linux a
+// mapping of its own, not the heap's: heap memory a program freed before keeps the small
+// pages it was written on, and asking for huge pages does not replace those, so a block
+// from it paid the small pages' faults again wherever the heap had been used. A hint:
+// where the system gives no huge pages on request, the block stays small pages. Throws
+// std::bad_alloc. Any thread.
+void* map_huge_pages(std::size_t bytes);
+
+// Gives back a block of map_huge_pages(bytes), the same `bytes`.
+void unmap_huge_pages(void* p, std::size_t bytes) noexcept;
+
+// Moves the huge page mapped at `from` (a block of map_huge_pages(kHugePageBytes)) onto
+// the huge page at `to`, inside another block, by its page tables: whatever lay at `to` is
+// replaced, and `from` is no longer mapped. False where the move failed (then `from` is
+// given back and `to` is as it was) or the system has no such call.
+bool move_huge_page(void* from, void* to) noexcept;
+
+// The bytes the process holds in every block map_huge_pages mapped and has not given back
+// (arrays on huge pages, the medium block pool's chunks, stocked pages): the pages of them
+// in memory, as the system counts them (mincore), so a huge page written anywhere is 2 MB,
+// a small page 4 KB, and a page never written nothing. Memory a count of the heap does not
+// see. Any thread; walks every block: for tests and benchmarks.
+std::size_t mapped_bytes_held();
 
 template <typename T>
 struct HugePageAllocator {
@@ -103,39 +102,25 @@ struct HugePageAllocator {
         if (bytes >= kOnHugePagesBytes) return Tier::kHugePages;
         return bytes >= kMediumBlockMinBytes ? Tier::kMedium : Tier::kHeap;
     }
-    static std::size_t rounded_bytes(std::size_t bytes) {
-        return (bytes + kHugePageBytes - 1) / kHugePageBytes * kHugePageBytes;
-    }
-    // What a block of `bytes` takes beyond the heap: its medium block or its huge pages.
-    static std::int64_t held_bytes(std::size_t bytes) {
-        const Tier t = tier(bytes);
-        return static_cast<std::int64_t>(t == Tier::kHeap     ? 0
-                                         : t == Tier::kMedium ? medium_block_bytes(bytes)
-                                                              : rounded_bytes(bytes));
-    }
-
     // The count is checked before it is turned into bytes, for every kind of block: a count
     // whose bytes wrap would otherwise ask for a small block.
     static constexpr std::size_t max_size() noexcept { return static_cast<std::size_t>(-1) / 2 / sizeof(T); }
     T* allocate(std::size_t n) {
         if (n > max_size()) throw std::bad_array_new_length();
         const std::size_t bytes = n * sizeof(T);
-        void* p = nullptr;
         switch (tier(bytes)) {
             case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
-            case Tier::kMedium: p = allocate_medium_block(bytes); break;
-            case Tier::kHugePages: p = map_huge_pages(rounded_bytes(bytes)); break;
+            case Tier::kMedium: return static_cast<T*>(allocate_medium_block(bytes));
+            case Tier::kHugePages: return static_cast<T*>(map_huge_pages(huge_block_bytes(bytes)));
         }
-        g_huge_array_bytes.fetch_add(held_bytes(bytes), std::memory_order_relaxed);  // once it is held
-        return static_cast<T*>(p);
+        return nullptr;
     }
     void deallocate(T* p, std::size_t n) noexcept {
         const std::size_t bytes = n * sizeof(T);
-        g_huge_array_bytes.fetch_sub(held_bytes(bytes), std::memory_order_relaxed);
         switch (tier(bytes)) {
             case Tier::kHeap: ::operator delete (p, std::align_val_t{alignof(T)}); return;
             case Tier::kMedium: free_medium_block(p, bytes); return;
-            case Tier::kHugePages: unmap_huge_pages(p, rounded_bytes(bytes)); return;
+            case Tier::kHugePages: unmap_huge_pages(p, huge_block_bytes(bytes)); return;
         }
     }
 

@@ -75,11 +75,7 @@ void* take_stocked_huge_page() noexcept { return stock().take(); }
 bool move_stocked_huge_page_to(void* where) noexcept {
 #if defined(__linux__) && defined(MREMAP_FIXED)
     void* page = stock().take();
-    if (page == nullptr) return false;
-    // The page tables move, not the bytes: a huge page stays one.
-    if (mremap(page, kHugePageBytes, kHugePageBytes, MREMAP_MAYMOVE | MREMAP_FIXED, where) == where) return true;
-    unmap_huge_pages(page, kHugePageBytes);
-    return false;
+    return page != nullptr && move_huge_page(page, where);
 #else
     (void)where;
     return false;

@@ -79,15 +79,17 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
     if (last <= first) return;
     const std::uintptr_t first_span = first / kPagesPerJob;
     const auto spans = static_cast<std::uint32_t>((last - 1) / kPagesPerJob - first_span + 1);
-    // A huge page may be replaced where it holds no live element and lies inside the block,
-    // which is whole huge pages (HugePageAllocator) from room of a megabyte up.
+    // A huge page may be replaced where it holds no live element and lies inside the block's
+    // whole huge pages (HugePageAllocator, from room of a megabyte up; a short tail is small
+    // pages, which a huge page moved there would overrun).
     constexpr bool kOnWholeHugePages = std::is_base_of_v<HugePageAllocator<T>, A>;
     const auto live_end = reinterpret_cast<std::uintptr_t>(v.data() + v.size());
-    const auto block_end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity());
+    const auto whole_end = reinterpret_cast<std::uintptr_t>(v.data()) +
+                           whole_huge_pages(v.capacity() * sizeof(T)) * kHugePageBytes;
     jobs.parallel_for("MapPages", 0, spans, 1, [=](std::uint32_t lo, std::uint32_t hi, unsigned) {
         for (std::uint32_t span = lo; span < hi; ++span) {
             const std::uintptr_t huge_page = (first_span + span) * kHugePageBytes;
-            if (kOnWholeHugePages && huge_page >= live_end && huge_page < block_end &&
+            if (kOnWholeHugePages && huge_page >= live_end && huge_page + kHugePageBytes <= whole_end &&
                 move_stocked_huge_page_to(reinterpret_cast<void*>(huge_page)))
                 continue;
             const std::uintptr_t from = std::max(first, (first_span + span) * kPagesPerJob);
@@ -103,12 +105,12 @@ void map_room(JobSystem& jobs, std::vector<T, A>& v, std::size_t end) {
 #endif
 }
 
-// The stocked pages map_room moves under an empty array on whole huge pages given room for
-// `count` elements of `element_bytes`: each huge page the room reaches, none under
+// The stocked pages map_room moves under an empty array on huge pages given room for
+// `count` elements of `element_bytes`: each whole huge page of its block, none under
 // kMappedRoomMinBytes (map_room maps nothing there).
 constexpr std::size_t stocked_room_pages(std::size_t count, std::size_t element_bytes) {
     const std::size_t bytes = count * element_bytes;
-    return bytes < kMappedRoomMinBytes ? 0 : (bytes + kHugePageBytes - 1) / kHugePageBytes;
+    return bytes < kMappedRoomMinBytes ? 0 : whole_huge_pages(bytes);
 }
 
 // An array a first step lays out on huge pages (memory/huge_page_vector.hpp), for the stock

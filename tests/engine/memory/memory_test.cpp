@@ -13,6 +13,7 @@
 
 #include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
+#include "memory/huge_page_vector.hpp"
 #include "solver/constraints.hpp"
 #include "stages/broadphase_state.hpp"
 #include "static_bodies.hpp"
@@ -54,6 +55,17 @@ TEST(Memory, PyramidAfterItsDropHoldsUnderElevenKilobytesPerBody) {
     // Room for a quarter more at most: the pile's contacts came in a few at a time.
     const World& world = SpaceInternals::world(pyramid.space);
     EXPECT_LE(world.contacts.capacity(), world.contacts.size() + world.contacts.size() / 4 + 64);
+}
+
+// What the process holds beyond the heap for the pyramid (its arrays on huge pages, the
+// medium block pool's chunks, as mapped_bytes_held counts them): a huge-page array's tail
+// is small pages, not a whole huge page more (13.5 KB a body with whole pages; the cap on
+// the heap and these together is issue 19's 11.1 KB, not met: docs/benchmarks.md).
+TEST(Memory, PyramidHoldsItsArraysTailsOnSmallPages) {
+    const auto start = static_cast<double>(mapped_bytes_held());
+    const Pyramid pyramid(kLanded);
+    const auto body_count = static_cast<double>(pyramid.scene.dynamic_body_count());
+    EXPECT_LT((static_cast<double>(mapped_bytes_held()) - start) / body_count, 12'600);
 }
 
 TEST(Memory, ContactArraysAreGivenBackWhenThePileComesApart) {
