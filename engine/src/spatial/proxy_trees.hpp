@@ -284,15 +284,19 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known&
     // Jobs only read the trees and the enlarged marks and write their own chunk's list,
     // sorted there: end_pair_search puts the sorted runs together.
     const std::uint32_t grain = m_settings.grain;
-    // Every moving proxy enlarged (a first step): the moving pairs from one walk of the moving
-    // tree against itself, into the first chunk's list before its search adds to it
-    // (order_by_first_user orders every list's pairs together); the searches then look
-    // only in the other tree.
+    // Every moving proxy enlarged (a first step), on one worker: the moving pairs from one
+    // walk of the moving tree against itself, into the first chunk's list before its search
+    // adds to it (order_by_first_user orders every list's pairs together); the searches then
+    // look only in the other tree. The same pairs in the same order as the searches give;
+    // with more workers the searches run side by side, and the walk and the ordering after
+    // it, one thread's, would leave the others waiting.
     const DynamicAabbTree& moving = m_trees[0];
-    const bool self = all_moving_enlarged() && moving.self_pairs(m_self_stack, [&](std::int32_t a, std::int32_t b) {
-        const Pair pair = make_pair(ProxyId::make(a, false), moving.user(a), ProxyId::make(b, false), moving.user(b));
-        if (!known(pair.user_a, pair.user_b)) m_chunk_pairs[0].push_back(pair);
-    });
+    const bool self = jobs.worker_count() == 1 && all_moving_enlarged() &&
+                      moving.self_pairs(m_self_stack, [&](std::int32_t a, std::int32_t b) {
+                          const Pair pair = make_pair(ProxyId::make(a, false), moving.user(a), ProxyId::make(b, false),
+                                                      moving.user(b));
+                          if (!known(pair.user_a, pair.user_b)) m_chunk_pairs[0].push_back(pair);
+                      });
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
         for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, self, out);
