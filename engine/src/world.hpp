@@ -278,9 +278,9 @@ struct ContactExtra {
 inline constexpr std::uint8_t kContactReports = 1u << 0;
 inline constexpr std::uint8_t kContactSensor = 1u << 1;
 
-// A pair of bodies whose fat bounds overlap. Most of the memory a pile holds: the fields
-// are ordered so that the record has no padding, the flags are bits, and nothing is kept
-// that the rest gives exactly (B's centre in A's frame when collided: cached_position()).
+// A pair of bodies whose fat bounds overlap. Most of the memory a pile holds: the fields are ordered so that the
+// record has no padding, the flags are bits, nothing is kept that the rest gives exactly (B's centre in A's frame
+// when collided: cached_position()). Every field has its initializer: create_contacts default-initializes records.
 struct Contact {
     std::uint32_t body_a = 0, body_b = 0;  // slots: body_a is the lower (World::contact_keys holds the pair key)
     Real friction = 0, restitution = 0;

@@ -103,6 +103,13 @@ public:
     // it accepts is passed over without its box being read (a caller's own cheaper test).
     template <typename Skip, typename Callback>
     void query(const Aabb& box, Skip&& skip, Callback&& callback) const;
+    // Calls report(a, b) once for every two proxies whose fat boxes overlap, a and b in the
+    // walk's order: the tree walked against itself, each overlapping pair of nodes met once
+    // (a query per proxy meets every pair twice, and walks down from the root for each).
+    // `stack` is the walk's scratch. Returns false, having reported nothing, when the child
+    // boxes are not current (make_child_boxes) or the tree is too tall for query()'s walk.
+    template <typename Report>
+    bool self_pairs(std::vector<std::pair<std::int32_t, std::int32_t>>& stack, Report&& report) const;
     // Makes every internal node's children's boxes in float, for query()'s walk. Worth it
     // when many queries follow (a pair search of many moved proxies): it reads every node.
     // With `jobs`, in parallel (the caller waits). They are kept from then on through moves
@@ -250,6 +257,11 @@ private:
     }
     template <typename Enter, typename OnLeaf>
     void traverse(Enter&& enter, OnLeaf&& on_leaf) const;
+    // query()'s walk on the child boxes below `node` (an internal node's id), whose box
+    // overlaps `box`; false when callback stopped it.
+    template <typename Skip, typename Callback>
+    bool walk_below(std::int32_t node, const Aabb& box, const OverlapTest& overlaps_box, Skip&& skip,
+                    Callback&& callback) const;
     std::int32_t allocate_node();
     void free_node(std::int32_t id);
     Aabb fatten(const Aabb& tight, const Vec3& displacement, Real margin) const;
@@ -502,24 +514,30 @@ void DynamicAabbTree::query(const Aabb& box, Skip&& skip, Callback&& callback) c
         traverse(overlaps_box, [&](std::int32_t id) { return skip(id) || callback(id); });
         return;
     }
+    if (!overlaps_box(m_nodes[static_cast<std::size_t>(m_root)].box)) return;
+    walk_below(m_root, box, overlaps_box, skip, callback);
+}
+
+template <typename Skip, typename Callback>
+bool DynamicAabbTree::walk_below(std::int32_t node, const Aabb& box, const OverlapTest& overlaps_box, Skip&& skip,
+                                 Callback&& callback) const {
     // traverse()'s walk, the same nodes entered in the same order, but a node's children
     // tested together on their float boxes before they are pushed, so an internal node's
     // own line is never read; a leaf let through is tested on its double box when popped,
     // unless skip passes it over. Depth first, the stack holds at most one waiting sibling
     // a level and the two children just pushed: height + 1 entries, so a fixed array with
     // no check for room.
-    if (!overlaps_box(m_nodes[static_cast<std::size_t>(m_root)].box)) return;
     const ChildTest children_overlap(box);
     const ChildBoxes* const lines = m_child_boxes.data();
     const Node* const nodes = m_nodes.data();
     std::int32_t stack[kWalkDepth];
     std::int32_t* top = stack;
-    *top++ = m_root;
+    *top++ = node;
     do {
         const std::int32_t entry = *--top;
         if (entry < 0) {
             const std::int32_t leaf = ~entry;
-            if (!skip(leaf) && overlaps_box(nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return;
+            if (!skip(leaf) && overlaps_box(nodes[static_cast<std::size_t>(leaf)].box) && !callback(leaf)) return false;
             continue;
         }
         const ChildBoxes& children = lines[static_cast<std::size_t>(entry)];
@@ -527,6 +545,67 @@ void DynamicAabbTree::query(const Aabb& box, Skip&& skip, Callback&& callback) c
         if ((found & 1u) != 0) *top++ = children.entry[0];
         if ((found & 2u) != 0) *top++ = children.entry[1];
     } while (top != stack);
+    return true;
+}
+
+template <typename Report>
+bool DynamicAabbTree::self_pairs(std::vector<std::pair<std::int32_t, std::int32_t>>& stack, Report&& report) const {
+    SPINDLE_ASSERT(!m_stale_boxes,
+                   "DynamicAabbTree::self_pairs: set_fat_box moved proxies and rebuild_enlarged has not run");
+    if (!m_child_boxes_current || height() >= kWalkDepth) return false;
+    if (height() == 0) return true;
+    // Entries as the child boxes hold them: an internal node's id, ~id for a leaf. A node
+    // against itself splits into its children against themselves and each other; two
+    // internal nodes into their children two by two, on their float boxes (which overlap
+    // wherever the double boxes do); a leaf against a subtree is a query of the leaf's box
+    // down that subtree; two leaves are tested on their double boxes, as a query tests a leaf.
+    const ChildBoxes* const lines = m_child_boxes.data();
+    const Node* const nodes = m_nodes.data();
+    const auto floats_overlap = [](const ChildBoxes& a, int i, const ChildBoxes& b, int j) {
+        const float* const a_min = a.min + 3 * i;
+        const float* const a_max = a.max + 3 * i;
+        const float* const b_min = b.min + 3 * j;
+        const float* const b_max = b.max + 3 * j;
+        return a_min[0] <= b_max[0] && b_min[0] <= a_max[0] && a_min[1] <= b_max[1] && b_min[1] <= a_max[1] &&
+               a_min[2] <= b_max[2] && b_min[2] <= a_max[2];
+    };
+    const auto leaf_against = [&](std::int32_t leaf, std::int32_t subtree) {
+        const Aabb& box = nodes[static_cast<std::size_t>(leaf)].box;
+        walk_below(
+            subtree, box, OverlapTest(box), [](std::int32_t) { return false; },
+            [&](std::int32_t other) {
+                report(leaf, other);
+                return true;
+            });
+    };
+    stack.clear();
+    stack.emplace_back(m_root, m_root);
+    while (!stack.empty()) {
+        const auto [x, y] = stack.back();
+        stack.pop_back();
+        if (x < 0 || y < 0) {
+            if (x >= 0 || y >= 0) {
+                leaf_against(x < 0 ? ~x : ~y, x < 0 ? y : x);
+            } else if (overlaps(nodes[static_cast<std::size_t>(~x)].box, nodes[static_cast<std::size_t>(~y)].box)) {
+                report(~x, ~y);
+            }
+            continue;
+        }
+        const ChildBoxes& a = lines[static_cast<std::size_t>(x)];
+        if (x == y) {
+            if (a.entry[0] >= 0) stack.emplace_back(a.entry[0], a.entry[0]);
+            if (a.entry[1] >= 0) stack.emplace_back(a.entry[1], a.entry[1]);
+            if (floats_overlap(a, 0, a, 1)) stack.emplace_back(a.entry[0], a.entry[1]);
+            continue;
+        }
+        const ChildBoxes& b = lines[static_cast<std::size_t>(y)];
+        for (int i = 0; i < 2; ++i) {
+            for (int j = 0; j < 2; ++j) {
+                if (floats_overlap(a, i, b, j)) stack.emplace_back(a.entry[i], b.entry[j]);
+            }
+        }
+    }
+    return true;
 }
 
 template <typename Callback>

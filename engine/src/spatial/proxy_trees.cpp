@@ -148,22 +148,61 @@ void ProxyTrees::sort_pairs(std::vector<Pair>& pairs) {
         std::sort(pairs.begin(), pairs.end(), canonical_less);
         return;
     }
+    sort_runs(pairs.data(), pairs.data() + pairs.size());
+}
+
+void ProxyTrees::sort_runs(Pair* begin, Pair* end) {
     constexpr std::ptrdiff_t kFew = 16;  // a box meets a few others: an insertion sort; a floor thousands
-    for (auto run = pairs.begin(); run != pairs.end();) {
+    for (Pair* run = begin; run != end;) {
         const std::uint64_t user = run->user_a;
-        const auto end = std::find_if(run, pairs.end(), [user](const Pair& p) { return p.user_a != user; });
-        if (end - run > kFew) {
-            std::sort(run, end, canonical_less);
+        Pair* const run_end = std::find_if(run, end, [user](const Pair& p) { return p.user_a != user; });
+        if (run_end - run > kFew) {
+            std::sort(run, run_end, canonical_less);
         } else {
-            for (auto i = run + 1; i < end; ++i) {
+            for (Pair* i = run + 1; i < run_end; ++i) {
                 const Pair pair = *i;
-                auto j = i;
+                Pair* j = i;
                 for (; j > run && canonical_less(pair, *(j - 1)); --j) *j = *(j - 1);
                 *j = pair;
             }
         }
-        run = end;
+        run = run_end;
     }
+}
+
+bool ProxyTrees::all_moving_enlarged() const {
+    const auto moving = m_trees[0].proxy_count();
+    if (moving == 0 || m_enlarged.size() < static_cast<std::size_t>(moving)) return false;
+    const auto enlarged_moving = std::count_if(m_enlarged.begin(), m_enlarged.end(),
+                                               [](ProxyId id) { return !id.is_static(); });
+    return enlarged_moving == moving;
+}
+
+void ProxyTrees::order_by_first_user(PairList& pairs) {
+    const std::uint32_t chunks = pair_chunks();
+    std::size_t total = 0;
+    std::uint64_t last_user = 0;
+    const auto for_each_pair = [&](auto&& visit) {
+        for (std::uint32_t c = 0; c < chunks; ++c) {
+            for (const Pair& p : m_chunk_pairs[c]) visit(p);
+        }
+    };
+    for (std::uint32_t c = 0; c < chunks; ++c) total += m_chunk_pairs[c].size();
+    for_each_pair([&](const Pair& p) { last_user = std::max(last_user, p.user_a); });
+    pairs.resize(total);  // raw room: every place is written below
+    if (last_user >= 4 * (total + static_cast<std::size_t>(proxy_count()))) {
+        // Users too sparse to count by: the lists joined and sorted whole.
+        std::size_t at = 0;
+        for_each_pair([&](const Pair& p) { pairs[at++] = p; });
+        std::sort(pairs.begin(), pairs.end(), canonical_less);
+    } else {
+        m_user_places.assign(static_cast<std::size_t>(last_user) + 2, 0);
+        for_each_pair([&](const Pair& p) { ++m_user_places[static_cast<std::size_t>(p.user_a) + 1]; });
+        for (std::size_t u = 1; u < m_user_places.size(); ++u) m_user_places[u] += m_user_places[u - 1];
+        for_each_pair([&](const Pair& p) { pairs[m_user_places[static_cast<std::size_t>(p.user_a)]++] = p; });
+        sort_runs(pairs.data(), pairs.data() + pairs.size());
+    }
+    m_run_starts.assign({0, total});
 }
 
 std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs) {
@@ -189,7 +228,19 @@ std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs
     return count;
 }
 
-void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs) {
+void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self) {
+    if (self) {
+        order_by_first_user(new_pairs);
+        merge_runs(jobs, new_pairs);  // one run: only its scratch laid out, as for a search's
+        // A first step's scratch, given back: the first list held nearly every pair, and the
+        // steps after find a few in each list.
+        std::vector<Pair>().swap(m_chunk_pairs[0]);
+        std::vector<std::uint32_t>().swap(m_user_places);
+        std::vector<std::pair<std::int32_t, std::int32_t>>().swap(m_self_stack);
+        for (const ProxyId id : m_enlarged) slots_of(id)[static_cast<std::size_t>(id.tree_id())] = -1;
+        m_enlarged.clear();
+        return;
+    }
     const std::uint32_t chunks = pair_chunks();
     m_run_starts.assign(chunks + 1, 0);
     for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
@@ -259,7 +310,8 @@ std::size_t ProxyTrees::heap_bytes() const noexcept {
                         m_chunk_pairs.capacity() * sizeof(std::vector<Pair>) +
                         m_run_starts.capacity() * sizeof(std::size_t) + m_merged_pairs.capacity() * sizeof(Pair) +
                         m_fat_ranges.capacity() * sizeof(FatBoxRange) + m_grown.capacity() +
-                        m_margins.capacity() * sizeof(Real);
+                        m_margins.capacity() * sizeof(Real) + m_self_stack.capacity() * sizeof(m_self_stack[0]) +
+                        m_user_places.capacity() * sizeof(std::uint32_t);
     for (const std::vector<Pair>& pairs : m_chunk_pairs) bytes += pairs.capacity() * sizeof(Pair);
     return bytes;
 }

@@ -176,18 +176,27 @@ private:
     std::vector<Real> m_margins;
     void mark_enlarged(ProxyId id);
     void unmark_enlarged(ProxyId id);
+    // With `moving_pairs_found`, a moving proxy does not search the moving tree (self_pairs did).
     template <typename Known>
-    void find_pairs_of(ProxyId proxy, const Known& known, std::vector<Pair>& out) const;
+    void find_pairs_of(ProxyId proxy, const Known& known, bool moving_pairs_found, std::vector<Pair>& out) const;
+    // Whether every moving proxy is enlarged (a first step): then one walk of the moving tree
+    // against itself finds the moving pairs, not a search per proxy.
+    bool all_moving_enlarged() const;
+    // The pairs of the searches and of the walk of the moving tree against itself, in
+    // canonical order: put in first users' order by counting, then each user's run sorted.
+    void order_by_first_user(PairList& pairs);
     // update_pairs' parts around its search: the rebuild and the float boxes before (returns
     // the searches to make), and the runs put together and the marks cleared after.
     std::uint32_t begin_pair_search(JobSystem& jobs, PairList& new_pairs);
-    void end_pair_search(JobSystem& jobs, PairList& new_pairs);
+    void end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self);
     static Pair make_pair(ProxyId p, std::uint64_t user_p, ProxyId q, std::uint64_t user_q) {
         if (user_q < user_p || (user_q == user_p && q.key() < p.key())) return {q, p, user_q, user_p};
         return {p, q, user_p, user_q};
     }
     // Sorts a chunk's pairs in canonical order.
     static void sort_pairs(std::vector<Pair>& pairs);
+    // Sorts each run of one first user in [begin, end), whose first users ascend.
+    static void sort_runs(Pair* begin, Pair* end);
     // The pair search's chunks: one job's enlarged proxies and one output list each.
     std::uint32_t pair_chunks() const noexcept {
         return (static_cast<std::uint32_t>(m_enlarged.size()) + m_settings.grain - 1) / m_settings.grain;
@@ -227,6 +236,10 @@ private:
     };
     std::vector<FatBoxRange> m_fat_ranges;
     std::vector<std::uint8_t> m_grown;
+    // The walk of the moving tree against itself: its stack, and per first user the count,
+    // then the place, of the pairs (order_by_first_user).
+    std::vector<std::pair<std::int32_t, std::int32_t>> m_self_stack;
+    std::vector<std::uint32_t> m_user_places;
 };
 
 template <typename Callback>
@@ -245,10 +258,12 @@ void ProxyTrees::query(const Aabb& box, Callback&& callback) const {
 // the proxy with the smaller key reports it, unless the caller knows it. Those two rules
 // read neither box, so the walk asks them before it reads the other's.
 template <typename Known>
-void ProxyTrees::find_pairs_of(ProxyId proxy, const Known& known, std::vector<Pair>& out) const {
+void ProxyTrees::find_pairs_of(ProxyId proxy, const Known& known, bool moving_pairs_found,
+                               std::vector<Pair>& out) const {
     const Aabb& box = fat_aabb(proxy);
     const std::uint64_t user_p = user(proxy);
-    for (int t = proxy.is_static() ? 0 : 1; t >= 0; --t) {
+    const int last = !proxy.is_static() && moving_pairs_found ? 1 : 0;
+    for (int t = proxy.is_static() ? 0 : 1; t >= last; --t) {
         const DynamicAabbTree& tree = m_trees[t];
         const auto passed_over = [&](std::int32_t tree_id) {
             const ProxyId other = ProxyId::make(tree_id, t == 1);
@@ -269,12 +284,25 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known&
     // Jobs only read the trees and the enlarged marks and write their own chunk's list,
     // sorted there: end_pair_search puts the sorted runs together.
     const std::uint32_t grain = m_settings.grain;
+    // Every moving proxy enlarged (a first step), on one worker: the moving pairs from one
+    // walk of the moving tree against itself, into the first chunk's list before its search
+    // adds to it (order_by_first_user orders every list's pairs together); the searches then
+    // look only in the other tree. The same pairs in the same order as the searches give;
+    // with more workers the searches run side by side, and the walk and the ordering after
+    // it, one thread's, would leave the others waiting.
+    const DynamicAabbTree& moving = m_trees[0];
+    const bool self = jobs.worker_count() == 1 && all_moving_enlarged() &&
+                      moving.self_pairs(m_self_stack, [&](std::int32_t a, std::int32_t b) {
+                          const Pair pair = make_pair(ProxyId::make(a, false), moving.user(a), ProxyId::make(b, false),
+                                                      moving.user(b));
+                          if (!known(pair.user_a, pair.user_b)) m_chunk_pairs[0].push_back(pair);
+                      });
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
-        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, out);
-        sort_pairs(out);
+        for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, self, out);
+        if (!self) sort_pairs(out);
     });
-    end_pair_search(jobs, new_pairs);
+    end_pair_search(jobs, new_pairs, self);
 }
 
 }  // namespace spindle

@@ -125,12 +125,15 @@ void create_contacts(World& world, std::span<const std::uint64_t> keys) {
 
     // The records are constructed and filled from the bodies' descriptions (cold: a first
     // step reads tens of thousands) in parallel; each job writes only its own contacts.
+    // Default-initialized, not value-initialized (`Contact()`): every field has its
+    // initializer, and value-initialization would first zero the whole record, then write
+    // the initialized fields over it again.
     std::atomic<std::uint32_t> reporting{0};
     world.jobs->parallel_for("NewContacts", static_cast<std::uint32_t>(first), end, kNewContactGrain,
                              [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
                                  std::uint32_t reports = 0;
                                  for (std::uint32_t c = lo; c < hi; ++c) {
-                                     Contact& contact = *::new (&world.contacts[c]) Contact();
+                                     Contact& contact = *::new (&world.contacts[c]) Contact;
                                      init_contact(world, made[c], contact);
                                      reports += contact.events != 0 ? 1u : 0u;
                                      world.contact_summaries[c] = contact_summary(contact);  // a sensor's has no points

@@ -500,7 +500,11 @@ TEST(ProxyTrees, FirstSearch_AnyMakingOrder_PairsInCanonicalOrder) {
     std::vector<std::vector<std::size_t>> orders{order, std::vector<std::size_t>(order.rbegin(), order.rend())};
     std::shuffle(order.begin(), order.end(), std::mt19937_64(3));
     orders.push_back(order);
-    for (const bool shared_users : {false, true}) {
+    // Users of one proxy each, of two proxies each, and too far apart to be counted (the
+    // first search orders its pairs by counting their first users where it can).
+    enum class Users { Own, Shared, Sparse };
+    for (const Users kind : {Users::Own, Users::Shared, Users::Sparse}) {
+        const int shared_users = static_cast<int>(kind);
         for (std::size_t o = 0; o < orders.size(); ++o) {
             for (const bool threaded : {false, true}) {
                 ProxyTrees bp(BroadphaseSettings{.grain = 5});
@@ -508,7 +512,9 @@ TEST(ProxyTrees, FirstSearch_AnyMakingOrder_PairsInCanonicalOrder) {
                 std::vector<std::uint64_t> users;
                 const ProxyId floor = bp.create_proxy(cube(Vec3(6, 0, 6), 7), 0, true);
                 for (const std::size_t k : orders[o]) {
-                    users.push_back(shared_users ? 1 + k / 2 : 1 + k);
+                    users.push_back(kind == Users::Shared   ? 1 + k / 2
+                                    : kind == Users::Sparse ? 1 + k * (std::uint64_t{1} << 40)
+                                                            : 1 + k);
                     ids.push_back(bp.create_proxy(cube(centres[k], 0.5), users.back(), false));
                 }
                 std::vector<Pair> expected;
