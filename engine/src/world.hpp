@@ -342,14 +342,18 @@ struct ContactMove {
 inline constexpr int kMaxContactManifolds = 8;
 
 // A contact's manifolds packed for the solver's listing: the point count of manifold m
-// in bits [3m, 3m + 3), and whether the contact has restitution (the top bit).
+// in bits [3m, 3m + 3), whether the contact has restitution (the top bit) and whether it
+// has rolling resistance (the bit below).
 inline constexpr int kSummaryBitsPerManifold = 3;
 inline constexpr std::uint32_t kSummaryRestitution = 1u << 31;
+inline constexpr std::uint32_t kSummaryRolls = 1u << 30;
+inline constexpr std::uint32_t kSummaryPointCounts = kSummaryRolls - 1;
 inline std::uint32_t contact_summary(const Contact& contact) {
     static_assert(kMaxManifoldPoints < (1 << kSummaryBitsPerManifold), "a point count in 3 bits");
-    static_assert(kMaxContactManifolds * kSummaryBitsPerManifold < 31, "the point counts below the restitution bit");
+    static_assert(kMaxContactManifolds * kSummaryBitsPerManifold < 30, "the point counts below the material bits");
     if ((contact.events & kContactSensor) != 0) return 0;  // a sensor's manifolds push nothing
     std::uint32_t summary = contact.restitution > 0 ? kSummaryRestitution : 0u;
+    if (contact.rolling_resistance > 0) summary |= kSummaryRolls;
     for (int m = 0; m < contact.manifold_count; ++m) {
         summary |= static_cast<std::uint32_t>(contact.manifold_at(m).point_count) << (kSummaryBitsPerManifold * m);
     }
@@ -448,6 +452,7 @@ struct World {
     std::size_t stocked_pages = 0;
     std::size_t first_step_bodies = 0;
     std::size_t first_step_contacts = 0;
+    bool first_step_rolls = false;  // one of those bodies has rolling resistance
 
     // The layer table: bit b of layer_masks[a] is set when layers a and b collide
     // (symmetric; all set by default, so filtering changes nothing until asked).

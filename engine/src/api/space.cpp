@@ -76,7 +76,8 @@ std::size_t told_contacts(const World& w) {
 void stock_first_step_pages(World& w) {
     const std::size_t told = told_contacts(w);
     const std::size_t contacts = told > 0 ? told : w.first_step_contacts;
-    const std::size_t pages = std::min(first_step_pages(w.first_step_bodies, contacts), kMostStockedPages);
+    const std::size_t pages = std::min(first_step_pages(w.first_step_bodies, contacts, w.first_step_rolls),
+                                       kMostStockedPages);
     while (w.stocked_pages < pages) {
         try {
             stock_huge_page();
@@ -94,6 +95,7 @@ void count_first_step(World& w, std::uint32_t slot) {
     w.first_step_contacts += pairs;
     const bool dynamic = w.bodies.type[slot] == MotionType::Dynamic;
     if (dynamic) w.first_step_bodies += 1;
+    w.first_step_rolls = w.first_step_rolls || w.bodies.traits[slot].rolling_resistance > 0;
     // A static floor made after the bodies resting on it brings their contacts.
     if (dynamic || pairs != 0) stock_first_step_pages(w);
 }

@@ -319,6 +319,7 @@ struct SolverScratch {
     struct ListedRange {
         std::vector<ManifoldRef> refs;
         bool restitution = false;  // any of them has restitution
+        bool rolls = false;        // any of them has rolling resistance
         std::size_t first = 0;     // where its refs go in manifolds
         bool same = false;         // they were in colored_manifolds where they go (join_range)
     };
@@ -343,7 +344,10 @@ struct SolverScratch {
     // writes their lanes, prepare_wide every other field).
     RawRoomVector<WideContact> wide;
     RawRoomVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (push_out, before read)
-    RawRoomVector<WideRolling> rolling;  // one per wide contact: written by prepare_wide where it rolls, else unread
+    // One per wide contact where any listed manifold rolls (`rolls`, this step's listing), else
+    // none: written by prepare_wide where a lane rolls, else unread.
+    RawRoomVector<WideRolling> rolling;
+    bool rolls = false;
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed
@@ -449,6 +453,10 @@ void find_support_scales(const World& world, SolverScratch& scratch);
 // the manifolds and bodies of the step; the others run per wide contact from the
 // colour loops.
 void pack_contacts(JobSystem& jobs, SolverScratch& scratch);
+// The rolling rows for this step's wide contacts where any listed manifold rolls, else
+// none (their memory given back): after pack_contacts, every step (a body's rolling
+// resistance may change while the colouring is kept).
+void size_rolling_rows(SolverScratch& scratch);
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi);  // wide [lo, hi)
 // push_anchors: the wide contact's kLanes push-out anchors (SolverScratch::push_anchors).

@@ -400,10 +400,6 @@ void pack_contacts(JobSystem& jobs, SolverScratch& scratch) {
     map_room(jobs, scratch.push_anchors, std::size_t{count} * kLanes);
     scratch.push_anchors.resize(std::size_t{count} * kLanes);
     if (far_above_use(scratch.push_anchors.capacity(), std::size_t{count} * kLanes)) fit_capacity(scratch.push_anchors);
-    // Not mapped ahead: most scenes never write it, and its pages stay untouched.
-    reserve_for(scratch.rolling, count);
-    scratch.rolling.resize(count);
-    if (far_above_use(scratch.rolling.capacity(), count)) fit_capacity(scratch.rolling);
     const auto immovable = static_cast<std::uint32_t>(scratch.bodies.size() - 1);
     jobs.parallel_for("PackContacts", 0, count, kPackGrain, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
         int c = 0;
@@ -728,11 +724,22 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
 
 }  // namespace
 
+void size_rolling_rows(SolverScratch& scratch) {
+    // Not mapped ahead: few scenes write it, and most of its pages stay untouched.
+    const std::size_t count = scratch.rolls ? scratch.wide.size() : 0;
+    reserve_for(scratch.rolling, count);
+    scratch.rolling.resize(count);
+    if (far_above_use(scratch.rolling.capacity(), count)) fit_capacity(scratch.rolling);
+}
+
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi) {
+    // Without rolling rows no lane rolls (size_rolling_rows): prepare_wide never writes this one.
+    WideRolling none;
     for (std::uint32_t k = lo; k < hi; ++k) {
         if (k + 1 < hi) prefetch_contacts(world, scratch, scratch.wide[k + 1]);
-        prepare_wide(world, scratch, params, scratch.wide[k], scratch.rolling[k]);
+        prepare_wide(world, scratch, params, scratch.wide[k], scratch.rolling.empty() ? none : scratch.rolling[k]);
+        SPINDLE_ASSERT(!scratch.wide[k].rolls || !scratch.rolling.empty(), "solver: a lane rolls without rolling rows");
     }
 }
 

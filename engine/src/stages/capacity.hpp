@@ -133,18 +133,19 @@ struct FirstStepArray {
 };
 
 // The arrays of the first step of `bodies` new dynamic bodies making `contacts` contacts that
-// take huge pages, as the stages lay them out. The wide contacts are counted as if the
+// take huge pages, as the stages lay them out; the rolling rows only where some contact
+// `rolls` (has rolling resistance: one of the bodies has it). The wide contacts are counted as if the
 // colours were full (the solver rounds each colour up to whole lanes). A list a step adds
 // on huge pages must be added here: PageStock.AFirstStepLaysOutTheArraysItsStockCounted
 // fails otherwise. The array's length is the rows': a row added or removed needs no count.
-constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts) {
+constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts, bool rolls) {
     const std::size_t wide = (contacts + kLanes - 1) / kLanes;
     const std::size_t slots = ContactIndex::slots_for(contacts);
     return std::to_array<FirstStepArray>({
         {"contact records", contacts, sizeof(Contact), true},
         {"wide contacts", wide, sizeof(WideContact), true},
         {"push anchors", wide * kLanes, sizeof(PushAnchors), true},
-        {"rolling rows", wide, sizeof(WideRolling), false},
+        {"rolling rows", rolls ? wide : 0, sizeof(WideRolling), false},
         {"solver bodies", bodies + 1, sizeof(SolverBody), true},
         {"pairs found", contacts, sizeof(Pair), false},
         {"pairs merged", contacts, sizeof(Pair), false},
@@ -164,10 +165,10 @@ constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts) {
 
 // The huge pages those arrays take: the pages moved under the mapped ones, and the chunks
 // (whole pages) of the medium block pool their blocks fill.
-constexpr std::size_t first_step_pages(std::size_t bodies, std::size_t contacts) {
+constexpr std::size_t first_step_pages(std::size_t bodies, std::size_t contacts, bool rolls) {
     std::size_t pages = 0;
     std::size_t pool_bytes = 0;
-    for (const FirstStepArray& array : first_step_arrays(bodies, contacts)) {
+    for (const FirstStepArray& array : first_step_arrays(bodies, contacts, rolls)) {
         pages += array.pages();
         pool_bytes += array.block_bytes();
     }

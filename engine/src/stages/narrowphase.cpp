@@ -396,7 +396,7 @@ void update_narrowphase(World& world) {
             // some contact reports events (a sensor's manifolds have no summary): then the
             // record says, and the pair's events are noted as for any other (ruling out must
             // not depend on who listens).
-            const bool apart = (world.contact_summaries[awake[k]] & (kSummaryRestitution - 1)) == 0;
+            const bool apart = (world.contact_summaries[awake[k]] & kSummaryPointCounts) == 0;
             if (apart && out_of_reach(world, awake[k], settings.speculative_distance, dt) &&
                 (!any_reporting || world.contacts[awake[k]].manifold_count == 0)) {
                 counts.out_of_reach += 1;

@@ -105,6 +105,7 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
     SolverScratch::ListedRange& range = scratch.listed[lo / kListGrain];
     range.refs.clear();
     bool restitution = false;
+    bool rolls = false;
     for (std::uint32_t k = lo; k < hi; ++k) {
         const std::uint32_t c = contacts[k];
         const std::uint32_t summary = world.contact_summaries[c];
@@ -113,14 +114,16 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
         const std::uint32_t a = solver_index(static_cast<std::uint32_t>(key >> 32));
         const std::uint32_t bb = solver_index(static_cast<std::uint32_t>(key & 0xffffffffu));
         constexpr std::uint32_t kCountMask = (1u << kSummaryBitsPerManifold) - 1;
-        std::uint32_t point_counts = summary & (kSummaryRestitution - 1);
+        std::uint32_t point_counts = summary & kSummaryPointCounts;
         for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
             if ((point_counts & kCountMask) == 0) continue;
             range.refs.push_back({c, m, a, bb});
             restitution = restitution || (summary & kSummaryRestitution) != 0;
+            rolls = rolls || (summary & kSummaryRolls) != 0;
         }
     }
     range.restitution = restitution;
+    range.rolls = rolls;
 }
 
 // JoinManifolds' range: its refs into the step's list, and into the last colouring's list
@@ -168,6 +171,7 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     // hundreds of new pages, each a fault on its first write.
     const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1}, {"JoinManifolds", ranges, 1}};
     bool restitution = false;
+    scratch.rolls = false;       // any listed manifold rolls: the ranges' say, as they are placed
     if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
         scratch.manifolds.clear();
         scratch.same_manifolds = scratch.colored_manifolds.empty();
@@ -181,6 +185,7 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
             range.first = total;
             total += range.refs.size();
             restitution = restitution || range.restitution;
+            scratch.rolls = scratch.rolls || range.rolls;
         }
         scratch.manifolds.resize(total);
         same_count = scratch.colored_manifolds.size() == total;
@@ -759,6 +764,7 @@ void solve(World& world, Real dt) {
         scratch.lead_made = false;
         world.counters.constraint_colorings += 1;
     }
+    size_rolling_rows(scratch);
     // Folded only where every phase that integrates has a constraint to carry it.
     scratch.folded = scratch.fold_body_passes && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;

@@ -80,6 +80,7 @@ void give_back_stock(World& world) {
     world.building_level = false;
     world.first_step_bodies = 0;
     world.first_step_contacts = 0;
+    world.first_step_rolls = false;
     if (world.stocked_pages != 0) give_back_stocked_huge_pages(std::exchange(world.stocked_pages, 0));
 }
 

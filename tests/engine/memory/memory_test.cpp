@@ -68,6 +68,39 @@ TEST(Memory, PyramidHoldsItsArraysTailsOnSmallPages) {
     EXPECT_LT((static_cast<double>(mapped_bytes_held()) - start) / body_count, 12'600);
 }
 
+// The rolling rows (one per wide contact, 704 bytes each) are kept only while some contact
+// rolls: the pyramid's boxes have no rolling resistance, and held 0.78 MB of rows no pass
+// read. A ball given rolling resistance on its floor gets them from the next step on, the
+// colouring kept (its contact and manifold the same), and gives them back without it.
+TEST(Memory, RollingRowsOnlyWhileAContactRolls) {
+    const Pyramid pyramid(kLanded);
+    const SolverScratch& boxes = *SpaceInternals::world(pyramid.space).solver;
+    ASSERT_GT(boxes.wide.size(), 1000u);
+    EXPECT_EQ(boxes.rolling.capacity(), 0u) << "rolling rows for a pyramid in which nothing rolls";
+
+    Space space;
+    test::add_static_box(space, Vec3(20, 1, 20), Vec3(0, -1, 0));
+    BodyDesc ball;
+    ball.shape = Shape::sphere(0.5);
+    ball.position = Vec3(0, 0.5, 0);
+    ball.linear_velocity = Vec3(2, 0, 0);
+    ball.angular_velocity = Vec3(0, 0, -4);
+    const BodyHandle handle = space.create_body(ball);
+    const SolverScratch& solver = *SpaceInternals::world(space).solver;
+    for (int i = 0; i < 10; ++i) space.update();
+    ASSERT_EQ(solver.wide.size(), 1u);
+    EXPECT_EQ(solver.rolling.size(), 0u);
+    const std::uint64_t colorings = SpaceInternals::world(space).counters.constraint_colorings;
+    space.set_rolling_resistance(handle, 0.1);
+    for (int i = 0; i < 10; ++i) space.update();
+    EXPECT_EQ(SpaceInternals::world(space).counters.constraint_colorings, colorings) << "the colouring was not kept";
+    EXPECT_EQ(solver.rolling.size(), 1u);
+    EXPECT_TRUE(solver.wide[0].rolls);
+    space.set_rolling_resistance(handle, 0);
+    space.update();
+    EXPECT_EQ(solver.rolling.size(), 0u);  // its capacity too once far above use (stages/capacity.hpp)
+}
+
 TEST(Memory, ContactArraysAreGivenBackWhenThePileComesApart) {
     Pyramid pyramid(kLanded);
     const World& world = SpaceInternals::world(pyramid.space);
@@ -197,8 +230,9 @@ TEST(Memory, ReservingMoreBodiesThanAHandleCanIndexThrowsNamingTheCount) {
 }
 
 // Every list the solver keeps between steps is in memory_report's solver_other: the
-// pyramid on two workers (the colours sorted, the first touches listed) gives its bytes
-// back as each list is emptied, byte for byte.
+// pyramid on two workers (the colours sorted, the first touches listed; its floor
+// with rolling resistance, so the rolling rows are kept) gives its bytes back as each list
+// is emptied, byte for byte.
 TEST(Memory, EveryListTheSolverKeepsIsCounted) {
     const SceneDesc scene = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/pyramid.toml");
     WorkStealingJobSystem::Options two_workers;
@@ -206,7 +240,8 @@ TEST(Memory, EveryListTheSolverKeepsIsCounted) {
     two_workers.pin = false;
     WorkStealingJobSystem jobs(two_workers);
     Space space(scene.settings, &jobs);
-    build(scene, space);
+    const std::vector<BodyHandle> bodies = build(scene, space);
+    space.set_rolling_resistance(bodies.front(), 0.05);  // the floor
     for (int i = 0; i < 10; ++i) space.update();
     SolverScratch& solver = *SpaceInternals::world(space).solver;
     std::size_t before = memory_report(space).solver_other;

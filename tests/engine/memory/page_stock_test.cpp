@@ -154,7 +154,8 @@ void expect_first_step_lays_out_its_arrays(const SpaceSettings& settings, Level&
         };
         bool same = true;
         MediumBlockCounts counted;
-        for (const FirstStepArray& array : first_step_arrays(world.first_step_bodies, world.contacts.size())) {
+        for (const FirstStepArray& array :
+             first_step_arrays(world.first_step_bodies, world.contacts.size(), world.first_step_rolls)) {
             if (array.mapped && array.pages() != 0) {
                 const auto it = mapped_pages.find(array.name);
                 const std::size_t laid_out = it == mapped_pages.end() ? 0 : it->second;
