@@ -116,8 +116,9 @@ Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide
 }
 
 // What central friction reads of the lanes' manifolds and bodies, gathered in double by
-// prepare_wide. Lanes and point slots without a manifold or point are zero. Not zeroed
-// when default-built: prepare_wide writes each field once, a lane at a time.
+// prepare_wide. Lanes and point slots without a manifold or point are zero, and lie
+// kEmptySeparation apart. Not zeroed when default-built: prepare_wide writes each field
+// once, a lane at a time.
 struct FrictionLanes {
     WideD3 anchor_a[kMaxManifoldPoints], anchor_b[kMaxManifoldPoints];  // each point from A's and B's centre
     WideD separation[kMaxManifoldPoints];
@@ -307,7 +308,10 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     // far apart. Lanes without a manifold are zeroed here, empty point slots of a lane and
     // the lock masks of an unlocked lane in the loop.
     FrictionLanes in;
-    if (wc.lanes < kLanes) in = FrictionLanes{};
+    if (wc.lanes < kLanes) {
+        in = FrictionLanes{};
+        for (WideD& gap : in.separation) gap = splat_d(kEmptySeparation);
+    }
     for (int axis = 0; axis < 3; ++axis) in.locked_a[axis] = in.locked_b[axis] = WideDMask{};
     Wide normal_impulse[kMaxManifoldPoints]{};
     WideD gravity_scale_a{}, gravity_scale_b{};
@@ -367,7 +371,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         for (int j = m.point_count; j < kMaxManifoldPoints; ++j) {
             in.anchor_a[j].set_lane(l, Vec3::Zero());
             in.anchor_b[j].set_lane(l, Vec3::Zero());
-            in.separation[j][l] = 0;
+            in.separation[j][l] = kEmptySeparation;
             in.filled[j][l] = 0;
         }
         if (contact.rolling_resistance > 0) prepare_rolling(world, contact, m, A, B, wc, rolling, l);
@@ -395,7 +399,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         ra[j] = narrow(in.anchor_a[j]);
         rb[j] = narrow(in.anchor_b[j]);
-        separation[j] = narrow(select(in.filled[j], in.separation[j], splat_d(kEmptySeparation)));
+        separation[j] = narrow(in.separation[j]);
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());
