@@ -33,16 +33,6 @@ constexpr Real kEmptySeparation = 1e18;  // an empty point slot: far apart, neve
 // blocks are long enough that a job's overhead stays small beside them.
 constexpr std::uint32_t kPackGrain = 256;
 
-// A tangent basis for a unit normal, the same for the same normal every time.
-void tangent_basis(const Vec3& n, Vec3& t1, Vec3& t2) {
-    if (std::abs(n.x()) >= 0.57735) {
-        t1 = Vec3(n.y(), -n.x(), 0).normalized();
-    } else {
-        t1 = Vec3(0, n.z(), -n.y()).normalized();
-    }
-    t2 = n.cross(t1);
-}
-
 // Fills a row's angular terms and returns its effective mass.
 Real make_row(const SolverBody& A, const SolverBody& B, const Vec3& ra, const Vec3& rb, const Vec3& dir,
               ContactRow& row) {
@@ -126,23 +116,52 @@ Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide
 }
 
 // What central friction reads of the lanes' manifolds and bodies, gathered in double by
-// prepare_wide. Lanes and point slots without a manifold or point stay zero.
+// prepare_wide. Lanes and point slots without a manifold or point are zero, and lie
+// kEmptySeparation apart. Not zeroed when default-built: prepare_wide writes each field
+// once, a lane at a time.
 struct FrictionLanes {
     WideD3 anchor_a[kMaxManifoldPoints], anchor_b[kMaxManifoldPoints];  // each point from A's and B's centre
-    WideD separation[kMaxManifoldPoints]{};
-    WideDMask filled[kMaxManifoldPoints]{};  // lanes with a point in the slot
+    WideD separation[kMaxManifoldPoints];
+    WideDMask filled[kMaxManifoldPoints];  // lanes with a point in the slot
     WideD3 normal, tangent[2];
     WideD3 friction_impulse;
     WideDMat3 inv_inertia_a, inv_inertia_b;
-    WideD inv_mass_a{}, inv_mass_b{};
+    WideD inv_mass_a, inv_mass_b;
     // Per world axis, lanes whose body has its translation along it locked.
-    WideDMask locked_a[3]{}, locked_b[3]{};
+    WideDMask locked_a[3], locked_b[3];
 };
 
 // The free part of v (without_axes, motion_locks.hpp): a locked axis is an exact zero.
 WideD3 free_part(const WideD3& v, const WideDMask (&locked)[3]) {
     const WideD zero{};
     return {select(locked[0], zero, v.x), select(locked[1], zero, v.y), select(locked[2], zero, v.z)};
+}
+
+// inverse_mass_along (motion_locks.hpp) for the lanes: inv_mass, or where the body has a
+// translation lock (`locked_body`) its share along the free axes.
+WideD inverse_mass_along(WideD inv_mass, WideDMask locked_body, const WideDMask (&locked)[3], const WideD3& dir) {
+    if (!any(locked_body)) return inv_mass;
+    const WideD3 free = free_part(dir, locked);
+    return select(locked_body, inv_mass * dot(free, free), inv_mass);
+}
+
+// A tangent basis for each lane's unit normal, the same for the same normal every time:
+// t1 normalized from (n.y, -n.x, 0) where |n.x| >= 0.57735, else from (0, n.z, -n.y), and
+// t2 = n x t1, made as Eigen's normalized() and cross() make them on one lane (a sum of
+// three squares by halves, a division by the root). Lanes not in `live` are zero.
+void tangent_basis(const WideD3& n, WideDMask live, WideD3& t1, WideD3& t2) {
+    const WideD zero{}, bound = splat_d(0.57735);
+    const WideDMask steep = abs_at_least(n.x, bound);
+    const WideD3 raw = select(steep, WideD3{n.y, -n.x, zero}, WideD3{zero, n.z, -n.y});
+    const WideD squared = dot(raw, raw);
+    const WideDMask positive = squared > zero;
+    t1 = raw / wide_sqrt(squared);
+    if (!all(positive)) t1 = select(positive, t1, raw);
+    t2 = cross(n, t1);
+    if (!all(live)) {
+        t1 = select(live, t1, WideD3{});
+        t2 = select(live, t2, WideD3{});
+    }
 }
 
 // Central friction of the lanes (Box3D's): the friction centre is the points' mean,
@@ -155,22 +174,29 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
     WideD3 center_a, center_b;
     WideD total{};
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
-        WideD weight = splat_d(2) - in.separation[j] / distance;
-        weight = select(weight < min_weight, min_weight, weight);  // std::clamp's order
-        weight = select(one < weight, one, weight);
+        // std::clamp's order: the lower bound where the weight is below it, then the upper.
+        const WideD weight = wide_min(one, wide_max(min_weight, splat_d(2) - in.separation[j] / distance));
         if (j == 0) {  // every manifold has a first point (a lane without one weighs a zero anchor)
             center_a = WideD3{} + weight * in.anchor_a[0];
             center_b = WideD3{} + weight * in.anchor_b[0];
             total = zero + weight;
             continue;
         }
-        center_a = select(in.filled[j], center_a + weight * in.anchor_a[j], center_a);
-        center_b = select(in.filled[j], center_b + weight * in.anchor_b[j], center_b);
-        total = select(in.filled[j], total + weight, total);
+        // A slot without a point adds weight 0 and its zero anchor: the sums are never -0
+        // after the first point (+0 + x is not), so adding +0 leaves each as it was.
+        const WideD filled_weight = select(in.filled[j], weight, zero);
+        center_a = center_a + filled_weight * in.anchor_a[j];
+        center_b = center_b + filled_weight * in.anchor_b[j];
+        total = total + filled_weight;
     }
     const WideDMask weighed = total > zero;
-    center_a = select(weighed, center_a / total, center_a);
-    center_b = select(weighed, center_b / total, center_b);
+    if (all(weighed)) {
+        center_a = center_a / total;
+        center_b = center_b / total;
+    } else {
+        center_a = select(weighed, center_a / total, center_a);
+        center_b = select(weighed, center_b / total, center_b);
+    }
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         const WideD3 arm = in.anchor_a[j] - center_a;
         wc.points[j].lever_arm = narrow(select(in.filled[j], wide_sqrt(dot(arm, arm)), zero));
@@ -186,8 +212,17 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
         wc.friction_row[t] = {narrow(ia[t]), narrow(ib[t])};
     }
     // k(s, t) = ms (Ps ts).(Ps tt) summed over both bodies (P: the free axes) + the angular terms.
-    const WideD3 free_a[2] = {free_part(in.tangent[0], in.locked_a), free_part(in.tangent[1], in.locked_a)};
-    const WideD3 free_b[2] = {free_part(in.tangent[0], in.locked_b), free_part(in.tangent[1], in.locked_b)};
+    WideD3 locked_free_a[2], locked_free_b[2];
+    const WideD3* free_a = in.tangent;
+    const WideD3* free_b = in.tangent;
+    if (wc.locked) {
+        for (int t = 0; t < 2; ++t) {
+            locked_free_a[t] = free_part(in.tangent[t], in.locked_a);
+            locked_free_b[t] = free_part(in.tangent[t], in.locked_b);
+        }
+        free_a = locked_free_a;
+        free_b = locked_free_b;
+    }
     auto linear = [&](int s, int t) {
         return in.inv_mass_a * dot(free_a[s], free_a[t]) + in.inv_mass_b * dot(free_b[s], free_b[t]);
     };
@@ -199,11 +234,17 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
     const WideD det = k00 * k11 - k01 * k01;
     const WideD trace = k00 + k11;
     const WideDMask invertible = det > splat_d(1e-9) * trace * trace;
-    const WideDMask pseudo = ~invertible & (trace > zero);
-    const WideD inv_sq = one / (trace * trace);
-    wc.friction_mass[0] = narrow(select(invertible, k11 / det, select(pseudo, k00 * inv_sq, zero)));
-    wc.friction_mass[1] = narrow(select(invertible, -k01 / det, select(pseudo, k01 * inv_sq, zero)));
-    wc.friction_mass[2] = narrow(select(invertible, k00 / det, select(pseudo, k11 * inv_sq, zero)));
+    if (all(invertible)) {
+        wc.friction_mass[0] = narrow(k11 / det);
+        wc.friction_mass[1] = narrow(-k01 / det);
+        wc.friction_mass[2] = narrow(k00 / det);
+    } else {
+        const WideDMask pseudo = ~invertible & (trace > zero);
+        const WideD inv_sq = one / (trace * trace);
+        wc.friction_mass[0] = narrow(select(invertible, k11 / det, select(pseudo, k00 * inv_sq, zero)));
+        wc.friction_mass[1] = narrow(select(invertible, -k01 / det, select(pseudo, k01 * inv_sq, zero)));
+        wc.friction_mass[2] = narrow(select(invertible, k00 / det, select(pseudo, k11 * inv_sq, zero)));
+    }
     wc.friction_impulse[0] = narrow(dot(in.tangent[0], in.friction_impulse));
     wc.friction_impulse[1] = narrow(dot(in.tangent[1], in.friction_impulse));
     const WideD3 twist_a = in.inv_inertia_a * in.normal, twist_b = in.inv_inertia_b * in.normal;
@@ -264,45 +305,47 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     const Bodies& b = world.bodies;
     const Vec3 g = world.settings.gravity;
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
-    // far apart.
+    // far apart. Lanes without a manifold are zeroed here, empty point slots of a lane and
+    // the lock masks of an unlocked lane in the loop.
     FrictionLanes in;
+    if (wc.lanes < kLanes) {
+        in = FrictionLanes{};
+        for (WideD& gap : in.separation) gap = splat_d(kEmptySeparation);
+    }
+    for (int axis = 0; axis < 3; ++axis) in.locked_a[axis] = in.locked_b[axis] = WideDMask{};
     Wide normal_impulse[kMaxManifoldPoints]{};
-    // Inverse mass sum of both bodies along the normal: the share of the free axes for a
-    // locked body, inv_mass_a + inv_mass_b otherwise.
-    Wide linear_sum{};
+    WideD gravity_scale_a{}, gravity_scale_b{};
+    WideDMask live{}, locks_a{}, locks_b{};  // lanes with a manifold; lanes whose body has a translation lock
     wc.locked = false;
     wc.tracks_push = false;
     wc.rolls = false;
-    wc.friction = wc.restitution = wc.gravity_normal = wc.against_static = Wide{};
+    wc.friction = wc.restitution = wc.against_static = Wide{};
     wc.radius_a = wc.radius_b = Wide{};
     wc.twist_impulse = Wide{};
     for (std::uint8_t& points : wc.slot_points) points = 0;
     const Real friction_distance = std::max(world.settings.solver.speculative_distance, Real(1e-3));
+    SolverBody scaled_a, scaled_b;  // a lane's bodies where a support scale is not 1
     for (int l = 0; l < wc.lanes; ++l) {
         const ManifoldRef& ref = scratch.manifolds[wc.ref[l]];
         const Contact& contact = world.contacts[ref.contact];
         const ContactManifold& m = contact.manifold_at(static_cast<int>(ref.manifold));
         // A light body carrying a heavier one is solved heavier here (support_scales.cpp).
         const SupportScale scale = scratch.support_scales.empty() ? SupportScale{} : scratch.support_scales[wc.ref[l]];
-        SolverBody scaled_a, scaled_b;
         const SolverBody& A = scaled(scratch.bodies[ref.a], scale.a, scaled_a);
         const SolverBody& B = scaled(scratch.bodies[ref.b], scale.b, scaled_b);
-        Vec3 tangent[2];
-        tangent_basis(m.normal, tangent[0], tangent[1]);
+        live[l] = -1;
         in.normal.set_lane(l, m.normal);
-        in.tangent[0].set_lane(l, tangent[0]);
-        in.tangent[1].set_lane(l, tangent[1]);
         in.inv_mass_a[l] = A.inv_mass;
         in.inv_mass_b[l] = B.inv_mass;
         if (((A.locks | B.locks) & kLockTranslation) != 0) {  // else the lane's masks stay clear
             wc.locked = true;
+            locks_a[l] = (A.locks & kLockTranslation) != 0 ? -1 : 0;
+            locks_b[l] = (B.locks & kLockTranslation) != 0 ? -1 : 0;
             for (int axis = 0; axis < 3; ++axis) {
                 in.locked_a[axis][l] = (A.locks & (1u << axis)) != 0 ? -1 : 0;
                 in.locked_b[axis][l] = (B.locks & (1u << axis)) != 0 ? -1 : 0;
             }
         }
-        linear_sum[l] = inverse_mass_along(A.inv_mass, A.locks, m.normal) +
-                        inverse_mass_along(B.inv_mass, B.locks, m.normal);
         in.inv_inertia_a.set_lane(l, A.inv_inertia);
         in.inv_inertia_b.set_lane(l, B.inv_inertia);
         in.friction_impulse.set_lane(l, m.friction_impulse);
@@ -314,8 +357,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.tracks_push = wc.tracks_push || contact.restitution > 0 || (contact.events & kContactReports) != 0;
         wc.radius_a[l] = m.radius_a;
         wc.radius_b[l] = m.radius_b;
-        wc.gravity_normal[l] = m.normal.dot(project_linear(scratch.gravity_scales[ref.b] * g, B.locks) -
-                                            project_linear(scratch.gravity_scales[ref.a] * g, A.locks));
+        gravity_scale_a[l] = scratch.gravity_scales[ref.a];
+        gravity_scale_b[l] = scratch.gravity_scales[ref.b];
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));
@@ -325,8 +368,25 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             normal_impulse[j][l] = src.normal_impulse;
             ++wc.slot_points[j];
         }
+        for (int j = m.point_count; j < kMaxManifoldPoints; ++j) {
+            in.anchor_a[j].set_lane(l, Vec3::Zero());
+            in.anchor_b[j].set_lane(l, Vec3::Zero());
+            in.separation[j][l] = kEmptySeparation;
+            in.filled[j][l] = 0;
+        }
         if (contact.rolling_resistance > 0) prepare_rolling(world, contact, m, A, B, wc, rolling, l);
     }
+    tangent_basis(in.normal, live, in.tangent[0], in.tangent[1]);
+    // Inverse mass sum of both bodies along the normal (the share of the free axes for a
+    // locked body, inverse_mass_along) and gravity's pull along it, as the scalar
+    // expressions make them on each lane: a lock zeroes the axes as project_linear does.
+    const Wide linear_sum = narrow(inverse_mass_along(in.inv_mass_a, locks_a, in.locked_a, in.normal) +
+                                   inverse_mass_along(in.inv_mass_b, locks_b, in.locked_b, in.normal));
+    const WideD3 gravity{splat_d(g.x()), splat_d(g.y()), splat_d(g.z())};
+    const WideD3 pull = wc.locked ? free_part(gravity_scale_b * gravity, in.locked_b) -
+                                        free_part(gravity_scale_a * gravity, in.locked_a)
+                                  : gravity_scale_b * gravity - gravity_scale_a * gravity;
+    wc.gravity_normal = narrow(select(live, dot(in.normal, pull), WideD{}));
     wc.inv_mass_a = narrow(in.inv_mass_a);
     wc.inv_mass_b = narrow(in.inv_mass_b);
     wc.normal = narrow(in.normal);
@@ -339,7 +399,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         ra[j] = narrow(in.anchor_a[j]);
         rb[j] = narrow(in.anchor_b[j]);
-        separation[j] = narrow(select(in.filled[j], in.separation[j], splat_d(kEmptySeparation)));
+        separation[j] = narrow(in.separation[j]);
     }
     WideVelocities s{};  // for the approach speeds
     if (wc.tracks_push) s = gather(wc, scratch.bodies.data());

@@ -184,6 +184,52 @@ inline WideD select(WideDMask m, WideD if_set, WideD if_clear) {
     return reinterpret_cast<WideD>((m & reinterpret_cast<WideDMask>(if_set)) |
                                    (~m & reinterpret_cast<WideDMask>(if_clear)));
 }
+// The lanes' sign bits, lane i in bit i: a mask's set lanes.
+inline unsigned lane_bits(WideDMask m) {
+#if defined(__AVX__)
+    const auto lo = reinterpret_cast<__m256d>(__builtin_shufflevector(m, m, 0, 1, 2, 3));
+    const auto hi = reinterpret_cast<__m256d>(__builtin_shufflevector(m, m, 4, 5, 6, 7));
+    return static_cast<unsigned>(_mm256_movemask_pd(lo)) | static_cast<unsigned>(_mm256_movemask_pd(hi)) << 4;
+#else
+    unsigned bits = 0;
+    for (int i = 0; i < kLanes; ++i) bits |= (m[i] < 0 ? 1u : 0u) << i;
+    return bits;
+#endif
+}
+inline bool any(WideDMask m) { return lane_bits(m) != 0; }
+inline bool all(WideDMask m) { return lane_bits(m) == (1u << kLanes) - 1; }
+// |a| >= b lane by lane, as std::abs(a) >= b: the sign bit cleared.
+inline WideDMask abs_at_least(WideD a, WideD b) {
+    constexpr std::int64_t kMagnitude = 0x7fffffffffffffff;
+    return reinterpret_cast<WideD>(reinterpret_cast<WideDMask>(a) & kMagnitude) >= b;
+}
+// a > b ? a : b and a < b ? a : b lane by lane: where either is NaN, b (x86's maxpd and
+// minpd, one instruction a half; GCC splits the vector ternary lane by lane).
+#if defined(__AVX__)
+template <class Op>
+inline WideD by_halves(WideD a, WideD b, Op op) {
+    const Double4 lo = op(__builtin_shufflevector(a, a, 0, 1, 2, 3), __builtin_shufflevector(b, b, 0, 1, 2, 3));
+    const Double4 hi = op(__builtin_shufflevector(a, a, 4, 5, 6, 7), __builtin_shufflevector(b, b, 4, 5, 6, 7));
+    return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+}
+inline WideD wide_max(WideD a, WideD b) {
+    return by_halves(a, b, [](Double4 x, Double4 y) -> Double4 { return _mm256_max_pd(x, y); });
+}
+inline WideD wide_min(WideD a, WideD b) {
+    return by_halves(a, b, [](Double4 x, Double4 y) -> Double4 { return _mm256_min_pd(x, y); });
+}
+#else
+inline WideD wide_max(WideD a, WideD b) {
+    WideD r;
+    for (int i = 0; i < kLanes; ++i) r[i] = a[i] > b[i] ? a[i] : b[i];
+    return r;
+}
+inline WideD wide_min(WideD a, WideD b) {
+    WideD r;
+    for (int i = 0; i < kLanes; ++i) r[i] = a[i] < b[i] ? a[i] : b[i];
+    return r;
+}
+#endif
 inline Wide narrow(WideD a) { return __builtin_convertvector(a, Wide); }  // each lane rounded as a scalar cast
 inline WideD wide_sqrt(WideD a) {
 #if defined(__AVX__)
@@ -198,8 +244,9 @@ inline WideD wide_sqrt(WideD a) {
 #endif
 }
 
+// Not zeroed when default-built (WideD3{} is zero): preparing writes what it reads.
 struct WideD3 {
-    WideD x{}, y{}, z{};
+    WideD x, y, z;
 
     void set_lane(int i, const Vec3& v) {
         x[i] = v.x();
@@ -223,7 +270,7 @@ inline Wide3 narrow(const WideD3& v) { return {narrow(v.x), narrow(v.y), narrow(
 
 // A 3x3 matrix per lane, row-major.
 struct WideDMat3 {
-    WideD m[3][3]{};
+    WideD m[3][3];
 
     void set_lane(int i, const Mat3& a) {
         for (int r = 0; r < 3; ++r) {

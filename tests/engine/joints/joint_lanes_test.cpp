@@ -343,6 +343,39 @@ TEST(JointLanes, SquareRootIsEachLanesScalarRootToTheBit) {
     EXPECT_EQ(differing, 0) << "of " << values.size() << " roots";
 }
 
+// The double lanes' max, min, |a| >= b and mask tests (wide.hpp; the contact solver's
+// preparing clamps its friction weights and picks its tangent basis with them): each
+// lane the scalar ternary's bits, NaN and signed zeros included, so a build with or
+// without AVX gives what std::clamp and std::abs gave.
+TEST(JointLanes, DoubleLanesMaxMinAndAbsAreTheScalarTernariesToTheBit) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double values[] = {0.0, -0.0, 1e-3, -1e-3, 1.0, -1.0, 0.57735, -0.57735, nan, 2.5, -7.0, 1e300};
+    auto bits = [](double x) {
+        std::uint64_t b;
+        std::memcpy(&b, &x, sizeof b);
+        return b;
+    };
+    int differing = 0;
+    for (double x : values) {
+        for (double y : values) {
+            const WideD a = splat_d(x), b = splat_d(y);
+            if (bits(wide_max(a, b)[3]) != bits(x > y ? x : y)) ++differing;
+            if (bits(wide_min(a, b)[6]) != bits(x < y ? x : y)) ++differing;
+            if ((abs_at_least(a, b)[5] != 0) != (std::abs(x) >= y)) ++differing;
+        }
+    }
+    EXPECT_EQ(differing, 0);
+    WideDMask mask{};
+    EXPECT_FALSE(any(mask));
+    mask[7] = -1;
+    EXPECT_TRUE(any(mask));
+    EXPECT_FALSE(all(mask));
+    for (int l = 0; l < kLanes; ++l) mask[l] = -1;
+    EXPECT_TRUE(all(mask));
+    mask[0] = 0;
+    EXPECT_FALSE(all(mask));
+}
+
 // Swing-twist joints swung nearly half a turn (150-178 degrees, where the arc that undoes
 // the swing is short of an axis and the float lanes' twist rests on 1 + cos(swing)): the
 // cone and twist rows still push as the scalar rows do.
