@@ -317,11 +317,6 @@ void remove_joint(World& world, std::uint32_t slot, std::uint32_t dying = ~0u) {
 
 }  // namespace
 
-bool joint_blocks_pair(const World& world, std::uint32_t a, std::uint32_t b) {
-    const auto& pairs = world.joints.blocked_pairs;
-    return !pairs.empty() && pairs.count(pair_key(a, b)) != 0;
-}
-
 const std::vector<std::uint32_t>& awake_joints(World& world) {
     Joints& js = world.joints;
     if (js.awake_dirty) {

@@ -75,8 +75,11 @@ inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
 }
 
 // True when a joint between bodies a and b (slots) switches their collision off; the
-// broadphase asks before it makes a contact for a new pair. Free without joints.
-bool joint_blocks_pair(const World& world, std::uint32_t a, std::uint32_t b);
+// broadphase asks before it makes a contact for each new pair. Inline, so that without
+// such a joint (most spaces) the question is one test of an empty table, not a call.
+inline bool joint_blocks_pair(const Joints& joints, std::uint32_t a, std::uint32_t b) {
+    return !joints.blocked_pairs.empty() && joints.blocked_pairs.count(pair_key(a, b)) != 0;
+}
 
 // The awake joints' slots (Joints::awake_list, rebuilt first if stale).
 const std::vector<std::uint32_t>& awake_joints(World& world);

@@ -232,8 +232,6 @@ void select_in_order(JobSystem& jobs, const char* name, std::uint32_t n, std::ui
 void make_contacts(World& world, BroadphaseState& bp) {
     const Bodies& b = world.bodies;
     std::atomic<std::uint64_t> filtered{0};
-    // Asked once, not in a call per pair: most spaces have no joint that keeps its bodies apart.
-    const bool any_joint_blocks = !world.joints.blocked_pairs.empty();
     select_in_order(*world.jobs, "NewPairs", static_cast<std::uint32_t>(bp.pairs.size()), kPairGrain, bp.range_counts,
                     bp.new_keys, [&](std::uint32_t k, std::uint64_t& key) {
                         const auto i = static_cast<std::uint32_t>(bp.pairs[k].user_a);
@@ -246,7 +244,7 @@ void make_contacts(World& world, BroadphaseState& bp) {
                         }
                         key = (std::uint64_t{std::min(i, j)} << 32) | std::max(i, j);
                         // Jointed bodies collide only if asked.
-                        if (any_joint_blocks && joint_blocks_pair(world, i, j)) return false;
+                        if (joint_blocks_pair(world.joints, i, j)) return false;
                         return true;
                     });
     world.counters.pairs_filtered += filtered.load(std::memory_order_relaxed);

@@ -113,7 +113,7 @@ std::set<std::uint64_t> allowed_overlaps(const World& world) {
             if (!b.alive[i] || !b.alive[j]) continue;
             if (b.type[i] != MotionType::Dynamic && b.type[j] != MotionType::Dynamic) continue;
             if (b.traits[i].sensor && b.traits[j].sensor) continue;
-            if (filter_blocks_pair(world, i, j) || joint_blocks_pair(world, i, j)) continue;
+            if (filter_blocks_pair(world, i, j) || joint_blocks_pair(world.joints, i, j)) continue;
             if (!bp.tree.test_overlap(bp.proxy[i], bp.proxy[j])) continue;
             pairs.insert(std::uint64_t{i} << 32 | j);
         }
