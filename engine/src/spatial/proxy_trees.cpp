@@ -230,38 +230,37 @@ std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs
 
 void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self) {
     if (self) {
-        order_by_first_user(new_pairs);
-        merge_runs(jobs, new_pairs);  // one run: only its scratch laid out, as for a search's
+        order_by_first_user(new_pairs);  // one run
+    } else {
+        const std::uint32_t chunks = pair_chunks();
+        m_run_starts.assign(chunks + 1, 0);
+        for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
+        // Raw room: each chunk's run is first written by its copy, in jobs where there are
+        // several (a first step's megabytes), here where there is one (a step's few pairs).
+        new_pairs.resize(m_run_starts[chunks]);
+        const auto join = [&](std::uint32_t begin, std::uint32_t end, unsigned) {
+            for (std::uint32_t c = begin; c < end; ++c) {
+                std::copy(m_chunk_pairs[c].begin(), m_chunk_pairs[c].end(),
+                          new_pairs.begin() + static_cast<std::ptrdiff_t>(m_run_starts[c]));
+            }
+        };
+        if (chunks == 1) {
+            join(0, 1, 0);
+        } else {
+            jobs.parallel_for("broadphase.join_pairs", 0, chunks, 1, join);
+        }
+    }
+    // The chunk order already fixes the result for a given enlarged list; sorting also
+    // frees it from the marking order, so the engine sees pairs in a canonical order.
+    // (The walk's one run: only the merge's scratch laid out, as for a search's.)
+    merge_runs(jobs, new_pairs);
+    if (self) {
         // A first step's scratch, given back: the first list held nearly every pair, and the
         // steps after find a few in each list.
         std::vector<Pair>().swap(m_chunk_pairs[0]);
         std::vector<std::uint32_t>().swap(m_user_places);
         std::vector<std::pair<std::int32_t, std::int32_t>>().swap(m_self_stack);
-        for (const ProxyId id : m_enlarged) slots_of(id)[static_cast<std::size_t>(id.tree_id())] = -1;
-        m_enlarged.clear();
-        return;
     }
-    const std::uint32_t chunks = pair_chunks();
-    m_run_starts.assign(chunks + 1, 0);
-    for (std::uint32_t c = 0; c < chunks; ++c) m_run_starts[c + 1] = m_run_starts[c] + m_chunk_pairs[c].size();
-    // Raw room: each chunk's run is first written by its copy, in jobs where there are
-    // several (a first step's megabytes), here where there is one (a step's few pairs).
-    new_pairs.resize(m_run_starts[chunks]);
-    const auto join = [&](std::uint32_t begin, std::uint32_t end, unsigned) {
-        for (std::uint32_t c = begin; c < end; ++c) {
-            std::copy(m_chunk_pairs[c].begin(), m_chunk_pairs[c].end(),
-                      new_pairs.begin() + static_cast<std::ptrdiff_t>(m_run_starts[c]));
-        }
-    };
-    if (chunks == 1) {
-        join(0, 1, 0);
-    } else {
-        jobs.parallel_for("broadphase.join_pairs", 0, chunks, 1, join);
-    }
-    // The chunk order already fixes the result for a given enlarged list; sorting also
-    // frees it from the marking order, so the engine sees pairs in a canonical order.
-    merge_runs(jobs, new_pairs);
-
     for (const ProxyId id : m_enlarged) slots_of(id)[static_cast<std::size_t>(id.tree_id())] = -1;
     m_enlarged.clear();
 }
