@@ -318,12 +318,14 @@ struct SolverScratch {
     // The lists of fixed ranges of contacts (list_range), before they are joined.
     struct ListedRange {
         std::vector<ManifoldRef> refs;
-        bool restitution = false;  // any of them has restitution
-        bool rolls = false;        // any of them has rolling resistance
-        std::size_t first = 0;     // where its refs go in manifolds
-        bool same = false;         // they were in colored_manifolds where they go (join_range)
+        std::uint32_t materials = 0;  // their contacts' summary bits but the point counts (restitution, rolls)
+        std::size_t first = 0;        // where its refs go in manifolds
+        bool same = false;            // they were in colored_manifolds where they go (join_range)
     };
     std::vector<ListedRange> listed;
+    // What the listed manifolds' contacts have between them: the or of their summary bits
+    // but the point counts (kSummaryRestitution, kSummaryRolls; world.hpp).
+    std::uint32_t listed_materials = 0;
     // The colouring below is a function of the manifold list, the joints and the bodies
     // (which are dynamic) alone: what it was made for, to reuse it while nothing changed.
     RawRoomVector<ManifoldRef> colored_manifolds;  // manifolds, as join_range leaves it
@@ -344,10 +346,9 @@ struct SolverScratch {
     // writes their lanes, prepare_wide every other field).
     RawRoomVector<WideContact> wide;
     RawRoomVector<PushAnchors> push_anchors;  // kLanes per wide contact: its push-out rows' (push_out, before read)
-    // One per wide contact where any listed manifold rolls (`rolls`, this step's listing), else
-    // none: written by prepare_wide where a lane rolls, else unread.
+    // One per wide contact where any listed manifold rolls (kSummaryRolls in
+    // listed_materials), else none: written by prepare_wide where a lane rolls, else unread.
     RawRoomVector<WideRolling> rolling;
-    bool rolls = false;
     std::uint32_t wide_begin[kColorCount + 1] = {};  // colour c holds wide[wide_begin[c], wide_begin[c + 1])
     std::vector<JointConstraint> joints;             // awake joints, in slot order
     std::vector<JointRef> joint_refs;                // the same, as listed

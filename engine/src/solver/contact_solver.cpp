@@ -786,7 +786,7 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
 
 void size_rolling_rows(SolverScratch& scratch) {
     // Not mapped ahead: few scenes write it, and most of its pages stay untouched.
-    const std::size_t count = scratch.rolls ? scratch.wide.size() : 0;
+    const std::size_t count = (scratch.listed_materials & kSummaryRolls) != 0 ? scratch.wide.size() : 0;
     reserve_for(scratch.rolling, count);
     scratch.rolling.resize(count);
     if (far_above_use(scratch.rolling.capacity(), count)) fit_capacity(scratch.rolling);

@@ -104,8 +104,7 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
     };
     SolverScratch::ListedRange& range = scratch.listed[lo / kListGrain];
     range.refs.clear();
-    bool restitution = false;
-    bool rolls = false;
+    std::uint32_t materials = 0;
     for (std::uint32_t k = lo; k < hi; ++k) {
         const std::uint32_t c = contacts[k];
         const std::uint32_t summary = world.contact_summaries[c];
@@ -118,12 +117,10 @@ void list_range(const World& world, std::span<const std::uint32_t> contacts, Sol
         for (std::uint32_t m = 0; point_counts != 0; ++m, point_counts >>= kSummaryBitsPerManifold) {
             if ((point_counts & kCountMask) == 0) continue;
             range.refs.push_back({c, m, a, bb});
-            restitution = restitution || (summary & kSummaryRestitution) != 0;
-            rolls = rolls || (summary & kSummaryRolls) != 0;
+            materials |= summary & ~kSummaryPointCounts;
         }
     }
-    range.restitution = restitution;
-    range.rolls = rolls;
+    range.materials = materials;
 }
 
 // JoinManifolds' range: its refs into the step's list, and into the last colouring's list
@@ -143,8 +140,8 @@ void join_range(SolverScratch& scratch, SolverScratch::ListedRange& range, bool 
 // contacts, in contact order (ListManifolds, then JoinManifolds), in one run_phases: one
 // fork and join, not three. Fixed chunks of bodies and ranges of contacts are listed in
 // parallel, each into its own slots, and the ranges joined in range order, so neither
-// depends on who ran what. Returns whether any listed manifold has restitution.
-bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
+// depends on who ran what. Their contacts' material bits go to listed_materials.
+void prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     const auto n = static_cast<std::uint32_t>(world.awake.size());
     // A first step's are megabytes of new pages: mapped in jobs, then first written by the
     // PrepareBodies blocks (raw room: the resizes write nothing).
@@ -170,13 +167,12 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     // and the barrier after it). The second copies them in, in jobs: a first step's list is
     // hundreds of new pages, each a fault on its first write.
     const Phase phases[] = {{"PrepareBodiesAndListManifolds", chunks + ranges, 1}, {"JoinManifolds", ranges, 1}};
-    bool restitution = false;
-    scratch.rolls = false;       // any listed manifold rolls: the ranges' say, as they are placed
-    if (chunks + ranges == 0) {  // no awake body: nothing to list, no jobs at all
+    scratch.listed_materials = 0;  // the ranges' say, as they are placed
+    if (chunks + ranges == 0) {    // no awake body: nothing to list, no jobs at all
         scratch.manifolds.clear();
         scratch.same_manifolds = scratch.colored_manifolds.empty();
         scratch.colored_manifolds.clear();
-        return restitution;
+        return;
     }
     bool same_count = false;  // as many manifolds as the last colouring's
     auto place = [&] {
@@ -184,8 +180,7 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
         for (SolverScratch::ListedRange& range : listed) {
             range.first = total;
             total += range.refs.size();
-            restitution = restitution || range.restitution;
-            scratch.rolls = scratch.rolls || range.rolls;
+            scratch.listed_materials |= range.materials;
         }
         scratch.manifolds.resize(total);
         same_count = scratch.colored_manifolds.size() == total;
@@ -219,7 +214,6 @@ bool prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
         greatest = std::max(greatest, chunk.greatest_inv_mass);
     }
     scratch.one_dynamic_mass = !(least < greatest);
-    return restitution;
 }
 
 // Greedy colouring (Box2D v3's graph colouring): the first colour whose bodies include
@@ -751,7 +745,8 @@ void solve(World& world, Real dt) {
 
     world.fast_lists.resize(world.jobs->worker_count());
     for (std::vector<FastStart>& list : world.fast_lists) list.clear();
-    const bool restitution = prepare_bodies_and_list_manifolds(world, scratch);
+    prepare_bodies_and_list_manifolds(world, scratch);
+    const bool restitution = (scratch.listed_materials & kSummaryRestitution) != 0;
     find_support_scales(world, scratch);  // light bodies carrying heavier ones; usually none
     prepare_joints(world, scratch, h);    // nothing to do in a scene without joints
     if (!same_constraints(world, scratch)) {
