@@ -299,9 +299,10 @@ const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
 
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
-// `rolling`: the wide contact's rolling rows, written only where a lane rolls.
+// `rolling`: the wide contact's rolling rows, written only where a lane rolls; null where
+// no listed manifold rolls (size_rolling_rows), so no lane can.
 void prepare_wide(const World& world, const SolverScratch& scratch, const ContactSolveParams& params, WideContact& wc,
-                  WideRolling& rolling) {
+                  WideRolling* rolling) {
     const Bodies& b = world.bodies;
     const Vec3 g = world.settings.gravity;
     // Gathered lane by lane; lanes and points without a manifold keep zero mass and lie
@@ -374,7 +375,10 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             in.separation[j][l] = kEmptySeparation;
             in.filled[j][l] = 0;
         }
-        if (contact.rolling_resistance > 0) prepare_rolling(world, contact, m, A, B, wc, rolling, l);
+        if (contact.rolling_resistance > 0) {
+            SPINDLE_ASSERT(rolling != nullptr, "solver: a lane rolls without rolling rows");
+            prepare_rolling(world, contact, m, A, B, wc, *rolling, l);
+        }
     }
     tangent_basis(in.normal, live, in.tangent[0], in.tangent[1]);
     // Inverse mass sum of both bodies along the normal (the share of the free axes for a
@@ -794,12 +798,10 @@ void size_rolling_rows(SolverScratch& scratch) {
 
 void prepare_contacts(const World& world, SolverScratch& scratch, const ContactSolveParams& params, std::uint32_t lo,
                       std::uint32_t hi) {
-    // Without rolling rows no lane rolls (size_rolling_rows): prepare_wide never writes this one.
-    WideRolling none;
+    WideRolling* const rolling = scratch.rolling.empty() ? nullptr : scratch.rolling.data();
     for (std::uint32_t k = lo; k < hi; ++k) {
         if (k + 1 < hi) prefetch_contacts(world, scratch, scratch.wide[k + 1]);
-        prepare_wide(world, scratch, params, scratch.wide[k], scratch.rolling.empty() ? none : scratch.rolling[k]);
-        SPINDLE_ASSERT(!scratch.wide[k].rolls || !scratch.rolling.empty(), "solver: a lane rolls without rolling rows");
+        prepare_wide(world, scratch, params, scratch.wide[k], rolling != nullptr ? rolling + k : nullptr);
     }
 }
 
