@@ -1,7 +1,6 @@
 #include "memory/medium_blocks.hpp"
 
 #include <array>
-#include <bit>
 #include <cstdint>
 #include <mutex>
 #include <new>
@@ -23,15 +22,15 @@ namespace spindle {
 
 namespace {
 
-static_assert(kMediumBlockEndBytes <= kHugePageBytes && std::has_single_bit(kMediumBlockMinBytes) &&
-                  std::has_single_bit(kMediumBlockEndBytes),
-              "a chunk is one huge page of power-of-two blocks");
+static_assert(kHugePageBytes % kMediumBlockMinBytes == 0 && kMediumBlockEndBytes <= kHugePageBytes,
+              "a chunk is one huge page of whole units");
 
-// A chunk is kUnits units of kMediumBlockMinBytes; a block of 2^k units starts at a
-// multiple of 2^k (a buddy system kept as one mask), so blocks of every size share chunks
-// and few chunks stand part-used: a chunk's huge page is all written, used or not.
+// A chunk is kUnits units of kMediumBlockMinBytes, kept as one mask; a block is a run of
+// free units, the first that fits, so blocks of every size share chunks and few chunks
+// stand part-used: a chunk's huge page is all written, used or not.
 constexpr std::uint32_t kUnits = kHugePageBytes / kMediumBlockMinBytes;
-static_assert(kUnits == 32, "a bit per unit in a 32-bit mask");
+static_assert(kUnits == 32 && kMediumBlockEndBytes / kMediumBlockMinBytes < kUnits,
+              "a bit per unit in a 32-bit mask, a block's run shorter than it");
 
 struct Chunk {
     std::uintptr_t base = 0;
@@ -45,22 +44,23 @@ void unmap_chunk(void* p) noexcept {
     unmap_huge_pages(p, kHugePageBytes);
 }
 
-// The units of a block of `bytes`: a power of two, under kUnits.
+// The units of a block of `bytes`, under kUnits, and its run of them as a mask.
 std::uint32_t units_of(std::size_t bytes) {
     return static_cast<std::uint32_t>(medium_block_bytes(bytes) / kMediumBlockMinBytes);
 }
+std::uint32_t mask_of(std::size_t bytes) { return (std::uint32_t{1} << units_of(bytes)) - 1; }
 
 class MediumBlockPool {
 public:
     void* allocate(std::size_t bytes) {
         const std::uint32_t units = units_of(bytes);
-        const std::uint32_t mask = (std::uint32_t{1} << units) - 1;
+        const std::uint32_t mask = mask_of(bytes);
         const std::lock_guard lock(m_mutex);
         // First fit over the chunks in use, then an empty one, then a new one.
         for (const bool empty : {false, true}) {
             for (Chunk& chunk : m_chunks) {
                 if ((chunk.used == 0) != empty) continue;
-                for (std::uint32_t unit = 0; unit < kUnits; unit += units) {
+                for (std::uint32_t unit = 0; unit + units <= kUnits; ++unit) {
                     if (((chunk.used >> unit) & mask) != 0) continue;
                     if (chunk.used == 0) --m_empty;
                     return take(chunk, unit, mask, bytes);
@@ -85,8 +85,7 @@ public:
     }
 
     void free(void* p, std::size_t bytes) noexcept {
-        const std::uint32_t units = units_of(bytes);
-        const std::uint32_t mask = (std::uint32_t{1} << units) - 1;
+        const std::uint32_t mask = mask_of(bytes);
         const auto address = reinterpret_cast<std::uintptr_t>(p);
         const std::uintptr_t base = address & ~(std::uintptr_t{kHugePageBytes} - 1);
         const std::lock_guard lock(m_mutex);
@@ -94,8 +93,8 @@ public:
             Chunk& chunk = m_chunks[i];
             if (chunk.base != base) continue;
             chunk.used &= ~(mask << ((address - base) / kMediumBlockMinBytes));
-            m_blocks[std::countr_zero(units)] -= 1;
-            SPINDLE_POISON(p, std::size_t{units} * kMediumBlockMinBytes);
+            m_blocks[medium_block_size_index(bytes)] -= 1;
+            SPINDLE_POISON(p, medium_block_bytes(bytes));
             if (chunk.used != 0 || ++m_empty <= kKeptEmptyMediumChunks) return;
             unmap_chunk(reinterpret_cast<void*>(chunk.base));
             m_chunks[i] = m_chunks.back();
@@ -113,7 +112,7 @@ public:
 private:
     void* take(Chunk& chunk, std::uint32_t unit, std::uint32_t mask, std::size_t bytes) {
         chunk.used |= mask << unit;
-        m_blocks[std::countr_zero(units_of(bytes))] += 1;
+        m_blocks[medium_block_size_index(bytes)] += 1;
         void* p = reinterpret_cast<void*>(chunk.base + std::size_t{unit} * kMediumBlockMinBytes);
         SPINDLE_UNPOISON(p, bytes);  // the block's tail past `bytes` stays poisoned
         return p;

@@ -230,6 +230,25 @@ TEST(MediumBlocks, ArraysOfAFewPagesShareAHugePage) {
     EXPECT_GT(huge_page_kb_over(begin_a, begin_a + kBytes), 0u);
 }
 
+TEST(MediumBlocks, BlocksTakeTheirWholeUnitsNotAPowerOfTwo) {
+    // Five arrays of 384 KB (six units each) fill 30 of a chunk's 32 units. Rounded up to
+    // powers of two (512 KB) they took 2.5 MB, two chunks: the pyramid's nine blocks of
+    // 1.63 MB took two chunks so (issue 19).
+    constexpr std::size_t kBytes = std::size_t{384} << 10;
+    const MediumBlockCounts before = medium_block_counts();
+    ASSERT_EQ(before.chunks, before.empty_chunks) << "no medium block in use before";
+    std::vector<HugePageVector<unsigned char>> arrays(5);
+    for (auto& v : arrays) v.reserve(kBytes);
+    const auto chunk_of = [](const HugePageVector<unsigned char>& v) {
+        return reinterpret_cast<std::uintptr_t>(v.data()) / kHugePageBytes;
+    };
+    for (const auto& v : arrays) EXPECT_EQ(chunk_of(v), chunk_of(arrays[0])) << "five blocks of six units in one chunk";
+    const MediumBlockCounts counts = medium_block_counts();
+    EXPECT_EQ(counts.chunks - counts.empty_chunks, 1u);
+    EXPECT_EQ(counts.blocks[medium_block_size_index(kBytes)], 5u);
+    EXPECT_EQ(medium_block_size_index(kBytes), 5u);  // six units
+}
+
 TEST(MediumBlocks, AFreedBlockServesTheNextOfItsSize) {
     // An array that moves as it grows (fit_capacity, a vector's regrowth) takes memory
     // already written instead of fresh pages.
@@ -241,7 +260,7 @@ TEST(MediumBlocks, AFreedBlockServesTheNextOfItsSize) {
         first = reinterpret_cast<std::uintptr_t>(v.data());
     }
     HugePageVector<unsigned char> w;
-    w.reserve(kBytes + 1000);  // another size, the same power-of-two block
+    w.reserve(kBytes + 1000);  // another size, the same units
     EXPECT_EQ(reinterpret_cast<std::uintptr_t>(w.data()), first);
 }
 

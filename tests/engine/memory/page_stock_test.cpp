@@ -165,14 +165,14 @@ void expect_first_step_lays_out_its_arrays(const SpaceSettings& settings, Level&
                     same = false;
                 }
             }
-            if (array.block_bytes() != 0)
-                counted.blocks[std::countr_zero(array.block_bytes() / kMediumBlockMinBytes)] += 1;
+            if (array.block_bytes() != 0) counted.blocks[medium_block_size_index(array.block_bytes())] += 1;
         }
         const MediumBlockCounts in_use = medium_block_counts();
         for (int k = 0; k < kMediumBlockSizes; ++k) {
             if (counted.blocks[k] == in_use.blocks[k]) continue;
-            std::fprintf(stderr, "blocks of %zu KB: counted %zu, in use %zu\n", (kMediumBlockMinBytes << k) >> 10,
-                         counted.blocks[k], in_use.blocks[k]);
+            std::fprintf(stderr, "blocks of %zu KB: counted %zu, in use %zu\n",
+                         (kMediumBlockMinBytes * static_cast<std::size_t>(k + 1)) >> 10, counted.blocks[k],
+                         in_use.blocks[k]);
             same = false;
         }
         return same;
