@@ -190,6 +190,7 @@ struct Bodies {
     // the slot its entry if it has none: for a body that can move only.
     void hold_history(std::uint32_t i, const Vec3& p, const Quat& r) {
         if (history_place[i] == kNoHistory) {
+            make_history_room();
             history_place[i] = history_count();
             for (int k = 0; k < 2; ++k) history_position[k].emplace_back(), history_orientation[k].emplace_back();
         }
@@ -202,6 +203,15 @@ struct Bodies {
         if (history_place[i] != kNoHistory) hold_history(i, origin(i), q[i]);
     }
     std::uint32_t history_count() const noexcept { return static_cast<std::uint32_t>(history_position[0].size()); }
+    // Room for one more history entry. An entry is a slot's at most, so the room doubles
+    // but never past the slots' own: a level whose bodies were reserved (1,240 for the
+    // pyramid) keeps no room for 2,048 entries, as doubling gave it.
+    void make_history_room() {
+        const std::size_t entries = history_count();
+        if (entries < history_position[0].capacity()) return;
+        const std::size_t room = std::max(entries + 1, std::min(2 * entries, generation.capacity()));
+        for (int k = 0; k < 2; ++k) history_position[k].reserve(room), history_orientation[k].reserve(room);
+    }
     bool is_live(BodyHandle h) const noexcept {
         return h.index < generation.size() && alive[h.index] && generation[h.index] == h.generation &&
                h.generation != 0;

@@ -180,6 +180,8 @@ static void fill(const World& world, std::uint32_t i, PublishedBuffer& p, bool i
 
 // Room in a published buffer for every body slot and history entry, before fill().
 static void fit_published(const Bodies& b, PublishedBuffer& p) {
+    // The histories' room, not a doubling of its own (Bodies::make_history_room).
+    if (p.previous.capacity() < b.history_count()) p.previous.reserve(b.history_position[0].capacity());
     if (p.size() < b.capacity() || p.previous.size() < b.history_count()) p.resize(b.capacity(), b.history_count());
 }
 
