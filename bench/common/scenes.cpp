@@ -75,6 +75,9 @@ BoxScene box_grid_scene(int per_side) {
 }
 
 std::vector<BodyHandle> add_to_space(Space& space, const BoxScene& scene, const BuildOptions& options) {
+    // Room for the floor and the boxes first, as the scene loader's build() asks for its
+    // bodies: the per-body arrays are made once, at their size, not grown as they come.
+    space.reserve_bodies(space.body_count() + 1 + scene.boxes.size());
     BodyDesc floor;
     floor.type = MotionType::Static;
     floor.friction = scene.friction;
