@@ -150,6 +150,7 @@ int bench(const BenchOptions& o) {
 
     std::array<double, static_cast<int>(Stage::Count)> stage_seconds{};
     std::vector<SerialProfile> serial_steps;
+    std::vector<std::vector<TraceEvent>> traced_steps;     // --serial's, one trace a step
     double analysis_seconds = 0;                           // --serial's, left out of the run's time
     std::uint64_t phases_before = 0, barriers_before = 0;  // run_phases' counts before the traced steps
     const Stopwatch watch;
@@ -176,13 +177,17 @@ int bench(const BenchOptions& o) {
         const UpdateStats& stats = space.last_update();
         for (std::size_t k = 0; k < stage_seconds.size(); ++k) stage_seconds[k] += stats.stage_seconds[k];
         if (i >= 1 && o.serial) {
+            // Kept, and profiled after the run: profiling a step takes longer than an idle
+            // worker spins before it sleeps, so every traced step would begin by waking the
+            // workers, a wait untraced steps never have.
             const Stopwatch analysis;
-            serial_steps.push_back(serial_profile(traced->trace_events()));
+            traced_steps.push_back(traced->trace_events());
             traced->clear_trace();
             analysis_seconds += analysis.elapsed_seconds();
         }
     }
     const double seconds = watch.elapsed_seconds() - analysis_seconds;
+    for (const std::vector<TraceEvent>& events : traced_steps) serial_steps.push_back(serial_profile(events));
     if (o.serial) traced->enable_trace(false);
     const double ms_per_step = o.steps > 1 ? 1e3 * (seconds - first_step_seconds) / static_cast<double>(o.steps - 1)
                                            : 0;

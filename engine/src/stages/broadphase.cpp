@@ -293,9 +293,10 @@ void update_broadphase(World& world, Real dt) {
     bp.moved_boxes.resize(n);
     bp.part_boxes.lay_out(b);
     std::atomic<std::uint32_t> marked{0};
+    std::atomic<std::uint32_t> moved{0};
     const Vec3 gravity_change = world.settings.gravity * dt;
     world.jobs->parallel_for("Bounds", 0, n, 128, [&](std::uint32_t lo, std::uint32_t hi, unsigned) {
-        std::uint32_t range_marked = 0;
+        std::uint32_t range_marked = 0, range_moved = 0;
         for (std::uint32_t k = lo; k < hi; ++k) {
             const std::uint32_t i = world.awake[k];
             const Shape& shape = b.traits[i].shape;
@@ -323,6 +324,7 @@ void update_broadphase(World& world, Real dt) {
             const Aabb fat = bp.tree.fat_box(bp.proxy[i], swept, stretch);
             bp.moved_ids[k] = bp.proxy[i];
             bp.moved_boxes[k] = fat;
+            ++range_moved;
             // note_fat_change, for this job's own bodies (a slot is marked by one job).
             const Aabb& before = bp.tree.fat_aabb(bp.proxy[i]);
             if ((fat.min != before.min || fat.max != before.max) && !bp.refit[i]) {
@@ -332,10 +334,12 @@ void update_broadphase(World& world, Real dt) {
             }
         }
         if (range_marked != 0) marked.fetch_add(range_marked, std::memory_order_relaxed);
+        if (range_moved != 0) moved.fetch_add(range_moved, std::memory_order_relaxed);
     });
     // The moved leaves' ancestors are only flagged: update_pairs rebuilds them before its
-    // searches, which are the next to read the tree.
-    bp.tree.set_fat_boxes(*world.jobs, bp.moved_ids, bp.moved_boxes);
+    // searches, which are the next to read the tree. A resting pile moves no proxy for
+    // steps on end: then there is nothing to set, and no jobs are forked for it.
+    if (moved.load(std::memory_order_relaxed) != 0) bp.tree.set_fat_boxes(*world.jobs, bp.moved_ids, bp.moved_boxes);
 
     // A pair found again (one of its proxies grew) has its contact: left out by the pair
     // jobs, which only read the index meanwhile.

@@ -13,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "api/space_internals.hpp"
 #include "stages/broadphase_state.hpp"
@@ -71,6 +72,43 @@ TEST(FatBoxRule, MovingFatBox_IsBoundsPlusSpeculativePlusTheShapesMargin_StaticI
     check("created");
     space.update();  // at rest: the boxes stay
     check("after a step");
+}
+
+// Bodies at rest move no proxy, so for steps on end the broadphase sets no fat box (it
+// skips set_fat_boxes when none moved); the first step a body moves again its box must
+// follow: after every step each awake body's fat box holds its bounds.
+TEST(FatBoxRule, BodiesAtRestForStepsThenPushed_TheirBoxesFollowFromTheFirstStep) {
+    Space space;
+    space.set_gravity(Vec3::Zero());
+    std::vector<BodyHandle> bodies;
+    for (int k = 0; k < 3; ++k) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3::Constant(0.5));
+        d.position = Vec3(0, 0, 3.0 * k);
+        d.allow_sleep = false;
+        bodies.push_back(space.create_body(d));
+    }
+    const World& world = SpaceInternals::world(space);
+    const BroadphaseState& bp = *world.broadphase;
+    const auto boxes_hold_bounds = [&](const char* when, int step) {
+        for (const std::uint32_t i : world.awake) {
+            EXPECT_TRUE(bp.tree.fat_aabb(bp.proxy[i]).contains(world.bodies.bounds[i]))
+                << when << ", step " << step << ": body " << i << "'s bounds left its fat box";
+        }
+    };
+    const std::uint32_t pushed = bodies[1].index;
+    const Aabb resting = bp.tree.fat_aabb(bp.proxy[pushed]);
+    for (int step = 0; step < 10; ++step) {
+        space.update();
+        boxes_hold_bounds("at rest", step);
+    }
+    EXPECT_TRUE(same_box(bp.tree.fat_aabb(bp.proxy[pushed]), resting, 0)) << "a body at rest got another box";
+    space.set_linear_velocity(bodies[1], Vec3(3, 0, 0));  // 5 cm a step: out of its box within steps
+    for (int step = 0; step < 20; ++step) {
+        space.update();
+        boxes_hold_bounds("pushed", step);
+    }
+    EXPECT_FALSE(same_box(bp.tree.fat_aabb(bp.proxy[pushed]), resting, 0)) << "the pushed body's box never moved";
 }
 
 TEST(FatBoxRule, BadRule_IsRefusedNamingTheField) {
