@@ -463,6 +463,12 @@ struct World {
     std::size_t first_step_bodies = 0;
     std::size_t first_step_contacts = 0;
     bool first_step_rolls = false;  // one of those bodies has rolling resistance
+    // The contacts that first step is expected to make: the game's count for its level's
+    // first where it gave one (SpaceSettings::capacity), else the pairs counted.
+    std::size_t first_step_contact_count() const {
+        const auto told = steps == 0 ? static_cast<std::size_t>(settings.capacity.contact_count) : 0;
+        return told > 0 ? told : first_step_contacts;
+    }
 
     // The layer table: bit b of layer_masks[a] is set when layers a and b collide
     // (symmetric; all set by default, so filtering changes nothing until asked).

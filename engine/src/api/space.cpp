@@ -74,10 +74,8 @@ std::size_t told_contacts(const World& w) {
 // it gave one (SpaceSettings::capacity), else the pairs the new proxies made. A hint: without memory for a page the
 // step maps its own.
 void stock_first_step_pages(World& w) {
-    const std::size_t told = told_contacts(w);
-    const std::size_t contacts = told > 0 ? told : w.first_step_contacts;
-    const std::size_t pages = std::min(first_step_pages(w.first_step_bodies, contacts, w.first_step_rolls),
-                                       kMostStockedPages);
+    const std::size_t pages = std::min(
+        first_step_pages(w.first_step_bodies, w.first_step_contact_count(), w.first_step_rolls), kMostStockedPages);
     while (w.stocked_pages < pages) {
         try {
             stock_huge_page();

@@ -178,11 +178,12 @@ bool ProxyTrees::all_moving_enlarged() const {
     return enlarged_moving == moving;
 }
 
-void ProxyTrees::order_by_first_user(PairList& pairs) {
+void ProxyTrees::order_by_first_user(PairList& pairs, std::span<const Pair> walked) {
     const std::uint32_t chunks = pair_chunks();
-    std::size_t total = 0;
+    std::size_t total = walked.size();
     std::uint64_t last_user = 0;
     const auto for_each_pair = [&](auto&& visit) {
+        for (const Pair& p : walked) visit(p);
         for (std::uint32_t c = 0; c < chunks; ++c) {
             for (const Pair& p : m_chunk_pairs[c]) visit(p);
         }
@@ -230,7 +231,8 @@ std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs
 
 void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self) {
     if (self) {
-        order_by_first_user(new_pairs);  // one run
+        order_by_first_user(new_pairs,
+                            m_merged_pairs);  // one run; the walk's pairs read before the merge lays out its scratch
     } else {
         const std::uint32_t chunks = pair_chunks();
         m_run_starts.assign(chunks + 1, 0);

@@ -123,9 +123,11 @@ public:
     // Clears the enlarged marks, and first rebuilds the parts of the trees that moves
     // enlarged (DynamicAabbTree::rebuild_enlarged). Who may call: the thread that owns the broadphase; it
     // runs jobs on `jobs` and waits for them (nothing else may touch the broadphase
-    // meanwhile). Safe from inside a job: parallel_for may nest.
+    // meanwhile). Safe from inside a job: parallel_for may nest. `expected_pairs`: how many
+    // pairs the caller expects (a level's first step: the contacts its bodies counted), so
+    // that the walk's list takes its room at once, among the arrays stocked for that step.
     template <typename Known>
-    void update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known);
+    void update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known, std::size_t expected_pairs = 0);
     // As above, every pair reported.
     void update_pairs(JobSystem& jobs, PairList& new_pairs) {
         update_pairs(jobs, new_pairs, [](std::uint64_t, std::uint64_t) { return false; });
@@ -182,9 +184,9 @@ private:
     // Whether every moving proxy is enlarged (a first step): then one walk of the moving tree
     // against itself finds the moving pairs, not a search per proxy.
     bool all_moving_enlarged() const;
-    // The pairs of the searches and of the walk of the moving tree against itself, in
-    // canonical order: put in first users' order by counting, then each user's run sorted.
-    void order_by_first_user(PairList& pairs);
+    // The pairs of the searches and of the walk of the moving tree against itself (`walked`),
+    // in canonical order: put in first users' order by counting, then each user's run sorted.
+    void order_by_first_user(PairList& pairs, std::span<const Pair> walked);
     // update_pairs' parts around its search: the rebuild and the float boxes before (returns
     // the searches to make), and the runs put together and the marks cleared after.
     std::uint32_t begin_pair_search(JobSystem& jobs, PairList& new_pairs);
@@ -278,25 +280,31 @@ void ProxyTrees::find_pairs_of(ProxyId proxy, const Known& known, bool moving_pa
 }
 
 template <typename Known>
-void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known) {
+void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known& known, std::size_t expected_pairs) {
     const std::uint32_t count = begin_pair_search(jobs, new_pairs);
     if (count == 0) return;
     // Jobs only read the trees and the enlarged marks and write their own chunk's list,
     // sorted there: end_pair_search puts the sorted runs together.
     const std::uint32_t grain = m_settings.grain;
     // Every moving proxy enlarged (a first step), on one worker: the moving pairs from one
-    // walk of the moving tree against itself, into the first chunk's list before its search
-    // adds to it (order_by_first_user orders every list's pairs together); the searches then
-    // look only in the other tree. The same pairs in the same order as the searches give;
-    // with more workers the searches run side by side, and the walk and the ordering after
-    // it, one thread's, would leave the others waiting.
+    // walk of the moving tree against itself (order_by_first_user orders them with every
+    // search's); the searches then look only in the other tree. The same pairs in the same
+    // order as the searches give; with more workers the searches run side by side, and the
+    // walk and the ordering after it, one thread's, would leave the others waiting. The
+    // walk's pairs go into the merge's scratch, which the ordering leaves free, with room for
+    // the expected pairs at once: a heap list grown by doubling wrote twice its megabyte on
+    // fresh pages in a first step (many_pyramids: 1 ms of page faults, docs/benchmarks.md).
     const DynamicAabbTree& moving = m_trees[0];
-    const bool self = jobs.worker_count() == 1 && all_moving_enlarged() &&
-                      moving.self_pairs(m_self_stack, [&](std::int32_t a, std::int32_t b) {
-                          const Pair pair = make_pair(ProxyId::make(a, false), moving.user(a), ProxyId::make(b, false),
-                                                      moving.user(b));
-                          if (!known(pair.user_a, pair.user_b)) m_chunk_pairs[0].push_back(pair);
-                      });
+    bool self = jobs.worker_count() == 1 && all_moving_enlarged();
+    if (self) {
+        m_merged_pairs.clear();
+        m_merged_pairs.reserve(expected_pairs);
+        self = moving.self_pairs(m_self_stack, [&](std::int32_t a, std::int32_t b) {
+            const Pair pair = make_pair(ProxyId::make(a, false), moving.user(a), ProxyId::make(b, false),
+                                        moving.user(b));
+            if (!known(pair.user_a, pair.user_b)) m_merged_pairs.push_back(pair);
+        });
+    }
     jobs.parallel_for("broadphase.find_pairs", 0, count, grain, [&](std::uint32_t begin, std::uint32_t end, unsigned) {
         std::vector<Pair>& out = m_chunk_pairs[begin / grain];
         for (std::uint32_t i = begin; i < end; ++i) find_pairs_of(m_enlarged[i], known, self, out);

@@ -347,7 +347,10 @@ void update_broadphase(World& world, Real dt) {
         return world.contact_index.contains((i << 32) | j);  // user values are slots, i <= j
     };
     next_part("BroadphasePairs");
-    bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact);  // sorted: the same order for any worker count
+    // A level's first step expects the pairs its bodies counted (memory/page_stock.hpp).
+    const std::size_t expected_pairs = world.building_level ? world.first_step_contact_count() : 0;
+    // Sorted: the same order for any worker count.
+    bp.tree.update_pairs(*world.jobs, bp.pairs, has_contact, expected_pairs);
     next_part("BroadphaseNewContacts");
     const auto made_from = static_cast<std::uint32_t>(world.contacts.size());
     make_contacts(world, bp);
