@@ -231,8 +231,8 @@ std::uint32_t ProxyTrees::begin_pair_search(JobSystem& jobs, PairList& new_pairs
 
 void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self) {
     if (self) {
-        order_by_first_user(new_pairs,
-                            m_merged_pairs);  // one run; the walk's pairs read before the merge lays out its scratch
+        // One run. The walk's pairs are read from the merge's scratch before the merge lays it out.
+        order_by_first_user(new_pairs, m_merged_pairs);
     } else {
         const std::uint32_t chunks = pair_chunks();
         m_run_starts.assign(chunks + 1, 0);
