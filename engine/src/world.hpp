@@ -463,10 +463,15 @@ struct World {
     std::size_t first_step_bodies = 0;
     std::size_t first_step_contacts = 0;
     bool first_step_rolls = false;  // one of those bodies has rolling resistance
-    // The contacts that first step is expected to make: the game's count for its level's
-    // first where it gave one (SpaceSettings::capacity), else the pairs counted.
+    // The game's count of its level's first contacts (SpaceSettings::capacity), before the
+    // space's first step; else 0.
+    std::size_t told_first_step_contacts() const {
+        return steps == 0 ? static_cast<std::size_t>(settings.capacity.contact_count) : 0;
+    }
+    // The contacts that first step is expected to make: the game's count where it gave one,
+    // else the pairs counted.
     std::size_t first_step_contact_count() const {
-        const auto told = steps == 0 ? static_cast<std::size_t>(settings.capacity.contact_count) : 0;
+        const std::size_t told = told_first_step_contacts();
         return told > 0 ? told : first_step_contacts;
     }
 

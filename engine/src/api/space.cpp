@@ -62,12 +62,6 @@ std::size_t new_pairs_of(const World& w, std::uint32_t slot) {
     return pairs;
 }
 
-// The game's count of its level's first contacts (SpaceSettings::capacity), before the
-// space's first step; else 0.
-std::size_t told_contacts(const World& w) {
-    return w.steps == 0 ? static_cast<std::size_t>(w.settings.capacity.contact_count) : 0;
-}
-
 // Stocks the pages the first step of the bodies made since the last update will write
 // (first_step_pages, stages/capacity.hpp): here, where the game builds its level, a page at a time, rather
 // than in that step. The contacts are the game's count for its level's first step where
@@ -89,7 +83,7 @@ void stock_first_step_pages(World& w) {
 // Counts a level's new body `slot` into its first step and stocks that step's pages.
 // The game's count of contacts, where it gave one, stands for the level's first: no query.
 void count_first_step(World& w, std::uint32_t slot) {
-    const std::size_t pairs = told_contacts(w) > 0 ? 0 : new_pairs_of(w, slot);
+    const std::size_t pairs = w.told_first_step_contacts() > 0 ? 0 : new_pairs_of(w, slot);
     w.first_step_contacts += pairs;
     const bool dynamic = w.bodies.type[slot] == MotionType::Dynamic;
     if (dynamic) w.first_step_bodies += 1;
