@@ -133,6 +133,38 @@ struct HugePageAllocator {
 template <typename T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
+// HugePageAllocator without its medium blocks: whole huge pages from kOnHugePagesBytes, the
+// heap below. For an array a step makes whole at once, which for a large level is a
+// megabyte or more: on the heap that is a mapping of fresh small pages (glibc maps such
+// blocks apart), each first write a fault, where whole huge pages fault once per 2 MB.
+// Below, the heap: a medium block would share the pool's chunks with the first step's
+// lists, whose small levels fill one (Jolt's pyramid's took a second 2 MB chunk for its
+// tree's 159 KB of child boxes).
+template <typename T>
+struct WholeHugePageAllocator : HugePageAllocator<T> {
+    using value_type = T;
+
+    WholeHugePageAllocator() = default;
+    template <typename U>
+    WholeHugePageAllocator(const WholeHugePageAllocator<U>&) noexcept {}
+
+    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kOnHugePagesBytes; }
+    T* allocate(std::size_t n) {
+        if (n > HugePageAllocator<T>::max_size()) throw std::bad_array_new_length();
+        if (on_huge_pages(n)) return HugePageAllocator<T>::allocate(n);
+        return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{alignof(T)}));
+    }
+    void deallocate(T* p, std::size_t n) noexcept {
+        if (on_huge_pages(n)) return HugePageAllocator<T>::deallocate(p, n);
+        ::operator delete (p, std::align_val_t{alignof(T)});
+    }
+
+    template <typename U>
+    bool operator==(const WholeHugePageAllocator<U>&) const noexcept {
+        return true;
+    }
+};
+
 // HugePageAllocator whose resize leaves the new elements unconstructed: the code after
 // each growing resize must construct every new element in place (placement new) before
 // anything else touches the array, so that jobs construct a first step's records instead

@@ -28,6 +28,7 @@
 
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <sys/resource.h>
 #endif
 
 using namespace spindle;
@@ -90,6 +91,29 @@ TEST(PageStock, AFirstStepTakesItsPagesFromTheStockItsBodiesReserved) {
 }
 
 namespace {
+
+// The page faults this process has taken (the kernel's minor faults: no disk).
+[[maybe_unused]] long minor_faults() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_minflt;
+}
+
+// Whether the system gives transparent huge pages where asked (madvise), as the arrays
+// mapped whole ask (memory/huge_page_vector.hpp).
+[[maybe_unused]] bool huge_pages_on_request() {
+    std::FILE* f = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
+    if (!f) return false;
+    char line[128] = {};
+    const bool read = std::fgets(line, sizeof line, f) != nullptr;
+    std::fclose(f);
+    return read && std::string(line).find("[never]") == std::string::npos;
+}
+
+// The fresh small pages a first step may write: its small lists' growth (many_pyramids':
+// 104-216, by what ran before in the machine), far from the 336 of an array of a megabyte on
+// the heap.
+[[maybe_unused]] constexpr long kFewFreshPages = 300;
 
 // A level of `count` boxes in a grid, `spacing` apart (2 m: none touches), above a floor.
 // make_grid's floor: a static slab whose top is y = 0.
@@ -231,6 +255,34 @@ TEST(PageStock, AFirstStepLaysOutTheArraysItsStockCounted) {
     const SceneDesc many = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/many_pyramids.toml");
     expect_first_step_lays_out_its_arrays(many.settings, [&](Space& space) { build(many, space); });
     expect_first_step_lays_out_its_arrays({}, [](Space& space) { make_grid(space, 8000, 2); });
+}
+
+// A first step writes its arrays on pages stocked or mapped whole, not on fresh small pages
+// of the heap: on a virtual machine each small page's first write is a fault of its own
+// (15 us on the development VM, docs/benchmarks.md), and many_pyramids' first step once
+// took 441 of them, 336 for the moving tree's float child boxes alone. A fresh process (a
+// death test's), as a game's first level; sanitizers' heaps lay memory out otherwise.
+TEST(PageStock, AFirstStepWritesFewFreshSmallPages) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
+    GTEST_SKIP() << "the heap is the sanitizer's, or not glibc's";
+#else
+    if (!huge_pages_on_request()) GTEST_SKIP() << "the system gives no huge pages: every array faults small pages";
+    const SceneDesc many = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/many_pyramids.toml");
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(
+        {
+            Space space{many.settings};
+            build(many, space);
+            World& world = SpaceInternals::world(space);
+            space.flush();
+            const long before = minor_faults();
+            step(world, many.settings.time_step.duration);
+            const long faults = minor_faults() - before;
+            std::fprintf(stderr, "many_pyramids' first step: %ld page faults\n", faults);
+            std::exit(faults <= kFewFreshPages ? 0 : 1);
+        },
+        ::testing::ExitedWithCode(0), "");
+#endif
 }
 
 // The pairs counted as the bodies are made are the contacts their first step makes: Jolt's
