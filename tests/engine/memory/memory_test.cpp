@@ -103,6 +103,20 @@ TEST(Memory, PyramidAfterItsDropHoldsUnderElevenKilobytesABodyAsTheProcessCounts
 // rolls: the pyramid's boxes have no rolling resistance, and held 0.78 MB of rows no pass
 // read. A ball given rolling resistance on its floor gets them from the next step on, the
 // colouring kept (its contact and manifold the same), and gives them back without it.
+// A colouring gives each colour's list its room at once (solver.cpp, color()): the lists of
+// the pyramid's first step hold exactly their refs, where lists grown by doubling held up
+// to twice theirs, on blocks taken and dropped a dozen times each.
+TEST(Memory, AColouringGivesEachColourItsRoomAtOnce) {
+    const Pyramid pyramid(1);
+    const SolverScratch& solver = *SpaceInternals::world(pyramid.space).solver;
+    std::size_t refs = 0;
+    for (const std::vector<std::uint32_t>& refs_of_colour : solver.colors) {
+        EXPECT_EQ(refs_of_colour.capacity(), refs_of_colour.size());
+        refs += refs_of_colour.size();
+    }
+    EXPECT_GT(refs, 0u) << "the pyramid's first step coloured nothing";
+}
+
 TEST(Memory, RollingRowsOnlyWhileAContactRolls) {
     const Pyramid pyramid(kLanded);
     const SolverScratch& boxes = *SpaceInternals::world(pyramid.space).solver;
