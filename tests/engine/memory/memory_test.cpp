@@ -99,10 +99,6 @@ TEST(Memory, PyramidAfterItsDropHoldsUnderElevenKilobytesABodyAsTheProcessCounts
 #endif
 }
 
-// The rolling rows (one per wide contact, 704 bytes each) are kept only while some contact
-// rolls: the pyramid's boxes have no rolling resistance, and held 0.78 MB of rows no pass
-// read. A ball given rolling resistance on its floor gets them from the next step on, the
-// colouring kept (its contact and manifold the same), and gives them back without it.
 // A colouring gives each colour's list its room at once (solver.cpp, color()): the lists of
 // the pyramid's first step hold exactly their refs, where lists grown by doubling held up
 // to twice theirs, on blocks taken and dropped a dozen times each.
@@ -117,6 +113,10 @@ TEST(Memory, AColouringGivesEachColourItsRoomAtOnce) {
     EXPECT_GT(refs, 0u) << "the pyramid's first step coloured nothing";
 }
 
+// The rolling rows (one per wide contact, 704 bytes each) are kept only while some contact
+// rolls: the pyramid's boxes have no rolling resistance, and held 0.78 MB of rows no pass
+// read. A ball given rolling resistance on its floor gets them from the next step on, the
+// colouring kept (its contact and manifold the same), and gives them back without it.
 TEST(Memory, RollingRowsOnlyWhileAContactRolls) {
     const Pyramid pyramid(kLanded);
     const SolverScratch& boxes = *SpaceInternals::world(pyramid.space).solver;

@@ -111,8 +111,7 @@ namespace {
 }
 
 // The fresh small pages a first step may write: its small lists' growth (many_pyramids':
-// 104-216, by what ran before in the machine), far from the 336 of an array of a megabyte on
-// the heap.
+// 122), far from the 336 of one array of a megabyte on the heap.
 [[maybe_unused]] constexpr long kFewFreshPages = 300;
 
 // A level of `count` boxes in a grid, `spacing` apart (2 m: none touches), above a floor.
