@@ -286,16 +286,18 @@ void ProxyTrees::update_pairs(JobSystem& jobs, PairList& new_pairs, const Known&
     // Jobs only read the trees and the enlarged marks and write their own chunk's list,
     // sorted there: end_pair_search puts the sorted runs together.
     const std::uint32_t grain = m_settings.grain;
-    // Every moving proxy enlarged (a first step), on one worker: the moving pairs from one
-    // walk of the moving tree against itself (order_by_first_user orders them with every
-    // search's); the searches then look only in the other tree. The same pairs in the same
-    // order as the searches give; with more workers the searches run side by side, and the
-    // walk and the ordering after it, one thread's, would leave the others waiting. The
-    // walk's pairs go into the merge's scratch, which the ordering leaves free, with room for
-    // the expected pairs at once: a heap list grown by doubling wrote twice its megabyte on
-    // fresh pages in a first step (many_pyramids: 1 ms of page faults, docs/benchmarks.md).
+    // Every moving proxy enlarged (a first step): the moving pairs from one walk of the
+    // moving tree against itself (order_by_first_user orders them with every search's); the
+    // searches then look only in the other tree. The same pairs in the same order as the
+    // searches give. On more workers too: the walk meets each overlapping node pair once,
+    // where a search per proxy starts from the root, so one thread's walk and ordering beat
+    // the searches side by side (many_pyramids' first step on two workers: 1.3-1.6 against
+    // 3.8 ms, docs/benchmarks.md). The walk's pairs go into the merge's scratch, which the
+    // ordering leaves free, with room for the expected pairs at once: a heap list grown by
+    // doubling wrote twice its megabyte on fresh pages in a first step (many_pyramids: 1 ms
+    // of page faults, docs/benchmarks.md).
     const DynamicAabbTree& moving = m_trees[0];
-    bool self = jobs.worker_count() == 1 && all_moving_enlarged();
+    bool self = all_moving_enlarged();
     if (self) {
         m_merged_pairs.clear();
         m_merged_pairs.reserve(expected_pairs);
