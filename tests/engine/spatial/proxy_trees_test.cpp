@@ -551,28 +551,36 @@ TEST(ProxyTrees, FirstSearch_AnyMakingOrder_PairsInCanonicalOrder) {
     }
 }
 
-// A first step on one worker walks the moving tree against itself. Its pairs go into room
-// for the pairs the caller expects, taken at once among the step's stocked arrays: a list
-// grown by doubling on the heap wrote twice its bytes on fresh pages (many_pyramids' first
-// step: 1 ms of page faults).
+// A first step walks the moving tree against itself, on one worker or several (the walk
+// meets each overlapping node pair once; searches side by side took 2-3 times as long in
+// many_pyramids' first step on two). Its pairs go into room for the pairs the caller
+// expects, taken at once among the step's stocked arrays: a list grown by doubling on the
+// heap wrote twice its bytes on fresh pages (many_pyramids' first step: 1 ms of page faults).
 TEST(ProxyTrees, FirstWalk_TakesTheRoomForTheExpectedPairsAtOnce) {
     constexpr std::size_t kExpected = std::size_t{1} << 16;
-    const auto first_walk = [](std::size_t expected) {
-        auto bp = std::make_unique<ProxyTrees>();
-        SingleThreadedJobSystem jobs;
-        for (std::uint64_t k = 0; k < 200; ++k) bp->create_proxy(cube(Vec3(1.5 * Real(k), 0, 0), 1), k, false);
-        PairList pairs;
-        bp->update_pairs(
-            jobs, pairs, [](std::uint64_t, std::uint64_t) { return false; }, expected);
-        EXPECT_EQ(pairs.size(), 199u);  // each cube overlaps its neighbours only
-        EXPECT_TRUE(is_canonical_and_unique(pairs));
-        return bp;
-    };
-    const auto unexpected = first_walk(0);
-    const auto expected = first_walk(kExpected);
-    // Without the expectation the walk's room is at most twice its 199 pairs.
-    EXPECT_GE(expected->heap_bytes(), unexpected->heap_bytes() + (kExpected - 2 * 199) * sizeof(Pair))
-        << "the walk's pairs did not take the expected room";
+    for (const bool threaded : {false, true}) {
+        const auto first_walk = [threaded](std::size_t expected) {
+            auto bp = std::make_unique<ProxyTrees>();
+            for (std::uint64_t k = 0; k < 200; ++k) bp->create_proxy(cube(Vec3(1.5 * Real(k), 0, 0), 1), k, false);
+            PairList pairs;
+            const auto unknown = [](std::uint64_t, std::uint64_t) { return false; };
+            if (threaded) {
+                test::ReverseThreadedJobSystem jobs(2);
+                bp->update_pairs(jobs, pairs, unknown, expected);
+            } else {
+                SingleThreadedJobSystem jobs;
+                bp->update_pairs(jobs, pairs, unknown, expected);
+            }
+            EXPECT_EQ(pairs.size(), 199u);  // each cube overlaps its neighbours only
+            EXPECT_TRUE(is_canonical_and_unique(pairs));
+            return bp;
+        };
+        const auto unexpected = first_walk(0);
+        const auto expected = first_walk(kExpected);
+        // Without the expectation the walk's room is at most twice its 199 pairs.
+        EXPECT_GE(expected->heap_bytes(), unexpected->heap_bytes() + (kExpected - 2 * 199) * sizeof(Pair))
+            << "the walk's pairs did not take the expected room" << (threaded ? " on two workers" : "");
+    }
 }
 
 TEST(ProxyTrees, RebuildStaticTree_KeepsProxiesAndPairs) {
