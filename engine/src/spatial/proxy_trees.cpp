@@ -257,9 +257,8 @@ void ProxyTrees::end_pair_search(JobSystem& jobs, PairList& new_pairs, bool self
     // (The walk's one run: only the merge's scratch laid out, as for a search's.)
     merge_runs(jobs, new_pairs);
     if (self) {
-        // A first step's scratch, given back: the first list held nearly every pair, and the
-        // steps after find a few in each list.
-        std::vector<Pair>().swap(m_chunk_pairs[0]);
+        // A first step's scratch, given back: the steps after walk nothing and count no
+        // users. (The walk's pairs were in the merge's scratch, a step's stocked array.)
         std::vector<std::uint32_t>().swap(m_user_places);
         std::vector<std::pair<std::int32_t, std::int32_t>>().swap(m_self_stack);
     }
