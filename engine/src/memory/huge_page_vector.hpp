@@ -107,17 +107,21 @@ struct HugePageAllocator {
     static constexpr std::size_t max_size() noexcept { return static_cast<std::size_t>(-1) / 2 / sizeof(T); }
     T* allocate(std::size_t n) {
         if (n > max_size()) throw std::bad_array_new_length();
-        const std::size_t bytes = n * sizeof(T);
-        switch (tier(bytes)) {
+        return allocate_in(tier(n * sizeof(T)), n * sizeof(T));
+    }
+    void deallocate(T* p, std::size_t n) noexcept { deallocate_in(tier(n * sizeof(T)), p, n * sizeof(T)); }
+    // A block of `bytes` of a kind, and its giving back: for allocators that choose the kind
+    // their own way (WholeHugePageAllocator).
+    static T* allocate_in(Tier kind, std::size_t bytes) {
+        switch (kind) {
             case Tier::kHeap: return static_cast<T*>(::operator new (bytes, std::align_val_t{alignof(T)}));
             case Tier::kMedium: return static_cast<T*>(allocate_medium_block(bytes));
             case Tier::kHugePages: return static_cast<T*>(map_huge_pages(huge_block_bytes(bytes)));
         }
         return nullptr;
     }
-    void deallocate(T* p, std::size_t n) noexcept {
-        const std::size_t bytes = n * sizeof(T);
-        switch (tier(bytes)) {
+    static void deallocate_in(Tier kind, T* p, std::size_t bytes) noexcept {
+        switch (kind) {
             case Tier::kHeap: ::operator delete (p, std::align_val_t{alignof(T)}); return;
             case Tier::kMedium: free_medium_block(p, bytes); return;
             case Tier::kHugePages: unmap_huge_pages(p, huge_block_bytes(bytes)); return;
@@ -148,15 +152,14 @@ struct WholeHugePageAllocator : HugePageAllocator<T> {
     template <typename U>
     WholeHugePageAllocator(const WholeHugePageAllocator<U>&) noexcept {}
 
-    static bool on_huge_pages(std::size_t n) { return n * sizeof(T) >= kOnHugePagesBytes; }
+    using Tier = typename HugePageAllocator<T>::Tier;
+    static Tier tier(std::size_t bytes) { return bytes >= kOnHugePagesBytes ? Tier::kHugePages : Tier::kHeap; }
     T* allocate(std::size_t n) {
         if (n > HugePageAllocator<T>::max_size()) throw std::bad_array_new_length();
-        if (on_huge_pages(n)) return HugePageAllocator<T>::allocate(n);
-        return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{alignof(T)}));
+        return HugePageAllocator<T>::allocate_in(tier(n * sizeof(T)), n * sizeof(T));
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        if (on_huge_pages(n)) return HugePageAllocator<T>::deallocate(p, n);
-        ::operator delete (p, std::align_val_t{alignof(T)});
+        HugePageAllocator<T>::deallocate_in(tier(n * sizeof(T)), p, n * sizeof(T));
     }
 
     template <typename U>
