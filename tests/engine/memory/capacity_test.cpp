@@ -22,6 +22,7 @@
 #include <sanitizer/asan_interface.h>
 #endif
 
+#include "huge_page_mode.hpp"
 #include "memory/huge_page_vector.hpp"
 #include "memory/medium_blocks.hpp"
 #include "stages/capacity.hpp"
@@ -33,16 +34,7 @@ namespace {
 
 constexpr std::size_t kRoomBytes = std::size_t{16} << 20;  // several whole huge pages, wherever it starts
 
-// The system's transparent huge page mode, the bracketed word of its setting ("always",
-// "madvise", "never"), or "" where there is none.
-std::string huge_page_mode() {
-    std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-    std::string text;
-    std::getline(in, text);
-    const auto open = text.find('[');
-    const auto close = text.find(']');
-    return open != std::string::npos && close > open ? text.substr(open + 1, close - open - 1) : "";
-}
+using test::huge_page_mode;
 
 // Kilobytes of huge pages in the mappings that hold any of [begin, end), from
 // /proc/self/smaps.

@@ -17,6 +17,7 @@
 
 #include "api/memory_report.hpp"
 #include "api/space_internals.hpp"
+#include "huge_page_mode.hpp"
 #include "memory/huge_page_vector.hpp"
 #include "memory/medium_blocks.hpp"
 #include "memory/page_stock.hpp"
@@ -97,17 +98,6 @@ namespace {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     return usage.ru_minflt;
-}
-
-// Whether the system gives transparent huge pages where asked (madvise), as the arrays
-// mapped whole ask (memory/huge_page_vector.hpp).
-[[maybe_unused]] bool huge_pages_on_request() {
-    std::FILE* f = std::fopen("/sys/kernel/mm/transparent_hugepage/enabled", "r");
-    if (!f) return false;
-    char line[128] = {};
-    const bool read = std::fgets(line, sizeof line, f) != nullptr;
-    std::fclose(f);
-    return read && std::string(line).find("[never]") == std::string::npos;
 }
 
 // The fresh small pages a first step may write: its small lists' growth (many_pyramids':
@@ -265,7 +255,8 @@ TEST(PageStock, AFirstStepWritesFewFreshSmallPages) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__) || !defined(__GLIBC__)
     GTEST_SKIP() << "the heap is the sanitizer's, or not glibc's";
 #else
-    if (!huge_pages_on_request()) GTEST_SKIP() << "the system gives no huge pages: every array faults small pages";
+    if (const std::string mode = test::huge_page_mode(); mode != "always" && mode != "madvise")
+        GTEST_SKIP() << "the system gives no huge pages: every array faults small pages";
     const SceneDesc many = load_scene(std::string(SPINDLE_SOURCE_DIR) + "/configs/scenes/many_pyramids.toml");
     GTEST_FLAG_SET(death_test_style, "threadsafe");
     EXPECT_EXIT(
