@@ -21,16 +21,16 @@ std::size_t body_bytes(const Bodies& b) {
 }
 
 std::size_t solver_other_bytes(const SolverScratch& s) {
-    std::size_t bytes = held(s.bodies) + held(s.manifolds) + held(s.colored_manifolds) + held(s.overflow) +
-                        held(s.joints) + held(s.joint_refs) + held(s.colored_joints) + held(s.wide_joints) +
-                        held(s.wide_swing_twists) + held(s.wide_hinges) + held(s.joint_overflow) + held(s.body_colors) +
-                        held(s.support_scales) + held(s.support_edges) + held(s.support_first) +
-                        held(s.support_by_lower) + held(s.support_queue) + held(s.supported) + held(s.phases) +
-                        held(s.plan) + held(s.push_velocities) + held(s.gravity_scales) + held(s.rolling) +
-                        held(s.manifold_colors) + held(s.body_starts) + held(s.sorted_refs) + held(s.body_chunks) +
-                        held(s.first_touch) + held(s.first_touched) + held(s.untouched) + held(s.kinematic) +
-                        held(s.touched) + held(s.overflow_touches) + held(s.touch_counts) + held(s.tail_plan) +
-                        held(s.lead_blocked) + held(s.lead_free) + held(s.in_tail) + held(s.tail_bodies);
+    std::size_t bytes =
+        held(s.bodies) + held(s.manifolds) + held(s.colored_manifolds) + held(s.overflow) + held(s.joints) +
+        held(s.joint_refs) + held(s.colored_joints) + held(s.wide_joints) + held(s.wide_swing_twists) +
+        held(s.wide_hinges) + held(s.joint_overflow) + held(s.body_colors) + held(s.support_scales) +
+        held(s.support_edges) + held(s.support_first) + held(s.support_by_lower) + held(s.support_queue) +
+        held(s.supported) + held(s.phases) + held(s.plan) + held(s.push_velocities) + held(s.warm_velocities) +
+        held(s.gravity_scales) + held(s.rolling) + held(s.manifold_colors) + held(s.body_starts) + held(s.sorted_refs) +
+        held(s.body_chunks) + held(s.first_touch) + held(s.first_touched) + held(s.untouched) + held(s.kinematic) +
+        held(s.touched) + held(s.overflow_touches) + held(s.touch_counts) + held(s.tail_plan) + held(s.lead_blocked) +
+        held(s.lead_free) + held(s.in_tail) + held(s.tail_bodies);
     for (int c = 0; c < kColorCount; ++c) bytes += held(s.colors[c]) + held(s.joint_colors[c]);
     for (const auto& range : s.listed) bytes += held(range.refs);
     bytes += held(s.listed);

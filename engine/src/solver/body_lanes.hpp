@@ -57,6 +57,25 @@ template <typename Lanes>
     }
 }
 
+// Adds the lanes' velocity changes `d` to the rows of `rows` (v and w, at the solver bodies'
+// indices) of the dynamic bodies, as scatter writes the velocities.
+template <typename Lanes, typename Rows>
+[[gnu::always_inline]] inline void scatter_add(const Lanes& lanes, const SolverBody* bodies, Rows* rows,
+                                               const WideVelocities& d) {
+    Wide a[kLanes] = {d.va.x, d.va.y, d.va.z, d.wa.x, d.wa.y, d.wa.z};
+    Wide b[kLanes] = {d.vb.x, d.vb.y, d.vb.z, d.wb.x, d.wb.y, d.wb.z};
+    transpose(a);
+    transpose(b);
+    auto add = [](Rows& row, Wide change) {
+        row.v += Vec3(Real(change[0]), Real(change[1]), Real(change[2]));
+        row.w += Vec3(Real(change[3]), Real(change[4]), Real(change[5]));
+    };
+    for (int l = 0; l < kLanes; ++l) {
+        if (bodies[lanes.a[l]].dynamic) add(rows[lanes.a[l]], a[l]);
+        if (bodies[lanes.b[l]].dynamic) add(rows[lanes.b[l]], b[l]);
+    }
+}
+
 // Velocity of B's anchor relative to A's, per lane.
 inline Wide3 point_velocity(const WideVelocities& s, const Wide3& ra, const Wide3& rb) {
     return s.vb + cross(s.wb, rb) - s.va - cross(s.wa, ra);

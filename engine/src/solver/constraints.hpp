@@ -291,6 +291,7 @@ struct SolverPhase {
     std::uint32_t constraints = 0;  // items of its own pass, when it does; the chunks of bodies follow
     std::uint32_t tail_begin = 0;   // the tail it carries: tail_plan[tail_begin, tail_end)
     std::uint32_t tail_end = 0;
+    bool warms = false;  // a relax phase that warm starts the next substep too (warm_in_relax)
 };
 
 // Support mass scaling (support_scales.cpp): the factors a manifold's rows multiply each
@@ -313,6 +314,10 @@ struct SolverScratch {
     // prepare_wide stay off the cold descriptions, each a cache miss (prepare_body_chunk).
     RawRoomVector<PushVelocity> push_velocities;
     RawRoomVector<Real> gravity_scales;
+    // Per solver body: the next substep's warm start of its contacts, added up by the relax
+    // pass that ends a substep (warm_in_relax) and added to the body's velocities as the next
+    // substep integrates them (zero for a body no contact touches, and after that).
+    RawRoomVector<PushVelocity> warm_velocities;
     // Touching manifolds of awake contacts, in contact order (list_range's ranges, joined).
     RawRoomVector<ManifoldRef> manifolds;
     // The lists of fixed ranges of contacts (list_range), before they are joined.
@@ -387,6 +392,16 @@ struct SolverScratch {
     // finalizing folds only without joints (their impulses are stored in phases of their own).
     bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
     bool folded = false;           // this step's plan folds the integration
+    // The warm start of every substep but the first made by the relax pass before it, each
+    // contact's right after it is relaxed, so a substep has one pass over the colours fewer:
+    // nothing changes a contact's impulses, anchors or masses between its relax and the next
+    // warm start, and the velocity changes, added up apart from the velocities the relax pass
+    // still reads (warm_velocities), reach them after the next substep integrates its
+    // velocities, as the warm start's would. The same motion up to rounding (the changes are
+    // summed before they are added); only on a folded step without joints (theirs turn with
+    // the bodies), with a solve and a relax pass.
+    bool warm_in_relax = true;  // false: every substep its warm start pass (tests compare the two)
+    bool warms = false;         // this step's plan warm starts in its relax passes
     // The bodies that no constraint before them in a pass touches, constraint by constraint
     // in a pass's order: item k of colour c (its wide joints, other joints, wide contacts)
     // has first_touched[first_touch[i], first_touch[i + 1]) with i = first_item[c] + k, so a
@@ -466,6 +481,11 @@ void warm_start_contact(WideContact& wc, const PushAnchors* push_anchors, Solver
 // The points whose rows ran are counted into `counts` (the worker's).
 void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
                    const ContactSolveParams& params, EffectCounts& counts);
+// The relax pass's solve_contact (params without bias), then the next substep's warm start:
+// its velocity changes added to `warm` (SolverScratch::warm_velocities), its push-out ones
+// to `push`, as warm_start_contact would apply them.
+void relax_and_warm_start_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
+                                  PushVelocity* warm, const ContactSolveParams& params, EffectCounts& counts);
 void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts);
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 

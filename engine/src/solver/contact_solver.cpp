@@ -15,7 +15,10 @@
 // (rare: bodies created or teleported inside each other).
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <type_traits>
+
+#include <spindle/platform/assert.hpp>
 
 #include "collision/compound.hpp"
 #include "collision/convex_hull.hpp"
@@ -583,8 +586,8 @@ inline void apply_tangents(const WideContact& wc, const WideAxisMasses& m, WideV
 // together by their 2x2 mass, within Coulomb's cone of friction x the touching impulse.
 // A lane without friction has an empty cone.
 template <bool kLocked>
-inline void solve_friction(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
-                           const TouchingImpulses& touching, EffectCounts& counts) {
+[[gnu::always_inline]] inline void solve_friction(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
+                                                  const TouchingImpulses& touching, EffectCounts& counts) {
     counts.friction += static_cast<std::uint64_t>(wc.lanes);
     {
         const Wide speed = dot(wc.normal, s.wb - s.wa);
@@ -610,9 +613,56 @@ inline void solve_friction(WideContact& wc, const WideAxisMasses& masses, WideVe
     apply_tangents<kLocked>(wc, masses, s, new0 - old0, new1 - old1);
 }
 
-template <bool kBias, bool kLocked>
+// The warm start's velocity changes: the impulses the contact has so far applied to `s`.
+template <bool kLocked>
+[[gnu::always_inline]] inline void apply_warm_start(const WideContact& wc, const WideAxisMasses& masses,
+                                                    WideVelocities& s) {
+    for (const WidePointRow& r : wc.point_rows) {
+        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, r.normal_impulse);
+    }
+    if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
+        apply_tangents<kLocked>(wc, masses, s, wc.friction_impulse[0], wc.friction_impulse[1]);
+        apply_angular_row(s, wc.twist_row, wc.twist_impulse);
+    }
+    if (wc.rolls) {
+        const WideRolling& r = *wc.rolling;
+        s.wa -= r.inv_inertia_a * r.impulse;
+        s.wb += r.inv_inertia_b * r.impulse;
+    }
+}
+
+// The warm start of the lanes' push-out impulses on the push-out velocities.
+void warm_start_push_lanes(const WideContact& wc, const PushAnchors* push_anchors, SolverBody* bodies,
+                           PushVelocity* push_velocities) {
+    for (int l = 0; l < kLanes; ++l) {
+        if (wc.push_impulse[l] <= 0) continue;
+        SolverBody& A = bodies[wc.a[l]];
+        SolverBody& B = bodies[wc.b[l]];
+        SolverBody copy_a, copy_b;
+        const SolverBody& Am = lane_body(wc, l, 0, A, copy_a);
+        const SolverBody& Bm = lane_body(wc, l, 1, B, copy_b);
+        const Vec3 normal = wc.normal.lane(l);
+        ContactRow row;
+        make_row(Am, Bm, push_anchors[l].ra, push_anchors[l].rb, normal, row);
+        PushVelocity& push_a = push_velocities[wc.a[l]];
+        PushVelocity& push_b = push_velocities[wc.b[l]];
+        Velocities push = load_push(push_a, push_b);
+        apply_row(Am, Bm, push, normal, row, wc.push_impulse[l]);
+        store_push(A, B, push_a, push_b, push);
+    }
+}
+
+// The same where a lane has any (rare: deep overlap).
+[[gnu::always_inline]] inline void warm_start_push(const WideContact& wc, const PushAnchors* push_anchors,
+                                                   SolverBody* bodies, PushVelocity* push_velocities) {
+    Wide impulses;
+    std::memcpy(&impulses, wc.push_impulse, sizeof impulses);
+    if (any(impulses > splat(0))) warm_start_push_lanes(wc, push_anchors, bodies, push_velocities);
+}
+
+template <bool kBias, bool kLocked, bool kWarm = false>
 void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
-                const ContactSolveParams& params, EffectCounts& counts) {
+                const ContactSolveParams& params, EffectCounts& counts, PushVelocity* warm = nullptr) {
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
@@ -708,6 +758,13 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
         }
     }
     scatter(wc, bodies, s);
+    if constexpr (kWarm) {
+        static_assert(!kBias, "the next substep's warm start follows its relax pass");
+        WideVelocities change;
+        apply_warm_start<kLocked>(wc, masses, change);
+        scatter_add(wc, bodies, warm, change);
+        warm_start_push(wc, push_anchors, bodies, push);
+    }
     if constexpr (kBias) {
         if (!any(deep_weight > zero)) return;
         for (int l = 0; l < kLanes; ++l) {
@@ -725,35 +782,9 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
-    for (const WidePointRow& r : wc.point_rows) {
-        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, r.normal_impulse);
-    }
-    if (any(wc.friction > splat(0))) {  // else the friction impulses are all zero
-        apply_tangents<kLocked>(wc, masses, s, wc.friction_impulse[0], wc.friction_impulse[1]);
-        apply_angular_row(s, wc.twist_row, wc.twist_impulse);
-    }
-    if (wc.rolls) {
-        const WideRolling& r = *wc.rolling;
-        s.wa -= r.inv_inertia_a * r.impulse;
-        s.wb += r.inv_inertia_b * r.impulse;
-    }
+    apply_warm_start<kLocked>(wc, masses, s);
     scatter(wc, bodies, s);
-    for (int l = 0; l < kLanes; ++l) {
-        if (wc.push_impulse[l] <= 0) continue;
-        SolverBody& A = bodies[wc.a[l]];
-        SolverBody& B = bodies[wc.b[l]];
-        SolverBody copy_a, copy_b;
-        const SolverBody& Am = lane_body(wc, l, 0, A, copy_a);
-        const SolverBody& Bm = lane_body(wc, l, 1, B, copy_b);
-        const Vec3 normal = wc.normal.lane(l);
-        ContactRow row;
-        make_row(Am, Bm, push_anchors[l].ra, push_anchors[l].rb, normal, row);
-        PushVelocity& push_a = push_velocities[wc.a[l]];
-        PushVelocity& push_b = push_velocities[wc.b[l]];
-        Velocities push = load_push(push_a, push_b);
-        apply_row(Am, Bm, push, normal, row, wc.push_impulse[l]);
-        store_push(A, B, push_a, push_b, push);
-    }
+    warm_start_push(wc, push_anchors, bodies, push_velocities);
 }
 
 template <bool kLocked>
@@ -823,6 +854,16 @@ void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodie
     } else {
         params.use_bias ? solve_wide<true, false>(wc, push_anchors, bodies, push, params, counts)
                         : solve_wide<false, false>(wc, push_anchors, bodies, push, params, counts);
+    }
+}
+
+void relax_and_warm_start_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
+                                  PushVelocity* warm, const ContactSolveParams& params, EffectCounts& counts) {
+    SPINDLE_ASSERT(!params.use_bias, "solver: the warm start follows the relax pass, not the biased one");
+    if (wc.locked) {
+        solve_wide<false, true, true>(wc, push_anchors, bodies, push, params, counts, warm);
+    } else {
+        solve_wide<false, false, true>(wc, push_anchors, bodies, push, params, counts, warm);
     }
 }
 

@@ -52,7 +52,7 @@ inline Wide wide_sqrt(Wide a) {
 
 // Eight rows of eight lanes turned into eight columns (the 8x8 transpose Box2D v3
 // gathers its bodies with): three rounds of shuffles instead of 64 lane inserts.
-inline void transpose(Wide (&r)[8]) {
+[[gnu::always_inline]] inline void transpose(Wide (&r)[8]) {
     static_assert(kLanes == 8, "an 8x8 transpose");
     Wide t[8], u[8];
     for (int i = 0; i < 8; i += 2) {

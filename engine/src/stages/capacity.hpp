@@ -159,6 +159,7 @@ constexpr auto first_step_arrays(std::size_t bodies, std::size_t contacts, bool 
         {"contact index positions", slots, sizeof(std::uint32_t), false},
         {"moved fat boxes", bodies, sizeof(Aabb), false},
         {"push velocities", bodies + 1, sizeof(PushVelocity), false},
+        {"warm velocities", bodies + 1, sizeof(PushVelocity), false},
         {"gravity scales", bodies + 1, sizeof(Real), false},
     });
 }

@@ -1,6 +1,7 @@
 // The constraint solver (soft step, as Box2D v3 and Box3D): per step, list the
 // touching manifolds and the joints, colour them, and prepare them (contact_solver.cpp,
-// joint_solver.cpp); per substep, integrate velocities, warm start, solve with soft
+// joint_solver.cpp); per substep, integrate velocities, warm start (after the first
+// substep, made by the relax pass before it: SolverScratch::warm_in_relax), solve with soft
 // position bias, integrate positions, relax without bias; then restitution and storing
 // impulses for the next step's warm start. The substeps run as one list of phases
 // (JobSystem::run_phases), a phase per pass over the bodies or over one colour: no two
@@ -75,6 +76,7 @@ void prepare_body_chunk(const World& world, SolverScratch& scratch, std::uint32_
         sb.v = sb.dynamic ? b.v[i] : limit_speed(b.v[i], max_linear);
         sb.w = sb.dynamic ? b.w[i] : limit_speed(b.w[i], max_angular);
         scratch.push_velocities[k] = PushVelocity{};
+        scratch.warm_velocities[k] = PushVelocity{};
         sb.dp = Vec3::Zero();
         sb.dq = Quat::Identity();
         sb.locks = b.locks[i];
@@ -150,11 +152,13 @@ void prepare_bodies_and_list_manifolds(World& world, SolverScratch& scratch) {
     map_room(*world.jobs, scratch.bodies, n + 1);
     scratch.bodies.resize(n + 1);
     scratch.push_velocities.resize(n + 1);
+    scratch.warm_velocities.resize(n + 1);
     scratch.gravity_scales.resize(n + 1);
     const std::uint32_t chunks = (n + kBodyGrain - 1) / kBodyGrain;
     scratch.body_chunks.resize(chunks);  // each written whole by its chunk
     scratch.bodies[n] = SolverBody{};    // the immovable partner of static and sleeping bodies
     scratch.push_velocities[n] = PushVelocity{};
+    scratch.warm_velocities[n] = PushVelocity{};
     scratch.gravity_scales[n] = 0;
 
     const std::vector<std::uint32_t>& contacts = awake_contacts(world);
@@ -616,9 +620,10 @@ void carry_tail(SolverScratch& scratch, std::size_t first) {
 // Adds the phases of one pass over the constraints: one per colour that has any (its
 // joints, if with_joints, and wide contacts share no dynamic body), then the overflow.
 // With `integrates`, each of its phases integrates the bodies it touches first, and the
-// first one also the untouched bodies, in chunks after its constraints.
+// first one also the untouched bodies, in chunks after its constraints. With `warms` (a relax
+// pass), each contact warm starts the next substep after it is relaxed.
 void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints,
-                          bool integrates = false) {
+                          bool integrates = false, bool warms = false) {
     const std::size_t first = scratch.phases.size();
     for (int c = 0; c < kColorCount; ++c) {
         const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) +
@@ -628,12 +633,14 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
         if (count == 0) continue;
         scratch.phases.push_back(Phase{name, count, count <= kOneBlockColor ? count : kConstraintGrain});
         scratch.plan.push_back(SolverPhase{pass, c});
+        scratch.plan.back().warms = warms;
     }
     const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||
                           scratch.wide.size() > scratch.wide_begin[kColorCount];
     if (overflow) {
         scratch.phases.push_back(Phase{name, 1, 1});
         scratch.plan.push_back(SolverPhase{pass, kColorCount});
+        scratch.plan.back().warms = warms;
     }
     if (integrates && first != scratch.phases.size()) {
         for (std::size_t p = first; p < scratch.phases.size(); ++p) {
@@ -676,9 +683,13 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
     const bool folded = scratch.folded;
     const auto kinematic = static_cast<std::uint32_t>(scratch.kinematic.size());
     for (int sub = 0; sub < settings.substeps; ++sub) {
+        // Warm started by the relax pass before it (SolverScratch::warm_in_relax): its first
+        // solve pass integrates the velocities and adds the warm start's changes.
+        const bool warmed = scratch.warms && sub > 0;
         if (!folded) plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
-        plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, folded);
-        for (int it = 0; it < settings.iterations; ++it) plan_constraint_pass(scratch, Pass::Solve, "Solve", true);
+        if (!warmed) plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, folded);
+        for (int it = 0; it < settings.iterations; ++it)
+            plan_constraint_pass(scratch, Pass::Solve, "Solve", true, warmed && it == 0);
         if (!folded) plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
         if (folded && kinematic != 0) {
             // Many constraints of a colour read a kinematic body at once: it moves between the
@@ -686,8 +697,10 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
             scratch.phases.push_back(Phase{"IntegrateKinematic", kinematic, kBodyPassGrain});
             scratch.plan.push_back(SolverPhase{Pass::IntegrateKinematic, 0});
         }
+        const bool warms_next = scratch.warms && sub + 1 < settings.substeps;
         for (int it = 0; it < settings.relax_iterations; ++it)
-            plan_constraint_pass(scratch, Pass::Relax, "Relax", true, folded && it == 0);
+            plan_constraint_pass(scratch, Pass::Relax, "Relax", true, folded && it == 0,
+                                 warms_next && it + 1 == settings.relax_iterations);
     }
     if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
     if (scratch.fold_body_passes && scratch.joints.empty() && !scratch.wide.empty()) {
@@ -775,11 +788,13 @@ void solve(World& world, Real dt) {
     // Folded only where every phase that integrates has a constraint to carry it.
     scratch.folded = scratch.fold_body_passes && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;
+    scratch.warms = scratch.folded && scratch.warm_in_relax && scratch.joints.empty() && settings.iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
     if (world.awake.empty() && scratch.wide.empty() && scratch.joints.empty()) return;
     SolverBody* bodies = scratch.bodies.data();
     PushVelocity* push = scratch.push_velocities.data();
+    PushVelocity* warm = scratch.warm_velocities.data();
     const Real* gravity_scales = scratch.gravity_scales.data();
 
     ContactSolveParams solve_params;
@@ -838,6 +853,23 @@ void solve(World& world, Real dt) {
             [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_params, counts); },
             [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, push, contact_params, counts); });
     };
+    // A warming relax phase's constraints [lo, hi) (contacts only: SolverScratch::warms).
+    auto relax_and_warm_colored = [&](int color, std::uint32_t lo, std::uint32_t hi, EffectCounts& counts) {
+        for_colored<true>(
+            scratch, color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
+            [&](WideContact& wc) {
+                relax_and_warm_start_contact(wc, push_anchors(wc), bodies, push, warm, relax_params, counts);
+            });
+    };
+    // Velocities integrated, then the warm start the relax pass before made added (and cleared).
+    auto integrate_warmed = [&](std::span<const std::uint32_t> ks, EffectCounts& counts) {
+        integrate_velocities(world, bodies, gravity_scales, h, ks, counts);
+        for (std::uint32_t k : ks) {
+            bodies[k].v += warm[k].v;
+            bodies[k].w += warm[k].w;
+            warm[k] = PushVelocity{};
+        }
+    };
     // Items [lo, hi) of a phase of the plan.
     auto run_items = [&](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
         EffectCounts& counts = world.scratch_counts[worker];
@@ -881,7 +913,14 @@ void solve(World& world, Real dt) {
                     [&](WideContact& wc) { warm_start_contact(wc, push_anchors(wc), bodies, push); });
                 break;
             }
-            case Pass::Solve: solve_colored(phase.color, lo, hi, joint_solve, solve_params, counts); break;
+            case Pass::Solve: {
+                if (phase.integrates)
+                    integrate_folded(phase, lo, hi,
+                                     [&](std::span<const std::uint32_t> ks) { integrate_warmed(ks, counts); });
+                const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
+                if (lo < own) solve_colored(phase.color, lo, own, joint_solve, solve_params, counts);
+                break;
+            }
             case Pass::Relax: {
                 if (phase.integrates) {
                     integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
@@ -889,7 +928,12 @@ void solve(World& world, Real dt) {
                     });
                 }
                 const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
-                if (lo < own) solve_colored(phase.color, lo, own, joint_relax, relax_params, counts);
+                if (lo >= own) break;
+                if (phase.warms) {
+                    relax_and_warm_colored(phase.color, lo, own, counts);
+                } else {
+                    solve_colored(phase.color, lo, own, joint_relax, relax_params, counts);
+                }
                 break;
             }
             case Pass::Restitution:

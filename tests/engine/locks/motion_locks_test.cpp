@@ -263,9 +263,10 @@ TEST(MotionLocks, PendulumLockedToAPlane_SwingsInIt) {
 // Locked bodies in contact, as every contact path the solver has for them: a 2D pyramid
 // locked to a plane (translation z locked), a column of cubes locked along x with a heavy
 // cube carried by a light one (a support scale), a tilted box and a free ball hitting
-// them, under a gravity with a part along each locked axis. The stored hash is the one the solver's lane by lane
+// them, under a gravity with a part along each locked axis. The stored hash was the one the solver's lane by lane
 // preparing gave (6eee171): preparing the lanes together must keep a locked lane's inverse masses, gravity and friction
-// rows to the bit.
+// rows to the bit. Stored again when the relax pass took over the next substep's warm start (the same motion up to
+// rounding: GoldenHash.WarmStartInTheRelaxPassMovesAsItsOwnPass).
 TEST(MotionLocks, LockedContacts_GiveTheStoredStateHash) {
     SpaceSettings settings = awake();
     settings.gravity = Vec3(0.8, -9.81, 0.6);  // along the locked axes too
@@ -310,7 +311,7 @@ TEST(MotionLocks, LockedContacts_GiveTheStoredStateHash) {
     ball.linear_velocity = Vec3(0, 0, -6);
     space.create_body(ball);
     for (int step = 0; step < 90; ++step) space.update();
-    EXPECT_EQ(space.state_hash(), 0x312b54c713d05a0cull) << std::hex << space.state_hash();
+    EXPECT_EQ(space.state_hash(), 0xe75802994f5b1430ull) << std::hex << space.state_hash();
 }
 
 }  // namespace motion_locks_test
