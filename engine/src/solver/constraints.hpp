@@ -393,13 +393,13 @@ struct SolverScratch {
     bool fold_body_passes = true;  // false: always the passes of their own (tests compare the two)
     bool folded = false;           // this step's plan folds the integration
     // The warm start of every substep but the first made by the relax pass before it, each
-    // contact's right after it is relaxed, so a substep has one pass over the colours fewer:
-    // nothing changes a contact's impulses, anchors or masses between its relax and the next
-    // warm start, and the velocity changes, added up apart from the velocities the relax pass
+    // constraint's right after it is relaxed, so a substep has one pass over the colours fewer:
+    // nothing changes a constraint's impulses, masses or bodies' poses (a joint's anchors turn
+    // with them) between its relax and the next warm start (the positions move before the
+    // relax pass), and the velocity changes, added up apart from the velocities the relax pass
     // still reads (warm_velocities), reach them after the next substep integrates its
     // velocities, as the warm start's would. The same motion up to rounding (the changes are
-    // summed before they are added); only on a folded step without joints (theirs turn with
-    // the bodies), with a solve and a relax pass.
+    // summed before they are added); only on a folded step, with a solve and a relax pass.
     bool warm_in_relax = true;  // false: every substep its warm start pass (tests compare the two)
     bool warms = false;         // this step's plan warm starts in its relax passes
     // The bodies that no constraint before them in a pass touches, constraint by constraint
@@ -496,6 +496,10 @@ Softness joint_softness(const SolverSettings& settings, Real h);  // joint_hertz
 void prepare_joints(World& world, SolverScratch& scratch, Real h);
 void warm_start_joint(JointConstraint& jc, SolverBody* bodies);
 void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts);
+// solve_joint in the relax pass, then the next substep's warm start added to `warm`
+// (relax_and_warm_start_contact says how).
+void relax_and_warm_start_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params,
+                                EffectCounts& counts, PushVelocity* warm);
 void store_joint_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo,
                           std::uint32_t hi);  // joints [lo, hi)
 
@@ -509,6 +513,8 @@ void prepare_joint_lanes(SolverScratch& scratch, std::uint32_t lo, std::uint32_t
 void warm_start_joint_lanes(const SolverScratch& scratch, const WideJoint& wj, SolverBody* bodies);
 void solve_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, const JointSolveParams& params,
                        EffectCounts& counts);
+void relax_and_warm_start_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies,
+                                      const JointSolveParams& params, EffectCounts& counts, PushVelocity* warm);
 void store_joint_lane_impulses(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 }  // namespace spindle

@@ -163,17 +163,19 @@ void prepare_joint_lanes(SolverScratch& scratch, std::uint32_t lo, std::uint32_t
     }
 }
 
-void warm_start_joint_lanes(const SolverScratch& scratch, const WideJoint& wj, SolverBody* bodies) {
-    WideVelocities s = gather(wj, bodies);
-    const WideMotion m = gather_motion(wj, bodies);
+namespace {
+
+// The warm start's velocity changes: the impulses the lanes' joints have so far applied to `s`.
+void apply_warm_start(const SolverScratch& scratch, const WideJoint& wj, const WideMotion& m, WideVelocities& s) {
     if (wj.type == JointType::SwingTwist) warm_start_swing_twist_lanes(wj, scratch.wide_swing_twists[wj.angular], m, s);
     if (wj.type == JointType::Hinge) warm_start_hinge_lanes(wj, scratch.wide_hinges[wj.angular], m, s);
     apply(wj, s, rotate(m.dqa, wj.ra), rotate(m.dqb, wj.rb), wj.impulse);
-    scatter(wj, bodies, s);
 }
 
-void solve_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, const JointSolveParams& params,
-                       EffectCounts& counts) {
+// solve_joint_lanes; with kWarm, then the next substep's warm start added to `warm`.
+template <bool kWarm>
+void solve_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, const JointSolveParams& params,
+                 EffectCounts& counts, PushVelocity* warm) {
     counts.joints += static_cast<std::uint64_t>(wj.lanes);
     WideVelocities s = gather(wj, bodies);
     const WideMotion m = gather_motion(wj, bodies);
@@ -182,6 +184,29 @@ void solve_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies
     if (wj.type == JointType::Hinge) solve_hinge_lanes(wj, scratch.wide_hinges[wj.angular], m, s, params);
     solve_point(wj, s, m, params);
     scatter(wj, bodies, s);
+    if constexpr (kWarm) {
+        WideVelocities change;
+        apply_warm_start(scratch, wj, m, change);
+        scatter_add(wj, bodies, warm, change);
+    }
+}
+
+}  // namespace
+
+void warm_start_joint_lanes(const SolverScratch& scratch, const WideJoint& wj, SolverBody* bodies) {
+    WideVelocities s = gather(wj, bodies);
+    apply_warm_start(scratch, wj, gather_motion(wj, bodies), s);
+    scatter(wj, bodies, s);
+}
+
+void solve_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, const JointSolveParams& params,
+                       EffectCounts& counts) {
+    solve_lanes<false>(scratch, wj, bodies, params, counts, nullptr);
+}
+
+void relax_and_warm_start_joint_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies,
+                                      const JointSolveParams& params, EffectCounts& counts, PushVelocity* warm) {
+    solve_lanes<true>(scratch, wj, bodies, params, counts, warm);
 }
 
 void store_joint_lane_impulses(SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi) {

@@ -324,10 +324,10 @@ void prepare_joints(World& world, SolverScratch& scratch, Real h) {
                              });
 }
 
-void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
-    SolverBody& A = bodies[jc.a];
-    SolverBody& B = bodies[jc.b];
-    Velocities s = load(A, B);
+namespace {
+
+// The warm start's velocity changes: the impulses the joint has so far applied to `s`.
+void apply_warm_start(const JointConstraint& jc, const SolverBody& A, const SolverBody& B, Velocities& s) {
     const Vec3 ra = A.dq * jc.ra, rb = B.dq * jc.rb;
     switch (jc.type) {
         case JointType::BallSocket: apply(A, B, s, ra, rb, jc.linear_impulse); break;
@@ -356,7 +356,26 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
         case JointType::Prismatic: warm_start_prismatic(jc, A, B, s); break;
         case JointType::Motor: warm_start_motor(jc, A, B, s); break;
     }
+}
+
+}  // namespace
+
+void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
+    SolverBody& A = bodies[jc.a];
+    SolverBody& B = bodies[jc.b];
+    Velocities s = load(A, B);
+    apply_warm_start(jc, A, B, s);
     store(A, B, s);
+}
+
+void relax_and_warm_start_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params,
+                                EffectCounts& counts, PushVelocity* warm) {
+    solve_joint(jc, bodies, params, counts);
+    const SolverBody& A = bodies[jc.a];
+    const SolverBody& B = bodies[jc.b];
+    Velocities change{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+    apply_warm_start(jc, A, B, change);
+    add_to(A, B, warm[jc.a], warm[jc.b], change);
 }
 
 void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams& params, EffectCounts& counts) {

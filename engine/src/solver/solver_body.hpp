@@ -80,6 +80,19 @@ inline void store_push(const SolverBody& A, const SolverBody& B, PushVelocity& p
     if (B.dynamic) push_b = {s.vb, s.wb};
 }
 
+// Adds a constraint's velocity changes to rows apart from its bodies' velocities, at the
+// same indices (SolverScratch::warm_velocities): only the dynamic bodies', as store writes.
+inline void add_to(const SolverBody& A, const SolverBody& B, PushVelocity& a, PushVelocity& b, const Velocities& s) {
+    if (A.dynamic) {
+        a.v += s.va;
+        a.w += s.wa;
+    }
+    if (B.dynamic) {
+        b.v += s.vb;
+        b.w += s.wb;
+    }
+}
+
 // An impulse at the anchors ra, rb (from each centre of mass): -impulse on A, +impulse on B.
 inline void apply(const SolverBody& A, const SolverBody& B, Velocities& s, const Vec3& ra, const Vec3& rb,
                   const Vec3& impulse) {

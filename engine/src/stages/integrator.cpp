@@ -46,10 +46,11 @@ void keep_momentum(SolverBody& sb, const Quat& start, const Mat3& inertia_local,
     sb.w = mid_spin;
 }
 
-// Over awake bodies `ks`: a range of them, or a list (a folded step's, solver.cpp).
+// Over awake bodies `ks`: a range of them, or a list (a folded step's, solver.cpp); with
+// `warm`, each body's row of it added last and cleared (SolverScratch::warm_velocities).
 template <typename Indices>
 void integrate_velocities_of(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, const Indices& ks,
-                             EffectCounts& c) {
+                             EffectCounts& c, PushVelocity* warm = nullptr) {
     const Bodies& b = world.bodies;
     const Vec3 gravity = world.settings.gravity;
     const Real max_linear = world.settings.solver.max_linear_speed;
@@ -81,6 +82,11 @@ void integrate_velocities_of(World& world, SolverBody* bodies, const Real* gravi
             sb.w *= 1 / (1 + h * d.angular_damping);
             ++c.damping;
         }
+        if (warm != nullptr) {
+            sb.v += warm[k].v;
+            sb.w += warm[k].w;
+            warm[k] = PushVelocity{};
+        }
     }
 }
 
@@ -109,8 +115,8 @@ void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_
     integrate_velocities_of(world, bodies, gravity_scales, h, std::views::iota(lo, hi), counts);
 }
 void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h,
-                          std::span<const std::uint32_t> ks, EffectCounts& counts) {
-    integrate_velocities_of(world, bodies, gravity_scales, h, ks, counts);
+                          std::span<const std::uint32_t> ks, EffectCounts& counts, PushVelocity* warm) {
+    integrate_velocities_of(world, bodies, gravity_scales, h, ks, counts, warm);
 }
 void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
                          std::uint32_t hi) {

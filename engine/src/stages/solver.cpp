@@ -788,7 +788,7 @@ void solve(World& world, Real dt) {
     // Folded only where every phase that integrates has a constraint to carry it.
     scratch.folded = scratch.fold_body_passes && !(scratch.wide.empty() && scratch.joints.empty()) &&
                      settings.relax_iterations > 0;
-    scratch.warms = scratch.folded && scratch.warm_in_relax && scratch.joints.empty() && settings.iterations > 0;
+    scratch.warms = scratch.folded && scratch.warm_in_relax && settings.iterations > 0;
     // A world at rest (every body asleep or static) has nothing to move or solve: no
     // passes at all, not a plan of empty ones each step.
     if (world.awake.empty() && scratch.wide.empty() && scratch.joints.empty()) return;
@@ -853,22 +853,15 @@ void solve(World& world, Real dt) {
             [&](JointConstraint& jc) { solve_joint(jc, bodies, joint_params, counts); },
             [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, push, contact_params, counts); });
     };
-    // A warming relax phase's constraints [lo, hi) (contacts only: SolverScratch::warms).
+    // A warming relax phase's constraints [lo, hi) (SolverScratch::warm_in_relax).
     auto relax_and_warm_colored = [&](int color, std::uint32_t lo, std::uint32_t hi, EffectCounts& counts) {
         for_colored<true>(
-            scratch, color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
+            scratch, color, lo, hi,
+            [&](WideJoint& wj) { relax_and_warm_start_joint_lanes(scratch, wj, bodies, joint_relax, counts, warm); },
+            [&](JointConstraint& jc) { relax_and_warm_start_joint(jc, bodies, joint_relax, counts, warm); },
             [&](WideContact& wc) {
                 relax_and_warm_start_contact(wc, push_anchors(wc), bodies, push, warm, relax_params, counts);
             });
-    };
-    // Velocities integrated, then the warm start the relax pass before made added (and cleared).
-    auto integrate_warmed = [&](std::span<const std::uint32_t> ks, EffectCounts& counts) {
-        integrate_velocities(world, bodies, gravity_scales, h, ks, counts);
-        for (std::uint32_t k : ks) {
-            bodies[k].v += warm[k].v;
-            bodies[k].w += warm[k].w;
-            warm[k] = PushVelocity{};
-        }
     };
     // Items [lo, hi) of a phase of the plan.
     auto run_items = [&](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
@@ -914,9 +907,11 @@ void solve(World& world, Real dt) {
                 break;
             }
             case Pass::Solve: {
-                if (phase.integrates)
-                    integrate_folded(phase, lo, hi,
-                                     [&](std::span<const std::uint32_t> ks) { integrate_warmed(ks, counts); });
+                if (phase.integrates) {  // then the warm start the relax pass before made
+                    integrate_folded(phase, lo, hi, [&](std::span<const std::uint32_t> ks) {
+                        integrate_velocities(world, bodies, gravity_scales, h, ks, counts, warm);
+                    });
+                }
                 const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
                 if (lo < own) solve_colored(phase.color, lo, own, joint_solve, solve_params, counts);
                 break;

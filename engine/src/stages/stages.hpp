@@ -33,8 +33,9 @@ struct SolverBody;
 struct PushVelocity;
 void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h, std::uint32_t lo,
                           std::uint32_t hi, EffectCounts& counts);
+// With `warm`, each body's warm start row added after and cleared (SolverScratch::warm_velocities).
 void integrate_velocities(World& world, SolverBody* bodies, const Real* gravity_scales, Real h,
-                          std::span<const std::uint32_t> ks, EffectCounts& counts);
+                          std::span<const std::uint32_t> ks, EffectCounts& counts, PushVelocity* warm = nullptr);
 void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h, std::uint32_t lo,
                          std::uint32_t hi);
 void integrate_positions(World& world, SolverBody* bodies, PushVelocity* push, Real h,
