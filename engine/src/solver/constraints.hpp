@@ -314,7 +314,7 @@ struct SolverScratch {
     // prepare_wide stay off the cold descriptions, each a cache miss (prepare_body_chunk).
     RawRoomVector<PushVelocity> push_velocities;
     RawRoomVector<Real> gravity_scales;
-    // Per solver body: the next substep's warm start of its contacts, added up by the relax
+    // Per solver body: the next substep's warm start of its constraints, added up by the relax
     // pass that ends a substep (warm_in_relax) and added to the body's velocities as the next
     // substep integrates them (zero for a body no contact touches, and after that).
     RawRoomVector<PushVelocity> warm_velocities;
