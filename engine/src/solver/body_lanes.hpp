@@ -57,16 +57,16 @@ template <typename Lanes>
     }
 }
 
-// Adds the lanes' velocity changes `d` to the rows of `rows` (v and w, at the solver bodies'
-// indices) of the dynamic bodies, as scatter writes the velocities.
-template <typename Lanes, typename Rows>
-[[gnu::always_inline]] inline void scatter_add(const Lanes& lanes, const SolverBody* bodies, Rows* rows,
+// Adds the lanes' velocity changes `d` to the dynamic bodies' rows of `rows` (at the solver
+// bodies' indices: SolverScratch::warm_velocities), as scatter writes the velocities.
+template <typename Lanes>
+[[gnu::always_inline]] inline void scatter_add(const Lanes& lanes, const SolverBody* bodies, PushVelocity* rows,
                                                const WideVelocities& d) {
     Wide a[kLanes] = {d.va.x, d.va.y, d.va.z, d.wa.x, d.wa.y, d.wa.z};
     Wide b[kLanes] = {d.vb.x, d.vb.y, d.vb.z, d.wb.x, d.wb.y, d.wb.z};
     transpose(a);
     transpose(b);
-    auto add = [](Rows& row, Wide change) {
+    auto add = [](PushVelocity& row, Wide change) {
         row.v += Vec3(Real(change[0]), Real(change[1]), Real(change[2]));
         row.w += Vec3(Real(change[3]), Real(change[4]), Real(change[5]));
     };

@@ -272,7 +272,8 @@ enum class Pass : std::uint8_t {
     StoreJoints,
     FinalizeBodies
 };
-// A phase that carries a body pass (SolverScratch::fold_body_passes): a warm-start or first
+// A phase that carries a body pass (SolverScratch::fold_body_passes): a warm-start phase (or
+// the first solve phase of a substep the relax pass warm started, warm_in_relax) or first
 // relax phase of a folded step integrates, before a constraint, the bodies it is the first
 // of its pass to touch (first_touch), and in its items past `constraints`, chunks of the
 // bodies no constraint touches; a StoreImpulses phase finalizes every awake body in chunks
@@ -382,7 +383,8 @@ struct SolverScratch {
     std::vector<BodyChunk> body_chunks;
     // The body passes folded into the constraint passes (solver.cpp), so a step has fewer
     // phases and barriers: each body's velocities are integrated just before the first
-    // constraint of a warm-start pass that touches it, its positions just before the first
+    // constraint of a warm-start pass (or of the first solve pass, where the relax pass warm
+    // started the substep: warm_in_relax) that touches it, its positions just before the first
     // of the first relax pass (two phases fewer a substep), and the bodies are finalized in
     // the phase that stores the contacts' impulses. Each body's arithmetic and its order
     // against its own constraints stay the same: bitwise the results of the passes of
