@@ -52,7 +52,12 @@ bool enter_ball(const Segment& s, const Vec3& c, Real r, LocalHit& hit) {
     const Real outside = m.squaredNorm() - r * r;
     if (outside < 0 || b > 0) return false;
     const Real dd = s.d.squaredNorm();
-    const Real discriminant = b * b - dd * outside;
+    // The discriminant from the centre's distance to the line, not as b^2 - dd |m|^2: far
+    // from the ball those terms cancel (a ray from a billion metres away loses r^2 in
+    // |m|^2 and misses, or hits a metre off). The closest point is off by round-off of
+    // |m| only (Haines et al., "Precision Improvements for Ray/Sphere Intersection").
+    const Vec3 closest = m - (b / dd) * s.d;
+    const Real discriminant = dd * (r * r - closest.squaredNorm());
     if (discriminant < 0) return false;
     const Real t = (-b - std::sqrt(discriminant)) / dd;
     if (t > 1) return false;
@@ -69,7 +74,9 @@ bool enter_cylinder_side(const Segment& s, Real h, Real r, LocalHit& hit) {
     const Real b = s.a.x() * s.d.x() + s.a.z() * s.d.z();
     const Real outside = s.a.x() * s.a.x() + s.a.z() * s.a.z() - r * r;
     if (outside < 0 || b > 0) return false;
-    const Real discriminant = b * b - dd * outside;
+    // As enter_ball's: from the axis's distance to the line (in x-z), which does not cancel.
+    const Real cx = s.a.x() - (b / dd) * s.d.x(), cz = s.a.z() - (b / dd) * s.d.z();
+    const Real discriminant = dd * (r * r - (cx * cx + cz * cz));
     if (discriminant < 0) return false;
     const Real t = (-b - std::sqrt(discriminant)) / dd;
     const Vec3 p = s.a + t * s.d;
