@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -166,7 +167,10 @@ void AsyncRunner::loop(std::promise<void>* started) {
             // The scale is read after the posted functions: one posted after set_time_scale
             // runs in an iteration whose update already takes the new scale.
             const double scale = m_time_scale.load(std::memory_order_relaxed);
-            const double dt = elapsed * scale + m_advance.exchange(0, std::memory_order_relaxed);
+            // Each term is finite (set_time_scale and advance check theirs), their sum need
+            // not be: saturated as update() saturates its accumulator, a sum past the
+            // largest double is just "too much" (the step cap drops it), not a failure.
+            const double dt = std::min(elapsed * scale + m_advance.exchange(0, std::memory_order_relaxed), kHuge);
             m_space.m_world->update_clock_rate = scale;
 
             const std::int64_t begin = now_nanoseconds();
@@ -234,7 +238,10 @@ AsyncStats AsyncRunner::stats() const {
         s = m_totals;
         updates = m_update_samples;
         locks = m_lock_samples;
-        s.steps_dropped = static_cast<std::uint64_t>(std::llround(m_dropped_steps));
+        // Saturated: a huge time scale or advance drops more steps than 64 bits count.
+        constexpr double kCountable = 18446744073709551616.0;  // 2^64
+        s.steps_dropped = m_dropped_steps >= kCountable ? std::numeric_limits<std::uint64_t>::max()
+                                                        : static_cast<std::uint64_t>(std::round(m_dropped_steps));
     }
     s.steps_per_second = s.seconds > 0 ? static_cast<double>(s.steps) / s.seconds : 0;
     s.update_ms_p50 = percentile(updates, 0.5);
