@@ -116,6 +116,17 @@ void require_ordered(Real lower, Real upper, const char* lower_field, const char
 
 [[noreturn]] void reject(const std::string& what) { throw Error("create_joint: " + what); }
 
+// Lengths and translations a joint drives its bodies to: at most the world's width (two
+// points within kMaxCoordinate of the origin); motor speeds at most kMaxCoordinate (m/s
+// or rad/s, far past the solver's speed limits). Beyond those the joint's error or its
+// impulses overflow: a 1e300 m rest length made every pose NaN.
+constexpr Real kMaxJointLength = 2 * kMaxCoordinate;
+void require_within(Real value, Real bound, const char* who, const char* field) {
+    if (!(std::isfinite(value) && std::abs(value) <= bound)) {
+        reject_field(who, field, ("must be finite and within +-" + number(bound)).c_str(), number(value));
+    }
+}
+
 // In the World frame both bodies' axes are one world axis (hinge, swing-twist): given
 // twice, the two must agree (after normalising). In the Local frame each is its body's.
 void require_same_world_axis(const JointDesc& d, const Vec3& a, const Vec3& b, const char* field_a,
@@ -144,8 +155,11 @@ void validate(const World& world, const JointDesc& d) {
     if (d.anchors.frame != JointFrame::World && d.anchors.frame != JointFrame::Local) {
         reject("anchors.frame is neither World nor Local");
     }
-    require_finite(d.anchors.a, "anchors.a");
-    require_finite(d.anchors.b, "anchors.b");
+    // Anchors are points (in world, or in a body's frame): held to the positions' bound,
+    // which keeps the lever arms' squares, the effective masses and the joint's error
+    // finite. One a light-year off is no anchor a game means; it made every pose NaN.
+    check_position(d.anchors.a, "create_joint", "anchors.a");
+    check_position(d.anchors.b, "create_joint", "anchors.b");
     if (d.type == JointType::Hinge) {
         const HingeParams& h = d.hinge;
         require_axis(h.axis_a, "hinge.axis_a");
@@ -160,7 +174,7 @@ void validate(const World& world, const JointDesc& d) {
         }
         require_non_negative(h.limit_spring_hertz, "hinge.limit_spring_hertz");
         require_non_negative(h.limit_damping_ratio, "hinge.limit_damping_ratio");
-        require(std::isfinite(h.motor_speed), "hinge.motor_speed", "must be finite", number(h.motor_speed));
+        require_within(h.motor_speed, kMaxCoordinate, "create_joint", "hinge.motor_speed");
         require_non_negative(h.max_motor_torque, "hinge.max_motor_torque");
     }
     if (d.type == JointType::SwingTwist) {
@@ -181,19 +195,16 @@ void validate(const World& world, const JointDesc& d) {
     if (d.type == JointType::Prismatic) {
         const PrismaticParams& p = d.prismatic;
         require_axis(p.axis_a, "prismatic.axis_a");
-        require(std::isfinite(p.lower_translation), "prismatic.lower_translation", "must be finite",
-                number(p.lower_translation));
-        require(std::isfinite(p.upper_translation), "prismatic.upper_translation", "must be finite",
-                number(p.upper_translation));
+        require_within(p.lower_translation, kMaxJointLength, "create_joint", "prismatic.lower_translation");
+        require_within(p.upper_translation, kMaxJointLength, "create_joint", "prismatic.upper_translation");
         if (p.enable_limit) {
             require_ordered(p.lower_translation, p.upper_translation, "prismatic.lower_translation",
                             "prismatic.upper_translation");
         }
         require_non_negative(p.spring_hertz, "prismatic.spring_hertz");
         require_non_negative(p.spring_damping_ratio, "prismatic.spring_damping_ratio");
-        require(std::isfinite(p.target_translation), "prismatic.target_translation", "must be finite",
-                number(p.target_translation));
-        require(std::isfinite(p.motor_speed), "prismatic.motor_speed", "must be finite", number(p.motor_speed));
+        require_within(p.target_translation, kMaxJointLength, "create_joint", "prismatic.target_translation");
+        require_within(p.motor_speed, kMaxCoordinate, "create_joint", "prismatic.motor_speed");
         require_non_negative(p.max_motor_force, "prismatic.max_motor_force");
     }
     if (d.type == JointType::Motor) {
@@ -209,10 +220,11 @@ void validate(const World& world, const JointDesc& d) {
     }
     if (d.type == JointType::Distance) {
         const DistanceParams& p = d.distance;
-        require(std::isfinite(p.rest_length), "distance.rest_length", "must be finite", number(p.rest_length));
+        require_within(p.rest_length, kMaxJointLength, "create_joint", "distance.rest_length");
         require_non_negative(p.spring_hertz, "distance.spring_hertz");
         require_non_negative(p.spring_damping_ratio, "distance.spring_damping_ratio");
         require_non_negative(p.min_length, "distance.min_length");
+        require_within(p.min_length, kMaxJointLength, "create_joint", "distance.min_length");
         require(std::isfinite(p.max_length), "distance.max_length", "must be finite", number(p.max_length));
         require_ordered(p.min_length, p.max_length, "distance.min_length", "distance.max_length");
     }
@@ -394,7 +406,7 @@ void Space::set_hinge_motor(JointHandle handle, bool enable, Real speed, Real ma
     Joint& j = w.joints.joint[handle.index];
     if (j.type != JointType::Hinge)
         throw Error("set_hinge_motor: " + to_string(handle) + " is a " + to_string(j.type) + " joint");
-    check_finite(speed, "set_hinge_motor", "speed");
+    require_within(speed, kMaxCoordinate, "set_hinge_motor", "speed");
     check_non_negative(max_torque, "set_hinge_motor", "max_torque");
     if (j.hinge.enable_motor != enable) j.motor_impulse = 0;
     j.hinge.enable_motor = enable;

@@ -5,11 +5,15 @@
 #include <spindle/engine/motion_state_manager.hpp>
 #include <spindle/platform/error.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 #include "api/describe.hpp"
+#include "collision/error_text.hpp"
 
 namespace spindle {
+
+static_assert(kMaxCoordinate == detail::kMaxShapeCoordinate, "shapes and positions share one bound");
 
 void reject_field(const char* who, const std::string& field, const char* rule, const std::string& got) {
     throw Error(std::string(who) + ": " + field + " " + rule + ", got " + got);
@@ -54,6 +58,12 @@ void check_direction(const Vec3& value, const char* who, const char* field) {
 void check_orientation(const Quat& value, const char* who, const char* field) {
     if (!is_finite(value) || value.norm() < 1e-9) {
         reject_field(who, field, "must be a finite, non-zero quaternion",
+                     "(w " + number(value.w()) + ", " + vec(value.vec()) + ")");
+    }
+    // Components past about 1e154 square to infinity: normalising divides by an infinite
+    // norm and leaves the zero quaternion (a body turned by nothing, its inertia zeroed).
+    if (!std::isfinite(value.norm())) {
+        reject_field(who, field, "must have a finite norm (components below 1e154)",
                      "(w " + number(value.w()) + ", " + vec(value.vec()) + ")");
     }
 }
@@ -134,31 +144,67 @@ void validate(const SpaceSettings& s) {
 
 // ---- shapes and bodies ----
 
+namespace {
+
+// A shape's sizes are held to the positions' bound (kMaxCoordinate), for the same reason:
+// bounds, squared distances and the tree's areas of a shape a 1e300 m across overflow
+// (NaN poses, a corrupt tree). Sizes as the primitives' fields name them.
+void check_size(Real value, const char* who, const char* field) {
+    check_positive(value, who, field);
+    if (value > kMaxCoordinate) {
+        reject_field(who, field, ("must be at most " + number(kMaxCoordinate) + " m").c_str(), number(value));
+    }
+}
+
+// A hull's, mesh's or compound's geometry, by its bounds in its own frame.
+void check_extent(const Shape& s, const char* who, const char* field) {
+    const Aabb local = s.bounds(Transform{Vec3::Zero(), Quat::Identity()});
+    const Real reach = std::max(local.min.cwiseAbs().maxCoeff(), local.max.cwiseAbs().maxCoeff());
+    if (!(reach <= kMaxCoordinate)) {
+        reject_field(who, field, ("must lie within " + number(kMaxCoordinate) + " m of the shape's origin").c_str(),
+                     "bounds " + vec(local.min) + " to " + vec(local.max));
+    }
+}
+
+}  // namespace
+
 void validate(const Shape& s, const char* who) {
     switch (s.type) {
-        case ShapeType::Sphere: check_positive(s.radius, who, "shape.radius"); return;
+        case ShapeType::Sphere: check_size(s.radius, who, "shape.radius"); return;
         case ShapeType::Capsule:
-            check_positive(s.half_height, who, "shape.half_height");
-            check_positive(s.radius, who, "shape.radius");
+            check_size(s.half_height, who, "shape.half_height");
+            check_size(s.radius, who, "shape.radius");
             return;
         case ShapeType::Box:
             if (!(is_finite(s.half_extents) && s.half_extents.minCoeff() > 0)) {
                 reject_field(who, "shape.half_extents", "must be finite and > 0", vec(s.half_extents));
             }
+            if (s.half_extents.maxCoeff() > kMaxCoordinate) {
+                reject_field(who, "shape.half_extents", ("must be at most " + number(kMaxCoordinate) + " m").c_str(),
+                             vec(s.half_extents));
+            }
             return;
         case ShapeType::ConvexHull:
             if (!s.hull) reject_field(who, "shape.hull", "must be set for a convex hull (Shape::convex_hull)", "none");
+            check_extent(s, who, "shape.hull");
             return;
         case ShapeType::Plane:
             check_direction(s.normal, who, "shape.normal");
             check_finite(s.offset, who, "shape.offset");
+            if (std::abs(s.offset) > kMaxCoordinate * s.normal.norm()) {
+                reject_field(who, "shape.offset",
+                             ("must put the plane within " + number(kMaxCoordinate) + " m of the origin").c_str(),
+                             number(s.offset));
+            }
             return;
         case ShapeType::TriangleMesh:
             if (!s.mesh)
                 reject_field(who, "shape.mesh", "must be set for a triangle mesh (Shape::triangle_mesh)", "none");
+            check_extent(s, who, "shape.mesh");
             return;
         case ShapeType::Compound:
             if (!s.parts) reject_field(who, "shape.parts", "must be set for a compound (Shape::compound)", "none");
+            check_extent(s, who, "shape.parts");
             return;
         case ShapeType::Count: break;
     }

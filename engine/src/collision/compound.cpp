@@ -43,9 +43,15 @@ void check_part(std::uint32_t i, const CompoundPart& part) {
         default: reject(i, std::string("must be a sphere, capsule, box or convex hull, got ") + to_string(s.type));
     }
     if (!is_finite(part.position)) reject(i, "position must be finite, got " + to_text(part.position));
+    if (part.position.cwiseAbs().maxCoeff() > detail::kMaxShapeCoordinate) {
+        reject(i, "position must be within " + to_text(detail::kMaxShapeCoordinate) + " m of the origin, got " +
+                      to_text(part.position));
+    }
     const Vec3 q = part.orientation.vec();
     const Real w = part.orientation.w();
-    if (!is_finite(part.orientation) || !(part.orientation.norm() > 0)) {
+    // A finite norm too: components past about 1e154 square to infinity, and normalising
+    // by an infinite norm leaves the zero quaternion.
+    if (!is_finite(part.orientation) || !(part.orientation.norm() > 0) || !is_finite(part.orientation.norm())) {
         reject(i, "orientation must be finite and non-zero, got (" + to_text(w) + ", " + to_text(q.x()) + ", " +
                       to_text(q.y()) + ", " + to_text(q.z()) + ") (w, x, y, z)");
     }

@@ -187,6 +187,11 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
             throw Error("convex hull: point " + std::to_string(i) + " must be finite, got " +
                         detail::to_text(points[i]));
         }
+        if (points[i].cwiseAbs().maxCoeff() > detail::kMaxShapeCoordinate) {
+            throw Error("convex hull: point " + std::to_string(i) + " must be within " +
+                        detail::to_text(detail::kMaxShapeCoordinate) + " m of the origin, got " +
+                        detail::to_text(points[i]));
+        }
         box.include(points[i]);
     }
     const Real size = (box.max - box.min).norm();

@@ -8,6 +8,11 @@
 
 namespace spindle::detail {
 
+// How far from its origin a hull's points and a mesh's vertices may lie: the bound of
+// positions (api/validation.hpp's kMaxCoordinate, the same value), past which the plane
+// tests, areas and bounds of the shape overflow.
+inline constexpr Real kMaxShapeCoordinate = 1e9;
+
 // Shortest text that reads back to the same double.
 inline std::string to_text(Real x) {
     char buffer[32];

@@ -33,6 +33,13 @@ Softness make_softness(Real hertz, Real damping_ratio, Real h) {
     const Real omega = 2 * kPi * hertz;
     const Real a1 = 2 * damping_ratio + h * omega;
     const Real a2 = h * omega * a1;
+    if (!std::isfinite(a2)) {
+        // So stiff or so damped that a2 overflows (a finite hertz or ratio near the largest
+        // double): the limit as it grows, a rigid row (mass scale 1, no impulse scale), not
+        // inf * 0. The bias rate omega / a1 written as 1 / (2 zeta / omega + h), which holds
+        // when omega overflows too.
+        return {1 / (2 * (damping_ratio / omega) + h), 1, 0};
+    }
     const Real a3 = 1 / (1 + a2);
     return {omega / a1, a2 * a3, a3};
 }

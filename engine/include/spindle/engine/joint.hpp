@@ -41,6 +41,8 @@ enum class JointFrame : std::uint8_t {
 
 // Where a joint attaches to each body. A ball-socket, hinge or fixed joint given one
 // world point uses it for both bodies.
+// Anchors are points: within 1e9 m of the origin (World) or of the body's origin (Local),
+// as positions are; create_joint refuses others, naming the anchor.
 struct JointAnchors {
     JointFrame frame = JointFrame::World;
     Vec3 a = Vec3::Zero();  // on body_a

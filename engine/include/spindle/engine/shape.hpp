@@ -1,6 +1,10 @@
 // Shapes: immutable geometry shared by bodies. A body's position is its shape's
 // origin; mass_properties() says where the centre of mass sits in that frame.
 // Factories validate their input and throw spindle::Error naming the field and value.
+// Like positions, a shape's geometry stays within a billion metres (1e9 m) of its origin:
+// a larger radius, half extent, plane offset, hull point, mesh vertex or compound part
+// position is refused (by the factory, or by create_body, set_shape and the queries for
+// a shape built by hand), since its bounds and distances would overflow.
 #pragma once
 
 #include <cstdint>

@@ -67,10 +67,10 @@ public:
     void reserve_bodies(std::size_t count);
 
     // Joints (same thread rule as bodies). create_joint validates first (bodies live
-    // and different, at least one dynamic, finite anchors, non-zero axes, ordered
-    // limits); a rejected joint leaves the space unchanged and the spindle::Error names
-    // the field. Creating or destroying a joint wakes both bodies. Destroying a body
-    // destroys its joints.
+    // and different, at least one dynamic, anchors within 1e9 m, non-zero axes, ordered
+    // limits, lengths and translations within 2e9 m and motor speeds within 1e9); a
+    // rejected joint leaves the space unchanged and the spindle::Error names the field. Creating or destroying a joint
+    // wakes both bodies. Destroying a body destroys its joints.
     JointHandle create_joint(const JointDesc& desc);
     void destroy_joint(JointHandle joint);
     bool contains(JointHandle joint) const noexcept;
