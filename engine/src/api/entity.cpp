@@ -17,6 +17,13 @@ void Entity::add_to(Space& space) {
 
 void Entity::remove_from_space() {
     if (!m_space) return;
+    if (!m_space->contains(m_handle)) {
+        // Destroyed through the space already: nothing live to copy back, and throwing
+        // here would leave the entity in a space that no longer has its body for good.
+        m_space = nullptr;
+        m_handle = BodyHandle{};
+        return;
+    }
     const MotionState s = m_space->internal_motion_state(m_handle);
     m_desc.position = s.position;
     m_desc.orientation = s.orientation;

@@ -88,9 +88,13 @@ const std::vector<HandleCall>& handle_calls() {
          }},
         {"read", [](Space& s, BodyHandle b) { (void)s.motion_states().read(b); }},
         {"create_joint a",
-         [](Space& s, BodyHandle b) { s.create_joint(JointDesc::ball_socket_at(b, BodyHandle{1, 1}, Vec3::Zero())); }},
+         [](Space& s, BodyHandle b) {
+             s.create_joint(JointDesc::ball_socket_at(b, BodyHandle{1, 1}, Vec3::Zero()));
+         }},
         {"create_joint b",
-         [](Space& s, BodyHandle b) { s.create_joint(JointDesc::ball_socket_at(BodyHandle{1, 1}, b, Vec3::Zero())); }},
+         [](Space& s, BodyHandle b) {
+             s.create_joint(JointDesc::ball_socket_at(BodyHandle{1, 1}, b, Vec3::Zero()));
+         }},
     };
     return calls;
 }
@@ -106,8 +110,9 @@ void expect_every_call_refuses(BodyHandle bad, const std::string& what,
             prepare(scene);
             prepare(twin);
         }
-        expect_rejected(*scene.space, *twin.space, [&] { c.call(*scene.space, bad); }, to_string(bad),
-                        std::string(c.name) + " with a " + what + " handle");
+        expect_rejected(
+            *scene.space, *twin.space, [&] { c.call(*scene.space, bad); }, to_string(bad),
+            std::string(c.name) + " with a " + what + " handle");
     }
 }
 
@@ -167,16 +172,15 @@ TEST(OutsideInput, JointHandlesOfDestroyedBodiesAndNeverMadeJointsAreRefused) {
         {"destroy_joint", [](Space& s, JointHandle j) { s.destroy_joint(j); }},
         {"joint_desc", [](Space& s, JointHandle j) { (void)s.joint_desc(j); }},
         {"set_hinge_motor", [](Space& s, JointHandle j) { s.set_hinge_motor(j, true, 1, 1); }},
-        {"set_motor_target",
-         [](Space& s, JointHandle j) { s.set_motor_target(j, Vec3::Zero(), Quat::Identity()); }},
+        {"set_motor_target", [](Space& s, JointHandle j) { s.set_motor_target(j, Vec3::Zero(), Quat::Identity()); }},
         {"set_mouse_target", [](Space& s, JointHandle j) { s.set_mouse_target(j, Vec3::Zero()); }},
         {"internal_joint_error", [](Space& s, JointHandle j) { (void)s.internal_joint_error(j); }},
         {"internal_hinge_angle", [](Space& s, JointHandle j) { (void)s.internal_hinge_angle(j); }},
     };
     for (JointHandle bad : {scene.joint, JointHandle{0, 0}, JointHandle{7, 1}, JointHandle{~0u, ~0u}}) {
         for (const auto& [name, call] : calls) {
-            expect_rejected(*scene.space, *twin.space, [&] { call(*scene.space, bad); }, to_string(bad),
-                            std::string(name));
+            expect_rejected(
+                *scene.space, *twin.space, [&] { call(*scene.space, bad); }, to_string(bad), std::string(name));
         }
     }
 }
@@ -186,15 +190,18 @@ TEST(OutsideInput, JointCallsForAnotherTypeAreRefused) {
     Scene scene = make_scene();
     Scene twin = make_scene();
     const std::string joint = to_string(scene.joint);
-    expect_rejected(*scene.space, *twin.space, [&] { scene.space->set_hinge_motor(scene.joint, true, 1, 1); }, joint,
-                    "set_hinge_motor on a distance joint");
-    expect_rejected(*scene.space, *twin.space,
-                    [&] { scene.space->set_motor_target(scene.joint, Vec3::Zero(), Quat::Identity()); }, joint,
-                    "set_motor_target on a distance joint");
-    expect_rejected(*scene.space, *twin.space, [&] { scene.space->set_mouse_target(scene.joint, Vec3::Zero()); },
-                    joint, "set_mouse_target on a distance joint");
-    expect_rejected(*scene.space, *twin.space, [&] { (void)scene.space->internal_hinge_angle(scene.joint); }, joint,
-                    "internal_hinge_angle on a distance joint");
+    expect_rejected(
+        *scene.space, *twin.space, [&] { scene.space->set_hinge_motor(scene.joint, true, 1, 1); }, joint,
+        "set_hinge_motor on a distance joint");
+    expect_rejected(
+        *scene.space, *twin.space, [&] { scene.space->set_motor_target(scene.joint, Vec3::Zero(), Quat::Identity()); },
+        joint, "set_motor_target on a distance joint");
+    expect_rejected(
+        *scene.space, *twin.space, [&] { scene.space->set_mouse_target(scene.joint, Vec3::Zero()); }, joint,
+        "set_mouse_target on a distance joint");
+    expect_rejected(
+        *scene.space, *twin.space, [&] { (void)scene.space->internal_hinge_angle(scene.joint); }, joint,
+        "internal_hinge_angle on a distance joint");
 }
 
 // Anchors are points on the bodies: one a billion kilometres away is no anchor a game
@@ -232,79 +239,81 @@ TEST(OutsideInput, AnchorsFarBeyondTheWorldAreRefusedOrHarmless) {
 // Finite targets and lengths as large as a double holds: the joint may not reach them,
 // but the bodies stay finite (speeds are held to the solver's limits).
 TEST(OutsideInput, HugeJointTargetsLengthsAndMotorsLeaveAFiniteState) {
-  for (const Real huge : {1e9, 1e300}) {
-    SCOPED_TRACE(huge);
-    std::vector<std::function<JointDesc(Scene&)>> joints{
-        [&](Scene& s) {
-            JointDesc d = JointDesc::distance_between(s.ground, s.box, Vec3(0, 0, 0), Vec3(2, 3, 0));
-            d.distance.rest_length = huge;
-            d.distance.max_length = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::distance_between(s.ground, s.box, Vec3(0, 0, 0), Vec3(2, 3, 0));
-            d.distance.enable_spring = true;
-            d.distance.spring_hertz = huge;
-            d.distance.spring_damping_ratio = huge;
-            d.distance.rest_length = huge;
-            d.distance.max_length = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::prismatic_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(1, 0, 0));
-            d.prismatic.enable_spring = true;
-            d.prismatic.spring_hertz = huge;
-            d.prismatic.target_translation = huge;
-            d.prismatic.enable_motor = true;
-            d.prismatic.motor_speed = huge;
-            d.prismatic.max_motor_force = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::prismatic_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(1, 0, 0));
-            d.prismatic.enable_limit = true;
-            d.prismatic.lower_translation = huge;
-            d.prismatic.upper_translation = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::hinge_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(0, 0, 1));
-            d.hinge.enable_motor = true;
-            d.hinge.motor_speed = huge;
-            d.hinge.max_motor_torque = huge;
-            d.hinge.limit_spring_hertz = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::motor_between(s.ground, s.box, Vec3(2, 3, 0));
-            d.motor.linear_offset = Vec3(huge, 0, 0);
-            d.motor.max_force = huge;
-            d.motor.max_torque = huge;
-            d.motor.linear_hertz = huge;
-            d.motor.angular_hertz = huge;
-            d.motor.linear_damping_ratio = huge;
-            return d;
-        },
-        [&](Scene& s) {
-            JointDesc d = JointDesc::swing_twist_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(0, 1, 0));
-            d.swing_twist.max_friction_torque = huge;
-            return d;
-        },
-    };
-    for (std::size_t k = 0; k < joints.size(); ++k) {
-        SCOPED_TRACE("joint " + std::to_string(k));
-        Scene scene = make_scene();
-        const std::string message = error_of([&] { scene.space->create_joint(joints[k](scene)); });
-        if (huge <= 1e9) { EXPECT_EQ(message, "(accepted)") << "within the world's bound"; }
-        if (message != "(accepted)") {
-            EXPECT_NE(message.find("create_joint: "), std::string::npos) << message;  // refused, naming the field
-            continue;
+    for (const Real huge : {1e9, 1e300}) {
+        SCOPED_TRACE(huge);
+        std::vector<std::function<JointDesc(Scene&)>> joints{
+            [&](Scene& s) {
+                JointDesc d = JointDesc::distance_between(s.ground, s.box, Vec3(0, 0, 0), Vec3(2, 3, 0));
+                d.distance.rest_length = huge;
+                d.distance.max_length = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::distance_between(s.ground, s.box, Vec3(0, 0, 0), Vec3(2, 3, 0));
+                d.distance.enable_spring = true;
+                d.distance.spring_hertz = huge;
+                d.distance.spring_damping_ratio = huge;
+                d.distance.rest_length = huge;
+                d.distance.max_length = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::prismatic_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(1, 0, 0));
+                d.prismatic.enable_spring = true;
+                d.prismatic.spring_hertz = huge;
+                d.prismatic.target_translation = huge;
+                d.prismatic.enable_motor = true;
+                d.prismatic.motor_speed = huge;
+                d.prismatic.max_motor_force = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::prismatic_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(1, 0, 0));
+                d.prismatic.enable_limit = true;
+                d.prismatic.lower_translation = huge;
+                d.prismatic.upper_translation = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::hinge_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(0, 0, 1));
+                d.hinge.enable_motor = true;
+                d.hinge.motor_speed = huge;
+                d.hinge.max_motor_torque = huge;
+                d.hinge.limit_spring_hertz = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::motor_between(s.ground, s.box, Vec3(2, 3, 0));
+                d.motor.linear_offset = Vec3(huge, 0, 0);
+                d.motor.max_force = huge;
+                d.motor.max_torque = huge;
+                d.motor.linear_hertz = huge;
+                d.motor.angular_hertz = huge;
+                d.motor.linear_damping_ratio = huge;
+                return d;
+            },
+            [&](Scene& s) {
+                JointDesc d = JointDesc::swing_twist_at(s.ground, s.box, Vec3(2, 3, 0), Vec3(0, 1, 0));
+                d.swing_twist.max_friction_torque = huge;
+                return d;
+            },
+        };
+        for (std::size_t k = 0; k < joints.size(); ++k) {
+            SCOPED_TRACE("joint " + std::to_string(k));
+            Scene scene = make_scene();
+            const std::string message = error_of([&] { scene.space->create_joint(joints[k](scene)); });
+            if (huge <= 1e9) {
+                EXPECT_EQ(message, "(accepted)") << "within the world's bound";
+            }
+            if (message != "(accepted)") {
+                EXPECT_NE(message.find("create_joint: "), std::string::npos) << message;  // refused, naming the field
+                continue;
+            }
+            scene.space->apply_impulse(scene.box, Vec3(0, 50, 10));
+            for (int i = 0; i < 60; ++i) scene.space->update();
+            expect_finite_state(*scene.space, {scene.ground, scene.sphere, scene.box});
         }
-        scene.space->apply_impulse(scene.box, Vec3(0, 50, 10));
-        for (int i = 0; i < 60; ++i) scene.space->update();
-        expect_finite_state(*scene.space, {scene.ground, scene.sphere, scene.box});
     }
-  }
 }
 
 // Motor and mouse targets as large as a double holds.
@@ -317,8 +326,9 @@ TEST(OutsideInput, HingeMotorSpeedBeyondTheBoundIsRefused) {
     };
     const JointHandle j = hinge(scene);
     hinge(twin);
-    expect_rejected(*scene.space, *twin.space, [&] { scene.space->set_hinge_motor(j, true, 1e300, 1e300); },
-                    "set_hinge_motor: speed", "1e300");
+    expect_rejected(
+        *scene.space, *twin.space, [&] { scene.space->set_hinge_motor(j, true, 1e300, 1e300); },
+        "set_hinge_motor: speed", "1e300");
     scene.space->set_hinge_motor(j, true, 1e9, 1e300);
     for (int i = 0; i < 30; ++i) scene.space->update();
     expect_finite_state(*scene.space, {scene.ground, scene.sphere, scene.box});
@@ -336,8 +346,12 @@ TEST(OutsideInput, HugeMotorAndMouseTargetsLeaveAFiniteState) {
     const std::string b = error_of([&] { scene.space->set_mouse_target(mouse, Vec3(0, -1e300, 0)); });
     for (int i = 0; i < 60; ++i) scene.space->update();
     expect_finite_state(*scene.space, {scene.ground, scene.sphere, scene.box});
-    if (a != "(accepted)") { EXPECT_NE(a.find("linear_offset"), std::string::npos) << a; }
-    if (b != "(accepted)") { EXPECT_NE(b.find("target"), std::string::npos) << b; }
+    if (a != "(accepted)") {
+        EXPECT_NE(a.find("linear_offset"), std::string::npos) << a;
+    }
+    if (b != "(accepted)") {
+        EXPECT_NE(b.find("target"), std::string::npos) << b;
+    }
 }
 
 // A joint needs one dynamic body; making its dynamic body static or kinematic later
@@ -347,7 +361,8 @@ TEST(OutsideInput, JointWhoseDynamicBodyIsMadeStaticOrKinematicLeavesAFiniteStat
     for (MotionType to : {MotionType::Static, MotionType::Kinematic}) {
         for (JointType type : {JointType::BallSocket, JointType::Hinge, JointType::Fixed, JointType::Distance,
                                JointType::Prismatic, JointType::SwingTwist, JointType::Motor}) {
-            SCOPED_TRACE(std::string(to_string(type)) + (to == MotionType::Static ? " made static" : " made kinematic"));
+            SCOPED_TRACE(std::string(to_string(type)) +
+                         (to == MotionType::Static ? " made static" : " made kinematic"));
             Scene scene = make_scene();
             JointDesc d = JointDesc::ball_socket_at(scene.ground, scene.box, Vec3(2, 3.5, 0));
             d.type = type;
@@ -458,6 +473,31 @@ TEST(OutsideInput, ShapeFactoriesRefusePointsBeyondTheBound) {
                   (void)Shape::convex_hull(std::vector<Vec3>{{-1e9, 0, 0}, {1e9, 0, 0}, {0, 1e9, 0}, {0, 0, 1e9}});
               }),
               "(accepted)");
+}
+
+// An Entity whose body the game destroyed through the space (its handle now stale) is
+// not stuck in the space: removing it lets it go (nothing live to copy back), and it can
+// be added again, to this space or another.
+TEST(OutsideInput, EntityWhoseBodyWasDestroyedThroughTheSpaceCanBeRemovedAndAddedAgain) {
+    Space space;
+    BodyDesc d;
+    d.position = Vec3(1, 2, 3);
+    Entity entity(d);
+    entity.add_to(space);
+    const BodyHandle first = entity.handle();
+    space.destroy_body(first);
+    EXPECT_NE(error_of([&] { (void)entity.position(); }).find(to_string(first)), std::string::npos);
+    const std::string removed = error_of([&] { entity.remove_from_space(); });
+    EXPECT_EQ(removed, "(accepted)");
+    EXPECT_FALSE(entity.in_space());
+    EXPECT_EQ(entity.position(), Vec3(1, 2, 3));  // as it was added
+    Space other;
+    entity.add_to(other);
+    EXPECT_TRUE(other.contains(entity.handle()));
+    entity.remove_from_space();
+    entity.add_to(space);
+    EXPECT_TRUE(space.contains(entity.handle()));
+    EXPECT_NE(entity.handle(), first);
 }
 
 // Mass and density as large or small as a double holds.

@@ -20,7 +20,8 @@ public:
 
     // Structure: the space's update thread, or any thread while it does not update.
     // add_to creates the body in the space from its current values (throws, and stays
-    // outside, on bad values); remove_from_space copies the live state back first.
+    // outside, on bad values); remove_from_space copies the live state back first (a body
+    // already destroyed through the space is just let go: the entity keeps its values).
     void add_to(Space& space);
     void remove_from_space();
 
