@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-
 namespace spindle::outside_compounds_test {
 namespace {
 
@@ -80,7 +79,8 @@ TEST(OutsideCompounds, DISABLED_FlatSlabOfSixteenBallsComesToRestOnTheGround) {
         SCOPED_TRACE(std::to_string(n * n) + " balls");
         std::vector<CompoundPart> parts;
         for (int x = 0; x < n; ++x) {
-            for (int z = 0; z < n; ++z) parts.push_back({Shape::sphere(0.1), Vec3(0.2 * x, 0, 0.2 * z), Quat::Identity()});
+            for (int z = 0; z < n; ++z)
+                parts.push_back({Shape::sphere(0.1), Vec3(0.2 * x, 0, 0.2 * z), Quat::Identity()});
         }
         Space space;
         BodyDesc ground;
@@ -184,7 +184,9 @@ TEST(OutsideCompounds, OrientationsOfAnyScaleAreNormalisedOrRefused) {
     const std::string query_error = error_text([&] {
         space.overlap_shape(Shape::box(Vec3(0.5, 0.1, 0.2)), {Vec3(0, 0, 0), huge}, found);
     });
-    if (query_error != "(accepted)") { EXPECT_NE(query_error.find("pose.q"), std::string::npos) << query_error; }
+    if (query_error != "(accepted)") {
+        EXPECT_NE(query_error.find("pose.q"), std::string::npos) << query_error;
+    }
     EXPECT_TRUE(space.internal_orientation(other).coeffs().allFinite());
 }
 

@@ -208,8 +208,12 @@ TEST(OutsideEvents, DestroyedAndRemadeInOneFrameEndsTheOldPairAndBeginsTheNew) {
     ASSERT_EQ(count(events, ContactEventKind::Begin), 1u);
     for (const ContactEvent& e : events) {
         EXPECT_EQ(e.body_a, floor);
-        if (e.kind == ContactEventKind::End) { EXPECT_EQ(e.body_b, first); }
-        if (e.kind == ContactEventKind::Begin) { EXPECT_EQ(e.body_b, second); }
+        if (e.kind == ContactEventKind::End) {
+            EXPECT_EQ(e.body_b, first);
+        }
+        if (e.kind == ContactEventKind::Begin) {
+            EXPECT_EQ(e.body_b, second);
+        }
     }
 }
 

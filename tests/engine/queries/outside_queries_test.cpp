@@ -43,8 +43,8 @@ std::optional<QueryHit> agreed_ray(const Space& space, const Vec3& from, const V
     std::vector<QueryHit> all;
     space.cast_ray_all(from, to, all, filter);
     const std::string what = "ray " + std::to_string(from.x()) + "," + std::to_string(from.y()) + "," +
-                             std::to_string(from.z()) + " -> " + std::to_string(to.x()) + "," +
-                             std::to_string(to.y()) + "," + std::to_string(to.z());
+                             std::to_string(from.z()) + " -> " + std::to_string(to.x()) + "," + std::to_string(to.y()) +
+                             "," + std::to_string(to.z());
     EXPECT_EQ(hit.has_value(), any) << what;
     EXPECT_EQ(hit.has_value(), !all.empty()) << what;
     if (hit && !all.empty()) {
@@ -69,7 +69,8 @@ TEST(OutsideQueries, ZeroLengthRaysMeetNothingAnywhere) {
     space.create_body(body(Shape::box(Vec3(1, 1, 1)), Vec3(5, 0, 0)));
     space.create_body(body(test::flat_grid_mesh(4, 1), Vec3(0, -3, 0)));
     space.create_body(body(Shape::plane(Vec3::UnitY(), -10), Vec3::Zero()));
-    for (const Vec3& p : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(6, 1, 1), Vec3(0, -3, 0), Vec3(0, -10, 0), Vec3(9, 9, 9)}) {
+    for (const Vec3& p :
+         {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(6, 1, 1), Vec3(0, -3, 0), Vec3(0, -10, 0), Vec3(9, 9, 9)}) {
         EXPECT_FALSE(agreed_ray(space, p, p).has_value()) << p.transpose();
     }
 }
@@ -79,16 +80,11 @@ TEST(OutsideQueries, ZeroLengthRaysMeetNothingAnywhere) {
 TEST(OutsideQueries, RayStartingInsideABodyMeetsTheBodyBeyondIt) {
     const CompoundPart parts[] = {{Shape::box(Vec3(1, 1, 1)), Vec3::Zero(), Quat::Identity()},
                                   {Shape::sphere(0.5), Vec3(0, 2, 0), Quat::Identity()}};
-    const std::vector<Shape> shapes{Shape::sphere(1), Shape::box(Vec3(1, 1, 1)), Shape::capsule(0.5, 1),
-                                    Shape::convex_hull(std::vector<Vec3>{{-1, -1, -1},
-                                                                         {1, -1, -1},
-                                                                         {-1, 1, -1},
-                                                                         {1, 1, -1},
-                                                                         {-1, -1, 1},
-                                                                         {1, -1, 1},
-                                                                         {-1, 1, 1},
-                                                                         {1, 1, 1}}),
-                                    Shape::compound(parts)};
+    const std::vector<Shape> shapes{
+        Shape::sphere(1), Shape::box(Vec3(1, 1, 1)), Shape::capsule(0.5, 1),
+        Shape::convex_hull(std::vector<Vec3>{
+            {-1, -1, -1}, {1, -1, -1}, {-1, 1, -1}, {1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {-1, 1, 1}, {1, 1, 1}}),
+        Shape::compound(parts)};
     for (const Shape& shape : shapes) {
         SCOPED_TRACE(to_string(shape.type));
         Space space(still());
@@ -113,19 +109,21 @@ TEST(OutsideQueries, RaysAlongFacesEdgesAndCornersAgreeAndHitTheSurface) {
     Space space(still());
     space.create_body(body(Shape::box(Vec3(1, 1, 1)), Vec3::Zero()));
     const std::vector<std::pair<Vec3, Vec3>> rays{
-        {{-5, 1, 0}, {5, 1, 0}},      // along the top face
-        {{-5, 1, 1}, {5, 1, 1}},      // along the top front edge
-        {{-5, -5, -5}, {5, 5, 5}},    // through two corners
-        {{0, 5, 0}, {0, 1, 0}},       // ending on the top face
-        {{0, 1, 0}, {0, 5, 0}},       // starting on the top face, leaving
-        {{0, 1, 0}, {0, -5, 0}},      // starting on the top face, entering
-        {{1, 5, 1}, {1, -5, 1}},      // down a vertical edge
+        {{-5, 1, 0}, {5, 1, 0}},                  // along the top face
+        {{-5, 1, 1}, {5, 1, 1}},                  // along the top front edge
+        {{-5, -5, -5}, {5, 5, 5}},                // through two corners
+        {{0, 5, 0}, {0, 1, 0}},                   // ending on the top face
+        {{0, 1, 0}, {0, 5, 0}},                   // starting on the top face, leaving
+        {{0, 1, 0}, {0, -5, 0}},                  // starting on the top face, entering
+        {{1, 5, 1}, {1, -5, 1}},                  // down a vertical edge
         {{-5, 1 + 1e-12, 0}, {5, 1 + 1e-12, 0}},  // just above the top face
         {{-5, 1 - 1e-12, 0}, {5, 1 - 1e-12, 0}},  // just inside it
     };
     for (const auto& [from, to] : rays) {
         const std::optional<QueryHit> hit = agreed_ray(space, from, to);
-        if (hit) { EXPECT_LE(hit->point.cwiseAbs().maxCoeff(), 1 + 1e-9) << hit->point.transpose(); }
+        if (hit) {
+            EXPECT_LE(hit->point.cwiseAbs().maxCoeff(), 1 + 1e-9) << hit->point.transpose();
+        }
     }
     // Straight down onto the top face's middle and onto the corner: both hit at y = 1.
     for (const Vec3& x : {Vec3(0, 0, 0), Vec3(1, 0, 1), Vec3(1, 0, 0)}) {
@@ -196,14 +194,16 @@ TEST(OutsideQueries, RaysABillionMetresLongHitSmallBodiesOnTheirSurface) {
             }
             EXPECT_EQ(hit->body, b);
             // A billion metres of ray holds its point to a few micrometres (1e9 x 2^-52 ~ 2e-7 m).
-            EXPECT_LE((hit->point - near->point).norm(), 1e-5) << hit->point.transpose() << " vs "
-                                                                << near->point.transpose();
+            EXPECT_LE((hit->point - near->point).norm(), 1e-5)
+                << hit->point.transpose() << " vs " << near->point.transpose();
         }
         // Sweeps and overlaps across the same distances.
-        const std::optional<QueryHit> sweep =
-            space.cast_shape(Shape::sphere(0.1), {Vec3(0, far, 0), Quat::Identity()}, Vec3(0, -far, 0));
+        const std::optional<QueryHit> sweep = space.cast_shape(Shape::sphere(0.1), {Vec3(0, far, 0), Quat::Identity()},
+                                                               Vec3(0, -far, 0));
         EXPECT_TRUE(sweep.has_value());
-        if (sweep) { EXPECT_NEAR(sweep->point.y(), top, 1e-5) << sweep->point.transpose(); }
+        if (sweep) {
+            EXPECT_NEAR(sweep->point.y(), top, 1e-5) << sweep->point.transpose();
+        }
         std::vector<BodyHandle> found;
         EXPECT_EQ(space.overlap_box({Vec3(-far, -far, -far), Vec3(far, far, far)}, found), 1u);
     }
@@ -214,15 +214,15 @@ TEST(OutsideQueries, ZeroTranslationSweepIsAnOverlapAtFractionZero) {
     Space space(still());
     const BodyHandle ball = space.create_body(body(Shape::sphere(1), Vec3::Zero()));
     space.create_body(body(test::flat_grid_mesh(4, 1), Vec3(0, -3, 0)));
-    const std::optional<QueryHit> touching =
-        space.cast_shape(Shape::box(Vec3(0.5, 0.5, 0.5)), {Vec3(1.2, 0, 0), Quat::Identity()}, Vec3::Zero());
+    const std::optional<QueryHit> touching = space.cast_shape(Shape::box(Vec3(0.5, 0.5, 0.5)),
+                                                              {Vec3(1.2, 0, 0), Quat::Identity()}, Vec3::Zero());
     ASSERT_TRUE(touching.has_value());
     EXPECT_EQ(touching->body, ball);
     EXPECT_EQ(touching->fraction, 0);
-    EXPECT_FALSE(space.cast_shape(Shape::box(Vec3(0.5, 0.5, 0.5)), {Vec3(3, 0, 0), Quat::Identity()}, Vec3::Zero())
-                     .has_value());
-    const std::optional<QueryHit> on_mesh =
-        space.cast_shape(Shape::sphere(0.5), {Vec3(0.3, -2.7, 0.2), Quat::Identity()}, Vec3::Zero());
+    EXPECT_FALSE(
+        space.cast_shape(Shape::box(Vec3(0.5, 0.5, 0.5)), {Vec3(3, 0, 0), Quat::Identity()}, Vec3::Zero()).has_value());
+    const std::optional<QueryHit> on_mesh = space.cast_shape(Shape::sphere(0.5),
+                                                             {Vec3(0.3, -2.7, 0.2), Quat::Identity()}, Vec3::Zero());
     ASSERT_TRUE(on_mesh.has_value());
     EXPECT_EQ(on_mesh->fraction, 0);
 }
@@ -292,16 +292,16 @@ TEST(OutsideQueries, EveryQueryFiltersByLayerGroupAndIgnore) {
     group5.group = 5;
     EXPECT_EQ(space.overlap_box(everywhere, found, group5), 1u);
     EXPECT_EQ(found.front(), hb);
-    const std::optional<QueryHit> sweep =
-        space.cast_shape(Shape::sphere(0.1), {Vec3(-5, 0, 0), Quat::Identity()}, Vec3(10, 0, 0), group5);
+    const std::optional<QueryHit> sweep = space.cast_shape(Shape::sphere(0.1), {Vec3(-5, 0, 0), Quat::Identity()},
+                                                           Vec3(10, 0, 0), group5);
     ASSERT_TRUE(sweep.has_value());
     EXPECT_EQ(sweep->body, hb);
     QueryFilter ignore_b;
     ignore_b.ignore = hb;
     ignore_b.layer_mask = 1u << 4;
     EXPECT_EQ(space.overlap_box(everywhere, found, ignore_b), 0u);
-    EXPECT_FALSE(space.cast_shape(Shape::sphere(0.1), {Vec3(-5, 0, 0), Quat::Identity()}, Vec3(10, 0, 0), ignore_b)
-                     .has_value());
+    EXPECT_FALSE(
+        space.cast_shape(Shape::sphere(0.1), {Vec3(-5, 0, 0), Quat::Identity()}, Vec3(10, 0, 0), ignore_b).has_value());
     QueryFilter none;
     none.layer_mask = 0;
     EXPECT_FALSE(agreed_ray(space, Vec3(-5, 0, 0), Vec3(5, 0, 0), none).has_value());
@@ -323,14 +323,16 @@ TEST(OutsideQueries, HandBuiltQueryShapesAreCheckedNamingTheField) {
     bad.type = ShapeType::Compound;
     EXPECT_NE(test::error_of([&] { space.overlap_shape(bad, {}, found); }).find("shape.parts"), std::string::npos);
     bad.type = ShapeType::ConvexHull;
-    EXPECT_NE(test::error_of([&] { space.cast_shape(bad, {}, Vec3(1, 0, 0)); }).find("shape.hull"),
-              std::string::npos);
+    EXPECT_NE(test::error_of([&] { space.cast_shape(bad, {}, Vec3(1, 0, 0)); }).find("shape.hull"), std::string::npos);
     bad.type = static_cast<ShapeType>(42);
     EXPECT_NE(test::error_of([&] { space.overlap_shape(bad, {}, found); }).find("shape.type"), std::string::npos);
-    EXPECT_NE(test::error_of([&] { space.overlap_shape(Shape::sphere(1), {Vec3(2e9, 0, 0), Quat::Identity()}, found); })
-                  .find("pose.p"),
+    EXPECT_NE(test::error_of([&] {
+                  space.overlap_shape(Shape::sphere(1), {Vec3(2e9, 0, 0), Quat::Identity()}, found);
+              }).find("pose.p"),
               std::string::npos);
-    EXPECT_NE(test::error_of([&] { space.overlap_box({Vec3(0, 0, 0), Vec3(2e9, 1, 1)}, found); }).find("box.max"),
+    EXPECT_NE(test::error_of([&] {
+                  space.overlap_box({Vec3(0, 0, 0), Vec3(2e9, 1, 1)}, found);
+              }).find("box.max"),
               std::string::npos);
 }
 
@@ -352,8 +354,8 @@ TEST(OutsideQueries, CompoundQueryShapeOverlapsWhatItsPartsOverlap) {
     ASSERT_EQ(found.size(), 2u);
     EXPECT_EQ(found[0], left);
     EXPECT_EQ(found[1], right);
-    const std::optional<QueryHit> sweep =
-        space.cast_shape(Shape::compound(parts), {Vec3(0, 5, 0), Quat::Identity()}, Vec3(0, -10, 0));
+    const std::optional<QueryHit> sweep = space.cast_shape(Shape::compound(parts), {Vec3(0, 5, 0), Quat::Identity()},
+                                                           Vec3(0, -10, 0));
     ASSERT_TRUE(sweep.has_value());
 }
 
