@@ -156,8 +156,8 @@ TEST(OutsideFriction, BallOnASlopeRollsAtFiveSeventhsOrSlipsAtCoulombsRate) {
             const double v1 = space->internal_linear_velocity(ball).dot(downhill);
             const double w1 = space->internal_angular_velocity(ball).z();
             const bool rolls = mu >= 2.0 / 7.0 * std::tan(kTheta);
-            const double expected =
-                rolls ? 5.0 / 7.0 * kGravity * std::sin(kTheta) : kGravity * (std::sin(kTheta) - mu * std::cos(kTheta));
+            const double expected = rolls ? 5.0 / 7.0 * kGravity * std::sin(kTheta)
+                                          : kGravity * (std::sin(kTheta) - mu * std::cos(kTheta));
             const double expected_alpha = rolls ? expected / kR : 2.5 * mu * kGravity * std::cos(kTheta) / kR;
             // Rolling down -x about +z: the spin is positive about z.
             const double alpha = w1 - w0;
@@ -222,9 +222,9 @@ Shape coin(double radius, double half_thickness) {
 }
 
 struct Settled {
-    double spin = 0;   // largest angular speed over the last second, rad/s
-    double drift = 0;  // largest distance from where it was a second before the end, m
-    double lowest = 0; // lowest point reached below the floor, m (from the shape's own bounds)
+    double spin = 0;    // largest angular speed over the last second, rad/s
+    double drift = 0;   // largest distance from where it was a second before the end, m
+    double lowest = 0;  // lowest point reached below the floor, m (from the shape's own bounds)
 };
 
 Settled drop_and_settle(Floor floor, const Shape& shape, const Quat& orientation, double lift) {
@@ -322,8 +322,7 @@ TEST(OutsideThin, StackOfFiveThinPlatesStaysStill) {
         }
         std::printf("[ measure  ] five plates on %s: drift %.3f mm, spin %.4f rad/s, top at %.4f m, deepest contact "
                     "%.2f mm\n",
-                    floor_name(floor), 1000 * drift, spin, space->internal_position(plates.back()).y(),
-                    1000 * deepest);
+                    floor_name(floor), 1000 * drift, spin, space->internal_position(plates.back()).y(), 1000 * deepest);
         EXPECT_LT(drift, 1e-3) << floor_name(floor);
         EXPECT_LT(spin, 0.02) << floor_name(floor);
         EXPECT_LT(deepest, SolverSettings{}.linear_slop) << floor_name(floor);
@@ -430,8 +429,8 @@ TEST(OutsideSpin, FastSpinAboutEachPrincipalAxisDoesNotDecay) {
     for (bool gyroscopic : {false, true}) {
         for (int axis = 0; axis < 3; ++axis) {
             if (gyroscopic && axis == 1) continue;
-            EXPECT_LT(fast_spin_momentum_change(axis, gyroscopic), 0.005) << "axis " << axis << " gyroscopic "
-                                                                           << gyroscopic;
+            EXPECT_LT(fast_spin_momentum_change(axis, gyroscopic), 0.005)
+                << "axis " << axis << " gyroscopic " << gyroscopic;
         }
     }
 }
@@ -483,8 +482,9 @@ void expect_tumbling_keeps_momentum(std::span<const Tumbler> cases) {
             worst_e = std::max(worst_e, std::abs(spin_energy(*space, body, mp) / e0 - 1));
             worst_com = std::max(worst_com, (space->internal_motion_state(body).center_of_mass - com0).norm());
         }
-        std::printf("[ measure  ] %s: worst |dL|/L %.3f %% (at mid-substep %.3f %%), |dE|/E %.3f %%, centre moved %.3g m\n", c.name,
-                    100 * worst_l, 100 * worst_mid, 100 * worst_e, worst_com);
+        std::printf(
+            "[ measure  ] %s: worst |dL|/L %.3f %% (at mid-substep %.3f %%), |dE|/E %.3f %%, centre moved %.3g m\n",
+            c.name, 100 * worst_l, 100 * worst_mid, 100 * worst_e, worst_com);
         EXPECT_LT(worst_l, 0.02) << c.name;
         EXPECT_LT(worst_e, 0.02) << c.name;
         EXPECT_LT(worst_com, 1e-6) << c.name;
@@ -761,8 +761,8 @@ TEST(OutsidePendulum, DISABLED_LightChainHoldsAHundredTimesHeavierEndMass) {
     step(*space, 240);
     const double stretch = (heavy.position.y() - space->internal_position(ball).y()) / (kLink * kLinks);
     const double speed = max_speed(*space, links);
-    std::printf("[ measure  ] chain of 10 x 1 kg holding 100 kg: stretched %.3f %%, fastest %.4f m/s\n",
-                100 * stretch, speed);
+    std::printf("[ measure  ] chain of 10 x 1 kg holding 100 kg: stretched %.3f %%, fastest %.4f m/s\n", 100 * stretch,
+                speed);
     EXPECT_TRUE(all_finite(*space, links));
     EXPECT_LT(std::abs(stretch), 0.03);
     EXPECT_LT(speed, 0.01);
@@ -815,7 +815,7 @@ TEST(OutsideFast, SmallProjectileAt300MetresPerSecondStopsAtAThinWall) {
 TEST(OutsideSleep, SleepersFallWhenTheirFloorGoes) {
     enum How { Destroyed, MadeDynamic, KinematicMovedAway, MiddleOfAStackDestroyed };
     for (How how : {Destroyed, MadeDynamic, KinematicMovedAway, MiddleOfAStackDestroyed}) {
-        Space space{SpaceSettings{}};  // sleeping on
+        Space space{SpaceSettings{}};                                 // sleeping on
         add_static_box(space, Vec3(20, 0.5, 20), Vec3(0, -10.5, 0));  // something far below
         BodyDesc f;
         f.type = how == KinematicMovedAway ? MotionType::Kinematic : MotionType::Static;

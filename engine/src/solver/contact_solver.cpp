@@ -801,19 +801,22 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
     // The points bounce one after another (Gauss-Seidel), each changing the others' speeds:
     // in one sweep a box landing flat on four points left the last one its bounce and the
-    // first ones less, so it rose short and turning. A few sweeps over the manifold's
-    // points, where any bounces, bring them all to their bounce together.
-    bool bounced = true;
-    for (int sweep = 0; sweep < kRestitutionSweeps && bounced; ++sweep) {
-        bounced = false;
+    // first ones less, so it rose short and turning. A few sweeps over the manifolds where
+    // more than one point bounces bring them all to their bounce together (one point's
+    // bounce is whole after one sweep: its manifold is swept once, as before).
+    WideMask sweeping = bouncy;
+    Wide bouncing = zero;  // per lane, the points that bounced in the first sweep
+    for (int sweep = 0; sweep < kRestitutionSweeps; ++sweep) {
+        if (sweep == 1) sweeping = sweeping & (bouncing > splat(1));
+        if (!any(sweeping)) break;
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
             const WidePoint& p = wc.points[j];
             WidePointRow& r = wc.point_rows[j];
             Wide& max_impulse = wc.max_normal_impulse[j];
             // Only points that approached fast enough and actually pushed bounce.
-            const WideMask bounce = bouncy & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
+            const WideMask bounce = sweeping & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
             if (!any(bounce)) continue;
-            bounced = true;
+            if (sweep == 0) bouncing = bouncing + select(bounce, splat(1), zero);
             const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
             // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
             // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
