@@ -394,7 +394,12 @@ namespace {
 
 // A box (0.2 x 0.5 x 1 half extents), turned arbitrarily, spinning at 50 rad/s about its
 // principal axis `axis`: the largest relative change of its angular momentum over 2 s.
-double fast_spin_momentum_change(int axis, bool gyroscopic) {
+struct MomentumChange {
+    double at_step_end = 0;  // L from the step's orientation and spin, as a user reads them
+    double mid_substep = 0;  // L where the engine keeps it (midstep_angular_momentum)
+};
+
+MomentumChange fast_spin_momentum_change(int axis, bool gyroscopic) {
     const Quat pose = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
     SpaceSettings settings;
     settings.gravity = Vec3::Zero();
@@ -416,7 +421,7 @@ double fast_spin_momentum_change(int axis, bool gyroscopic) {
     }
     std::printf("[ measure  ] spin 50 rad/s about axis %d, gyroscopic %d: worst |dL|/L %.4f %% (mid-substep %.4f %%)\n",
                 axis, gyroscopic, 100 * worst, 100 * worst_mid);
-    return worst;
+    return {worst, worst_mid};
 }
 
 }  // namespace
@@ -429,25 +434,29 @@ TEST(OutsideSpin, FastSpinAboutEachPrincipalAxisDoesNotDecay) {
     for (bool gyroscopic : {false, true}) {
         for (int axis = 0; axis < 3; ++axis) {
             if (gyroscopic && axis == 1) continue;
-            EXPECT_LT(fast_spin_momentum_change(axis, gyroscopic), 0.005)
+            EXPECT_LT(fast_spin_momentum_change(axis, gyroscopic).at_step_end, 0.005)
                 << "axis " << axis << " gyroscopic " << gyroscopic;
         }
     }
 }
 
 // The same about the intermediate axis, with gyroscopic motion: it flips over and over
-// (rounding starts it), and its world angular momentum must stay within 2 % while it does.
-// Disabled: fails at 6118a81: 8.7 % at the step's end orientation, 5.2 % even at the middle
-// of the last substep, where keep_momentum (integrator.cpp) takes L. The box turns 0.2 rad
-// a substep. Not the rotation's first-order update: an exact exponential map (tried) gave
-// 8.0 %; nor the two fixed-point passes: eight gave 6.6 %. The cause left to find is in how
-// keep_momentum rebuilds L from the spin at the orientation turned back half a substep,
-// which matches the midpoint the spin was made for only while nothing changes w between
-// substeps and the turn is small; a body that keeps L itself (a stored world L per
-// gyroscopic body, w = I(q_mid)^-1 L) would not drift. Any change there moves the chains
-// golden hash (its capsule links are elongated, so always gyroscopic).
+// (rounding starts it), and its angular momentum must not drift while it does: within 1 %
+// where the engine keeps it (the middle of the last substep's turn).
+// Disabled: fails at 6118a81: 5.2 % in 2 s (8.7 % from the step's end orientation and
+// spin). The box turns 0.2 rad a substep. Cause, found by trying: keep_momentum
+// (integrator.cpp) takes L at the orientation turned back half a substep and solves the
+// new spin at the one turned on half a substep, by integrate_rotation's first-order update
+// and two fixed-point passes; neither midpoint is the other at 0.2 rad a substep, and L
+// walks. With the turns of gyroscopic bodies made exactly (the exponential map, in
+// keep_momentum and integrate_positions) and the passes run to convergence (8), L at
+// mid-substep stays within 0.009 % here, 0.001 % for the thin bodies below, and energy
+// within 0.001 % (tried; it moves the chains golden hash: its capsule links are elongated,
+// so always gyroscopic). What is left from the step's end orientation (6.8 %, 8.3 %) is
+// bounded, not drift: the published spin is the one the body turned by over the last
+// substep, half a substep behind the published orientation.
 TEST(OutsideSpin, DISABLED_FastSpinAboutTheIntermediateAxisKeepsItsMomentum) {
-    EXPECT_LT(fast_spin_momentum_change(1, true), 0.02);
+    EXPECT_LT(fast_spin_momentum_change(1, true).mid_substep, 0.01);
 }
 
 namespace {
@@ -459,7 +468,9 @@ struct Tumbler {
     bool gyroscopic;
 };
 
-void expect_tumbling_keeps_momentum(std::span<const Tumbler> cases) {
+// at_step_end: L as a user reads it from the step's orientation and spin, within 2 %;
+// else L where the engine keeps it (midstep_angular_momentum), within 1 %.
+void expect_tumbling_keeps_momentum(std::span<const Tumbler> cases, bool at_step_end) {
     for (const Tumbler& c : cases) {
         SpaceSettings settings;
         settings.gravity = Vec3::Zero();
@@ -485,7 +496,11 @@ void expect_tumbling_keeps_momentum(std::span<const Tumbler> cases) {
         std::printf(
             "[ measure  ] %s: worst |dL|/L %.3f %% (at mid-substep %.3f %%), |dE|/E %.3f %%, centre moved %.3g m\n",
             c.name, 100 * worst_l, 100 * worst_mid, 100 * worst_e, worst_com);
-        EXPECT_LT(worst_l, 0.02) << c.name;
+        if (at_step_end) {
+            EXPECT_LT(worst_l, 0.02) << c.name;
+        } else {
+            EXPECT_LT(worst_mid, 0.01) << c.name;
+        }
         EXPECT_LT(worst_e, 0.02) << c.name;
         EXPECT_LT(worst_com, 1e-6) << c.name;
     }
@@ -506,20 +521,21 @@ TEST(OutsideSpin, TumblingBodiesKeepAngularMomentumAndEnergy) {
         {"box minor axis", Shape::box(Vec3(0.1, 0.3, 0.6)), Vec3(12, 0.3, 0.3), true},
         {"compound off centre", Shape::compound(parts), Vec3(3, 8, 1), true},
     };
-    expect_tumbling_keeps_momentum(cases);
+    expect_tumbling_keeps_momentum(cases, true);
 }
 
 // A thin rod and a thin capsule (elongated: always gyroscopic) spun fast about their long
-// axis and a little across it: they cone about their angular momentum, which must stay.
-// Disabled: fails at 6118a81: the rod's L moves 8.7 % (2.7 % at mid-substep) and the
-// capsule's 9.1 % (3.9 %) within 4 s; energy 1.9 % and 0.5 %. Same cause as
+// axis and a little across it: they cone about their angular momentum, which must not
+// drift (within 1 % where the engine keeps it).
+// Disabled: fails at 6118a81: the rod's L drifts 2.7 % (8.7 % from the step's end) and the
+// capsule's 3.9 % (9.1 %) within 4 s. Cause and the fix tried: see
 // DISABLED_FastSpinAboutTheIntermediateAxisKeepsItsMomentum.
 TEST(OutsideSpin, DISABLED_FastConingThinBodiesKeepAngularMomentum) {
     const Tumbler cases[] = {
         {"rod tilted spin", Shape::box(Vec3(1, 0.05, 0.05)), Vec3(20, 3, 1), false},
         {"capsule tilted spin", Shape::capsule(0.8, 0.05), Vec3(2, 20, 1), false},
     };
-    expect_tumbling_keeps_momentum(cases);
+    expect_tumbling_keeps_momentum(cases, false);
 }
 
 // ---- Moving platforms --------------------------------------------------------------------------
