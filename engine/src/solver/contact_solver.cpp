@@ -787,6 +787,9 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
     warm_start_push(wc, push_anchors, bodies, push_velocities);
 }
 
+// Sweeps of the restitution pass over a bouncing manifold's points (restitution_wide).
+constexpr int kRestitutionSweeps = 4;
+
 template <bool kLocked>
 void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
     const Wide zero = splat(0);
@@ -796,23 +799,35 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
     WideVelocities s = gather(wc, bodies);
     WideAxisMasses masses;
     if constexpr (kLocked) masses = axis_masses(wc, bodies);
-    for (int j = 0; j < kMaxManifoldPoints; ++j) {
-        const WidePoint& p = wc.points[j];
-        WidePointRow& r = wc.point_rows[j];
-        Wide& max_impulse = wc.max_normal_impulse[j];
-        // Only points that approached fast enough and actually pushed bounce.
-        const WideMask bounce = bouncy & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
-        if (!any(bounce)) continue;
-        const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
-        // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
-        // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
-        const Wide approach = wc.relative_velocity[j] + wc.gravity_normal * splat(h);
-        const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
-        const Wide total = wide_max(r.normal_impulse + impulse, zero);
-        const Wide applied = select(bounce, total - r.normal_impulse, zero);
-        r.normal_impulse += applied;
-        max_impulse = wide_max(max_impulse, applied);
-        apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, applied);
+    // The points bounce one after another (Gauss-Seidel), each changing the others' speeds:
+    // in one sweep a box landing flat on four points left the last one its bounce and the
+    // first ones less, so it rose short and turning. A few sweeps over the manifolds where
+    // more than one point bounces bring them all to their bounce together (one point's
+    // bounce is whole after one sweep: its manifold is swept once, as before).
+    WideMask sweeping = bouncy;
+    Wide bouncing = zero;  // per lane, the points that bounced in the first sweep
+    for (int sweep = 0; sweep < kRestitutionSweeps; ++sweep) {
+        if (sweep == 1) sweeping = sweeping & (bouncing > splat(1));
+        if (!any(sweeping)) break;
+        for (int j = 0; j < kMaxManifoldPoints; ++j) {
+            const WidePoint& p = wc.points[j];
+            WidePointRow& r = wc.point_rows[j];
+            Wide& max_impulse = wc.max_normal_impulse[j];
+            // Only points that approached fast enough and actually pushed bounce.
+            const WideMask bounce = sweeping & (wc.relative_velocity[j] <= splat(-threshold)) & (max_impulse > zero);
+            if (!any(bounce)) continue;
+            if (sweep == 0) bouncing = bouncing + select(bounce, splat(1), zero);
+            const Wide vn = dot(wc.normal, point_velocity(s, p.ra, p.rb));
+            // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
+            // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
+            const Wide approach = wc.relative_velocity[j] + wc.gravity_normal * splat(h);
+            const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
+            const Wide total = wide_max(r.normal_impulse + impulse, zero);
+            const Wide applied = select(bounce, total - r.normal_impulse, zero);
+            r.normal_impulse += applied;
+            max_impulse = wide_max(max_impulse, applied);
+            apply_row<kLocked>(wc, masses, s, wc.normal, r.normal_row, applied);
+        }
     }
     scatter(wc, bodies, s);
 }

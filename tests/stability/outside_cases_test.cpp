@@ -1,0 +1,881 @@
+// Hard cases written from outside the team (session 41): variants of the kinds issue 16
+// named (friction at the friction angle, thin shapes, rolling, free spin, stacks on moving
+// platforms, bounces, pendulums, fast bodies, sleeping), through the public API only,
+// each against its analytic answer with a tolerance a game-physics user would accept.
+#include <spindle/engine/space.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "../engine/grid_mesh.hpp"
+#include "scene_util.hpp"
+
+namespace spindle::stability::outside {
+
+namespace {
+
+enum class Floor { Plane, Box, Mesh };
+
+const char* floor_name(Floor f) {
+    switch (f) {
+        case Floor::Plane: return "plane";
+        case Floor::Box: return "box";
+        case Floor::Mesh: return "mesh";
+    }
+    return "?";
+}
+
+// A static floor whose top face passes through the origin, turned by `tilt`, with
+// friction mu. The mesh is a grid of 1 m cells (its inner edges are where a sliding or
+// rolling body would catch).
+BodyHandle add_floor(Space& space, Floor kind, const Quat& tilt, double mu, double restitution = 0) {
+    BodyDesc d;
+    d.type = MotionType::Static;
+    d.friction = mu;
+    d.restitution = restitution;
+    d.orientation = tilt;
+    switch (kind) {
+        case Floor::Plane: d.shape = Shape::plane(Vec3::UnitY(), 0); break;
+        case Floor::Box:
+            d.shape = Shape::box(Vec3(25, 0.5, 6));
+            d.position = tilt * Vec3(0, -0.5, 0);
+            break;
+        case Floor::Mesh: d.shape = test::flat_grid_mesh(50, 1.0); break;
+    }
+    return space.create_body(d);
+}
+
+Quat about_z(double angle) { return Quat(Eigen::AngleAxisd(angle, Vec3::UnitZ())); }
+Quat about_x(double angle) { return Quat(Eigen::AngleAxisd(angle, Vec3::UnitX())); }
+
+void step(Space& space, int steps) {
+    for (int i = 0; i < steps; ++i) space.update();
+}
+
+// A body resting on a slope of angle theta about z (downhill is -x along the slope),
+// released at rest at local (x0, lift, 0) in the slope's frame.
+enum class Slider { Box, Capsule };
+
+BodyHandle add_slider(Space& space, Slider kind, const Quat& tilt, double mu) {
+    BodyDesc d;
+    d.friction = mu;
+    if (kind == Slider::Box) {
+        // Flat enough not to tip over before it slides (tan theta < 0.25 / 0.1).
+        d.shape = Shape::box(Vec3(0.25, 0.1, 0.25));
+        d.position = tilt * Vec3(2, 0.1, 0);
+        d.orientation = tilt;
+    } else {
+        // Lying with its axis downhill: it cannot roll down, only slide.
+        d.shape = Shape::capsule(0.3, 0.1);
+        d.position = tilt * Vec3(2, 0.1, 0);
+        d.orientation = tilt * about_z(kPi / 2);
+    }
+    return space.create_body(d);
+}
+
+const char* slider_name(Slider s) { return s == Slider::Box ? "box" : "capsule"; }
+
+}  // namespace
+
+// ---- Friction at the friction angle ----------------------------------------------------
+// Coulomb: a body on a slope sticks while tan(theta) < mu and slides at g (sin - mu cos)
+// above. Just under (tan = 0.85 mu) it must stay put: under 3 mm in 5 s, the few mm a
+// player never sees. Just over (tan = 1.15 mu) it must accelerate at Coulomb's rate within
+// 5 % (measured between 0.5 s and 1.5 s, after the soft contact has taken the load).
+TEST(OutsideFriction, JustUnderTheFrictionAngleBoxesAndCapsulesStayPut) {
+    for (Floor floor : {Floor::Plane, Floor::Box, Floor::Mesh}) {
+        for (Slider kind : {Slider::Box, Slider::Capsule}) {
+            for (double mu : {0.2, 0.5, 1.0}) {
+                const double theta = std::atan(0.85 * mu);
+                auto space = make_space();
+                const Quat tilt = about_z(theta);
+                add_floor(*space, floor, tilt, mu);
+                const BodyHandle body = add_slider(*space, kind, tilt, mu);
+                const Vec3 start = space->internal_position(body);
+                step(*space, 300);
+                const double drift = (space->internal_position(body) - start).norm();
+                std::printf("[ measure  ] %s on %s, mu %.1f at 0.85 mu: drift %.3f mm in 5 s\n", slider_name(kind),
+                            floor_name(floor), mu, 1000 * drift);
+                EXPECT_LT(drift, 3e-3) << slider_name(kind) << " on " << floor_name(floor) << " mu " << mu;
+            }
+        }
+    }
+}
+
+TEST(OutsideFriction, JustOverTheFrictionAngleBoxesAndCapsulesSlideAtCoulombsRate) {
+    for (Floor floor : {Floor::Plane, Floor::Box, Floor::Mesh}) {
+        for (Slider kind : {Slider::Box, Slider::Capsule}) {
+            for (double mu : {0.2, 0.5, 1.0}) {
+                const double theta = std::atan(1.15 * mu);
+                auto space = make_space();
+                const Quat tilt = about_z(theta);
+                add_floor(*space, floor, tilt, mu);
+                const BodyHandle body = add_slider(*space, kind, tilt, mu);
+                const Vec3 downhill = tilt * -Vec3::UnitX();
+                step(*space, 30);
+                const double v0 = space->internal_linear_velocity(body).dot(downhill);
+                step(*space, 60);
+                const double v1 = space->internal_linear_velocity(body).dot(downhill);
+                const double a = v1 - v0;  // over 1 s
+                const double expected = kGravity * (std::sin(theta) - mu * std::cos(theta));
+                std::printf("[ measure  ] %s on %s, mu %.1f at 1.15 mu: a %.4f m/s^2 (Coulomb %.4f, %.1f %%)\n",
+                            slider_name(kind), floor_name(floor), mu, a, expected, 100 * (a / expected - 1));
+                EXPECT_NEAR(a, expected, 0.05 * expected)
+                    << slider_name(kind) << " on " << floor_name(floor) << " mu " << mu;
+            }
+        }
+    }
+}
+
+// A ball on a slope rolls without slipping while mu >= 2/7 tan(theta), at a = 5/7 g sin;
+// with less friction it slides at g (sin - mu cos) and spins up at 5 mu g cos / (2 r).
+// Within 3 %: a user sees a ball roll too fast or too slow well before that.
+TEST(OutsideFriction, BallOnASlopeRollsAtFiveSeventhsOrSlipsAtCoulombsRate) {
+    constexpr double kTheta = 0.3, kR = 0.25;
+    for (Floor floor : {Floor::Plane, Floor::Box, Floor::Mesh}) {
+        for (double mu : {0.05, 0.5}) {
+            auto space = make_space();
+            const Quat tilt = about_z(kTheta);
+            add_floor(*space, floor, tilt, mu);
+            BodyDesc d;
+            d.shape = Shape::sphere(kR);
+            d.position = tilt * Vec3(5, kR, 0);
+            d.friction = mu;
+            const BodyHandle ball = space->create_body(d);
+            const Vec3 downhill = tilt * -Vec3::UnitX();
+            step(*space, 15);
+            const double v0 = space->internal_linear_velocity(ball).dot(downhill);
+            const double w0 = space->internal_angular_velocity(ball).z();
+            step(*space, 60);
+            const double v1 = space->internal_linear_velocity(ball).dot(downhill);
+            const double w1 = space->internal_angular_velocity(ball).z();
+            const bool rolls = mu >= 2.0 / 7.0 * std::tan(kTheta);
+            const double expected = rolls ? 5.0 / 7.0 * kGravity * std::sin(kTheta)
+                                          : kGravity * (std::sin(kTheta) - mu * std::cos(kTheta));
+            const double expected_alpha = rolls ? expected / kR : 2.5 * mu * kGravity * std::cos(kTheta) / kR;
+            // Rolling down -x about +z: the spin is positive about z.
+            const double alpha = w1 - w0;
+            const double height = (space->internal_position(ball)).dot(tilt * Vec3::UnitY());
+            std::printf(
+                "[ measure  ] ball on %s, mu %.2f: a %.4f (%.4f), alpha %.3f (%.3f), centre %.2f mm above its rest\n",
+                floor_name(floor), mu, v1 - v0, expected, alpha, expected_alpha, 1000 * (height - kR));
+            EXPECT_NEAR(v1 - v0, expected, 0.03 * expected) << floor_name(floor) << " mu " << mu;
+            EXPECT_NEAR(alpha, expected_alpha, 0.03 * expected_alpha) << floor_name(floor) << " mu " << mu;
+            EXPECT_GT(height - kR, -0.005) << floor_name(floor) << " mu " << mu;
+        }
+    }
+}
+
+// A cube sliding across a mesh floor's inner edges slows at mu g as on a plane, and does
+// not hop on them (a classic of triangle-mesh ground: ghost collisions on inner edges).
+TEST(OutsideFriction, CubeSlidingAcrossMeshEdgesDeceleratesAtMuGWithoutHopping) {
+    constexpr double kMu = 0.3, kV = 6;
+    for (Floor floor : {Floor::Plane, Floor::Mesh}) {
+        for (double yaw : {0.0, 0.7}) {
+            auto space = make_space();
+            add_floor(*space, floor, Quat::Identity(), kMu);
+            BodyDesc d;
+            d.shape = Shape::box(Vec3::Constant(0.2));
+            d.position = Vec3(-10, 0.2, 0.3);
+            d.orientation = Quat(Eigen::AngleAxisd(yaw, Vec3::UnitY()));
+            d.linear_velocity = Vec3(kV, 0, 0.5 * kV);
+            d.friction = kMu;
+            const BodyHandle box = space->create_body(d);
+            double worst_up = 0, worst_w = 0, worst_dv = 0;
+            const double speed0 = d.linear_velocity.norm();
+            for (int i = 1; i <= 90; ++i) {
+                space->update();
+                const Vec3 v = space->internal_linear_velocity(box);
+                worst_up = std::max(worst_up, std::abs(v.y()));
+                worst_w = std::max(worst_w, space->internal_angular_velocity(box).norm());
+                const double expected = std::max(0.0, speed0 - kMu * kGravity * i * kStep);
+                worst_dv = std::max(worst_dv, std::abs(Vec3(v.x(), 0, v.z()).norm() - expected));
+            }
+            std::printf("[ measure  ] cube sliding on %s, yaw %.1f: worst |v - (v0 - mu g t)| %.3f m/s, vertical "
+                        "%.3f m/s, spin %.3f rad/s\n",
+                        floor_name(floor), yaw, worst_dv, worst_up, worst_w);
+            // 0.1 m/s of the 6.7 m/s: a few % of the speed; a hop of 0.1 m/s rises 0.5 mm.
+            EXPECT_LT(worst_dv, 0.1) << floor_name(floor) << " yaw " << yaw;
+            EXPECT_LT(worst_up, 0.1) << floor_name(floor) << " yaw " << yaw;
+            EXPECT_LT(worst_w, 0.5) << floor_name(floor) << " yaw " << yaw;
+        }
+    }
+}
+
+// ---- Thin shapes dropped flat and on an edge ---------------------------------------------
+namespace {
+
+Shape coin(double radius, double half_thickness) {
+    std::vector<Vec3> points;
+    for (int i = 0; i < 24; ++i) {
+        const double a = 2 * kPi * i / 24;
+        for (double y : {-half_thickness, half_thickness})
+            points.emplace_back(radius * std::cos(a), y, radius * std::sin(a));
+    }
+    return Shape::convex_hull(points);
+}
+
+struct Settled {
+    double spin = 0;    // largest angular speed over the last second, rad/s
+    double drift = 0;   // largest distance from where it was a second before the end, m
+    double lowest = 0;  // lowest point reached below the floor, m (from the shape's own bounds)
+};
+
+Settled drop_and_settle(Floor floor, const Shape& shape, const Quat& orientation, double lift) {
+    auto space = make_space();
+    add_floor(*space, floor, Quat::Identity(), 0.6);
+    BodyDesc d;
+    d.shape = shape;
+    d.orientation = orientation;
+    d.position = Vec3(0.3, 0, 0.2);
+    d.position.y() = lift - shape.bounds(Transform{d.position, orientation}).min.y();
+    const BodyHandle body = space->create_body(d);
+    Settled s;
+    for (int i = 0; i < 150; ++i) {
+        space->update();
+        const Transform pose{space->internal_position(body), space->internal_orientation(body)};
+        s.lowest = std::max(s.lowest, -shape.bounds(pose).min.y());
+    }
+    const Vec3 before = space->internal_position(body);
+    for (int i = 0; i < 60; ++i) {
+        space->update();
+        s.spin = std::max(s.spin, space->internal_angular_velocity(body).norm());
+        s.drift = std::max(s.drift, (space->internal_position(body) - before).norm());
+    }
+    return s;
+}
+
+}  // namespace
+
+// Plates 1 cm thick, a coin (a 24-sided hull 6 mm thick), a thin rod: dropped flat from
+// 10 cm, and tilted so that they land on an edge or a corner first. After 2.5 s they must
+// lie still: under 0.02 rad/s and 1 mm over the last second (a plate that walks or spins
+// on the floor is the complaint), never deeper than 1 cm in the floor on landing.
+TEST(OutsideThin, PlatesCoinsAndRodsDroppedFlatOrOnAnEdgeSettle) {
+    struct Case {
+        const char* name;
+        Shape shape;
+    };
+    const Case cases[] = {
+        {"plate 1 x 0.01 x 1", Shape::box(Vec3(0.5, 0.005, 0.5))},
+        {"plate 0.4 x 0.01 x 0.1", Shape::box(Vec3(0.2, 0.005, 0.05))},
+        {"coin r 0.1 x 0.006", coin(0.1, 0.003)},
+        {"rod 2 x 0.02 x 0.02", Shape::box(Vec3(1, 0.01, 0.01))},
+        {"capsule rod 2 x r 0.01", Shape::capsule(1, 0.01)},
+    };
+    const Quat flat = Quat::Identity();
+    const Quat edge = Quat(Eigen::AngleAxisd(0.6, Vec3(1, 0, 0.3).normalized()));
+    const Quat capsule_flat = about_z(kPi / 2);
+    for (const Case& c : cases) {
+        for (Floor floor : {Floor::Plane, Floor::Box, Floor::Mesh}) {
+            for (bool on_edge : {false, true}) {
+                Quat q = on_edge ? edge : flat;
+                if (c.shape.type == ShapeType::Capsule) q = q * capsule_flat;
+                const Settled s = drop_and_settle(floor, c.shape, q, 0.1);
+                std::printf("[ measure  ] %s on %s dropped %s: spin %.4f rad/s, drift %.3f mm, deepest %.2f mm\n",
+                            c.name, floor_name(floor), on_edge ? "on an edge" : "flat", s.spin, 1000 * s.drift,
+                            1000 * s.lowest);
+                EXPECT_LT(s.spin, 0.02) << c.name << " on " << floor_name(floor) << (on_edge ? " edge" : " flat");
+                EXPECT_LT(s.drift, 1e-3) << c.name << " on " << floor_name(floor) << (on_edge ? " edge" : " flat");
+                EXPECT_LT(s.lowest, 0.01) << c.name << " on " << floor_name(floor) << (on_edge ? " edge" : " flat");
+            }
+        }
+    }
+}
+
+// Five thin plates 2 cm thick stacked flat, each turned a little from the one below: a
+// pile of books or tiles. They must stay stacked and still (no walking, no spin).
+TEST(OutsideThin, StackOfFiveThinPlatesStaysStill) {
+    for (Floor floor : {Floor::Plane, Floor::Mesh}) {
+        auto space = make_space();
+        add_floor(*space, floor, Quat::Identity(), 0.6);
+        std::vector<BodyHandle> plates;
+        for (int i = 0; i < 5; ++i) {
+            BodyDesc d;
+            d.shape = Shape::box(Vec3(0.3, 0.01, 0.2));
+            d.position = Vec3(0.05 * i, 0.01 + 0.02 * i, 0.3);
+            d.orientation = Quat(Eigen::AngleAxisd(0.2 * i, Vec3::UnitY()));
+            plates.push_back(space->create_body(d));
+        }
+        step(*space, 120);
+        const std::vector<Vec3> settled = positions(*space, plates);
+        double spin = 0;
+        for (int i = 0; i < 60; ++i) {
+            space->update();
+            for (BodyHandle p : plates) spin = std::max(spin, space->internal_angular_velocity(p).norm());
+        }
+        const double drift = max_displacement(*space, plates, settled);
+        // Each contact may press in up to the linear slop (the engine's allowed penetration;
+        // soft contacts under more load press in more: 3.4 mm under four plates, 1.3 mm
+        // under one were measured).
+        double deepest = 0, below = 0;  // below: the top of what the plate lies on
+        for (BodyHandle p : plates) {
+            const double y = space->internal_position(p).y();
+            deepest = std::max(deepest, below - (y - 0.01));
+            below = y + 0.01;
+        }
+        std::printf("[ measure  ] five plates on %s: drift %.3f mm, spin %.4f rad/s, top at %.4f m, deepest contact "
+                    "%.2f mm\n",
+                    floor_name(floor), 1000 * drift, spin, space->internal_position(plates.back()).y(), 1000 * deepest);
+        EXPECT_LT(drift, 1e-3) << floor_name(floor);
+        EXPECT_LT(spin, 0.02) << floor_name(floor);
+        EXPECT_LT(deepest, SolverSettings{}.linear_slop) << floor_name(floor);
+    }
+}
+
+// ---- Rolling -------------------------------------------------------------------------------
+// A ball and a capsule rolling at 8 m/s (spin matched, v = w r) on a plane, a box and a
+// mesh: no sinking below the linear slop, speed kept within 1 % over 1.5 s (nothing
+// brakes a rolling body without rolling resistance), and v = w r held within 1 %.
+TEST(OutsideRolling, BallAndCapsuleRollOnPlaneBoxAndMeshWithoutSinkingOrSlowing) {
+    constexpr double kR = 0.2, kV = 8;
+    for (Floor floor : {Floor::Plane, Floor::Box, Floor::Mesh}) {
+        for (bool capsule : {false, true}) {
+            auto space = make_space();
+            add_floor(*space, floor, Quat::Identity(), 0.6);
+            BodyDesc d;
+            d.shape = capsule ? Shape::capsule(0.3, kR) : Shape::sphere(kR);
+            // The capsule lies along z and rolls along x.
+            d.orientation = capsule ? about_x(kPi / 2) : Quat::Identity();
+            d.position = Vec3(-12, kR, 0.4);
+            d.linear_velocity = Vec3(kV, 0, 0);
+            d.angular_velocity = Vec3(0, 0, -kV / kR);
+            const BodyHandle body = space->create_body(d);
+            double deepest = 0, worst_slip = 0, worst_speed = 0;
+            for (int i = 0; i < 90; ++i) {
+                space->update();
+                const double v = space->internal_linear_velocity(body).x();
+                const double w = -space->internal_angular_velocity(body).z();
+                deepest = std::max(deepest, kR - space->internal_position(body).y());
+                worst_slip = std::max(worst_slip, std::abs(v - w * kR) / kV);
+                worst_speed = std::max(worst_speed, std::abs(v - kV) / kV);
+            }
+            std::printf("[ measure  ] %s rolling on %s at 8 m/s: sank %.3f mm, worst slip %.3f %%, speed off %.3f %%\n",
+                        capsule ? "capsule" : "ball", floor_name(floor), 1000 * deepest, 100 * worst_slip,
+                        100 * worst_speed);
+            EXPECT_LT(deepest, 0.005) << floor_name(floor) << (capsule ? " capsule" : " ball");
+            EXPECT_LT(worst_slip, 0.01) << floor_name(floor) << (capsule ? " capsule" : " ball");
+            EXPECT_LT(worst_speed, 0.01) << floor_name(floor) << (capsule ? " capsule" : " ball");
+        }
+    }
+}
+
+// ---- Free spin without gravity ---------------------------------------------------------------
+namespace {
+
+Vec3 angular_momentum(const Space& space, BodyHandle body, const MassProperties& mp) {
+    const Mat3 r = space.internal_orientation(body).toRotationMatrix();
+    return r * mp.inertia * r.transpose() * space.internal_angular_velocity(body);
+}
+
+// The same at the middle of the last substep's turn, where the engine's gyroscopic spin
+// is taken (integrator.cpp, keep_momentum): the orientation turned back half a substep.
+Vec3 midstep_angular_momentum(const Space& space, BodyHandle body, const MassProperties& mp) {
+    const Real substep = space.settings().time_step.duration / space.settings().solver.substeps;
+    const Vec3 w = space.internal_angular_velocity(body);
+    const Mat3 r = integrate_rotation(space.internal_orientation(body), w, -substep / 2).toRotationMatrix();
+    return r * mp.inertia * r.transpose() * w;
+}
+
+double spin_energy(const Space& space, BodyHandle body, const MassProperties& mp) {
+    const Vec3 w = space.internal_angular_velocity(body);
+    return 0.5 * w.dot(angular_momentum(space, body, mp));
+}
+
+}  // namespace
+
+namespace {
+
+// A box (0.2 x 0.5 x 1 half extents), turned arbitrarily, spinning at 50 rad/s about its
+// principal axis `axis`: the largest relative change of its angular momentum over 2 s.
+struct MomentumChange {
+    double at_step_end = 0;  // L from the step's orientation and spin, as a user reads them
+    double mid_substep = 0;  // L where the engine keeps it (midstep_angular_momentum)
+};
+
+MomentumChange fast_spin_momentum_change(int axis, bool gyroscopic) {
+    const Quat pose = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+    SpaceSettings settings;
+    settings.gravity = Vec3::Zero();
+    auto space = make_space(settings);
+    BodyDesc d;
+    d.shape = Shape::box(Vec3(0.2, 0.5, 1.0));
+    d.orientation = pose;
+    d.angular_velocity = pose * (50 * Vec3::Unit(axis));
+    d.gyroscopic = gyroscopic;
+    const BodyHandle body = space->create_body(d);
+    const MassProperties mp = mass_of(d);
+    const Vec3 l0 = angular_momentum(*space, body, mp);
+    const Vec3 m0 = midstep_angular_momentum(*space, body, mp);
+    double worst = 0, worst_mid = 0;
+    for (int i = 0; i < 120; ++i) {
+        space->update();
+        worst = std::max(worst, (angular_momentum(*space, body, mp) - l0).norm() / l0.norm());
+        worst_mid = std::max(worst_mid, (midstep_angular_momentum(*space, body, mp) - m0).norm() / m0.norm());
+    }
+    std::printf("[ measure  ] spin 50 rad/s about axis %d, gyroscopic %d: worst |dL|/L %.4f %% (mid-substep %.4f %%)\n",
+                axis, gyroscopic, 100 * worst, 100 * worst_mid);
+    return {worst, worst_mid};
+}
+
+}  // namespace
+
+// Spinning at 50 rad/s about each principal axis, with and without gyroscopic motion:
+// nothing acts on the box, so its spin must not change, within 0.5 % over 2 s (a spin
+// that decays by a few rad/s is plain to see). About the intermediate axis with gyroscopic
+// motion the spin is unstable (it flips): DISABLED_FastSpinAboutTheIntermediateAxis.
+TEST(OutsideSpin, FastSpinAboutEachPrincipalAxisDoesNotDecay) {
+    for (bool gyroscopic : {false, true}) {
+        for (int axis = 0; axis < 3; ++axis) {
+            if (gyroscopic && axis == 1) continue;
+            EXPECT_LT(fast_spin_momentum_change(axis, gyroscopic).at_step_end, 0.005)
+                << "axis " << axis << " gyroscopic " << gyroscopic;
+        }
+    }
+}
+
+// The same about the intermediate axis, with gyroscopic motion: it flips over and over
+// (rounding starts it), and its angular momentum must not drift while it does: within 1 %
+// where the engine keeps it (the middle of the last substep's turn).
+// Disabled: fails at 6118a81: 5.2 % in 2 s (8.7 % from the step's end orientation and
+// spin). The box turns 0.2 rad a substep. Cause, found by trying: keep_momentum
+// (integrator.cpp) takes L at the orientation turned back half a substep and solves the
+// new spin at the one turned on half a substep, by integrate_rotation's first-order update
+// and two fixed-point passes; neither midpoint is the other at 0.2 rad a substep, and L
+// walks. With the turns of gyroscopic bodies made exactly (the exponential map, in
+// keep_momentum and integrate_positions) and the passes run to convergence (8), L at
+// mid-substep stays within 0.009 % here, 0.001 % for the thin bodies below, and energy
+// within 0.001 % (tried; it moves the chains golden hash: its capsule links are elongated,
+// so always gyroscopic). What is left from the step's end orientation (6.8 %, 8.3 %) is
+// bounded, not drift: the published spin is the one the body turned by over the last
+// substep, half a substep behind the published orientation.
+TEST(OutsideSpin, DISABLED_FastSpinAboutTheIntermediateAxisKeepsItsMomentum) {
+    EXPECT_LT(fast_spin_momentum_change(1, true).mid_substep, 0.01);
+}
+
+namespace {
+
+struct Tumbler {
+    const char* name;
+    Shape shape;
+    Vec3 w;
+    bool gyroscopic;
+};
+
+// at_step_end: L as a user reads it from the step's orientation and spin, within 2 %;
+// else L where the engine keeps it (midstep_angular_momentum), within 1 %.
+void expect_tumbling_keeps_momentum(std::span<const Tumbler> cases, bool at_step_end) {
+    for (const Tumbler& c : cases) {
+        SpaceSettings settings;
+        settings.gravity = Vec3::Zero();
+        auto space = make_space(settings);
+        BodyDesc d;
+        d.shape = c.shape;
+        d.angular_velocity = c.w;
+        d.gyroscopic = c.gyroscopic;
+        const BodyHandle body = space->create_body(d);
+        const MassProperties mp = mass_of(d);
+        const Vec3 l0 = angular_momentum(*space, body, mp);
+        const double e0 = spin_energy(*space, body, mp);
+        const Vec3 com0 = space->internal_motion_state(body).center_of_mass;
+        const Vec3 m0 = midstep_angular_momentum(*space, body, mp);
+        double worst_l = 0, worst_e = 0, worst_com = 0, worst_mid = 0;
+        for (int i = 0; i < 240; ++i) {
+            space->update();
+            worst_l = std::max(worst_l, (angular_momentum(*space, body, mp) - l0).norm() / l0.norm());
+            worst_mid = std::max(worst_mid, (midstep_angular_momentum(*space, body, mp) - m0).norm() / m0.norm());
+            worst_e = std::max(worst_e, std::abs(spin_energy(*space, body, mp) / e0 - 1));
+            worst_com = std::max(worst_com, (space->internal_motion_state(body).center_of_mass - com0).norm());
+        }
+        std::printf(
+            "[ measure  ] %s: worst |dL|/L %.3f %% (at mid-substep %.3f %%), |dE|/E %.3f %%, centre moved %.3g m\n",
+            c.name, 100 * worst_l, 100 * worst_mid, 100 * worst_e, worst_com);
+        if (at_step_end) {
+            EXPECT_LT(worst_l, 0.02) << c.name;
+        } else {
+            EXPECT_LT(worst_mid, 0.01) << c.name;
+        }
+        EXPECT_LT(worst_e, 0.02) << c.name;
+        EXPECT_LT(worst_com, 1e-6) << c.name;
+    }
+}
+
+}  // namespace
+
+// Dzhanibekov's wing nut: a body spun about its intermediate axis with a small
+// perturbation flips over and over; its angular momentum (a world vector, as a user
+// measures it from the step's orientation and spin) and energy stay within 2 % over 4 s.
+// Also about the minor axis (stable), and a compound whose centre of mass is off its
+// origin (the centre must stay put).
+TEST(OutsideSpin, TumblingBodiesKeepAngularMomentumAndEnergy) {
+    const CompoundPart parts[] = {{Shape::sphere(0.3), Vec3(0, 0, 0)},
+                                  {Shape::box(Vec3(0.6, 0.1, 0.2)), Vec3(0.8, 0.2, 0)}};
+    const Tumbler cases[] = {
+        {"box intermediate axis", Shape::box(Vec3(0.1, 0.3, 0.6)), Vec3(0.05, 12, 0.05), true},
+        {"box minor axis", Shape::box(Vec3(0.1, 0.3, 0.6)), Vec3(12, 0.3, 0.3), true},
+        {"compound off centre", Shape::compound(parts), Vec3(3, 8, 1), true},
+    };
+    expect_tumbling_keeps_momentum(cases, true);
+}
+
+// A thin rod and a thin capsule (elongated: always gyroscopic) spun fast about their long
+// axis and a little across it: they cone about their angular momentum, which must not
+// drift (within 1 % where the engine keeps it).
+// Disabled: fails at 6118a81: the rod's L drifts 2.7 % (8.7 % from the step's end) and the
+// capsule's 3.9 % (9.1 %) within 4 s. Cause and the fix tried: see
+// DISABLED_FastSpinAboutTheIntermediateAxisKeepsItsMomentum.
+TEST(OutsideSpin, DISABLED_FastConingThinBodiesKeepAngularMomentum) {
+    const Tumbler cases[] = {
+        {"rod tilted spin", Shape::box(Vec3(1, 0.05, 0.05)), Vec3(20, 3, 1), false},
+        {"capsule tilted spin", Shape::capsule(0.8, 0.05), Vec3(2, 20, 1), false},
+    };
+    expect_tumbling_keeps_momentum(cases, false);
+}
+
+// ---- Moving platforms --------------------------------------------------------------------------
+// A cube on a kinematic platform is carried by friction. mu 0.8 holds it under the
+// platform's accelerations here (at most 3 m/s^2 < mu g = 7.8): it must stay where it
+// was put on the platform, within 5 mm over 3 s.
+namespace {
+
+enum Motion { Constant, Accelerating, Turntable, Elevator };
+
+// How far the cube moved on the platform (in the platform's frame) over 3 s.
+double carried_cube_slip(Motion motion) {
+    {
+        auto space = make_space();
+        BodyDesc p;
+        p.type = MotionType::Kinematic;
+        p.shape = Shape::box(Vec3(3, 0.1, 3));
+        p.position = Vec3(0, -0.1, 0);
+        p.friction = 0.8;
+        if (motion == Constant) p.linear_velocity = Vec3(2, 0, 1);
+        if (motion == Turntable) p.angular_velocity = Vec3(0, 1.2, 0);  // 1.2^2 x 2 = 2.9 m/s^2 at 2 m
+        if (motion == Elevator) p.linear_velocity = Vec3(0, 1.5, 0);
+        const BodyHandle platform = space->create_body(p);
+        BodyDesc c;
+        c.shape = Shape::box(Vec3::Constant(0.25));
+        c.position = Vec3(2, 0.25, 0);
+        c.friction = 0.8;
+        // Moving with the platform from the start (as if put there long ago).
+        c.linear_velocity = p.linear_velocity + p.angular_velocity.cross(c.position - p.position);
+        c.angular_velocity = p.angular_velocity;
+        const BodyHandle cube = space->create_body(c);
+        step(*space, 30);  // let the contact take the load
+        auto in_platform = [&] {
+            const Quat q = space->internal_orientation(platform);
+            return Vec3(q.conjugate() * (space->internal_position(cube) - space->internal_position(platform)));
+        };
+        const Vec3 start = in_platform();
+        double worst = 0;
+        for (int i = 1; i <= 180; ++i) {
+            if (motion == Accelerating) {
+                const double t = i * kStep;
+                space->move_kinematic(platform, Vec3(1.5 * t * t, -0.1, 0), Quat::Identity());  // a = 3 m/s^2
+            }
+            space->update();
+            worst = std::max(worst, (in_platform() - start).norm());
+        }
+        std::printf("[ measure  ] cube on platform motion %d: moved %.3f mm on it in 3 s\n", motion, 1000 * worst);
+        return worst;
+    }
+}
+
+}  // namespace
+
+TEST(OutsidePlatform, CubeOnAMovingKinematicPlatformIsCarried) {
+    for (Motion motion : {Constant, Accelerating, Elevator}) EXPECT_LT(carried_cube_slip(motion), 5e-3) << motion;
+}
+
+// Disabled: fails at 6118a81. The cube slides 1.36 m off a turntable (1.2 rad/s, cube at 2 m:
+// 2.9 m/s^2 < mu g = 7.8) in 3 s. Two causes. (1) A recycled manifold's anchors are its
+// points' offsets from the body centres when it was collided (Contact::anchor_a/b), not
+// turned with the bodies since: the platform's point under the cube is taken up to 10
+// degrees (the recycling limit) behind where it is, so friction matches the cube to the
+// platform's velocity of up to 8 steps before, and the cube coasts straight until the
+// manifold is collided again. Turning each anchor by its body's turn since the collide in
+// prepare_wide (a round part's surface point kept on the normal, as recycle() does) takes
+// the slip from 1356 mm to 74 mm, but moves every golden hash (resting piles turn a little).
+// (2) What is left is velocity-level friction in a turning frame: within a step the cube
+// moves straight while the platform's point turns, ~w^2 r dt^2 / 2 = 0.4 mm a step outward,
+// never corrected because sticking friction has no position term. Proposed: a soft
+// tangential bias from the anchors' drift while a contact sticks (issue 16's "feed the
+// tangential error back"), which also moves the hashes.
+TEST(OutsidePlatform, DISABLED_CubeOnATurntableIsCarried) { EXPECT_LT(carried_cube_slip(Turntable), 5e-3); }
+
+// ---- Bounces ---------------------------------------------------------------------------------------
+// A ball and a cube dropped flat from 2 m onto the floor rise again to e^2 of the drop
+// (restitution mixes as the larger: the floor has 0). Within 5 % of the drop height for
+// e = 0.5 and 1; e = 0 must not bounce (under 1 cm).
+TEST(OutsideBounce, BallsAndCubesBounceToESquaredOfTheirDrop) {
+    constexpr double kDrop = 2;
+    for (Floor floor : {Floor::Plane, Floor::Mesh}) {
+        for (bool cube : {false, true}) {
+            for (double e : {0.0, 0.5, 1.0}) {
+                auto space = make_space();
+                add_floor(*space, floor, Quat::Identity(), 0.6);
+                BodyDesc d;
+                d.shape = cube ? Shape::box(Vec3::Constant(0.2)) : Shape::sphere(0.2);
+                d.position = Vec3(0.3, 0.2 + kDrop, 0.3);
+                d.restitution = e;
+                const BodyHandle body = space->create_body(d);
+                bool landed = false;
+                double apex = 0;
+                for (int i = 0; i < 150; ++i) {
+                    space->update();
+                    const double h = space->internal_position(body).y() - 0.2;
+                    if (!landed && space->internal_linear_velocity(body).y() > 0) landed = true;
+                    if (landed) apex = std::max(apex, h);
+                }
+                std::printf("[ measure  ] %s on %s, e %.1f: rose to %.3f m (e^2 h = %.3f)\n", cube ? "cube" : "ball",
+                            floor_name(floor), e, apex, e * e * kDrop);
+                EXPECT_NEAR(apex, e * e * kDrop, std::max(0.01, 0.05 * kDrop * e * e))
+                    << (cube ? "cube" : "ball") << " on " << floor_name(floor) << " e " << e;
+            }
+        }
+    }
+}
+
+// A cube dropped flat from 2 m lands flat: it must not come out of the landing turning
+// (under 0.1 rad/s, where a player sees no wobble) or sliding off sideways (under 2 cm).
+// Disabled: fails at 6118a81 on a plane and on a mesh alike: 3.1 rad/s on the mesh, 1.4
+// rad/s and 0.3 m/s sideways at the step after landing, settling 0.3 s later. The four
+// speculative points of the landing face are solved one after another with one iteration
+// a substep: the first takes the whole approach and the later ones less, so the impulses
+// (24, 18, 32, 19 N s) turn the cube. Not fixed here: a block solve of a manifold's points
+// (Box2D v2's for two), or more iterations where a manifold closes fast, would do; both
+// change the solver's results for every scene.
+TEST(OutsideBounce, DISABLED_CubeDroppedFlatLandsFlat) {
+    for (Floor floor : {Floor::Plane, Floor::Mesh}) {
+        auto space = make_space();
+        add_floor(*space, floor, Quat::Identity(), 0.6);
+        const BodyHandle cube = add_box(*space, Vec3::Constant(0.2), Vec3(0.3, 2.2, 0.3));
+        double spin = 0, sideways = 0;
+        for (int i = 0; i < 90; ++i) {
+            space->update();
+            spin = std::max(spin, space->internal_angular_velocity(cube).norm());
+            const Vec3 x = space->internal_position(cube);
+            sideways = std::max(sideways, std::hypot(x.x() - 0.3, x.z() - 0.3));
+        }
+        std::printf("[ measure  ] cube dropped flat on %s: spin %.3f rad/s, moved sideways %.1f mm\n",
+                    floor_name(floor), spin, 1000 * sideways);
+        EXPECT_LT(spin, 0.1) << floor_name(floor);
+        EXPECT_LT(sideways, 0.02) << floor_name(floor);
+    }
+}
+
+// The contact points a box coming down fast over a mesh makes lie under the box (within
+// its footprint and a slop), whatever triangles are near.
+// Disabled: fails at 6118a81: at 12 cm above the grid (a speculative manifold, closing at
+// 6 m/s) two of the four points are at (0, -1) and (1, -1), mesh vertices over a metre
+// from the box (x, z in 0.1..0.5). The SAT picks the face axis of a neighbouring triangle
+// (separation 12 cm along y though the shapes are 16 cm apart), its clip leaves nothing,
+// and face_manifold's fallback takes the deepest incident vertex wherever it lies; the
+// merge of same-normal manifolds then keeps those far points for the area they span. The
+// solver pushes there (likely why a cube bouncing on a mesh rises 4 % over e^2 h where on a
+// plane it rises 0.5 % under, OutsideBounce). Fix (tried): in face_manifold, let
+// the deepest vertex stand in only where it lies over the reference face (as
+// face_of_b_over already asks); then the points are the box's four corners. It moves
+// the pile golden hash, so it is left for the lead.
+TEST(OutsideMesh, DISABLED_ContactPointsOfABoxComingDownFastLieUnderIt) {
+    auto space = make_space();
+    add_floor(*space, Floor::Mesh, Quat::Identity(), 0.6);
+    EventSettings events;
+    events.publish_contact_points = true;
+    space->set_events(events);
+    const BodyHandle cube = add_box(*space, Vec3::Constant(0.2), Vec3(0.3, 2.2, 0.3));
+    double worst = 0;
+    std::vector<ContactPointInfo> points;
+    for (int i = 0; i < 60; ++i) {
+        space->update();
+        space->read_contact_points(points);
+        const Vec3 x = space->internal_position(cube);
+        for (const ContactPointInfo& p : points) {
+            worst = std::max(worst, std::max(std::abs(p.point.x() - x.x()), std::abs(p.point.z() - x.z())) - 0.2);
+        }
+    }
+    std::printf("[ measure  ] box over a mesh: farthest contact point %.3f m outside its footprint\n", worst);
+    EXPECT_LT(worst, 0.01);
+}
+
+// ---- Pendulums --------------------------------------------------------------------------------------
+// A 1 kg ball of radius 0.1 on a 1.5 m arm, hung from a static body by a hinge and by a
+// rigid distance joint, swung 0.1 rad: a physical pendulum,
+// T = 2 pi sqrt((2/5 r^2 + L^2) / (g L)) (within 1 %: a clock a user would notice).
+TEST(OutsidePendulum, HingeAndDistancePendulumsSwingAtTheirPeriod) {
+    constexpr double kL = 1.5, kR = 0.1, kAmp = 0.1;
+    const double period = 2 * kPi * std::sqrt((0.4 * kR * kR + kL * kL) / (kGravity * kL));
+    for (bool hinge : {true, false}) {
+        auto space = make_space();
+        const BodyHandle pivot = add_static_box(*space, Vec3::Constant(0.05), Vec3(0, 3, 0));
+        BodyDesc d;
+        d.shape = Shape::sphere(kR);
+        d.mass = 1;
+        d.position = Vec3(0, 3, 0) + kL * Vec3(std::sin(kAmp), -std::cos(kAmp), 0);
+        const BodyHandle bob = space->create_body(d);
+        if (hinge) {
+            space->create_joint(JointDesc::hinge_at(pivot, bob, Vec3(0, 3, 0), Vec3::UnitZ()));
+        } else {
+            space->create_joint(JointDesc::distance_between(pivot, bob, Vec3(0, 3, 0), d.position));
+        }
+        // Times the bob crosses x = 0 going the same way, interpolated within the step.
+        std::vector<double> crossings;
+        double x_prev = space->internal_position(bob).x();
+        for (int i = 1; i <= 300; ++i) {
+            space->update();
+            const double x = space->internal_position(bob).x();
+            if (x_prev > 0 && x <= 0) crossings.push_back((i - 1 + x_prev / (x_prev - x)) * kStep);
+            x_prev = x;
+        }
+        ASSERT_GE(crossings.size(), 2u);
+        const double measured = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+        std::printf("[ measure  ] %s pendulum: period %.4f s (analytic %.4f, %.2f %%)\n", hinge ? "hinge" : "distance",
+                    measured, period, 100 * (measured / period - 1));
+        EXPECT_NEAR(measured, period, 0.01 * period) << (hinge ? "hinge" : "distance");
+    }
+}
+
+// A chain of ten 1 kg links holding a 100 kg ball at the default settings: it must hang
+// still, no longer than 3 % over its length (soft joints stretch under load), and not
+// jitter (under 1 cm/s at the end).
+// Disabled: fails at 6118a81: after 4 s it is 3.8 % long and the ball still bounces up and
+// down at 0.17 m/s (0.62 m/s at 1.3 s; the amplitude beats rather than decays). The joints'
+// softness and damping are set for the links' effective mass (SolverSettings::joint_hertz,
+// joint_damping_ratio), so the 100 kg ball rings on them underdamped. 8 substeps: 3.6 %,
+// 0.03 m/s. Not fixed: a joint damping scaled to the heavier side's mass, or Box3D's
+// relaxed joint softness, would change the chains golden scene.
+TEST(OutsidePendulum, DISABLED_LightChainHoldsAHundredTimesHeavierEndMass) {
+    auto space = make_space();
+    const BodyHandle ceiling = add_static_box(*space, Vec3::Constant(0.1), Vec3(0, 10, 0));
+    std::vector<BodyHandle> links;
+    BodyHandle prev = ceiling;
+    constexpr int kLinks = 10;
+    constexpr double kLink = 0.4;
+    for (int i = 0; i < kLinks; ++i) {
+        BodyDesc d;
+        d.shape = Shape::capsule(0.15, 0.04);
+        d.mass = 1;
+        d.position = Vec3(0, 10 - kLink * (i + 0.5), 0);
+        const BodyHandle link = space->create_body(d);
+        space->create_joint(JointDesc::ball_socket_at(prev, link, Vec3(0, 10 - kLink * i, 0)));
+        links.push_back(link);
+        prev = link;
+    }
+    BodyDesc heavy;
+    heavy.shape = Shape::sphere(0.2);
+    heavy.mass = 100;
+    heavy.position = Vec3(0, 10 - kLink * kLinks - 0.2, 0);
+    const BodyHandle ball = space->create_body(heavy);
+    space->create_joint(JointDesc::ball_socket_at(prev, ball, Vec3(0, 10 - kLink * kLinks, 0)));
+    links.push_back(ball);
+    step(*space, 240);
+    const double stretch = (heavy.position.y() - space->internal_position(ball).y()) / (kLink * kLinks);
+    const double speed = max_speed(*space, links);
+    std::printf("[ measure  ] chain of 10 x 1 kg holding 100 kg: stretched %.3f %%, fastest %.4f m/s\n", 100 * stretch,
+                speed);
+    EXPECT_TRUE(all_finite(*space, links));
+    EXPECT_LT(std::abs(stretch), 0.03);
+    EXPECT_LT(speed, 0.01);
+}
+
+// ---- Fast bodies -----------------------------------------------------------------------------------
+// A small fast projectile (a 2 cm ball or a 1 cm x 4 cm capsule, `fast`) at 300 m/s
+// against a static wall 2 cm thick and against a one-sided mesh wall (no thickness at
+// all): it must end on the near side, never through.
+TEST(OutsideFast, SmallProjectileAt300MetresPerSecondStopsAtAThinWall) {
+    for (bool mesh : {false, true}) {
+        for (bool capsule : {false, true}) {
+            SpaceSettings settings;
+            settings.gravity = Vec3::Zero();
+            auto space = make_space(settings);
+            BodyDesc wall;
+            wall.type = MotionType::Static;
+            if (mesh) {
+                // The grid on y = 0 turned to face -x, at x = 5.
+                wall.shape = test::flat_grid_mesh(4, 1.0);
+                wall.orientation = about_z(kPi / 2);
+                wall.position = Vec3(5, 0, 0);
+            } else {
+                wall.shape = Shape::box(Vec3(0.01, 2, 2));
+                wall.position = Vec3(5, 0, 0);
+            }
+            space->create_body(wall);
+            BodyDesc d;
+            d.shape = capsule ? Shape::capsule(0.02, 0.005) : Shape::sphere(0.01);
+            d.orientation = about_z(kPi / 2 + 0.3);
+            d.position = Vec3(-3, 0.13, -0.21);
+            d.linear_velocity = Vec3(300, 0, 0);
+            d.fast = true;
+            const BodyHandle bullet = space->create_body(d);
+            double furthest = -kHuge;
+            for (int i = 0; i < 10; ++i) {
+                space->update();
+                furthest = std::max(furthest, space->internal_position(bullet).x());
+            }
+            std::printf("[ measure  ] %s at 300 m/s into a %s wall at x = 5: furthest x %.4f\n",
+                        capsule ? "capsule" : "ball", mesh ? "mesh" : "2 cm box", furthest);
+            EXPECT_LT(furthest, mesh ? 5.0 : 4.99) << (capsule ? "capsule" : "ball") << (mesh ? " mesh" : " box");
+        }
+    }
+}
+
+// ---- Sleeping -----------------------------------------------------------------------------------------
+// Bodies asleep on a floor that goes away must fall: destroyed, made dynamic, or a
+// kinematic floor moved away. And a sleeping cube hit by a ball wakes and moves.
+TEST(OutsideSleep, SleepersFallWhenTheirFloorGoes) {
+    enum How { Destroyed, MadeDynamic, KinematicMovedAway, MiddleOfAStackDestroyed };
+    for (How how : {Destroyed, MadeDynamic, KinematicMovedAway, MiddleOfAStackDestroyed}) {
+        Space space{SpaceSettings{}};                                 // sleeping on
+        add_static_box(space, Vec3(20, 0.5, 20), Vec3(0, -10.5, 0));  // something far below
+        BodyDesc f;
+        f.type = how == KinematicMovedAway ? MotionType::Kinematic : MotionType::Static;
+        f.shape = Shape::box(Vec3(3, 0.25, 3));
+        f.position = Vec3(0, -0.25, 0);
+        const BodyHandle floor = space.create_body(f);
+        const std::vector<BodyHandle> cubes = add_cube_stack(space, 3, Vec3(0.2, 0, 0));
+        step(space, 120);
+        bool asleep = true;
+        for (BodyHandle c : cubes) asleep = asleep && !space.internal_is_awake(c);
+        ASSERT_TRUE(asleep) << "how " << how;
+        BodyHandle top = cubes.back();
+        switch (how) {
+            case Destroyed: space.destroy_body(floor); break;
+            case MadeDynamic: space.set_motion_type(floor, MotionType::Dynamic); break;
+            case KinematicMovedAway: space.move_kinematic(floor, Vec3(0, -3, 0), Quat::Identity()); break;
+            case MiddleOfAStackDestroyed: space.destroy_body(cubes[1]); break;
+        }
+        const double y0 = space.internal_position(top).y();
+        step(space, 30);
+        const double fell = y0 - space.internal_position(top).y();
+        // Half a second of free fall is 1.2 m (a floor made dynamic falls with them); the
+        // stack with its middle gone falls 1 m onto the cube below.
+        std::printf("[ measure  ] sleepers, floor gone (how %d): top fell %.3f m in 0.5 s\n", how, fell);
+        EXPECT_GT(fell, how == MiddleOfAStackDestroyed ? 0.9 : 1.0) << "how " << how;
+    }
+}
+
+TEST(OutsideSleep, ASleepingCubeHitByABallWakesAndMoves) {
+    Space space{SpaceSettings{}};
+    test::add_ground_plane(space);
+    const BodyHandle cube = add_box(space, Vec3::Constant(0.5), Vec3(0, 0.5, 0));
+    step(space, 90);
+    ASSERT_FALSE(space.internal_is_awake(cube));
+    BodyDesc d;
+    d.shape = Shape::sphere(0.3);
+    d.density = 5000;
+    d.position = Vec3(-5, 0.3, 0);
+    d.linear_velocity = Vec3(8, 0, 0);
+    space.create_body(d);
+    step(space, 90);
+    const double moved = space.internal_position(cube).x();
+    std::printf("[ measure  ] sleeping cube hit by a ball: moved %.3f m\n", moved);
+    EXPECT_GT(moved, 0.2);
+}
+
+}  // namespace spindle::stability::outside
