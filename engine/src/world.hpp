@@ -336,10 +336,15 @@ struct Contact {
 // A contact's material from its bodies' (when made, and when a body's changes): geometric
 // mean friction and the larger restitution, as most engines; the larger rolling
 // resistance, as Box3D.
+// A pair's coefficients at most this: the solver keeps them in floats, where a coefficient of
+// 1e300 is infinite and infinity times a zero impulse is NaN. Beyond 1e9 nothing slides or
+// rolls anyway, and a bounce is held to the speed limit (restitution_wide).
+inline constexpr Real kMaxMixedMaterial = 1e9;
 inline void mix_materials(const BodyTraits& a, const BodyTraits& b, Contact& contact) {
-    contact.friction = std::sqrt(a.friction * b.friction);
-    contact.restitution = std::max(a.restitution, b.restitution);
-    contact.rolling_resistance = static_cast<float>(std::max(a.rolling_resistance, b.rolling_resistance));
+    contact.friction = std::min(std::sqrt(a.friction * b.friction), kMaxMixedMaterial);
+    contact.restitution = std::min(std::max(a.restitution, b.restitution), kMaxMixedMaterial);
+    contact.rolling_resistance =
+        static_cast<float>(std::min(std::max(a.rolling_resistance, b.rolling_resistance), kMaxMixedMaterial));
 }
 
 // A contact moved to a removed one's place (remove_contacts).

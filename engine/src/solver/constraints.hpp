@@ -488,7 +488,8 @@ void solve_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodie
 // to `push`, as warm_start_contact would apply them.
 void relax_and_warm_start_contact(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
                                   PushVelocity* warm, const ContactSolveParams& params, EffectCounts& counts);
-void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts);
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real max_speed, Real h,
+                       EffectCounts& counts);
 void store_contact_impulses(World& world, const SolverScratch& scratch, std::uint32_t lo, std::uint32_t hi);
 
 // joint_solver.cpp. prepare_joints lists the awake joints (nothing when there are

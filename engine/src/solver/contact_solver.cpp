@@ -791,7 +791,8 @@ void warm_start_wide(WideContact& wc, const PushAnchors* push_anchors, SolverBod
 constexpr int kRestitutionSweeps = 4;
 
 template <bool kLocked>
-void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
+void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real max_speed, Real h,
+                      EffectCounts& counts) {
     const Wide zero = splat(0);
     const WideMask bouncy = wc.restitution > zero;
     if (!any(bouncy)) return;
@@ -821,7 +822,12 @@ void restitution_wide(WideContact& wc, SolverBody* bodies, Real threshold, Real 
             // Semi-implicit Euler conserves v^2/2 - a.x - h a.v/2, not the plain energy;
             // reversing v at an impact costs h a v of it unless the bounce speed gains a h.
             const Wide approach = wc.relative_velocity[j] + wc.gravity_normal * splat(h);
-            const Wide impulse = -p.normal_mass * (vn + wc.restitution * wide_min(approach, zero));
+            // The bounce's speed no more than the speed limit: the step holds the stored
+            // velocities to it, and the impulse is the next step's warm start too (a
+            // restitution of 1e9 would hurl the bodies that far in its first substep).
+            const Wide speed = -wide_min(approach, zero);
+            const Wide rebound = select(speed > zero, wide_min(wc.restitution * speed, splat(max_speed)), zero);
+            const Wide impulse = -p.normal_mass * (vn - rebound);
             const Wide total = wide_max(r.normal_impulse + impulse, zero);
             const Wide applied = select(bounce, total - r.normal_impulse, zero);
             r.normal_impulse += applied;
@@ -882,11 +888,12 @@ void relax_and_warm_start_contact(WideContact& wc, PushAnchors* push_anchors, So
     }
 }
 
-void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real h, EffectCounts& counts) {
+void apply_restitution(WideContact& wc, SolverBody* bodies, Real threshold, Real max_speed, Real h,
+                       EffectCounts& counts) {
     if (wc.locked) {
-        restitution_wide<true>(wc, bodies, threshold, h, counts);
+        restitution_wide<true>(wc, bodies, threshold, max_speed, h, counts);
     } else {
-        restitution_wide<false>(wc, bodies, threshold, h, counts);
+        restitution_wide<false>(wc, bodies, threshold, max_speed, h, counts);
     }
 }
 

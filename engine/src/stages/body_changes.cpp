@@ -25,19 +25,27 @@ BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape
         mp.inertia *= traits.mass / mp.mass;
         mp.mass = traits.mass;
     }
-    if (!(mp.mass > 0) || !mp.inertia.allFinite()) {
+    if (!(mp.mass > 0)) {
         throw Error(std::string(who) + ": the shape has no volume (mass " + number(mp.mass) + ")");
+    }
+    const std::string range = "within [" + number(kMinMass) + ", " + number(kMaxMass) + "]";
+    if (!(mp.mass >= kMinMass && mp.mass <= kMaxMass)) {
+        throw Error(std::string(who) + ": mass must be " + range + " kg (the solver's single precision), got " +
+                    number(mp.mass));
+    }
+    // Principal inertias, ascending: a compound's inertia need not be diagonal.
+    const Vec3 principal =
+        mp.inertia.allFinite()
+            ? Vec3(Eigen::SelfAdjointEigenSolver<Mat3>(mp.inertia, Eigen::EigenvaluesOnly).eigenvalues())
+            : Vec3(mp.inertia.diagonal());
+    if (!(principal.x() >= kMinMass && principal.z() <= kMaxMass)) {
+        throw Error(std::string(who) + ": its mass properties are out of range: principal inertias must be " + range +
+                    " kg m^2 (the solver's single precision), got " + vec(principal));
     }
     out.inv_mass = 1 / mp.mass;
     out.inv_inertia = mp.inertia.inverse();
-    // A mass so small that its inverse overflows would turn every impulse into NaN.
-    if (!std::isfinite(out.inv_mass) || !out.inv_inertia.allFinite()) {
-        throw Error(std::string(who) + ": mass " + number(mp.mass) + " is too small: its inverse is not finite");
-    }
     out.inertia = mp.inertia;
     out.local_com = mp.center_of_mass;
-    // Principal inertias, ascending: a compound's inertia need not be diagonal.
-    const Vec3 principal = Eigen::SelfAdjointEigenSolver<Mat3>(mp.inertia, Eigen::EigenvaluesOnly).eigenvalues();
     out.elongated = principal.z() > kElongatedInertiaRatio * principal.x();
     return out;
 }

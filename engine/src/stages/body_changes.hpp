@@ -18,6 +18,12 @@ namespace spindle {
 // without bound, and it falls late (docs/benchmarks.md, h45, session 19). Box3D applies
 // its gyroscopic step to every body; a body this far from a sphere is where it matters.
 inline constexpr Real kElongatedInertiaRatio = 10;
+// The solver works in single precision (solver/wide.hpp): a dynamic body's mass and principal
+// inertias must lie within [kMinMass, kMaxMass] (kg, kg m^2), where float holds them, their
+// inverses and their products with lever arms and impulses with room to spare (a 1 mm grain's
+// inertia is ~1e-13 kg m^2, a 1 km rock's ~1e18). Beyond it an impulse turns into inf or NaN.
+inline constexpr Real kMinMass = 1e-24;
+inline constexpr Real kMaxMass = 1e24;
 
 // A body's mass, inertia and centre of mass as create_body computes them: from the
 // shape and the description's density or mass for a dynamic body, none otherwise.
@@ -28,8 +34,8 @@ struct BodyMass {
     Vec3 local_com = Vec3::Zero();  // in the shape's frame
     bool elongated = false;         // kElongatedInertiaRatio
 };
-// Throws spindle::Error ("<who>: the shape has no volume ...") for a shape or mass that
-// gives no finite inverse.
+// Throws spindle::Error ("<who>: the shape has no volume ...", "<who>: mass ... must be within
+// ...") for a shape or mass that gives no finite inverse, or one out of the solver's range.
 BodyMass body_mass(const BodyTraits& traits, MotionType type, const Shape& shape, const char* who);
 
 // These bodies' friction, restitution or rolling resistance changed (descriptions already set; slots

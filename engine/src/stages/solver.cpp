@@ -830,6 +830,7 @@ void solve(World& world, Real dt) {
     plan_step(world, scratch, restitution);  // no pass at all over a scene without bouncy contacts
     world.scratch_counts.assign(world.jobs->worker_count(), EffectCounts{});
     const Real restitution_threshold = settings.restitution_threshold;
+    const Real max_bounce = settings.max_linear_speed;
     auto push_anchors = [&](const WideContact& wc) {
         return scratch.push_anchors.data() + kLanes * static_cast<std::size_t>(&wc - scratch.wide.data());
     };
@@ -941,7 +942,9 @@ void solve(World& world, Real dt) {
             case Pass::Restitution:
                 for_colored<false>(
                     scratch, phase.color, lo, hi, [](WideJoint&) {}, [](JointConstraint&) {},
-                    [&](WideContact& wc) { apply_restitution(wc, bodies, restitution_threshold, h, counts); });
+                    [&](WideContact& wc) {
+                        apply_restitution(wc, bodies, restitution_threshold, max_bounce, h, counts);
+                    });
                 break;
         }
     };

@@ -248,3 +248,98 @@ TEST(InvalidBody, ShapeFactoriesRejectBadValues) {
             false, [&] { Shape::plane(Vec3::Zero(), 0); }, "normal");
     }
 }
+
+// The solver keeps masses in single precision: a dynamic body whose mass or principal
+// inertias leave [kMinMass, kMaxMass] is refused (a hull of 10 nm made the state NaN when it
+// touched the floor: its inverse inertia overflowed a float). As a static or kinematic body
+// it has no mass and is accepted.
+TEST(InvalidBody, MassesOutOfTheSolversRangeAreRefused) {
+    const Real legs = 1e-8;
+    const std::vector<Vec3> speck{Vec3(0, 0, 0), Vec3(legs, 0, 0), Vec3(0, legs, 0), Vec3(0, 0, legs)};
+    for (MotionType type : kMotionTypes) {
+        const bool dynamic = type == MotionType::Dynamic;
+        BodyDesc d = body_of(type);
+        d.shape = Shape::convex_hull(speck);
+        try_body(d, !dynamic, "principal inertias", "a hull of 10 nm");
+        d.shape = Shape::sphere(1e5);  // 4e18 kg, 2e28 kg m^2 at water's density
+        try_body(d, !dynamic, "principal inertias", "a sphere of 100 km");
+        d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        d.mass = 1e25;
+        try_body(d, !dynamic, "mass", "1e25 kg");
+        d.mass = 1e-30;
+        try_body(d, !dynamic, "mass", "1e-30 kg");
+    }
+    // What a game holds is in range: a 1 mm grain, a 10 km sphere, a metre box of 1e24 kg.
+    BodyDesc d = body_of(MotionType::Dynamic);
+    d.shape = Shape::sphere(1e-3);
+    try_body(d, true, "mass", "a 1 mm grain");
+    d.shape = Shape::sphere(1e4);
+    try_body(d, true, "mass", "a sphere of 10 km");
+    d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+    d.mass = 1e24;  // the range's top (stages/body_changes.hpp)
+    try_body(d, true, "mass", "1e24 kg");
+}
+
+// Bodies at the ends of that range fall onto a floor and come to rest with a finite state.
+TEST(InvalidBody, BodiesAtTheEndsOfTheMassRangeStayFinite) {
+    Space space;
+    test::add_static_box(space, Vec3(20, 1, 20), Vec3(0, -1, 0));
+    std::vector<BodyHandle> bodies;
+    const auto add = [&](const Shape& shape, Real mass, const Vec3& position) {
+        BodyDesc d;
+        d.shape = shape;
+        d.mass = mass;
+        d.position = position;
+        d.angular_velocity = Vec3(1, 2, 3);
+        bodies.push_back(space.create_body(d));
+    };
+    const Real legs = 1e-5;  // the smallest hull of the range at water's density: inertias ~1e-24
+    add(Shape::convex_hull(std::vector<Vec3>{Vec3(0, 0, 0), Vec3(legs, 0, 0), Vec3(0, legs, 0), Vec3(0, 0, legs)}), 0,
+        Vec3(0, 0.01, 0));
+    add(Shape::sphere(1e-3), 0, Vec3(1, 0.01, 0));
+    add(Shape::box(Vec3(0.5, 0.5, 0.5)), 1e24, Vec3(3, 0.6, 0));
+    add(Shape::box(Vec3(0.5, 0.5, 0.5)), 1e-20, Vec3(3, 1.7, 0));  // a feather on the heavy box
+    for (int i = 0; i < 120; ++i) space.update();
+    for (BodyHandle body : bodies) {
+        EXPECT_TRUE(space.position(body).allFinite()) << to_string(body);
+        EXPECT_TRUE(space.linear_velocity(body).allFinite()) << to_string(body);
+        EXPECT_TRUE(space.angular_velocity(body).allFinite()) << to_string(body);
+        EXPECT_GT(space.position(body).y(), -0.01) << to_string(body) << " fell through the floor";
+    }
+}
+
+// Friction, restitution and rolling resistance take any finite value >= 0; the solver keeps a
+// pair's in floats, where 1e300 is infinite: a box resting with friction 1e300 went NaN, and
+// one dropped with restitution 1e30 was hurled 1e27 m by its bounce's warm start. Now the
+// states stay finite and a bounce keeps to the speed limit.
+TEST(InvalidBody, HugeMaterialCoefficientsKeepTheStateFinite) {
+    SpaceSettings settings;
+    Space space(settings);
+    test::add_static_box(space, Vec3(20, 1, 20), Vec3(0, -1, 0));
+    const auto add = [&](const Vec3& position, Real friction, Real restitution, Real rolling) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3(0.5, 0.5, 0.5));
+        d.position = position;
+        d.friction = friction;
+        d.restitution = restitution;
+        d.rolling_resistance = rolling;
+        return space.create_body(d);
+    };
+    const BodyHandle resting = add(Vec3(0, 0.5, 0), 1e300, 0, 0);
+    const BodyHandle sliding = add(Vec3(4, 0.5, 0), 1e300, 0, 1e300);
+    space.set_linear_velocity(sliding, Vec3(3, 0, 0));
+    const BodyHandle bouncing = add(Vec3(-4, 3, 0), 0.6, 1e30, 0);
+    const BodyHandle wilder = add(Vec3(-8, 3, 0), 0.6, 1e300, 0);
+    const Real limit = settings.solver.max_linear_speed;
+    const int steps = 90;
+    for (int i = 0; i < steps; ++i) space.update();
+    for (BodyHandle body : {resting, sliding, bouncing, wilder}) {
+        EXPECT_TRUE(space.position(body).allFinite()) << to_string(body);
+        EXPECT_TRUE(space.angular_velocity(body).allFinite()) << to_string(body);
+        EXPECT_LE(space.linear_velocity(body).norm(), limit) << to_string(body);
+        // No further than the speed limit carries it in the run's 1.5 s.
+        EXPECT_LE(space.position(body).norm(), 10 + limit * steps / 60.0) << to_string(body);
+    }
+    EXPECT_NEAR(space.position(resting).y(), 0.5, 0.01);  // friction holds, it does not move
+    EXPECT_LT(std::abs(space.position(sliding).x() - 4), 0.1) << "friction 1e300 stops a slide at once";
+}

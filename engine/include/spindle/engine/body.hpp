@@ -82,6 +82,8 @@ struct BodyDesc {
     Quat orientation = Quat::Identity();  // normalised at creation; must not be zero
     Vec3 linear_velocity = Vec3::Zero();
     Vec3 angular_velocity = Vec3::Zero();
+    // A dynamic body's mass and principal inertias must come out within [1e-24, 1e24] (kg,
+    // kg m^2): the solver works in single precision (create_body refuses a body beyond).
     Real density = 1000;  // kg/m^3; used when mass == 0
     Real mass = 0;        // kg; > 0 overrides density (inertia scaled to match)
     Real friction = 0.6;
