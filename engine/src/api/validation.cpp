@@ -9,11 +9,8 @@
 #include <cmath>
 
 #include "api/describe.hpp"
-#include "collision/error_text.hpp"
 
 namespace spindle {
-
-static_assert(kMaxCoordinate == detail::kMaxShapeCoordinate, "shapes and positions share one bound");
 
 void reject_field(const char* who, const std::string& field, const char* rule, const std::string& got) {
     throw Error(std::string(who) + ": " + field + " " + rule + ", got " + got);

@@ -9,6 +9,8 @@
 #include <spindle/engine/settings.hpp>
 #include <spindle/engine/shape.hpp>
 
+#include "collision/error_text.hpp"  // kMaxCoordinate
+
 namespace spindle {
 
 class MotionStateManager;
@@ -20,7 +22,6 @@ void check_finite(Real value, const char* who, const char* field);
 void check_finite(const Vec3& value, const char* who, const char* field);
 // Finite and within kMaxCoordinate of the origin in every axis.
 void check_position(const Vec3& value, const char* who, const char* field);
-inline constexpr Real kMaxCoordinate = 1e9;
 void check_non_negative(Real value, const char* who, const char* field);  // finite and >= 0
 void check_positive(Real value, const char* who, const char* field);      // finite and > 0
 void check_at_least(int value, int least, const char* who, const char* field);

@@ -43,8 +43,8 @@ void check_part(std::uint32_t i, const CompoundPart& part) {
         default: reject(i, std::string("must be a sphere, capsule, box or convex hull, got ") + to_string(s.type));
     }
     if (!is_finite(part.position)) reject(i, "position must be finite, got " + to_text(part.position));
-    if (part.position.cwiseAbs().maxCoeff() > detail::kMaxShapeCoordinate) {
-        reject(i, "position must be within " + to_text(detail::kMaxShapeCoordinate) + " m of the origin, got " +
+    if (part.position.cwiseAbs().maxCoeff() > kMaxCoordinate) {
+        reject(i, "position must be within " + to_text(kMaxCoordinate) + " m of the origin, got " +
                       to_text(part.position));
     }
     const Vec3 q = part.orientation.vec();

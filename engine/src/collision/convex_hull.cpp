@@ -187,10 +187,9 @@ ConvexHull::ConvexHull(std::span<const Vec3> points) {
             throw Error("convex hull: point " + std::to_string(i) + " must be finite, got " +
                         detail::to_text(points[i]));
         }
-        if (points[i].cwiseAbs().maxCoeff() > detail::kMaxShapeCoordinate) {
+        if (points[i].cwiseAbs().maxCoeff() > kMaxCoordinate) {
             throw Error("convex hull: point " + std::to_string(i) + " must be within " +
-                        detail::to_text(detail::kMaxShapeCoordinate) + " m of the origin, got " +
-                        detail::to_text(points[i]));
+                        detail::to_text(kMaxCoordinate) + " m of the origin, got " + detail::to_text(points[i]));
         }
         box.include(points[i]);
     }

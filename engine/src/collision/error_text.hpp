@@ -6,12 +6,17 @@
 
 #include <spindle/engine/math.hpp>
 
-namespace spindle::detail {
+namespace spindle {
 
-// How far from its origin a hull's points and a mesh's vertices may lie: the bound of
-// positions (api/validation.hpp's kMaxCoordinate, the same value), past which the plane
-// tests, areas and bounds of the shape overflow.
-inline constexpr Real kMaxShapeCoordinate = 1e9;
+// The world's bound: positions, and a shape's sizes, points and vertices (from its origin),
+// within a billion metres (api/validation.cpp checks positions, the factories shapes): far
+// enough for any game world, near enough that squared distances, bounds, a shape's plane
+// tests and areas and the step's sums stay finite.
+inline constexpr Real kMaxCoordinate = 1e9;
+
+}  // namespace spindle
+
+namespace spindle::detail {
 
 // Shortest text that reads back to the same double.
 inline std::string to_text(Real x) {

@@ -35,10 +35,9 @@ TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const std::
             throw Error("triangle mesh: vertex " + std::to_string(i) + " must be finite, got " +
                         detail::to_text(vertices[i]));
         }
-        if (vertices[i].cwiseAbs().maxCoeff() > detail::kMaxShapeCoordinate) {
+        if (vertices[i].cwiseAbs().maxCoeff() > kMaxCoordinate) {
             throw Error("triangle mesh: vertex " + std::to_string(i) + " must be within " +
-                        detail::to_text(detail::kMaxShapeCoordinate) + " m of the origin, got " +
-                        detail::to_text(vertices[i]));
+                        detail::to_text(kMaxCoordinate) + " m of the origin, got " + detail::to_text(vertices[i]));
         }
     }
     for (std::size_t k = 0; k < indices.size(); ++k) {
