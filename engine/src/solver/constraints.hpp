@@ -107,6 +107,10 @@ struct WideContact {
     // A lane's contact has rolling resistance: its rows are in `rolling` (set with it by
     // prepare_wide), which no pass reads otherwise.
     bool rolls = false;
+    // The lanes (bit l for lane l) whose bodies close faster than the settled speed as the
+    // step begins (a landing, a hit): every pass sweeps their normal rows until they
+    // settle (solve_wide).
+    std::uint8_t sweep_lanes = 0;
     WideRolling* rolling = nullptr;  // this wide contact's in SolverScratch::rolling, where it rolls
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through
     // the overlap's centre on the push-out velocities, kept over the step's substeps. The
@@ -454,6 +458,7 @@ struct ContactSolveParams {
     Real push_out = 0;        // push-out speed
     Real slop = 0;            // gaps wider than this carry no friction
     Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
+    Real settled_speed = 0;   // a lane's normal rows are swept again while one changes a point's speed more
     // How deep a point's last impulse holds its soft row at rest, per unit impulse over
     // the effective mass (impulse_scale x impulse = mass x mass_scale x bias_rate x depth),
     // for soft and static_soft; set with them (held_per_impulse()).
