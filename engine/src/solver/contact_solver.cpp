@@ -369,7 +369,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         // sweep the rows until they settle (solve_wide).
         bool apart = true;
         for (int j = 0; j < m.point_count; ++j) apart = apart && m.points[j].separation > 0;
-        if (apart && m.normal.dot(b.v[contact.body_b] - b.v[contact.body_a]) < -params.settled_speed) wc.sweep_lanes |= 1u << l;
+        if (apart && m.normal.dot(b.v[contact.body_b] - b.v[contact.body_a]) < -params.settled_speed)
+            wc.sweep_lanes |= 1u << l;
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));
@@ -738,9 +739,9 @@ constexpr int kNormalSweeps = 4;
 // rows' terms are the first sweep's. Rare: solve_wide's build with kSweeps, which only
 // such wide contacts run.
 template <bool kBias, bool kLocked>
-[[gnu::always_inline]] inline void sweep_normal_rows(WideContact& wc, const WideAxisMasses& masses,
-                                                     WideVelocities& s, const Wide (&gap)[kMaxManifoldPoints],
-                                                     const LaneSoftness& soft, const ContactSolveParams& params) {
+[[gnu::always_inline]] inline void sweep_normal_rows(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
+                                                     const Wide (&gap)[kMaxManifoldPoints], const LaneSoftness& soft,
+                                                     const ContactSolveParams& params) {
     NormalTerms terms[kMaxManifoldPoints];
     for (int j = 0; j < kMaxManifoldPoints; ++j) terms[j] = normal_terms<kBias>(gap[j], wc.recovery[j], soft, params);
     const Wide settled = splat(params.settled_speed);
