@@ -132,7 +132,31 @@ struct FrictionLanes {
     WideD inv_mass_a, inv_mass_b;
     // Per world axis, lanes whose body has its translation along it locked.
     WideDMask locked_a[3], locked_b[3];
+    // Lanes (a bit each) whose bodies turned since their manifold was collided, and for
+    // those, each body's turn and round part (ContactManifold::radius_a, radius_b).
+    std::uint32_t turned = 0;
+    Quat turn_a[kLanes], turn_b[kLanes];
+    Real radius_a[kLanes], radius_b[kLanes];
 };
+
+// The friction centre of the lanes whose bodies turned since their manifold was collided,
+// turned with them: the anchors are the points' offsets when collided, and a body carried
+// on a turning one is carried by the velocity of the point under it now (10 degrees behind,
+// the cube on a turntable coasted straight off it). A round part's surface point stays on
+// the normal, as recycle() keeps it. Only friction's: the normal rows keep their anchors
+// fixed under their fixed normal while the manifold is recycled (Box3D's); turning those
+// under it moved the supports of a tilting box under its load, and a tall stack fell.
+void turn_centers(const FrictionLanes& in, WideD3& center_a, WideD3& center_b) {
+    for (int l = 0; l < kLanes; ++l) {
+        if ((in.turned & (1u << l)) == 0) continue;
+        const Vec3 n(in.normal.x[l], in.normal.y[l], in.normal.z[l]);
+        const Vec3 round_a = in.radius_a[l] * n, round_b = in.radius_b[l] * n;
+        const Vec3 a(center_a.x[l], center_a.y[l], center_a.z[l]);
+        const Vec3 b(center_b.x[l], center_b.y[l], center_b.z[l]);
+        center_a.set_lane(l, in.turn_a[l] * (a - round_a) + round_a);
+        center_b.set_lane(l, in.turn_b[l] * (b + round_b) - round_b);
+    }
+}
 
 // The free part of v (without_axes, motion_locks.hpp): a locked axis is an exact zero.
 WideD3 free_part(const WideD3& v, const WideDMask (&locked)[3]) {
@@ -204,6 +228,7 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
         const WideD3 arm = in.anchor_a[j] - center_a;
         wc.points[j].lever_arm = narrow(select(in.filled[j], wide_sqrt(dot(arm, arm)), zero));
     }
+    if (in.turned != 0) turn_centers(in, center_a, center_b);
     wc.center_a = narrow(center_a);
     wc.center_b = narrow(center_b);
     WideD3 ia[2], ib[2], ra_x[2], rb_x[2];
@@ -317,6 +342,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         for (WideD& gap : in.separation) gap = splat_d(kEmptySeparation);
     }
     for (int axis = 0; axis < 3; ++axis) in.locked_a[axis] = in.locked_b[axis] = WideDMask{};
+    in.turned = 0;
     Wide normal_impulse[kMaxManifoldPoints]{};
     WideD gravity_scale_a{}, gravity_scale_b{};
     WideDMask live{}, locks_a{}, locks_b{};  // lanes with a manifold; lanes whose body has a translation lock
@@ -363,6 +389,17 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.radius_b[l] = m.radius_b;
         gravity_scale_a[l] = scratch.gravity_scales[ref.a];
         gravity_scale_b[l] = scratch.gravity_scales[ref.b];
+        // A recycled manifold's bodies may have turned since it was collided: its friction
+        // centre turns with them (prepare_friction).
+        const Quat& qa = b.q[contact.body_a];
+        const Quat& qb = b.q[contact.body_b];
+        if (!(qa.coeffs() == contact.cached_qa.coeffs() && qb.coeffs() == contact.cached_qb.coeffs())) {
+            in.turned |= 1u << l;
+            in.turn_a[l] = qa * contact.cached_qa.conjugate();
+            in.turn_b[l] = qb * contact.cached_qb.conjugate();
+            in.radius_a[l] = m.radius_a;
+            in.radius_b[l] = m.radius_b;
+        }
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));
