@@ -709,19 +709,15 @@ TEST(OutsideBounce, DISABLED_CubeDroppedFlatLandsFlat) {
 }
 
 // The contact points a box coming down fast over a mesh makes lie under the box (within
-// its footprint and a slop), whatever triangles are near.
-// Disabled: fails at 6118a81: at 12 cm above the grid (a speculative manifold, closing at
-// 6 m/s) two of the four points are at (0, -1) and (1, -1), mesh vertices over a metre
-// from the box (x, z in 0.1..0.5). The SAT picks the face axis of a neighbouring triangle
-// (separation 12 cm along y though the shapes are 16 cm apart), its clip leaves nothing,
-// and face_manifold's fallback takes the deepest incident vertex wherever it lies; the
-// merge of same-normal manifolds then keeps those far points for the area they span. The
-// solver pushes there (likely why a cube bouncing on a mesh rises 4 % over e^2 h where on a
-// plane it rises 0.5 % under, OutsideBounce). Fix (tried): in face_manifold, let
-// the deepest vertex stand in only where it lies over the reference face (as
-// face_of_b_over already asks); then the points are the box's four corners. It moves
-// the pile golden hash, so it is left for the lead.
-TEST(OutsideMesh, DISABLED_ContactPointsOfABoxComingDownFastLieUnderIt) {
+// its footprint and a slop), whatever triangles are near. At ff39273, at 12 cm above the
+// grid (a speculative manifold, closing at 6 m/s), two of the four points were at (0, -1)
+// and (1, -1), mesh vertices over a metre from the box (x, z in 0.1..0.5): the SAT picked
+// the box's bottom face against a neighbouring triangle, its clip left nothing, and
+// face_manifold's fallback took that triangle's deepest vertex wherever it lay; the merge of
+// same-normal manifolds then kept those far points for the area they span. Now against a
+// mesh's triangle only a vertex over the box's face stands in (between hulls any still must:
+// overlapping hulls were left without a manifold, ConvexConsistency and SatAxes).
+TEST(OutsideMesh, ContactPointsOfABoxComingDownFastLieUnderIt) {
     auto space = make_space();
     add_floor(*space, Floor::Mesh, Quat::Identity(), 0.6);
     EventSettings events;
