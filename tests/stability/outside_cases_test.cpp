@@ -587,20 +587,58 @@ TEST(OutsidePlatform, CubeOnAMovingKinematicPlatformIsCarried) {
     for (Motion motion : {Constant, Accelerating, Elevator}) EXPECT_LT(carried_cube_slip(motion), 5e-3) << motion;
 }
 
-// Disabled: fails at 6118a81. The cube slides 1.36 m off a turntable (1.2 rad/s, cube at 2 m:
-// 2.9 m/s^2 < mu g = 7.8) in 3 s. Two causes. (1) A recycled manifold's anchors are its
-// points' offsets from the body centres when it was collided (Contact::anchor_a/b), not
-// turned with the bodies since: the platform's point under the cube is taken up to 10
-// degrees (the recycling limit) behind where it is, so friction matches the cube to the
-// platform's velocity of up to 8 steps before, and the cube coasts straight until the
-// manifold is collided again. Turning each anchor by its body's turn since the collide in
-// prepare_wide (a round part's surface point kept on the normal, as recycle() does) takes
-// the slip from 1356 mm to 74 mm, but moves every golden hash (resting piles turn a little).
-// (2) What is left is velocity-level friction in a turning frame: within a step the cube
-// moves straight while the platform's point turns, ~w^2 r dt^2 / 2 = 0.4 mm a step outward,
-// never corrected because sticking friction has no position term. Proposed: a soft
-// tangential bias from the anchors' drift while a contact sticks (issue 16's "feed the
-// tangential error back"), which also moves the hashes.
+// A cube carried on a turntable moves with the platform's surface under it: its velocity
+// within 2 degrees of that surface's, also when its manifold was collided steps before (the
+// friction centre turns with the bodies, prepare_friction) and not only when just collided.
+TEST(OutsidePlatform, CubeOnATurntableMovesWithTheSurfaceUnderIt) {
+    auto space = make_space();
+    BodyDesc p;
+    p.type = MotionType::Kinematic;
+    p.shape = Shape::box(Vec3(3, 0.1, 3));
+    p.position = Vec3(0, -0.1, 0);
+    p.friction = 0.8;
+    p.angular_velocity = Vec3(0, 1.2, 0);
+    const BodyHandle platform = space->create_body(p);
+    BodyDesc c;
+    c.shape = Shape::box(Vec3::Constant(0.25));
+    c.position = Vec3(2, 0.25, 0);
+    c.friction = 0.8;
+    c.linear_velocity = p.angular_velocity.cross(c.position - p.position);
+    c.angular_velocity = p.angular_velocity;
+    const BodyHandle cube = space->create_body(c);
+    step(*space, 30);
+    double worst = 0;
+    for (int i = 0; i < 60; ++i) {
+        space->update();
+        const Vec3 surface =
+            p.angular_velocity.cross(space->internal_position(cube) - space->internal_position(platform));
+        const Vec3 v = space->internal_linear_velocity(cube);
+        worst = std::max(worst, std::acos(std::clamp(v.dot(surface) / (v.norm() * surface.norm()), -1.0, 1.0)));
+    }
+    std::printf("[ measure  ] cube on a turntable: velocity at most %.2f degrees from the surface's\n",
+                worst * 180 / kPi);
+    EXPECT_LT(worst, 2 * kPi / 180);
+}
+
+// Disabled: the cube slid 1.36 m off a turntable (1.2 rad/s, cube at 2 m: 2.9 m/s^2 < mu g =
+// 7.8) in 3 s at ff39273; 74 mm now. Two causes. (1) Fixed: a recycled manifold's friction
+// centre was its points' offsets from the body centres when collided, not turned with the
+// bodies since, so friction matched the cube to the platform's velocity of up to 10 degrees
+// before (prepare_friction now turns it; turning the normal rows' anchors too, under their
+// fixed normal, made a 20-cube stack fall, so those stay as collided). (2) Left: velocity-
+// level friction in a turning frame: within a step the cube moves straight while the
+// platform's point turns, ~w^2 r dt^2 / 2 = 0.4 mm a step outward, never corrected because
+// sticking friction has no position term. Tried (/tmp/h42a_friction_drift.patch): a static-
+// friction anchor, the friction centre's slip summed while the manifold sticks (turned with
+// the heavier body, carried across collides, dropped when the impulse reaches the cone or
+// the slip the slop) and fed back as a tangential bias in the biased pass. At the contact's
+// soft rate it holds the cube to 0.18 mm, but resting scenes stop settling (HeavyOnLight
+// stacks end at 0.08 m/s, the small plane-locked pyramid creeps 22 mm, the 5-level card
+// house ends at 2 mm/s, a 2 m rod dropped flat spins, an overlapping pyramid ends 10.3 mm
+// deep); at 0.1x that rate those pass but the slip outgrows the slop and the cube slides
+// 67 mm. The drift measured at each manifold's centre also sees a pile's soft give, which
+// the bias then fights; a bias only where the slip keeps growing, or a slip measured per
+// point, may separate the two.
 TEST(OutsidePlatform, DISABLED_CubeOnATurntableIsCarried) { EXPECT_LT(carried_cube_slip(Turntable), 5e-3); }
 
 // ---- Bounces ---------------------------------------------------------------------------------------
@@ -663,19 +701,15 @@ TEST(OutsideBounce, CubeDroppedFlatLandsFlat) {
 }
 
 // The contact points a box coming down fast over a mesh makes lie under the box (within
-// its footprint and a slop), whatever triangles are near.
-// Disabled: fails at 6118a81: at 12 cm above the grid (a speculative manifold, closing at
-// 6 m/s) two of the four points are at (0, -1) and (1, -1), mesh vertices over a metre
-// from the box (x, z in 0.1..0.5). The SAT picks the face axis of a neighbouring triangle
-// (separation 12 cm along y though the shapes are 16 cm apart), its clip leaves nothing,
-// and face_manifold's fallback takes the deepest incident vertex wherever it lies; the
-// merge of same-normal manifolds then keeps those far points for the area they span. The
-// solver pushes there (likely why a cube bouncing on a mesh rises 4 % over e^2 h where on a
-// plane it rises 0.5 % under, OutsideBounce). Fix (tried): in face_manifold, let
-// the deepest vertex stand in only where it lies over the reference face (as
-// face_of_b_over already asks); then the points are the box's four corners. It moves
-// the pile golden hash, so it is left for the lead.
-TEST(OutsideMesh, DISABLED_ContactPointsOfABoxComingDownFastLieUnderIt) {
+// its footprint and a slop), whatever triangles are near. At ff39273, at 12 cm above the
+// grid (a speculative manifold, closing at 6 m/s), two of the four points were at (0, -1)
+// and (1, -1), mesh vertices over a metre from the box (x, z in 0.1..0.5): the SAT picked
+// the box's bottom face against a neighbouring triangle, its clip left nothing, and
+// face_manifold's fallback took that triangle's deepest vertex wherever it lay; the merge of
+// same-normal manifolds then kept those far points for the area they span. Now against a
+// mesh's triangle only a vertex over the box's face stands in (between hulls any still must:
+// overlapping hulls were left without a manifold, ConvexConsistency and SatAxes).
+TEST(OutsideMesh, ContactPointsOfABoxComingDownFastLieUnderIt) {
     auto space = make_space();
     add_floor(*space, Floor::Mesh, Quat::Identity(), 0.6);
     EventSettings events;

@@ -208,21 +208,54 @@ void collide_parts(std::uint32_t part_a, const Aabb& a_box, PosedParts& b, std::
     }
 }
 
-// The `capacity` manifolds that rank deepest, in part-pair order (the order of the walk),
-// so the order does not depend on which were kept.
+// The `capacity` manifolds kept of more: half of them those that rank deepest, then one at
+// a time the one farthest from every manifold kept (the deepest first where as far), so
+// that what is kept spans the support. The deepest alone lie where the body sinks most: a
+// flat slab of 16 balls on the ground was held on its lower side only, tipped, and then
+// held on the other, for ever. In part-pair order (the order of the walk), so the order
+// does not depend on which were kept.
 int emit(Gathered& g, Manifold* out, int capacity) {
     const Manifold* begin = g.list.data();
-    if (g.count > capacity) {
-        std::array<int, kMaxGathered> order;
-        for (int i = 0; i < g.count; ++i) order[static_cast<std::size_t>(i)] = i;
-        std::stable_sort(order.begin(), order.begin() + g.count, [&](int x, int y) { return g.ranks[x] < g.ranks[y]; });
-        std::sort(order.begin(), order.begin() + capacity);
-        for (int i = 0; i < capacity; ++i)
-            out[i] = g.list[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-        return capacity;
+    if (g.count <= capacity) {
+        std::copy(begin, begin + g.count, out);
+        return g.count;
     }
-    std::copy(begin, begin + g.count, out);
-    return g.count;
+    std::array<int, kMaxGathered> order;
+    for (int i = 0; i < g.count; ++i) order[static_cast<std::size_t>(i)] = i;
+    std::stable_sort(order.begin(), order.begin() + g.count, [&](int x, int y) { return g.ranks[x] < g.ranks[y]; });
+    // Each manifold's centre (the mean of its points), and its squared distance to the
+    // nearest kept one (-1: no point to place it by).
+    std::array<Vec3, kMaxGathered> centres;
+    std::array<Real, kMaxGathered> nearest;
+    for (int i = 0; i < g.count; ++i) {
+        const Manifold& m = g.list[static_cast<std::size_t>(i)];
+        Vec3 c = Vec3::Zero();
+        for (int j = 0; j < m.point_count; ++j) c += m.points[j].point;
+        centres[static_cast<std::size_t>(i)] = m.point_count > 0 ? Vec3(c / m.point_count) : c;
+        nearest[static_cast<std::size_t>(i)] = m.point_count > 0 ? kHuge : -1;
+    }
+    // order[0, slot) is kept; order[slot, count) the rest, still by rank.
+    const int deepest = std::max(1, capacity / 2);
+    for (int slot = 0; slot < capacity; ++slot) {
+        int pick = slot;  // the deepest of the rest, or the farthest from those kept
+        if (slot >= deepest) {
+            for (int r = slot + 1; r < g.count; ++r) {
+                if (nearest[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] >
+                    nearest[static_cast<std::size_t>(order[static_cast<std::size_t>(pick)])])
+                    pick = r;
+            }
+        }
+        std::rotate(order.begin() + slot, order.begin() + pick, order.begin() + pick + 1);
+        const auto kept = static_cast<std::size_t>(order[static_cast<std::size_t>(slot)]);
+        if (nearest[kept] < 0) continue;
+        for (int r = slot + 1; r < g.count; ++r) {
+            const auto k = static_cast<std::size_t>(order[static_cast<std::size_t>(r)]);
+            if (nearest[k] >= 0) nearest[k] = std::min(nearest[k], (centres[k] - centres[kept]).squaredNorm());
+        }
+    }
+    std::sort(order.begin(), order.begin() + capacity);
+    for (int i = 0; i < capacity; ++i) out[i] = g.list[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    return capacity;
 }
 
 // Shape a against each of compound b's parts near it, through `pair(part, pose, exact

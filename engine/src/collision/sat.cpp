@@ -474,18 +474,26 @@ int deepest_vertex_contact(const Posed& ref, std::uint32_t face, const Posed& in
     return 1;
 }
 
+bool over_face(const Posed& ref, std::uint32_t face, const Vec3& n, const Vec3& p);
+
 // The manifold (in A's frame) of reference face `face`, of B when `reference_is_b`, with
 // the deepest incident vertex standing in when no clipped point is within reach (unless
-// `clipped_only`). False when there is no point.
+// `clipped_only`). Where B is a triangle of a mesh (`b_is_triangle`) and A's face the
+// reference, only a vertex over that face stands in: one beside it lies over the face's
+// plane carried on past its edges, which says nothing of where the shapes meet (a box
+// coming down fast over a mesh took a neighbouring triangle's far corners as its points),
+// and the triangles under the face make its contact. Between hulls it always stands in: a
+// chosen axis must make a manifold (overlapping hulls had none). False when there is no point.
 bool face_manifold(const Posed& pa, const Posed& pb, std::uint32_t face, bool reference_is_b, Real speculative,
-                   bool clipped_only, Manifold& m) {
+                   bool clipped_only, Manifold& m, bool b_is_triangle = false) {
     const Posed& ref = reference_is_b ? pb : pa;
     const Posed& inc = reference_is_b ? pa : pb;
     // Clipping leaves at most (incident face + reference face) vertices.
     ScratchBuffer<ContactCandidate, kInlineVertices> candidates(pa.view.vertex_count + pb.view.vertex_count);
     Vec3 n;
     int count = face_contact(ref, face, inc, reference_is_b, speculative, n, candidates.data());
-    if (count == 0 && !clipped_only)
+    if (count == 0 && !clipped_only &&
+        (reference_is_b || !b_is_triangle || over_face(ref, face, n, inc.vertices[inc.support(-n)])))
         count = deepest_vertex_contact(ref, face, inc, reference_is_b, speculative, candidates.data());
     if (count == 0) return false;
     m.normal = reference_is_b ? Vec3(-n) : n;
@@ -664,14 +672,16 @@ enum class SatResult { Apart, Touching, NormalOnly };
 // collide_polyhedra's work on a posed pair: Touching with the manifold in A's frame, or Apart.
 // Before the whole SAT makes the manifold of the axis it chose, normal_only(normal) (the
 // normal in A's frame) may say its points are not wanted: the answer is then NormalOnly, with
-// the cache kept as for Touching and m as it was. (A chosen axis always makes a manifold: the
-// deepest vertex stands in for a face's clip, and it lies at the face's separation, which is
-// within reach.) With `keep_face_b` (a face of B, or -1), a cache that keeps that face, past
-// the slop, has it measured over (face_of_b_over) before any whole SAT.
+// the cache kept as for Touching and m as it was. (Between hulls a chosen axis always makes a
+// manifold: the deepest vertex stands in for a face's clip, and it lies at the face's
+// separation, which is within reach. With `b_is_triangle`, B a triangle of a mesh, A's face
+// may make none: face_manifold.) With `keep_face_b` (a face of B, or -1), a cache that keeps
+// that face, past the slop, has it measured over (face_of_b_over) before any whole SAT.
 template <typename NormalOnly>
 [[gnu::always_inline]] inline SatResult sat_posed(const PreparedPolyhedron& prepared, const Posed& pa, const Posed& pb,
                                                   Real speculative, Manifold& m, FeatureCache* cache, Real feature_slop,
-                                                  NormalOnly&& normal_only, int keep_face_b = -1) {
+                                                  NormalOnly&& normal_only, int keep_face_b = -1,
+                                                  bool b_is_triangle = false) {
     using Kind = FeatureCache::Kind;
     if (cache && cache->kind() != Kind::None) {
         const CachedAxis axis = cached_axis(*cache, pa, pb);
@@ -716,7 +726,7 @@ template <typename NormalOnly>
     // face_manifold's normal, as it makes it.
     if (normal_only(reference_is_b ? Vec3(-pb.normal(reference.face)) : pa.normal(reference.face)))
         return SatResult::NormalOnly;
-    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m)) {
+    if (!face_manifold(pa, pb, reference.face, reference_is_b, speculative, false, m, b_is_triangle)) {
         remember_axis(cache, Kind::None, 0, 0, 0);
         return SatResult::Apart;
     }
@@ -749,7 +759,7 @@ bool collide_polyhedron_triangle(const PreparedPolyhedron& prepared, const Trans
             return measure.again(m);
         };
         switch (sat_posed(prepared, pa, pb, speculative, m, cache, feature_slop, normal_only,
-                          measure.points_matter ? -1 : static_cast<int>(measure.face))) {
+                          measure.points_matter ? -1 : static_cast<int>(measure.face), true)) {
             case SatResult::Apart: return false;
             case SatResult::Touching:
                 manifold_to_world(m, xa);

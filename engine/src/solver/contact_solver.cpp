@@ -118,6 +118,19 @@ Wide make_row(const WideMat3& inv_inertia_a, const WideMat3& inv_inertia_b, Wide
     return select(k > splat(0), splat(1) / k, splat(0));
 }
 
+// A unit quaternion per lane, in double.
+struct WideDQuat {
+    WideD3 v;
+    WideD w{};
+};
+
+// q v q^-1 for each lane's unit q: v + w t + u x t, with u q's vector part and t = 2 u x v.
+WideD3 rotate(const WideDQuat& q, const WideD3& v) {
+    const WideD3 half = cross(q.v, v);
+    const WideD3 t = half + half;
+    return v + q.w * t + cross(q.v, t);
+}
+
 // What central friction reads of the lanes' manifolds and bodies, gathered in double by
 // prepare_wide. Lanes and point slots without a manifold or point are zero, and lie
 // kEmptySeparation apart. Not zeroed when default-built: prepare_wide writes each field
@@ -132,7 +145,27 @@ struct FrictionLanes {
     WideD inv_mass_a, inv_mass_b;
     // Per world axis, lanes whose body has its translation along it locked.
     WideDMask locked_a[3], locked_b[3];
+    // Lanes whose bodies turned since their manifold was collided (any_turned: some lane),
+    // each body's turn since (the identity where neither turned), and each body's round
+    // part (ContactManifold::radius_a, radius_b).
+    WideDMask turned;
+    bool any_turned = false;
+    WideDQuat turn_a, turn_b;
+    WideD radius_a, radius_b;
 };
+
+// The friction centre of the lanes whose bodies turned since their manifold was collided,
+// turned with them: the anchors are the points' offsets when collided, and a body carried
+// on a turning one is carried by the velocity of the point under it now (10 degrees behind,
+// the cube on a turntable coasted straight off it). A round part's surface point stays on
+// the normal, as recycle() keeps it. Only friction's: the normal rows keep their anchors
+// fixed under their fixed normal while the manifold is recycled (Box3D's); turning those
+// under it moved the supports of a tilting box under its load, and a tall stack fell.
+void turn_centers(const FrictionLanes& in, WideD3& center_a, WideD3& center_b) {
+    const WideD3 round_a = in.radius_a * in.normal, round_b = in.radius_b * in.normal;
+    center_a = select(in.turned, rotate(in.turn_a, center_a - round_a) + round_a, center_a);
+    center_b = select(in.turned, rotate(in.turn_b, center_b + round_b) - round_b, center_b);
+}
 
 // The free part of v (without_axes, motion_locks.hpp): a locked axis is an exact zero.
 WideD3 free_part(const WideD3& v, const WideDMask (&locked)[3]) {
@@ -204,6 +237,7 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
         const WideD3 arm = in.anchor_a[j] - center_a;
         wc.points[j].lever_arm = narrow(select(in.filled[j], wide_sqrt(dot(arm, arm)), zero));
     }
+    if (in.any_turned) turn_centers(in, center_a, center_b);
     wc.center_a = narrow(center_a);
     wc.center_b = narrow(center_b);
     WideD3 ia[2], ib[2], ra_x[2], rb_x[2];
@@ -317,6 +351,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         for (WideD& gap : in.separation) gap = splat_d(kEmptySeparation);
     }
     for (int axis = 0; axis < 3; ++axis) in.locked_a[axis] = in.locked_b[axis] = WideDMask{};
+    in.any_turned = false;
     Wide normal_impulse[kMaxManifoldPoints]{};
     WideD gravity_scale_a{}, gravity_scale_b{};
     WideDMask live{}, locks_a{}, locks_b{};  // lanes with a manifold; lanes whose body has a translation lock
@@ -371,6 +406,22 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         for (int j = 0; j < m.point_count; ++j) apart = apart && m.points[j].separation > 0;
         if (apart && m.normal.dot(b.v[contact.body_b] - b.v[contact.body_a]) < -params.settled_speed)
             wc.sweep_lanes |= 1u << l;
+        // A recycled manifold's bodies may have turned since it was collided: its friction
+        // centre turns with them (prepare_friction).
+        const Quat& qa = b.q[contact.body_a];
+        const Quat& qb = b.q[contact.body_b];
+        const bool turned_a = !(qa.coeffs() == contact.cached_qa.coeffs());
+        const bool turned_b = !(qb.coeffs() == contact.cached_qb.coeffs());
+        in.turned[l] = turned_a || turned_b ? -1 : 0;
+        in.any_turned = in.any_turned || turned_a || turned_b;
+        const Quat turn_a = turned_a ? Quat(qa * contact.cached_qa.conjugate()) : Quat::Identity();
+        const Quat turn_b = turned_b ? Quat(qb * contact.cached_qb.conjugate()) : Quat::Identity();
+        in.turn_a.v.set_lane(l, turn_a.vec());
+        in.turn_a.w[l] = turn_a.w();
+        in.turn_b.v.set_lane(l, turn_b.vec());
+        in.turn_b.w[l] = turn_b.w();
+        in.radius_a[l] = m.radius_a;
+        in.radius_b[l] = m.radius_b;
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));

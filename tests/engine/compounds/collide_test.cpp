@@ -60,12 +60,16 @@ TEST(CompoundCollide, EachTouchingPartPairHasItsOwnManifoldInPartOrder) {
     EXPECT_LT((flipped[2].normal + Vec3::UnitY()).norm(), 1e-12);
 }
 
-TEST(CompoundCollide, MorePartPairsThanFitKeepTheDeepestInPartOrder) {
-    // Leg i reaches i mm below the plane: legs 3..6 are the deepest four.
+TEST(CompoundCollide, MorePartPairsThanFitKeepTheDeepestAndTheFarthestApartInPartOrder) {
+    // Leg i reaches i mm below the plane. Of four, half are the deepest (legs 5 and 6, at
+    // x = 1), then the farthest from those kept: leg 2 (x = -1, the deeper of the two
+    // there), then leg 4 (x = 0, as far from leg 2 as from leg 6 and deeper than leg 3). The
+    // deepest four (legs 3 to 6) held the bench on its half at x >= 0 only.
     const Shape plane = Shape::plane(Vec3::UnitY(), 0);
     const std::vector<Manifold> m = collide_all(plane, Transform{}, six_legged_bench(0.001), Transform{}, 4);
     ASSERT_EQ(m.size(), 4u);
-    for (std::uint32_t i = 0; i < 4; ++i) EXPECT_EQ(m[i].part_b, i + 3);
+    const std::uint32_t kept[] = {2, 4, 5, 6};
+    for (std::uint32_t i = 0; i < 4; ++i) EXPECT_EQ(m[i].part_b, kept[i]);
 }
 
 TEST(CompoundCollide, ManyTouchingPartsKeepTheDeepestInPartOrder) {

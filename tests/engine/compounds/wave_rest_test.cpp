@@ -127,7 +127,8 @@ TEST(CompoundWaveRest, LogRockingOnAWaveMeshSleepsAsOnAFlatMesh) {
 // landing manifolds (solve_wide) changed the first impact; it never held in general. Laid
 // at x = -2.0, -1.9, ..., 2.0 and spun at +-1.5 and +-0.7 rad/s, the log's energy rises
 // more than 0.01 J/kg in a step in 25 of 164 placements on 4234c64's parent (worst 0.074
-// J/kg) and 25 with the sweeps (worst 0.074). Cause, found by trying: contact recycling
+// J/kg), 25 with the sweeps (worst 0.074) and 21 with them and a compound pair's part
+// manifolds chosen deepest and farthest apart (worst 0.075). Cause, found by trying: contact recycling
 // keeps a pair's manifolds while its bodies moved less than 10 slops (5 cm) and turned
 // less than 10 degrees, and a compound's part manifolds against a mesh likewise; a rolling
 // hexagonal prism brings its next corner down inside that, no manifold has it, and it
