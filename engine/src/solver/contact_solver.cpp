@@ -399,12 +399,13 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         wc.radius_b[l] = m.radius_b;
         gravity_scale_a[l] = scratch.gravity_scales[ref.a];
         gravity_scale_b[l] = scratch.gravity_scales[ref.b];
-        // The bodies close faster than the settled speed as the step begins (their
-        // velocities in the world: the solver's may be integrating already): the passes
-        // sweep the rows until they settle (solve_wide).
-        bool apart = true;
-        for (int j = 0; j < m.point_count; ++j) apart = apart && m.points[j].separation > 0;
-        if (apart && m.normal.dot(b.v[contact.body_b] - b.v[contact.body_a]) < -params.settled_speed)
+        // A manifold of two points or more whose bodies are about to touch, closing faster
+        // than the settled speed as the step begins (their velocities in the world: the
+        // solver's may be integrating already): the passes sweep its rows until they settle
+        // (solve_wide). One point's row is settled by one sweep.
+        bool landing = m.point_count > 1;
+        for (int j = 0; j < m.point_count && landing; ++j) landing = m.points[j].separation > 0;
+        if (landing && m.normal.dot(b.v[contact.body_b] - b.v[contact.body_a]) < -params.settled_speed)
             wc.sweep_lanes |= 1u << l;
         // A recycled manifold's bodies may have turned since it was collided: its friction
         // centre turns with them (prepare_friction).
@@ -783,7 +784,7 @@ template <bool kBias, bool kLocked, bool kMasked = false>
 }
 
 // At most this many sweeps over a wide contact's normal rows per pass, the first included.
-constexpr int kNormalSweeps = 4;
+constexpr int kNormalSweeps = 3;
 
 // The sweeps after the first in the lanes whose bodies close fast (see solve_wide), each
 // lane's until no row of it changes its point's speed by more than the settled speed. The
