@@ -540,27 +540,41 @@ namespace {
 
 enum Motion { Constant, Accelerating, Turntable, Elevator };
 
+// A kinematic platform moving as `motion` says and a cube on it, moving with it from the
+// start (as if put there long ago), mu 0.8.
+struct CarriedCube {
+    std::unique_ptr<Space> space;
+    BodyDesc platform_desc;
+    BodyHandle platform, cube;
+};
+
+CarriedCube cube_on_platform(Motion motion) {
+    CarriedCube made{make_space(), {}, {}, {}};
+    BodyDesc& p = made.platform_desc;
+    p.type = MotionType::Kinematic;
+    p.shape = Shape::box(Vec3(3, 0.1, 3));
+    p.position = Vec3(0, -0.1, 0);
+    p.friction = 0.8;
+    if (motion == Constant) p.linear_velocity = Vec3(2, 0, 1);
+    if (motion == Turntable) p.angular_velocity = Vec3(0, 1.2, 0);  // 1.2^2 x 2 = 2.9 m/s^2 at 2 m
+    if (motion == Elevator) p.linear_velocity = Vec3(0, 1.5, 0);
+    made.platform = made.space->create_body(p);
+    BodyDesc c;
+    c.shape = Shape::box(Vec3::Constant(0.25));
+    c.position = Vec3(2, 0.25, 0);
+    c.friction = 0.8;
+    c.linear_velocity = p.linear_velocity + p.angular_velocity.cross(c.position - p.position);
+    c.angular_velocity = p.angular_velocity;
+    made.cube = made.space->create_body(c);
+    return made;
+}
+
 // How far the cube moved on the platform (in the platform's frame) over 3 s.
 double carried_cube_slip(Motion motion) {
     {
-        auto space = make_space();
-        BodyDesc p;
-        p.type = MotionType::Kinematic;
-        p.shape = Shape::box(Vec3(3, 0.1, 3));
-        p.position = Vec3(0, -0.1, 0);
-        p.friction = 0.8;
-        if (motion == Constant) p.linear_velocity = Vec3(2, 0, 1);
-        if (motion == Turntable) p.angular_velocity = Vec3(0, 1.2, 0);  // 1.2^2 x 2 = 2.9 m/s^2 at 2 m
-        if (motion == Elevator) p.linear_velocity = Vec3(0, 1.5, 0);
-        const BodyHandle platform = space->create_body(p);
-        BodyDesc c;
-        c.shape = Shape::box(Vec3::Constant(0.25));
-        c.position = Vec3(2, 0.25, 0);
-        c.friction = 0.8;
-        // Moving with the platform from the start (as if put there long ago).
-        c.linear_velocity = p.linear_velocity + p.angular_velocity.cross(c.position - p.position);
-        c.angular_velocity = p.angular_velocity;
-        const BodyHandle cube = space->create_body(c);
+        CarriedCube made = cube_on_platform(motion);
+        Space* space = made.space.get();
+        const BodyHandle platform = made.platform, cube = made.cube;
         step(*space, 30);  // let the contact take the load
         auto in_platform = [&] {
             const Quat q = space->internal_orientation(platform);
@@ -591,21 +605,10 @@ TEST(OutsidePlatform, CubeOnAMovingKinematicPlatformIsCarried) {
 // within 2 degrees of that surface's, also when its manifold was collided steps before (the
 // friction centre turns with the bodies, prepare_friction) and not only when just collided.
 TEST(OutsidePlatform, CubeOnATurntableMovesWithTheSurfaceUnderIt) {
-    auto space = make_space();
-    BodyDesc p;
-    p.type = MotionType::Kinematic;
-    p.shape = Shape::box(Vec3(3, 0.1, 3));
-    p.position = Vec3(0, -0.1, 0);
-    p.friction = 0.8;
-    p.angular_velocity = Vec3(0, 1.2, 0);
-    const BodyHandle platform = space->create_body(p);
-    BodyDesc c;
-    c.shape = Shape::box(Vec3::Constant(0.25));
-    c.position = Vec3(2, 0.25, 0);
-    c.friction = 0.8;
-    c.linear_velocity = p.angular_velocity.cross(c.position - p.position);
-    c.angular_velocity = p.angular_velocity;
-    const BodyHandle cube = space->create_body(c);
+    CarriedCube made = cube_on_platform(Turntable);
+    Space* space = made.space.get();
+    const BodyDesc& p = made.platform_desc;
+    const BodyHandle platform = made.platform, cube = made.cube;
     step(*space, 30);
     double worst = 0;
     for (int i = 0; i < 60; ++i) {
@@ -628,7 +631,7 @@ TEST(OutsidePlatform, CubeOnATurntableMovesWithTheSurfaceUnderIt) {
 // fixed normal, made a 20-cube stack fall, so those stay as collided). (2) Left: velocity-
 // level friction in a turning frame: within a step the cube moves straight while the
 // platform's point turns, ~w^2 r dt^2 / 2 = 0.4 mm a step outward, never corrected because
-// sticking friction has no position term. Tried (/tmp/h42a_friction_drift.patch): a static-
+// sticking friction has no position term. Tried (session 42, not committed): a static-
 // friction anchor, the friction centre's slip summed while the manifold sticks (turned with
 // the heavier body, carried across collides, dropped when the impulse reaches the cone or
 // the slip the slop) and fed back as a tangential bias in the biased pass. At the contact's

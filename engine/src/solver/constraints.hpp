@@ -107,9 +107,9 @@ struct WideContact {
     // A lane's contact has rolling resistance: its rows are in `rolling` (set with it by
     // prepare_wide), which no pass reads otherwise.
     bool rolls = false;
-    // The lanes (bit l for lane l) whose bodies close faster than the settled speed as the
-    // step begins (a landing, a hit): every pass sweeps their normal rows until they
-    // settle (solve_wide).
+    // The lanes (bit l for lane l) whose manifold lands: two points or more about to touch,
+    // the bodies closing faster than the settled speed as the step begins. Every pass
+    // sweeps their normal rows until they settle (solve_wide).
     std::uint8_t sweep_lanes = 0;
     WideRolling* rolling = nullptr;  // this wide contact's in SolverScratch::rolling, where it rolls
     // Push-out of deep overlap (split impulse), per lane: the impulse of one row through

@@ -809,6 +809,8 @@ template <bool kBias, bool kLocked>
     }
 }
 
+// kSweeps: the build that sweeps landing lanes again (wc.sweep_lanes). The passes pick it
+// for the wide contacts with such lanes; the locked build, rare, always has it and asks.
 template <bool kBias, bool kLocked, bool kWarm = false, bool kSweeps = kLocked>
 void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, PushVelocity* push,
                 const ContactSolveParams& params, EffectCounts& counts, PushVelocity* warm = nullptr) {
