@@ -548,7 +548,12 @@ struct CarriedCube {
     BodyHandle platform, cube;
 };
 
-CarriedCube cube_on_platform(Motion motion) {
+// A turntable's rate (rad/s) and the cube's distance from its axis (m).
+struct Turn {
+    double rate = 1.2, radius = 2;  // 1.2^2 x 2 = 2.9 m/s^2
+};
+
+CarriedCube cube_on_platform(Motion motion, Turn turn = {}) {
     CarriedCube made{make_space(), {}, {}, {}};
     BodyDesc& p = made.platform_desc;
     p.type = MotionType::Kinematic;
@@ -556,12 +561,12 @@ CarriedCube cube_on_platform(Motion motion) {
     p.position = Vec3(0, -0.1, 0);
     p.friction = 0.8;
     if (motion == Constant) p.linear_velocity = Vec3(2, 0, 1);
-    if (motion == Turntable) p.angular_velocity = Vec3(0, 1.2, 0);  // 1.2^2 x 2 = 2.9 m/s^2 at 2 m
+    if (motion == Turntable) p.angular_velocity = Vec3(0, turn.rate, 0);
     if (motion == Elevator) p.linear_velocity = Vec3(0, 1.5, 0);
     made.platform = made.space->create_body(p);
     BodyDesc c;
     c.shape = Shape::box(Vec3::Constant(0.25));
-    c.position = Vec3(2, 0.25, 0);
+    c.position = Vec3(motion == Turntable ? turn.radius : 2, 0.25, 0);
     c.friction = 0.8;
     c.linear_velocity = p.linear_velocity + p.angular_velocity.cross(c.position - p.position);
     c.angular_velocity = p.angular_velocity;
@@ -570,9 +575,9 @@ CarriedCube cube_on_platform(Motion motion) {
 }
 
 // How far the cube moved on the platform (in the platform's frame) over 3 s.
-double carried_cube_slip(Motion motion) {
+double carried_cube_slip(Motion motion, Turn turn = {}) {
     {
-        CarriedCube made = cube_on_platform(motion);
+        CarriedCube made = cube_on_platform(motion, turn);
         Space* space = made.space.get();
         const BodyHandle platform = made.platform, cube = made.cube;
         step(*space, 30);  // let the contact take the load
@@ -623,26 +628,19 @@ TEST(OutsidePlatform, CubeOnATurntableMovesWithTheSurfaceUnderIt) {
     EXPECT_LT(worst, 2 * kPi / 180);
 }
 
-// Disabled: the cube slid 1.36 m off a turntable (1.2 rad/s, cube at 2 m: 2.9 m/s^2 < mu g =
-// 7.8) in 3 s at ff39273; 74 mm now. Two causes. (1) Fixed: a recycled manifold's friction
-// centre was its points' offsets from the body centres when collided, not turned with the
-// bodies since, so friction matched the cube to the platform's velocity of up to 10 degrees
-// before (prepare_friction now turns it; turning the normal rows' anchors too, under their
-// fixed normal, made a 20-cube stack fall, so those stay as collided). (2) Left: velocity-
-// level friction in a turning frame: within a step the cube moves straight while the
-// platform's point turns, ~w^2 r dt^2 / 2 = 0.4 mm a step outward, never corrected because
-// sticking friction has no position term. Tried (session 42, not committed): a static-
-// friction anchor, the friction centre's slip summed while the manifold sticks (turned with
-// the heavier body, carried across collides, dropped when the impulse reaches the cone or
-// the slip the slop) and fed back as a tangential bias in the biased pass. At the contact's
-// soft rate it holds the cube to 0.18 mm, but resting scenes stop settling (HeavyOnLight
-// stacks end at 0.08 m/s, the small plane-locked pyramid creeps 22 mm, the 5-level card
-// house ends at 2 mm/s, a 2 m rod dropped flat spins, an overlapping pyramid ends 10.3 mm
-// deep); at 0.1x that rate those pass but the slip outgrows the slop and the cube slides
-// 67 mm. The drift measured at each manifold's centre also sees a pile's soft give, which
-// the bias then fights; a bias only where the slip keeps growing, or a slip measured per
-// point, may separate the two.
-TEST(OutsidePlatform, DISABLED_CubeOnATurntableIsCarried) { EXPECT_LT(carried_cube_slip(Turntable), 5e-3); }
+// The cube slid 1.36 m off the turntable in 3 s at ff39273 (a recycled manifold's friction
+// centre not turned with the bodies since its collide; session 42 turned it), then 74 mm at
+// c0f2223: the friction centre's anchors stay fixed offsets through a step while the surfaces
+// under them turn, so the cube was matched to the platform's velocity of the step's start
+// and moved on the tangent, 0.4 mm a step outward, never taken back while it stuck. Friction
+// now reads the surfaces turned to the pass's time in the step (prepare_friction).
+TEST(OutsidePlatform, CubeOnATurntableIsCarried) { EXPECT_LT(carried_cube_slip(Turntable), 5e-3); }
+
+// Slow and wide, fast and near the axis, and near the friction's limit (5.0 of 7.8 m/s^2).
+TEST(OutsidePlatform, CubesOnTurntablesOfOtherRatesAndRadiiAreCarried) {
+    for (const Turn turn : {Turn{0.4, 2.8}, Turn{3, 0.5}, Turn{2.5, 0.8}})
+        EXPECT_LT(carried_cube_slip(Turntable, turn), 5e-3) << turn.rate << " rad/s at " << turn.radius << " m";
+}
 
 // ---- Bounces ---------------------------------------------------------------------------------------
 // A ball and a cube dropped flat from 2 m onto the floor rise again to e^2 of the drop

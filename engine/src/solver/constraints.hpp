@@ -135,7 +135,11 @@ struct WideContact {
     // the normal does not turn with the body, so a rolling ball's contact stays below it.
     Wide radius_a{}, radius_b{};
     Wide3 center_a, center_b;  // the friction centre from each centre of mass
-    Wide friction_mass[3]{};   // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
+    // How fast the friction centre's relative surface velocity along each tangent changes
+    // as the bodies turn through the step: its anchors are fixed offsets from the centres
+    // of mass, where the surface points under them turn (prepare_friction).
+    Wide friction_turn[2]{};
+    Wide friction_mass[3]{};  // inverse of the 2x2 tangent matrix: (0,0), (0,1), (1,1)
     Wide twist_mass{};
     WidePoint points[kMaxManifoldPoints];
     // Read by the biased pass only.
@@ -296,7 +300,8 @@ struct SolverPhase {
     std::uint32_t constraints = 0;  // items of its own pass, when it does; the chunks of bodies follow
     std::uint32_t tail_begin = 0;   // the tail it carries: tail_plan[tail_begin, tail_end)
     std::uint32_t tail_end = 0;
-    bool warms = false;  // a relax phase that warm starts the next substep too (warm_in_relax)
+    bool warms = false;         // a relax phase that warm starts the next substep too (warm_in_relax)
+    std::uint32_t substep = 0;  // of a constraint pass: which substep of the step it is in
 };
 
 // Support mass scaling (support_scales.cpp): the factors a manifold's rows multiply each
@@ -459,6 +464,11 @@ struct ContactSolveParams {
     Real slop = 0;            // gaps wider than this carry no friction
     Real recovery_depth = 0;  // overlap beyond this is pushed out by the split impulse
     Real settled_speed = 0;   // a lane's normal rows are swept again while one changes a point's speed more
+    Real step = 0;            // the step's length, dt
+    // When in the step a pass's friction matches the surfaces' velocities (solve_friction):
+    // the middle of its substep for the biased pass, whose velocities move the bodies
+    // through it, and the substep's end for the relax pass, whose velocities start the next.
+    Real turn_time = 0;
     // How deep a point's last impulse holds its soft row at rest, per unit impulse over
     // the effective mass (impulse_scale x impulse = mass x mass_scale x bias_rate x depth),
     // for soft and static_soft; set with them (held_per_impulse()).

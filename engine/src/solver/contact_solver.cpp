@@ -152,6 +152,9 @@ struct FrictionLanes {
     bool any_turned = false;
     WideDQuat turn_a, turn_b;
     WideD radius_a, radius_b;
+    // Each body's angular velocity as the step begins, at most a radian a step
+    // (prepare_friction's turning surfaces).
+    WideD3 spin_a, spin_b;
 };
 
 // The friction centre of the lanes whose bodies turned since their manifold was collided,
@@ -240,6 +243,17 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
     if (in.any_turned) turn_centers(in, center_a, center_b);
     wc.center_a = narrow(center_a);
     wc.center_b = narrow(center_b);
+    // The friction centre's anchors are fixed offsets through the step, but the surface
+    // points under them turn with their bodies: a point at offset r on a body turning at w
+    // is, a time t on, at r + t w x r, and moves at w x r + t w x (w x r). Friction reads
+    // the surfaces at that time (ContactSolveParams::turn_time), or a body carried by a
+    // turning one moves on the tangent, not the circle, and drifts out a little every
+    // step (a cube on a turntable slid 74 mm in 3 s). A round part's surface point stays
+    // on the normal (turn_centers): only its centre's offset turns. Nil at rest.
+    const WideD3 turning_a = center_a - in.radius_a * in.normal, turning_b = center_b + in.radius_b * in.normal;
+    const WideD3 pull = cross(in.spin_b, cross(in.spin_b, turning_b)) - cross(in.spin_a, cross(in.spin_a, turning_a));
+    wc.friction_turn[0] = narrow(dot(in.tangent[0], pull));
+    wc.friction_turn[1] = narrow(dot(in.tangent[1], pull));
     WideD3 ia[2], ib[2], ra_x[2], rb_x[2];
     for (int t = 0; t < 2; ++t) {
         ra_x[t] = cross(center_a, in.tangent[t]);
@@ -334,6 +348,14 @@ const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
     return copy;
 }
 
+// A body's angular velocity w as prepare_friction turns its surface through a step of
+// length dt: at most a radian a step, where the turn's first-order term (t w x (w x r))
+// stops following the surface (at 60 Hz, from 60 rad/s).
+Vec3 step_spin(const Vec3& w, Real dt) {
+    const Real turn = w.norm() * dt;
+    return turn > 1 ? Vec3(w / turn) : w;
+}
+
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
 // `rolling`: the wide contact's rolling rows, written only where a lane rolls; null where
@@ -423,6 +445,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         in.turn_b.w[l] = turn_b.w();
         in.radius_a[l] = m.radius_a;
         in.radius_b[l] = m.radius_b;
+        in.spin_a.set_lane(l, step_spin(A.w, params.step));
+        in.spin_b.set_lane(l, step_spin(B.w, params.step));
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));
@@ -647,7 +671,8 @@ inline void apply_tangents(const WideContact& wc, const WideAxisMasses& m, WideV
 // A lane without friction has an empty cone.
 template <bool kLocked>
 [[gnu::always_inline]] inline void solve_friction(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
-                                                  const TouchingImpulses& touching, EffectCounts& counts) {
+                                                  const TouchingImpulses& touching, Wide turn_time,
+                                                  EffectCounts& counts) {
     counts.friction += static_cast<std::uint64_t>(wc.lanes);
     {
         const Wide speed = dot(wc.normal, s.wb - s.wa);
@@ -658,7 +683,9 @@ template <bool kLocked>
         apply_angular_row(s, wc.twist_row, total - old);
     }
     const Wide3 dv = point_velocity(s, wc.center_a, wc.center_b);
-    const Wide v0 = dot(wc.tangent[0], dv), v1 = dot(wc.tangent[1], dv);
+    // The surfaces' velocities at the pass's time in the step (prepare_friction).
+    const Wide v0 = dot(wc.tangent[0], dv) + turn_time * wc.friction_turn[0];
+    const Wide v1 = dot(wc.tangent[1], dv) + turn_time * wc.friction_turn[1];
     const Wide old0 = wc.friction_impulse[0], old1 = wc.friction_impulse[1];
     const Wide m00 = wc.friction_mass[0], m01 = wc.friction_mass[1], m11 = wc.friction_mass[2];
     Wide new0 = old0 - (m00 * v0 + m01 * v1);
@@ -853,7 +880,8 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     // colours left it.
     const bool rubs = any(wc.friction > zero);
     if constexpr (kBias) {
-        if (rubs) solve_friction<kLocked>(wc, masses, s, touching_impulses(wc, gap, params), counts);
+        if (rubs)
+            solve_friction<kLocked>(wc, masses, s, touching_impulses(wc, gap, params), splat(params.turn_time), counts);
     }
     for (int j = 0; j < kMaxManifoldPoints; ++j) {
         counts.contact_points += wc.slot_points[j];
@@ -885,7 +913,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
                 counts.rolling += static_cast<std::uint64_t>(wc.lanes);
                 solve_rolling(*wc.rolling, s, touching.pressed);
             }
-            if (rubs) solve_friction<kLocked>(wc, masses, s, touching, counts);
+            if (rubs) solve_friction<kLocked>(wc, masses, s, touching, splat(params.turn_time), counts);
         }
     }
     scatter(wc, bodies, s);

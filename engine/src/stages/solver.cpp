@@ -629,7 +629,7 @@ void carry_tail(SolverScratch& scratch, std::size_t first) {
 // With `integrates`, each of its phases integrates the bodies it touches first, and the
 // first one also the untouched bodies, in chunks after its constraints. With `warms` (a relax
 // pass), each contact warm starts the next substep after it is relaxed.
-void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints,
+void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints, int substep,
                           bool integrates = false, bool warms = false) {
     const std::size_t first = scratch.phases.size();
     for (int c = 0; c < kColorCount; ++c) {
@@ -641,6 +641,7 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
         scratch.phases.push_back(Phase{name, count, count <= kOneBlockColor ? count : kConstraintGrain});
         scratch.plan.push_back(SolverPhase{pass, c});
         scratch.plan.back().warms = warms;
+        scratch.plan.back().substep = static_cast<std::uint32_t>(substep);
     }
     const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||
                           scratch.wide.size() > scratch.wide_begin[kColorCount];
@@ -648,6 +649,7 @@ void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, b
         scratch.phases.push_back(Phase{name, 1, 1});
         scratch.plan.push_back(SolverPhase{pass, kColorCount});
         scratch.plan.back().warms = warms;
+        scratch.plan.back().substep = static_cast<std::uint32_t>(substep);
     }
     if (integrates && first != scratch.phases.size()) {
         for (std::size_t p = first; p < scratch.phases.size(); ++p) {
@@ -694,9 +696,9 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
         // solve pass integrates the velocities and adds the warm start's changes.
         const bool warmed = scratch.warms && sub > 0;
         if (!folded) plan_body_pass(scratch, Pass::IntegrateVelocities, "IntegrateVelocities", n);
-        if (!warmed) plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, folded);
+        if (!warmed) plan_constraint_pass(scratch, Pass::WarmStart, "WarmStart", true, sub, folded);
         for (int it = 0; it < settings.iterations; ++it)
-            plan_constraint_pass(scratch, Pass::Solve, "Solve", true, warmed && it == 0);
+            plan_constraint_pass(scratch, Pass::Solve, "Solve", true, sub, warmed && it == 0);
         if (!folded) plan_body_pass(scratch, Pass::IntegratePositions, "IntegratePositions", n);
         if (folded && kinematic != 0) {
             // Many constraints of a colour read a kinematic body at once: it moves between the
@@ -706,10 +708,10 @@ void plan_step(World& world, SolverScratch& scratch, bool restitution) {
         }
         const bool warms_next = scratch.warms && sub + 1 < settings.substeps;
         for (int it = 0; it < settings.relax_iterations; ++it)
-            plan_constraint_pass(scratch, Pass::Relax, "Relax", true, folded && it == 0,
+            plan_constraint_pass(scratch, Pass::Relax, "Relax", true, sub, folded && it == 0,
                                  warms_next && it + 1 == settings.relax_iterations);
     }
-    if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false);
+    if (restitution) plan_constraint_pass(scratch, Pass::Restitution, "Restitution", false, settings.substeps - 1);
     if (scratch.fold_body_passes && scratch.joints.empty() && !scratch.wide.empty()) {
         // Storing the contacts' impulses and finalizing the bodies read and write nothing of
         // each other's: one phase, the bodies in chunks after the wide contacts.
@@ -821,6 +823,7 @@ void solve(World& world, Real dt) {
     // A speed that would carry a point a tenth of the slop in a substep (0.12 m/s at the
     // defaults): below it, what one sweep of a manifold leaves is less than a player sees.
     solve_params.settled_speed = settings.linear_slop * solve_params.inv_h / 10;
+    solve_params.step = dt;
     ContactSolveParams relax_params = solve_params;
     relax_params.use_bias = false;
     const JointSolveParams joint_solve{joint_softness(settings, h), 1 / h, true};
@@ -865,14 +868,21 @@ void solve(World& world, Real dt) {
             [&](WideContact& wc) { solve_contact(wc, push_anchors(wc), bodies, push, contact_params, counts); });
     };
     // A warming relax phase's constraints [lo, hi) (SolverScratch::warm_in_relax).
-    auto relax_and_warm_colored = [&](int color, std::uint32_t lo, std::uint32_t hi, EffectCounts& counts) {
+    auto relax_and_warm_colored = [&](int color, std::uint32_t lo, std::uint32_t hi,
+                                      const ContactSolveParams& contact_params, EffectCounts& counts) {
         for_colored<true>(
             scratch, color, lo, hi,
             [&](WideJoint& wj) { relax_and_warm_start_joint_lanes(scratch, wj, bodies, joint_relax, counts, warm); },
             [&](JointConstraint& jc) { relax_and_warm_start_joint(jc, bodies, joint_relax, counts, warm); },
             [&](WideContact& wc) {
-                relax_and_warm_start_contact(wc, push_anchors(wc), bodies, push, warm, relax_params, counts);
+                relax_and_warm_start_contact(wc, push_anchors(wc), bodies, push, warm, contact_params, counts);
             });
+    };
+    // A pass's parameters with the time in the step its friction reads the surfaces at
+    // (ContactSolveParams::turn_time): the middle of a biased pass's substep, a relax pass's end.
+    auto timed = [h](ContactSolveParams params, const SolverPhase& phase, Real part) {
+        params.turn_time = (static_cast<Real>(phase.substep) + part) * h;
+        return params;
     };
     // Items [lo, hi) of a phase of the plan.
     auto run_items = [&](const SolverPhase& phase, std::uint32_t lo, std::uint32_t hi, unsigned worker) {
@@ -924,7 +934,7 @@ void solve(World& world, Real dt) {
                     });
                 }
                 const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
-                if (lo < own) solve_colored(phase.color, lo, own, joint_solve, solve_params, counts);
+                if (lo < own) solve_colored(phase.color, lo, own, joint_solve, timed(solve_params, phase, 0.5), counts);
                 break;
             }
             case Pass::Relax: {
@@ -935,10 +945,11 @@ void solve(World& world, Real dt) {
                 }
                 const std::uint32_t own = phase.integrates ? std::min(hi, phase.constraints) : hi;
                 if (lo >= own) break;
+                const ContactSolveParams params = timed(relax_params, phase, 1);
                 if (phase.warms) {
-                    relax_and_warm_colored(phase.color, lo, own, counts);
+                    relax_and_warm_colored(phase.color, lo, own, params, counts);
                 } else {
-                    solve_colored(phase.color, lo, own, joint_relax, relax_params, counts);
+                    solve_colored(phase.color, lo, own, joint_relax, params, counts);
                 }
                 break;
             }
