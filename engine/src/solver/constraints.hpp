@@ -469,6 +469,8 @@ struct ContactSolveParams {
     // the middle of its substep for the biased pass, whose velocities move the bodies
     // through it, and the substep's end for the relax pass, whose velocities start the next.
     Real turn_time = 0;
+    // How long gravity has acted on the velocities a pass solves: to its substep's end.
+    Real fall_time = 0;
     // How deep a point's last impulse holds its soft row at rest, per unit impulse over
     // the effective mass (impulse_scale x impulse = mass x mass_scale x bias_rate x depth),
     // for soft and static_soft; set with them (held_per_impulse()).

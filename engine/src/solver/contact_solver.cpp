@@ -774,11 +774,14 @@ template <bool kBias>
     }
 }
 
-// Point j's normal row solved once on `s`; the impulse it applied. kMasked: in the lanes
-// of `active` only (a lane's result never depends on which lanes share its wide contact).
+// Point j's normal row solved once on `s`; the impulse it applied. `fallen`: the lanes'
+// relative speed along the normal gravity has added since the step began (see below).
+// kMasked: in the lanes of `active` only (a lane's result never depends on which lanes
+// share its wide contact).
 template <bool kBias, bool kLocked, bool kMasked = false>
 [[gnu::always_inline]] inline Wide solve_normal_row(WideContact& wc, const WideAxisMasses& masses, WideVelocities& s,
-                                                    int j, const NormalTerms& terms, WideMask active = WideMask()) {
+                                                    int j, const NormalTerms& terms, Wide fallen,
+                                                    WideMask active = WideMask()) {
     const WidePoint& p = wc.points[j];
     WidePointRow& r = wc.point_rows[j];
     const Wide zero = splat(0);
@@ -792,13 +795,16 @@ template <bool kBias, bool kLocked, bool kMasked = false>
     const Wide total = wide_max(r.normal_impulse + impulse, zero);
     impulse = total - r.normal_impulse;
     if constexpr (kMasked) impulse = select(active, impulse, zero);
-    // Restitution bounces off the approach speed at impact: the speed when the
-    // point first pushes in this step, gravity of the earlier substeps included.
+    // Restitution bounces off the approach speed at impact: the step's start's, with what
+    // gravity added by the substep the point first pushes in. Not `vn`, the speed the
+    // iteration has reached: that holds the other contacts' impulses not yet settled (the
+    // warm start of a contact about to let go), and a ball struck into a row of touching
+    // balls bounced the next one off at twice its speed (a Newton's cradle gained energy).
     if (wc.tracks_push) {
         Wide& approach = wc.relative_velocity[j];
         Wide& max_impulse = wc.max_normal_impulse[j];
         const WideMask first_push = (impulse > zero) & (max_impulse == zero);
-        approach = select(first_push, wide_min(approach, vn), approach);
+        approach = select(first_push, wide_min(approach, approach + fallen), approach);
         max_impulse = wide_max(max_impulse, impulse);
     }
     if constexpr (kMasked) {
@@ -824,12 +830,13 @@ template <bool kBias, bool kLocked>
     NormalTerms terms[kMaxManifoldPoints];
     for (int j = 0; j < kMaxManifoldPoints; ++j) terms[j] = normal_terms<kBias>(gap[j], wc.recovery[j], soft, params);
     const Wide settled = splat(params.settled_speed);
+    const Wide fallen = wc.gravity_normal * splat(params.fall_time);
     WideMask active;
     for (int l = 0; l < kLanes; ++l) active[l] = (wc.sweep_lanes >> l) & 1u ? -1 : 0;
     for (int sweep = 1; sweep < kNormalSweeps && any(active); ++sweep) {
         WideMask moved = splat(0) > splat(1);
         for (int j = 0; j < kMaxManifoldPoints; ++j) {
-            const Wide impulse = solve_normal_row<kBias, kLocked, true>(wc, masses, s, j, terms[j], active);
+            const Wide impulse = solve_normal_row<kBias, kLocked, true>(wc, masses, s, j, terms[j], fallen, active);
             moved = moved | (wide_max(impulse, -impulse) > wc.points[j].normal_mass * settled);
         }
         active = active & moved;
@@ -879,6 +886,7 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
     // friction (a log in the groove of two) keeps whatever self-stress the order of the
     // colours left it.
     const bool rubs = any(wc.friction > zero);
+    const Wide fallen = wc.gravity_normal * splat(params.fall_time);  // solve_normal_row's
     if constexpr (kBias) {
         if (rubs)
             solve_friction<kLocked>(wc, masses, s, touching_impulses(wc, gap, params), splat(params.turn_time), counts);
@@ -893,7 +901,8 @@ void solve_wide(WideContact& wc, PushAnchors* push_anchors, SolverBody* bodies, 
             deep_ra += depth * p.ra;
             deep_rb += depth * p.rb;
         }
-        solve_normal_row<kBias, kLocked>(wc, masses, s, j, normal_terms<kBias>(gap[j], wc.recovery[j], soft, params));
+        solve_normal_row<kBias, kLocked>(wc, masses, s, j, normal_terms<kBias>(gap[j], wc.recovery[j], soft, params),
+                                         fallen);
     }
     // The points of a lane push on one pair of bodies, so each row's impulse changes the
     // others' speeds: one sweep in order leaves the later points a share of the earlier

@@ -879,9 +879,11 @@ void solve(World& world, Real dt) {
             });
     };
     // A pass's parameters with the time in the step its friction reads the surfaces at
-    // (ContactSolveParams::turn_time): the middle of a biased pass's substep, a relax pass's end.
+    // (ContactSolveParams::turn_time): the middle of a biased pass's substep, a relax pass's
+    // end; and how long gravity has acted on its velocities (fall_time).
     auto timed = [h](ContactSolveParams params, const SolverPhase& phase, Real part) {
         params.turn_time = (static_cast<Real>(phase.substep) + part) * h;
+        params.fall_time = static_cast<Real>(phase.substep + 1) * h;
         return params;
     };
     // Items [lo, hi) of a phase of the plan.
