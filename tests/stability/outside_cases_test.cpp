@@ -329,6 +329,44 @@ TEST(OutsideThin, StackOfFiveThinPlatesStaysStill) {
     }
 }
 
+// Twenty poker chips (4 x 4 cm, 3.3 mm thick, 10 g) stacked flat: the stack must keep its
+// height within 5 % (each contact a sixth of a millimetre) and stay put.
+// Disabled: found in session 43: the top sits at 30 % of the built height (5 chips: 53 %,
+// 10: 41 %). A soft contact holds its load at a depth of load / (m_eff w^2) (SolverSettings::
+// contact_hertz; ContactSolveParams::held_per_impulse), about 0.28 mm per chip carried
+// between two equal bodies at 30 Hz whatever their size: the twenty chips' contacts press in
+// 2.3 mm on average, two thirds of a chip. Box3D's soft contacts share the model. The
+// plates above (2 cm) show the same depths (3.4 mm under four), within their slop. A fix
+// holds a resting contact at no depth whatever its load (e.g. the soft row's rest length
+// offset by the depth its warm-started load holds, or support scaling by the whole load
+// carried), without letting an impact's impulse push the bodies apart the next step.
+TEST(OutsideThin, DISABLED_StackOfTwentyPokerChipsKeepsItsHeight) {
+    auto space = make_space();
+    add_floor(*space, Floor::Plane, Quat::Identity(), 0.5);
+    constexpr int kChips = 20;
+    constexpr double kThick = 0.0033;
+    std::vector<BodyHandle> chips;
+    for (int i = 0; i < kChips; ++i) {
+        BodyDesc d;
+        d.shape = Shape::box(Vec3(0.02, kThick / 2, 0.02));
+        d.mass = 0.01;
+        d.friction = 0.5;
+        d.position = Vec3(0, kThick * (i + 0.5), 0);
+        chips.push_back(space->create_body(d));
+    }
+    step(*space, 300);
+    const double top = space->internal_position(chips.back()).y() + kThick / 2;
+    double sideways = 0;
+    for (BodyHandle c : chips) {
+        const Vec3 x = space->internal_position(c);
+        sideways = std::max(sideways, std::hypot(x.x(), x.z()));
+    }
+    std::printf("[ measure  ] twenty chips: top at %.2f %% of the built height, %.2f mm sideways\n",
+                100 * top / (kChips * kThick), 1000 * sideways);
+    EXPECT_GT(top, 0.95 * kChips * kThick);
+    EXPECT_LT(sideways, 1e-3);
+}
+
 // ---- Rolling -------------------------------------------------------------------------------
 // A ball and a capsule rolling at 8 m/s (spin matched, v = w r) on a plane, a box and a
 // mesh: no sinking below the linear slop, speed kept within 1 % over 1.5 s (nothing
