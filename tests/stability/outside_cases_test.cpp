@@ -572,6 +572,48 @@ TEST(OutsideSpin, FastConingThinBodiesKeepAngularMomentum) {
     expect_tumbling_keeps_momentum(cases, false);
 }
 
+// A top (a hull: a sharp tip 13 cm below its centre of mass, a 10 cm rim) spun at 150 rad/s,
+// tilted 0.2 rad, on a floor with mu 0.3: fast enough to precess about its pinned tip (as it
+// does on a ball-socket pivot: tilt 0.22-0.27 rad for 5 s). It must stay up: its tilt under
+// 0.45 rad (its rim touches the floor at 1 rad) and its spin kept. At d60bc49 it fell within
+// 4 s on 60 Hz steps (at 120 Hz it stood): each substep's turn of 0.6 rad carries the tip a
+// little off the point friction held (the chord, w x (w x r) h^2 / 2, 0.4 mm a substep), so
+// the tip slid, the tilt grew and the rim came down. prepare_friction's turning pull is that
+// correction, but it was cut to a radian a step of the whole spin, which on a top is mostly
+// spin about the tip's own arm and moves nothing; it is now cut where the arm itself turns
+// more than a radian a step (turning_pull). The tip still slides (about 0.1 m/s).
+TEST(OutsideSpin, FastTopOnARoughFloorStaysUp) {
+    std::vector<Vec3> points{Vec3(0, -0.1, 0)};
+    for (int i = 0; i < 16; ++i) {
+        const double a = 2 * kPi * i / 16;
+        points.push_back(Vec3(0.1 * std::cos(a), 0.05, 0.1 * std::sin(a)));
+        points.push_back(Vec3(0.08 * std::cos(a), 0.08, 0.08 * std::sin(a)));
+    }
+    for (bool gyroscopic : {false, true}) {
+        auto space = make_space();
+        add_floor(*space, Floor::Plane, Quat::Identity(), 0.3);
+        BodyDesc d;
+        d.shape = Shape::convex_hull(points);
+        d.friction = 0.3;
+        d.gyroscopic = gyroscopic;
+        d.orientation = Quat(Eigen::AngleAxisd(0.2, Vec3::UnitZ()));
+        d.position = Vec3(0, 0.101, 0);
+        d.angular_velocity = d.orientation * Vec3(0, 150, 0);
+        const BodyHandle top = space->create_body(d);
+        double tilt = 0;
+        for (int i = 0; i < 300; ++i) {
+            space->update();
+            const Vec3 up = space->internal_orientation(top) * Vec3::UnitY();
+            tilt = std::max(tilt, std::acos(std::clamp(up.y(), -1.0, 1.0)));
+        }
+        const double spin = space->internal_angular_velocity(top).norm();
+        std::printf("[ measure  ] top (gyroscopic %d): tilt at most %.3f rad, spin %.1f rad/s after 5 s\n", gyroscopic,
+                    tilt, spin);
+        EXPECT_LT(tilt, 0.45) << "gyroscopic " << gyroscopic;
+        EXPECT_GT(spin, 140) << "gyroscopic " << gyroscopic;
+    }
+}
+
 // ---- Moving platforms --------------------------------------------------------------------------
 // A cube on a kinematic platform is carried by friction. mu 0.8 holds it under the
 // platform's accelerations here (at most 3 m/s^2 < mu g = 7.8): it must stay where it

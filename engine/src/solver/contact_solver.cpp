@@ -152,8 +152,7 @@ struct FrictionLanes {
     bool any_turned = false;
     WideDQuat turn_a, turn_b;
     WideD radius_a, radius_b;
-    // Each body's angular velocity as the step begins, at most a radian a step
-    // (prepare_friction's turning surfaces).
+    // Each body's angular velocity as the step begins (prepare_friction's turning surfaces).
     WideD3 spin_a, spin_b;
 };
 
@@ -203,12 +202,26 @@ void tangent_basis(const WideD3& n, WideDMask live, WideD3& t1, WideD3& t2) {
     }
 }
 
+// w x (w x r) for each lane's spin w and arm r: how fast the velocity of the surface point
+// at r changes as the body turns it. The point's offset is taken to turn on a straight
+// line, r + t w x r: through a step of length dt that holds while it turns less than a
+// radian about the arm's own length (a top's tip, on its spin axis, barely turns; a box's
+// corner tumbling at 60 rad/s would); beyond, the pull is scaled down to that radian.
+WideD3 turning_pull(const WideD3& w, const WideD3& r, Real dt) {
+    const WideD3 moving = cross(w, r);
+    const WideD moving_sq = dot(moving, moving) * splat_d(dt * dt), arm_sq = dot(r, r);
+    const WideDMask far = moving_sq > arm_sq;
+    WideD3 pull = cross(w, moving);
+    if (any(far)) pull = select(far, wide_sqrt(arm_sq / moving_sq) * pull, pull);
+    return pull;
+}
+
 // Central friction of the lanes (Box3D's): the friction centre is the points' mean,
 // weighted down for points farther apart than friction_distance (up to twice that they
 // fade out, so the centre moves smoothly as points come and go); the two tangent rows at
 // the centre with their coupled 2x2 effective mass; the twist row about the normal. In
 // double, every lane as the scalar products would make it.
-void prepare_friction(const FrictionLanes& in, Real friction_distance, WideContact& wc) {
+void prepare_friction(const FrictionLanes& in, Real friction_distance, Real dt, WideContact& wc) {
     const WideD zero{}, one = splat_d(1), min_weight = splat_d(1e-3), distance = splat_d(friction_distance);
     WideD3 center_a, center_b;
     WideD total{};
@@ -248,10 +261,12 @@ void prepare_friction(const FrictionLanes& in, Real friction_distance, WideConta
     // is, a time t on, at r + t w x r, and moves at w x r + t w x (w x r). Friction reads
     // the surfaces at that time (ContactSolveParams::turn_time), or a body carried by a
     // turning one moves on the tangent, not the circle, and drifts out a little every
-    // step (a cube on a turntable slid 74 mm in 3 s). A round part's surface point stays
-    // on the normal (turn_centers): only its centre's offset turns. Nil at rest.
+    // step (a cube on a turntable slid 74 mm in 3 s), and a fast top's tip, which the body
+    // turns about, slides off as the step's turn carries it (turning_pull). A round part's
+    // surface point stays on the normal (turn_centers): only its centre's offset turns.
+    // Nil at rest.
     const WideD3 turning_a = center_a - in.radius_a * in.normal, turning_b = center_b + in.radius_b * in.normal;
-    const WideD3 pull = cross(in.spin_b, cross(in.spin_b, turning_b)) - cross(in.spin_a, cross(in.spin_a, turning_a));
+    const WideD3 pull = turning_pull(in.spin_b, turning_b, dt) - turning_pull(in.spin_a, turning_a, dt);
     wc.friction_turn[0] = narrow(dot(in.tangent[0], pull));
     wc.friction_turn[1] = narrow(dot(in.tangent[1], pull));
     WideD3 ia[2], ib[2], ra_x[2], rb_x[2];
@@ -348,14 +363,6 @@ const SolverBody& scaled(const SolverBody& body, Real scale, SolverBody& copy) {
     return copy;
 }
 
-// A body's angular velocity w as prepare_friction turns its surface through a step of
-// length dt: at most a radian a step, where the turn's first-order term (t w x (w x r))
-// stops following the surface (at 60 Hz, from 60 rad/s).
-Vec3 step_spin(const Vec3& w, Real dt) {
-    const Real turn = w.norm() * dt;
-    return turn > 1 ? Vec3(w / turn) : w;
-}
-
 // A WideContact from its lanes' manifolds, with rows from the bodies at the step's
 // start. Every field is written, so the array is reused from step to step as it is.
 // `rolling`: the wide contact's rolling rows, written only where a lane rolls; null where
@@ -445,8 +452,8 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         in.turn_b.w[l] = turn_b.w();
         in.radius_a[l] = m.radius_a;
         in.radius_b[l] = m.radius_b;
-        in.spin_a.set_lane(l, step_spin(A.w, params.step));
-        in.spin_b.set_lane(l, step_spin(B.w, params.step));
+        in.spin_a.set_lane(l, A.w);
+        in.spin_b.set_lane(l, B.w);
         for (int j = 0; j < m.point_count; ++j) {
             const ContactPoint& src = m.points[j];
             in.anchor_a[j].set_lane(l, contact.anchor_a(src));
@@ -483,7 +490,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
     wc.normal = narrow(in.normal);
     wc.tangent[0] = narrow(in.tangent[0]);
     wc.tangent[1] = narrow(in.tangent[1]);
-    prepare_friction(in, friction_distance, wc);
+    prepare_friction(in, friction_distance, params.step, wc);
     const WideMat3 inv_inertia_a = narrow(in.inv_inertia_a), inv_inertia_b = narrow(in.inv_inertia_b);
     Wide3 ra[kMaxManifoldPoints], rb[kMaxManifoldPoints];
     Wide separation[kMaxManifoldPoints];  // the gathered doubles, each rounded as a float cast rounds it
