@@ -264,6 +264,10 @@ struct ContactManifold {
     // Rolling resistance's angular impulse (world), kept for warm starting; zero unless the
     // contact has rolling resistance.
     float rolling_impulse[3] = {};
+    // The factor the last solved step scaled the lower body's inverse mass by in this
+    // manifold's rows (support_scales.cpp; 1: none): the impulses above and the points' were
+    // solved with it, and are warm started as their push on that body (prepare_wide).
+    float support_scale = 1;
     // The round part (sphere, capsule radius; else 0) of each touching shape or part, set
     // when collided, so that recycling and the solver stay off the cold descriptions.
     Real radius_a = 0, radius_b = 0;

@@ -336,7 +336,7 @@ Real rolling_radius(const Shape& shape) {
 // here per manifold, so a compound's parts each brake with their own radius and normal
 // impulse). The first rolling lane clears `rolling`, the wide contact's, and points it there.
 void prepare_rolling(const World& world, const Contact& contact, const ContactManifold& m, const SolverBody& A,
-                     const SolverBody& B, WideContact& wc, WideRolling& rolling, int l) {
+                     const SolverBody& B, Real kept, WideContact& wc, WideRolling& rolling, int l) {
     const Bodies& b = world.bodies;
     const Real radius = std::max(rolling_radius(part_shape(b.traits[contact.body_a].shape, m.part_a)),
                                  rolling_radius(part_shape(b.traits[contact.body_b].shape, m.part_b)));
@@ -351,7 +351,18 @@ void prepare_rolling(const World& world, const Contact& contact, const ContactMa
     rolling.mass.set_lane(l, inverse_or_pseudo(Mat3(A.inv_inertia + B.inv_inertia), has_locks(A, B)));
     rolling.inv_inertia_a.set_lane(l, A.inv_inertia);
     rolling.inv_inertia_b.set_lane(l, B.inv_inertia);
-    rolling.impulse.set_lane(l, Vec3(m.rolling_impulse[0], m.rolling_impulse[1], m.rolling_impulse[2]));
+    rolling.impulse.set_lane(l, kept * Vec3(m.rolling_impulse[0], m.rolling_impulse[1], m.rolling_impulse[2]));
+}
+
+// The share of a manifold's stored impulses its warm start keeps: the push they give the
+// lower body of a support contact as it was solved (its inverse mass scaled by the stored
+// support_scale), now at this step's scale, and never more than whole. A light box holding
+// up a heavy ball is solved as heavy as the ball (support_scales.cpp); when the ball rolls
+// off it, the contact is no longer a support and the box is solved at its own mass, and
+// its last impulse, which held up the ball, launched the box at 23 m/s.
+Real kept_share(const ContactManifold& m, const SupportScale& scale) {
+    const Real now = std::min(scale.a, scale.b);
+    return m.support_scale < now ? m.support_scale / now : Real(1);
 }
 
 // The body, or (scale != 1) a copy of it in `copy` with its inverse mass and inertia scaled.
@@ -417,8 +428,9 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         }
         in.inv_inertia_a.set_lane(l, A.inv_inertia);
         in.inv_inertia_b.set_lane(l, B.inv_inertia);
-        in.friction_impulse.set_lane(l, m.friction_impulse);
-        wc.twist_impulse[l] = m.twist_impulse;
+        const Real kept = kept_share(m, scale);
+        in.friction_impulse.set_lane(l, kept * m.friction_impulse);
+        wc.twist_impulse[l] = static_cast<float>(kept * m.twist_impulse);
         wc.friction[l] = contact.friction;
         wc.against_static[l] =
             b.type[contact.body_a] == MotionType::Static || b.type[contact.body_b] == MotionType::Static ? 1 : 0;
@@ -460,7 +472,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
             in.anchor_b[j].set_lane(l, contact.anchor_b(src));
             in.separation[j][l] = src.separation;
             in.filled[j][l] = -1;
-            normal_impulse[j][l] = src.normal_impulse;
+            normal_impulse[j][l] = static_cast<float>(kept * src.normal_impulse);
             ++wc.slot_points[j];
         }
         for (int j = m.point_count; j < kMaxManifoldPoints; ++j) {
@@ -471,7 +483,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         }
         if (contact.rolling_resistance > 0) {
             SPINDLE_ASSERT(rolling != nullptr, "solver: a lane rolls without rolling rows");
-            prepare_rolling(world, contact, m, A, B, wc, *rolling, l);
+            prepare_rolling(world, contact, m, A, B, kept, wc, *rolling, l);
         }
     }
     tangent_basis(in.normal, live, in.tangent[0], in.tangent[1]);
@@ -1088,6 +1100,10 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.friction_impulse = wc.friction_impulse[0][l] * wc.tangent[0].lane(l) +
                                  wc.friction_impulse[1][l] * wc.tangent[1].lane(l);
             m.twist_impulse = wc.twist_impulse[l];
+            m.support_scale = scratch.support_scales.empty()
+                                  ? 1.0f
+                                  : static_cast<float>(std::min(scratch.support_scales[wc.ref[l]].a,
+                                                                scratch.support_scales[wc.ref[l]].b));
             m.pushed_point = -1;
             m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {

@@ -196,6 +196,7 @@ void make_manifold(const Manifold& found, const Shape& shape_a, const Shape& sha
     made.pushed_point = -1;
     made.pushed_speed = 0;
     made.twist_impulse = 0;
+    made.support_scale = 1;
     std::fill(std::begin(made.rolling_impulse), std::end(made.rolling_impulse), 0.0f);
     made.radius_a = round_radius(part_shape(shape_a, found.part_a));
     made.radius_b = round_radius(part_shape(shape_b, found.part_b));
@@ -243,6 +244,7 @@ void carry_impulses(const Contact& old_contact, ContactManifold& fresh) {
     if (facing) {
         fresh.friction_impulse = facing->friction_impulse - facing->friction_impulse.dot(fresh.normal) * fresh.normal;
         fresh.twist_impulse = facing->twist_impulse;
+        fresh.support_scale = facing->support_scale;
         if (old_contact.rolling_resistance > 0) {
             std::copy(std::begin(facing->rolling_impulse), std::end(facing->rolling_impulse), fresh.rolling_impulse);
         }
