@@ -903,11 +903,42 @@ TEST(OutsidePendulum, HingeAndDistancePendulumsSwingAtTheirPeriod) {
     }
 }
 
+// Ten 1 kg capsule links on ball-socket joints hung from a static box at (0, 10, 0), `tilt`
+// from straight down (about z), and a 100 kg ball of radius 0.2 on the last: the links,
+// then the ball.
+std::vector<BodyHandle> hang_heavy_chain(Space& space, double tilt) {
+    constexpr int kLinks = 10;
+    constexpr double kLink = 0.4;
+    const Vec3 top(0, 10, 0);
+    const Vec3 down(std::sin(tilt), -std::cos(tilt), 0);
+    BodyHandle prev = add_static_box(space, Vec3::Constant(0.1), top);
+    std::vector<BodyHandle> bodies;
+    for (int i = 0; i < kLinks; ++i) {
+        BodyDesc d;
+        d.shape = Shape::capsule(0.15, 0.04);
+        d.mass = 1;
+        d.orientation = about_z(tilt);
+        d.position = top + kLink * (i + 0.5) * down;
+        const BodyHandle link = space.create_body(d);
+        space.create_joint(JointDesc::ball_socket_at(prev, link, top + kLink * i * down));
+        bodies.push_back(link);
+        prev = link;
+    }
+    BodyDesc heavy;
+    heavy.shape = Shape::sphere(0.2);
+    heavy.mass = 100;
+    heavy.position = top + (kLink * kLinks + 0.2) * down;
+    const BodyHandle ball = space.create_body(heavy);
+    space.create_joint(JointDesc::ball_socket_at(prev, ball, top + kLink * kLinks * down));
+    bodies.push_back(ball);
+    return bodies;
+}
+
 // A chain of ten 1 kg links holding a 100 kg ball at the default settings: it must hang
 // still, no longer than 3 % over its length (soft joints stretch under load), and not
 // jitter (under 1 cm/s at the end).
-// Disabled: fails at 6118a81 and a4df795: after 4 s it is 3.76 % long and the ball still
-// bounces up and down at 0.17 m/s (period 0.76 s). Two causes, found by trying (h42b):
+// Disabled: fails at 6118a81, a4df795 and c0f2223: after 4 s it is 3.76 % long and the ball
+// still bounces up and down at 0.17 m/s (period 0.76 s). Two causes, found by trying (h42b):
 // - The stretch is the soft joints' own, not the bounce: settled or mid-bounce, the chain
 //   is 3.6 % long at 4, 8 or 16 substeps, 1 or 4 iterations, 1 to 4 relax iterations,
 //   damping ratio 2 to 20. The model of SolverSettings::joint_hertz (a joint stretches
@@ -926,38 +957,73 @@ TEST(OutsidePendulum, HingeAndDistancePendulumsSwingAtTheirPeriod) {
 //   against 0.08; 0.082 m at ratio 4) and Distance.RigidRodKeepsItsLength at 10. A damping
 //   scaled to the pair's mass ratio (not tried) would reach only the ball's own joint,
 //   which carries 1/11 of the bounce.
+// Support mass scaling for joints, as contacts have it (support_scales.cpp), tried (h43b;
+// the commit "Experiment: support mass scaling for joints" on branch h43b-chain, reverted
+// after it): in the joints' rows a body is made as heavy as the heaviest body it carries
+// (farther from a static body by joint hops). It holds this chain to 0.209 % and still
+// (0.0000 m/s), but it is no fix: scaling both bodies of a joint alike changes nothing,
+// so in a chain only the ball's own joint changes, which solves the last link as if it
+// weighed 100 kg; that link, and so the chain, then feels a hundredth of the ball's pull,
+// and the chain, free of its load, moves the ball instead of the ball the chain.
+// OutsidePendulum.DISABLED_HeavyBallSwungOnALightChainStaysShort shows it: swung from 40
+// degrees the ball reaches 7.0 m/s at the bottom (4.4 m/s is all its drop gives), rises
+// 0.40 m over its release and swings in 3.57 s (4.33 s unscaled). Scaling only the
+// joint's lighter body gives the same numbers; with the relax pass at the real masses, it
+// rises 0.38 m. Any scaling that keeps a light body from feeling the load it carries
+// makes energy wherever that body moves along the load; a contact's support scaling
+// stays on supported stacks, which barely move, and a swinging chain does not. What
+// remains is a stiffer joint solved well enough: the exact solve of a joint tree (a
+// chain's block-tridiagonal system, as PhysX's articulations and Baraff's linear-time
+// solve do), not tried.
 TEST(OutsidePendulum, DISABLED_LightChainHoldsAHundredTimesHeavierEndMass) {
     auto space = make_space();
-    const BodyHandle ceiling = add_static_box(*space, Vec3::Constant(0.1), Vec3(0, 10, 0));
-    std::vector<BodyHandle> links;
-    BodyHandle prev = ceiling;
-    constexpr int kLinks = 10;
-    constexpr double kLink = 0.4;
-    for (int i = 0; i < kLinks; ++i) {
-        BodyDesc d;
-        d.shape = Shape::capsule(0.15, 0.04);
-        d.mass = 1;
-        d.position = Vec3(0, 10 - kLink * (i + 0.5), 0);
-        const BodyHandle link = space->create_body(d);
-        space->create_joint(JointDesc::ball_socket_at(prev, link, Vec3(0, 10 - kLink * i, 0)));
-        links.push_back(link);
-        prev = link;
-    }
-    BodyDesc heavy;
-    heavy.shape = Shape::sphere(0.2);
-    heavy.mass = 100;
-    heavy.position = Vec3(0, 10 - kLink * kLinks - 0.2, 0);
-    const BodyHandle ball = space->create_body(heavy);
-    space->create_joint(JointDesc::ball_socket_at(prev, ball, Vec3(0, 10 - kLink * kLinks, 0)));
-    links.push_back(ball);
+    const std::vector<BodyHandle> bodies = hang_heavy_chain(*space, 0);
+    const double rest_y = space->internal_position(bodies.back()).y();
     step(*space, 240);
-    const double stretch = (heavy.position.y() - space->internal_position(ball).y()) / (kLink * kLinks);
-    const double speed = max_speed(*space, links);
+    const double stretch = (rest_y - space->internal_position(bodies.back()).y()) / 4.0;
+    const double speed = max_speed(*space, bodies);
     std::printf("[ measure  ] chain of 10 x 1 kg holding 100 kg: stretched %.3f %%, fastest %.4f m/s\n", 100 * stretch,
                 speed);
-    EXPECT_TRUE(all_finite(*space, links));
+    EXPECT_TRUE(all_finite(*space, bodies));
     EXPECT_LT(std::abs(stretch), 0.03);
     EXPECT_LT(speed, 0.01);
+}
+
+// The same chain released 40 degrees out, a wrecking ball's swing: the chain must not
+// stretch 3 % at the bottom of a swing (the ball's weight and its swing's pull), and the
+// ball must never swing higher than it was released (no energy from the solver). Also
+// prints its period (4.2 s for a rigid pendulum of the ball and the links at 40 degrees).
+// Disabled: fails at c0f2223: 6.88 % long at the bottom of a swing (highest -0.07 m, 4.33 s
+// a swing). The cause is the hanging chain's (above), with the swing's pull added. Support
+// mass scaling for joints (above) holds it to 0.3 % but swings the ball up 0.40 m over its
+// release, in 3.57 s.
+TEST(OutsidePendulum, DISABLED_HeavyBallSwungOnALightChainStaysShort) {
+    auto space = make_space();
+    const std::vector<BodyHandle> bodies = hang_heavy_chain(*space, 40 * kPi / 180);
+    const BodyHandle ball = bodies.back();
+    const double release_y = space->internal_position(ball).y();
+    double highest = -kHuge, longest = 0;
+    bool past_bottom = false;
+    std::vector<double> crossings;  // times the ball crosses x = 0, within the step
+    double x_prev = space->internal_position(ball).x();
+    for (int i = 0; i < 300; ++i) {
+        space->update();
+        const Vec3 x = space->internal_position(ball);
+        if ((x_prev > 0) != (x.x() > 0)) crossings.push_back((i + x_prev / (x_prev - x.x())) * kStep);
+        x_prev = x.x();
+        past_bottom = past_bottom || x.x() < 0;
+        if (past_bottom) highest = std::max(highest, x.y());
+        longest = std::max(longest, ((x - Vec3(0, 10, 0)).norm() - 4.2) / 4.0);
+    }
+    const double period = crossings.size() < 2
+                              ? 0
+                              : 2 * (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+    std::printf("[ measure  ] 100 kg ball swung on 10 x 1 kg links: highest %.4f m over its release, longest %.3f %%, "
+                "period %.3f s\n",
+                highest - release_y, 100 * longest, period);
+    EXPECT_TRUE(all_finite(*space, bodies));
+    EXPECT_LT(highest, release_y);
+    EXPECT_LT(longest, 0.03);
 }
 
 // A cantilever: ten 20 kg boxes (0.5 x 0.2 x 0.2 m) welded end to end by fixed joints, the
