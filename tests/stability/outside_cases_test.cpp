@@ -972,9 +972,12 @@ std::vector<BodyHandle> hang_heavy_chain(Space& space, double tilt) {
 // rises 0.38 m. Any scaling that keeps a light body from feeling the load it carries
 // makes energy wherever that body moves along the load; a contact's support scaling
 // stays on supported stacks, which barely move, and a swinging chain does not. What
-// remains is a stiffer joint solved well enough: the exact solve of a joint tree (a
-// chain's block-tridiagonal system, as PhysX's articulations and Baraff's linear-time
-// solve do), not tried.
+// remains is solving a joint tree's rows together, exactly (a chain's block-tridiagonal
+// system, as PhysX's articulations and Baraff's linear-time method do), not tried in the
+// engine. In a one-dimensional model of this chain (h43b: the bodies on a vertical line,
+// the engine's soft step, which with one Gauss-Seidel pass gives the engine's 3.764 % and
+// 0.1741 m/s), solving each pass's rows exactly holds it to 2.47 % and still at the
+// default softness, and to 0.02 % with each joint a spring for the mass below it.
 TEST(OutsidePendulum, DISABLED_LightChainHoldsAHundredTimesHeavierEndMass) {
     auto space = make_space();
     const std::vector<BodyHandle> bodies = hang_heavy_chain(*space, 0);
