@@ -957,9 +957,8 @@ std::vector<BodyHandle> hang_heavy_chain(Space& space, double tilt) {
 //   against 0.08; 0.082 m at ratio 4) and Distance.RigidRodKeepsItsLength at 10. A damping
 //   scaled to the pair's mass ratio (not tried) would reach only the ball's own joint,
 //   which carries 1/11 of the bounce.
-// Support mass scaling for joints, as contacts have it (support_scales.cpp), tried (h43b;
-// the commit "Experiment: support mass scaling for joints" on branch h43b-chain, reverted
-// after it): in the joints' rows a body is made as heavy as the heaviest body it carries
+// Support mass scaling for joints, as contacts have it (support_scales.cpp), tried in
+// session 43 (h43b, not landed): in the joints' rows a body is made as heavy as the heaviest body it carries
 // (farther from a static body by joint hops). It holds this chain to 0.209 % and still
 // (0.0000 m/s), but it is no fix: scaling both bodies of a joint alike changes nothing,
 // so in a chain only the ball's own joint changes, which solves the last link as if it
