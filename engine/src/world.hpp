@@ -304,6 +304,10 @@ struct Contact {
     bool sleeping : 1 = false;        // written by one thread at a time, as every field of a contact
     bool touch_reported : 1 = false;  // touching as last reported by a Begin (an End clears it)
     bool pushed : 1 = false;          // a reporting contact pushed in its last solved step (a Hit starts a push)
+    // A shape of the pair is a mesh or a compound as the contact is made (init_contact):
+    // recycling asks such pairs whether a turn brought a point into touch
+    // (holds_its_features). A shape changed since only makes the question asked or skipped.
+    bool meshy : 1 = false;
     // Whether the poses below are those the manifolds were last collided at (both
     // rotations and centres of mass): while the bodies stay close to them the manifolds
     // are recycled, not collided again (narrowphase.cpp).

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -164,6 +165,29 @@ int collide_cached(const Shape& a, const Transform& xa, const Shape& b, const Tr
 // (or half its swing) per axis: a long body turning about its length counts its girth.
 inline Vec3 modified_cross(const Vec3& a, const Vec3& b) {
     return {a.y() * b.z() + a.z() * b.y(), a.z() * b.x() + a.x() * b.z(), a.x() * b.y() + a.y() * b.x()};
+}
+
+// How far a turn may move a body's points along a manifold's normal, relative to its centre,
+// before the manifold no longer stands for the pair (tilt_reach), in linear slops: half, so
+// that no point of the body has come nearer the other shape than the manifold's points
+// have by more than the slop.
+inline constexpr Real kRecycleTiltSlops = 0.5;
+
+// How far a body's turn since its manifold was collided can have moved any of its points
+// along the manifold's normal n (world) relative to its centre: `turn` the body's turn in the
+// world (then to now; |vec| = sin(angle / 2)), `then` its orientation when collided, its
+// points within `reach` of its centre along each of its own axes. Only the turn's part
+// about axes in the contact plane (its tilt t, of vec v = t + (v.n)n) moves a point along
+// n: n.(turn r - r) = 2w n.(t x r) + 2(v.n)(t.r) - 2(n.r)|t|^2, bounded term by term, the
+// first as Box3D's modified cross bounds |t x r|. A body spinning about the normal (a box
+// turning where it lies) tilts nothing.
+inline Real tilt_reach(const Quat& turn, const Quat& then, const Vec3& reach, const Vec3& n) {
+    const Vec3 v = turn.vec();
+    const Real along = v.dot(n);
+    const Vec3 t = v - along * n;
+    const Vec3 local = (then.conjugate() * t).cwiseAbs();
+    return 2 * (std::abs(turn.w()) * modified_cross(local, reach).norm() + std::abs(along) * local.dot(reach) +
+                t.squaredNorm() * reach.norm());
 }
 
 // Contact recycling keeps manifolds only while neither body has turned more than 10 degrees

@@ -284,9 +284,13 @@ int collide_shape_parts(const Shape& a, const Transform& xa, const Shape& b, con
 // Whether a compound's part, collided with a mesh where `was` says, has since moved so little
 // that its manifolds then still serve (contact recycling, narrowphase.cpp, for one part): its
 // centre has moved less than `tolerance`, less the swing of its points about it (the body's
-// turn since, in the body's frame, over the part's half-extents there), and the body has
-// turned less than 10 degrees. The mesh has not moved (met_at).
-bool part_recycles(const MeshQuery& was, const Vec3& centre, const Quat& turn, const Vec3& extents, Real tolerance) {
+// turn since, in the body's frame, over the part's half-extents there), the body has turned
+// less than 10 degrees, and its tilt against each manifold's normal has moved the part's
+// core points along it less than `tilt_tolerance` (tilt_reach; as a whole contact's,
+// holds_its_features in narrowphase.cpp: a rolling prism part's next edge must not come
+// down unheld). The mesh has not moved (met_at).
+bool part_recycles(const MeshQuery& was, std::span<const Manifold> kept, const Vec3& centre, const Quat& turn,
+                   const Vec3& extents, Real radius, Real tolerance, Real tilt_tolerance) {
     if (!was.has_manifolds) return false;
     const Real distance = (centre - was.centre).norm();
     if (distance >= tolerance) return false;
@@ -295,7 +299,14 @@ bool part_recycles(const MeshQuery& was, const Vec3& centre, const Quat& turn, c
     // sin(angle / 2) times the axis, in the body's frame: twice its cross with a point's
     // offset from the centre is how far the point has swung.
     const Vec3 local = (was.turn.conjugate() * turn).vec().cwiseAbs();
-    return distance + 2 * modified_cross(local, extents).norm() < tolerance;
+    if (!(distance + 2 * modified_cross(local, extents).norm() < tolerance)) return false;
+    const Vec3 core = (extents.array() - radius).cwiseMax(0);
+    const Quat world_turn = turn * was.turn.conjugate();
+    if (4 * local.norm() * core.norm() < tilt_tolerance) return true;  // tilt_reach's bound for any normal
+    for (const Manifold& m : kept) {
+        if (tilt_reach(world_turn, was.turn, core, m.normal) >= tilt_tolerance) return false;
+    }
+    return true;
 }
 
 // A recycled part's manifold, as recycle() moves a contact's (narrowphase.cpp): each point
@@ -340,13 +351,15 @@ int collide_mesh_compound_cached(const Shape& mesh, const Transform& xm, const S
                                  Real speculative, Manifold* out, int capacity, TriangleFeatureWalk& walk,
                                  std::span<const Aabb> b_boxes, const PairMotion* motion, Real recycle_distance) {
     const bool recycling = walk.met_at(*mesh.mesh, xm) && recycle_distance > 0;
+    const Real tilt_tolerance = kRecycleTiltSlops * walk.slop();
     const Compound& parts = *b.parts;
     return collide_shape_parts(
         mesh, xm, b, xb, b_boxes, speculative, out, capacity, motion,
         [&](const Shape& part, const Transform& x, const Aabb& box, std::uint32_t i, Manifold* found, Real reach) {
             const Vec3 centre = xb.apply(parts.part_bounds(i).center());
             const MeshQuery* const was = recycling ? walk.last(i) : nullptr;
-            if (was && part_recycles(*was, centre, xb.q, parts.part_bounds(i).extents(), recycle_distance)) {
+            if (was && part_recycles(*was, walk.kept(*was), centre, xb.q, parts.part_bounds(i).extents(),
+                                     round_radius(part), recycle_distance, tilt_tolerance)) {
                 const PartMove move(*was, centre, xb.q);  // before carry() moves the record `was` is in
                 const std::span<const Manifold> kept = walk.carry(i);
                 for (std::size_t m = 0; m < kept.size(); ++m) found[m] = move.moved(kept[m], round_radius(part));

@@ -68,6 +68,10 @@ public:
     // The last collide's record of `part`, or null. Calls come in increasing part, each
     // before that part's query() or carry().
     const MeshQuery* last(std::uint32_t part);
+    // The manifolds kept with `was`, a record last() gave, as they were made.
+    std::span<const Manifold> kept(const MeshQuery& was) const {
+        return {m_queries->manifolds.data() + was.first_manifold, was.manifold_count};
+    }
     // Takes `part`'s record from the last collide into this one as it was (its query, its
     // triangles' features and its manifolds), in place of query(): the part is not collided.
     // Returns its manifolds.

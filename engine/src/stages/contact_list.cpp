@@ -34,6 +34,10 @@ void init_contact(const World& world, std::uint64_t key, Contact& contact) {
     contact.body_b = b;
     mix_materials(bodies.traits[a], bodies.traits[b], contact);
     contact.events = contact_event_flags(world, a, b);
+    const auto meshy = [](const Shape& s) {
+        return s.type == ShapeType::TriangleMesh || s.type == ShapeType::Compound;
+    };
+    contact.meshy = meshy(bodies.traits[a].shape) || meshy(bodies.traits[b].shape);
 }
 
 // Takes the removed positions (ascending) out of an up-to-date awake list and renames the
