@@ -302,7 +302,7 @@ bool part_recycles(const MeshQuery& was, std::span<const Manifold> kept, const V
     if (!(distance + 2 * modified_cross(local, extents).norm() < tolerance)) return false;
     const Vec3 core = (extents.array() - radius).cwiseMax(0);
     const Quat world_turn = turn * was.turn.conjugate();
-    if (4 * local.norm() * core.norm() < tilt_tolerance) return true;  // tilt_reach's bound for any normal
+    if (!may_tilt(world_turn, core, tilt_tolerance)) return true;
     for (const Manifold& m : kept) {
         if (tilt_reach(world_turn, was.turn, core, m.normal) >= tilt_tolerance) return false;
     }

@@ -2,6 +2,7 @@
 // colours that let each batch run in parallel without two jobs writing one body.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -308,6 +309,7 @@ struct SolverPhase {
 // body's inverse mass and inertia by; 1 but for a light body carrying a heavier one.
 struct SupportScale {
     Real a = 1, b = 1;
+    Real lower() const { return std::min(a, b); }  // the lower body's (the other's is 1)
 };
 // A support contact: manifold ref k's upper body rests on its lower one.
 struct SupportEdge {
@@ -482,6 +484,11 @@ inline Real held_per_impulse(const Softness& soft) { return soft.impulse_scale /
 
 // support_scales.cpp: fills scratch.support_scales from the step's manifolds and bodies.
 void find_support_scales(const World& world, SolverScratch& scratch);
+
+// Manifold ref k's support scales this step (1 and 1 where the list is empty).
+inline SupportScale support_scale(const SolverScratch& scratch, std::uint32_t k) {
+    return scratch.support_scales.empty() ? SupportScale{} : scratch.support_scales[k];
+}
 
 // contact_solver.cpp. pack_contacts lays the colours' manifolds out in scratch.wide
 // (which manifold and bodies each lane holds); prepare_contacts fills in the rest from

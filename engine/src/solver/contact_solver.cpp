@@ -361,7 +361,7 @@ void prepare_rolling(const World& world, const Contact& contact, const ContactMa
 // off it, the contact is no longer a support and the box is solved at its own mass, and
 // its last impulse, which held up the ball, launched the box at 23 m/s.
 Real kept_share(const ContactManifold& m, const SupportScale& scale) {
-    const Real now = std::min(scale.a, scale.b);
+    const Real now = scale.lower();
     return m.support_scale < now ? m.support_scale / now : Real(1);
 }
 
@@ -410,7 +410,7 @@ void prepare_wide(const World& world, const SolverScratch& scratch, const Contac
         const Contact& contact = world.contacts[ref.contact];
         const ContactManifold& m = contact.manifold_at(static_cast<int>(ref.manifold));
         // A light body carrying a heavier one is solved heavier here (support_scales.cpp).
-        const SupportScale scale = scratch.support_scales.empty() ? SupportScale{} : scratch.support_scales[wc.ref[l]];
+        const SupportScale scale = support_scale(scratch, wc.ref[l]);
         const SolverBody& A = scaled(scratch.bodies[ref.a], scale.a, scaled_a);
         const SolverBody& B = scaled(scratch.bodies[ref.b], scale.b, scaled_b);
         live[l] = -1;
@@ -1100,10 +1100,7 @@ void store_contact_impulses(World& world, const SolverScratch& scratch, std::uin
             m.friction_impulse = wc.friction_impulse[0][l] * wc.tangent[0].lane(l) +
                                  wc.friction_impulse[1][l] * wc.tangent[1].lane(l);
             m.twist_impulse = wc.twist_impulse[l];
-            m.support_scale = scratch.support_scales.empty()
-                                  ? 1.0f
-                                  : static_cast<float>(std::min(scratch.support_scales[wc.ref[l]].a,
-                                                                scratch.support_scales[wc.ref[l]].b));
+            m.support_scale = static_cast<float>(support_scale(scratch, wc.ref[l]).lower());
             m.pushed_point = -1;
             m.pushed_speed = 0;
             for (int j = 0; j < m.point_count; ++j) {

@@ -114,16 +114,6 @@ bool recycles(const Contact& contact, const Bodies& b, Real touching, Real apart
            tolerance;
 }
 
-// Whether either body's points can have swung kRecycleTiltSlops slops about its centre (4
-// |sin(angle / 2)| |r| bounds tilt_reach and half how much nearer the manifold's points any
-// point can have come): a resting body's turn is far below it, and the shapes are not read.
-inline bool turned_far(const Contact& contact, const Bodies& b, const Turns& turns, Real tolerance) {
-    const auto far = [&](const Quat& turn, std::uint32_t i) {
-        return 16 * turn.vec().squaredNorm() * b.extents[i].core_reach.squaredNorm() >= tolerance * tolerance;
-    };
-    return far(turns.dqa, contact.body_a) || far(turns.dqb, contact.body_b);
-}
-
 // Box3D's test above bounds how far any point has moved, up to 10 slops, not whether a point
 // that no manifold holds can have come into touch. Against a mesh a compound's manifolds miss
 // points: a rolling hexagonal prism part's next edge, past the speculative distance when
@@ -133,21 +123,22 @@ inline bool turned_far(const Contact& contact, const Bodies& b, const Turns& tur
 // nearer the other shape than the manifold's points only as the body tilts against the
 // normal; a slide, a fall or a spin about the normal moves every point alike. So where one
 // shape is a mesh (whose ridges no manifold of another triangle sees) or a compound (whose
-// parts may have no manifold among the pair's few), a turned body (turned_far) keeps the
+// parts may have no manifold among the pair's few), a turned body (may_tilt) keeps the
 // manifolds only while its tilt against each one's normal has moved its points along it
 // less than kRecycleTiltSlops slops (tilt_reach). Two convex shapes keep Box3D's test alone:
 // asked whether a corner had come lower than the manifold's points (the other shape taken
 // flat under them), a pyramid's boxes, each half on two below, tipped a corner over the gap
 // as it settled and were collided again for nothing (39 % more narrowphase), and a ragdoll's
 // capsules hanging over a bench's edge, collided again as they swung, slid it off the bench.
-// A rolling ball's core is its centre, which no turn moves. Out of line: only turning pairs ask.
+// A rolling ball's core is its centre, which no turn moves. Out of line: only mesh and
+// compound pairs (Contact::meshy) ask.
 [[gnu::noinline]] bool holds_its_features(const Contact& contact, const Bodies& b, const Turns& turns, Real tolerance) {
     if (contact.manifold_count == 0) return true;
     for (int side = 0; side < 2; ++side) {
         const std::uint32_t i = side ? contact.body_b : contact.body_a;
         const Vec3& core = b.extents[i].core_reach;  // zero for a static body
         const Quat& turn = side ? turns.dqb : turns.dqa;
-        if (16 * turn.vec().squaredNorm() * core.squaredNorm() < tolerance * tolerance) continue;
+        if (!may_tilt(turn, core, tolerance)) continue;
         const Quat& then = side ? contact.cached_qb : contact.cached_qa;
         for (int m = 0; m < contact.manifold_count; ++m) {
             if (tilt_reach(turn, then, core, contact.manifold_at(m).normal) >= tolerance) return false;
@@ -455,8 +446,7 @@ void update_narrowphase(World& world) {
             const bool recyclable = !any_fast || (!b.is_fast(a) && !b.is_fast(bb));
             Turns turns;
             if (recyclable && recycles(contact, b, touching_recycle_distance, recycle_distance, turns) &&
-                (!contact.meshy || !turned_far(contact, b, turns, tilt_tolerance) ||
-                 holds_its_features(contact, b, turns, tilt_tolerance))) {
+                (!contact.meshy || holds_its_features(contact, b, turns, tilt_tolerance))) {
                 recycle(contact, b, turns);
                 counts.reused += 1;
                 counts.touching += contact.manifold_count > 0 ? 1u : 0u;

@@ -632,25 +632,23 @@ void carry_tail(SolverScratch& scratch, std::size_t first) {
 void plan_constraint_pass(SolverScratch& scratch, Pass pass, const char* name, bool with_joints, int substep,
                           bool integrates = false, bool warms = false) {
     const std::size_t first = scratch.phases.size();
+    auto add_phase = [&](int color, std::uint32_t count, std::uint32_t grain) {
+        scratch.phases.push_back(Phase{name, count, grain});
+        SolverPhase& phase = scratch.plan.emplace_back(SolverPhase{pass, color});
+        phase.warms = warms;
+        phase.substep = static_cast<std::uint32_t>(substep);
+    };
     for (int c = 0; c < kColorCount; ++c) {
         const auto joints = with_joints ? static_cast<std::uint32_t>(scratch.joint_colors[c].size()) +
                                               (scratch.wide_joint_begin[c + 1] - scratch.wide_joint_begin[c])
                                         : 0u;
         const std::uint32_t count = joints + (scratch.wide_begin[c + 1] - scratch.wide_begin[c]);
         if (count == 0) continue;
-        scratch.phases.push_back(Phase{name, count, count <= kOneBlockColor ? count : kConstraintGrain});
-        scratch.plan.push_back(SolverPhase{pass, c});
-        scratch.plan.back().warms = warms;
-        scratch.plan.back().substep = static_cast<std::uint32_t>(substep);
+        add_phase(c, count, count <= kOneBlockColor ? count : kConstraintGrain);
     }
     const bool overflow = (with_joints && !scratch.joint_overflow.empty()) ||
                           scratch.wide.size() > scratch.wide_begin[kColorCount];
-    if (overflow) {
-        scratch.phases.push_back(Phase{name, 1, 1});
-        scratch.plan.push_back(SolverPhase{pass, kColorCount});
-        scratch.plan.back().warms = warms;
-        scratch.plan.back().substep = static_cast<std::uint32_t>(substep);
-    }
+    if (overflow) add_phase(kColorCount, 1, 1);
     if (integrates && first != scratch.phases.size()) {
         for (std::size_t p = first; p < scratch.phases.size(); ++p) {
             scratch.plan[p].integrates = true;
