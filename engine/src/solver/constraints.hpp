@@ -228,8 +228,9 @@ struct WideJoint {
     Wide3 ra, rb;        // anchors from each centre of mass at the step's start, world
     Wide3 delta_center;  // B's centre of mass minus A's at the step's start
     Wide inv_mass_a{}, inv_mass_b{};
-    WideSym3 inv_inertia_a, inv_inertia_b;  // world, fixed for the step
+    WideSym3 inv_inertia_a, inv_inertia_b;  // world, at the step's start (WideMotion's turn them)
     Wide3 impulse;                          // accumulated (JointConstraint::linear_impulse)
+    bool turns_a = false, turns_b = false;  // a lane's A or B has an inertia that turning changes
 };
 
 // A swing-twist block's angular rows (joint_swing_twist.cpp): JointConstraint's, per lane.

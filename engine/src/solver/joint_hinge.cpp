@@ -28,11 +28,11 @@ WideAlignRows align_rows(const WideHinge& w, const WideMotion& m) {
 
 // The two alignment rows as one soft 2x2 block, its inverse scaled by K's trace as
 // joint_lanes.cpp's 3x3 is (0 where K is: nothing can turn).
-void solve_alignment(const WideJoint& wj, WideHinge& w, const WideAlignRows& rows, WideVelocities& s,
+void solve_alignment(const WideMotion& m, WideHinge& w, const WideAlignRows& rows, WideVelocities& s,
                      const JointSolveParams& p) {
     const Softness soft = pass_softness(p);
-    const Wide3 ia0 = wj.inv_inertia_a * rows.u[0], ib0 = wj.inv_inertia_b * rows.u[0];
-    const Wide3 ia1 = wj.inv_inertia_a * rows.u[1], ib1 = wj.inv_inertia_b * rows.u[1];
+    const Wide3 ia0 = m.inv_inertia_a * rows.u[0], ib0 = m.inv_inertia_b * rows.u[0];
+    const Wide3 ia1 = m.inv_inertia_a * rows.u[1], ib1 = m.inv_inertia_b * rows.u[1];
     const Wide zero = splat(0);
     const Wide trace = dot(rows.u[0], ia0 + ib0) + dot(rows.u[1], ia1 + ib1);
     const Wide scale = select(trace > zero, splat(1) / trace, zero);
@@ -76,16 +76,15 @@ void prepare_hinge_lane(WideHinge& w, int lane, const JointConstraint& jc) {
     w.upper_impulse[lane] = static_cast<float>(jc.upper_impulse);
 }
 
-void warm_start_hinge_lanes(const WideJoint& wj, const WideHinge& w, const WideMotion& m, WideVelocities& s) {
+void warm_start_hinge_lanes(const WideHinge& w, const WideMotion& m, WideVelocities& s) {
     const WideAlignRows rows = align_rows(w, m);
     const Wide axial = w.motor_impulse + w.lower_impulse - w.upper_impulse;
-    apply_angular(wj, s, w.align_impulse[0] * rows.u[0] + w.align_impulse[1] * rows.u[1] + axial * rows.axis);
+    apply_angular(m, s, w.align_impulse[0] * rows.u[0] + w.align_impulse[1] * rows.u[1] + axial * rows.axis);
 }
 
-void solve_hinge_lanes(const WideJoint& wj, WideHinge& w, const WideMotion& m, WideVelocities& s,
-                       const JointSolveParams& p) {
+void solve_hinge_lanes(WideHinge& w, const WideMotion& m, WideVelocities& s, const JointSolveParams& p) {
     const WideAlignRows rows = align_rows(w, m);
-    const WideAngularRow axial = angular_row(wj, rows.axis);
+    const WideAngularRow axial = angular_row(m, rows.axis);
     {
         const Wide cdot = angular_speed(s, axial.axis) - w.motor_speed;
         const Wide old = w.motor_impulse;
@@ -107,7 +106,7 @@ void solve_hinge_lanes(const WideJoint& wj, WideHinge& w, const WideMotion& m, W
                                          violated, p);
         apply_row(s, axial, -upper);
     }
-    solve_alignment(wj, w, rows, s, p);
+    solve_alignment(m, w, rows, s, p);
 }
 
 void store_hinge_lane(const WideHinge& w, int lane, JointConstraint& jc) {

@@ -52,20 +52,38 @@ Wide3 solve_symmetric(const WideSym3& k, const Wide3& v) {
             inv * (c02 * v.x + c12 * v.y + c22 * v.z)};
 }
 
-[[gnu::always_inline]] inline WideMotion gather_motion(const WideJoint& wj, const SolverBody* bodies) {
+// Room for a turned inverse inertia, written only where a lane's body turns it (a WideSym3
+// starts at zero: filling two at every solve would cost more than most joints' turning).
+union TurnedInertia {
+    TurnedInertia() {}
+    WideSym3 value;
+};
+
+// `turned_inertia` holds the inverse inertias turned by the lanes' rotations where the
+// motion refers to them (it must outlive the motion).
+[[gnu::always_inline]] inline WideMotion gather_motion(const WideJoint& wj, const SolverBody* bodies,
+                                                       TurnedInertia (&turned_inertia)[2]) {
     Wide ma[kLanes], mb[kLanes];
     gather_rows(bodies, wj.a, kMotionRow, ma);
     gather_rows(bodies, wj.b, kMotionRow, mb);
-    return {
-        {ma[0], ma[1], ma[2]}, {mb[0], mb[1], mb[2]}, {{ma[3], ma[4], ma[5]}, ma[6]}, {{mb[3], mb[4], mb[5]}, mb[6]}};
+    const WideQuat dqa{{ma[3], ma[4], ma[5]}, ma[6]}, dqb{{mb[3], mb[4], mb[5]}, mb[6]};
+    if (wj.turns_a) turned_inertia[0].value = turned(wj.inv_inertia_a, dqa);
+    if (wj.turns_b) turned_inertia[1].value = turned(wj.inv_inertia_b, dqb);
+    return {{ma[0], ma[1], ma[2]},
+            {mb[0], mb[1], mb[2]},
+            dqa,
+            dqb,
+            wj.turns_a ? turned_inertia[0].value : wj.inv_inertia_a,
+            wj.turns_b ? turned_inertia[1].value : wj.inv_inertia_b};
 }
 
 // An impulse at the anchors: -impulse on A, +impulse on B.
-inline void apply(const WideJoint& wj, WideVelocities& s, const Wide3& ra, const Wide3& rb, const Wide3& impulse) {
+inline void apply(const WideJoint& wj, const WideMotion& m, WideVelocities& s, const Wide3& ra, const Wide3& rb,
+                  const Wide3& impulse) {
     s.va -= wj.inv_mass_a * impulse;
-    s.wa -= wj.inv_inertia_a * cross(ra, impulse);
+    s.wa -= m.inv_inertia_a * cross(ra, impulse);
     s.vb += wj.inv_mass_b * impulse;
-    s.wb += wj.inv_inertia_b * cross(rb, impulse);
+    s.wb += m.inv_inertia_b * cross(rb, impulse);
 }
 
 // The point row, after the type's angular rows.
@@ -77,8 +95,8 @@ void solve_point(WideJoint& wj, WideVelocities& s, const WideMotion& m, const Jo
     const Wide3 cdot = point_velocity(s, ra, rb);
     // K from the anchors now: a light link can turn far within a step, and a mass from
     // the step's start would then overshoot.
-    WideSym3 k = lever_term(wj.inv_inertia_a, ra);
-    const WideSym3 kb = lever_term(wj.inv_inertia_b, rb);
+    WideSym3 k = lever_term(m.inv_inertia_a, ra);
+    const WideSym3 kb = lever_term(m.inv_inertia_b, rb);
     const Wide linear = wj.inv_mass_a + wj.inv_mass_b;
     k.xx += linear + kb.xx;
     k.yy += linear + kb.yy;
@@ -89,7 +107,7 @@ void solve_point(WideJoint& wj, WideVelocities& s, const WideMotion& m, const Jo
     const Wide3 x = solve_symmetric(k, cdot + splat(soft.bias_rate) * c);
     const Wide3 impulse = splat(-soft.mass_scale) * x - splat(soft.impulse_scale) * wj.impulse;
     wj.impulse += impulse;
-    apply(wj, s, ra, rb, impulse);
+    apply(wj, m, s, ra, rb, impulse);
 }
 
 }  // namespace
@@ -144,6 +162,7 @@ void prepare_joint_lanes(SolverScratch& scratch, std::uint32_t lo, std::uint32_t
     for (std::uint32_t k = lo; k < hi; ++k) {
         WideJoint& wj = scratch.wide_joints[k];
         // Empty lanes keep the zeros they were packed with: no mass, no impulse.
+        wj.turns_a = wj.turns_b = false;
         for (int l = 0; l < wj.lanes; ++l) {
             const JointConstraint& jc = scratch.joints[wj.joint[l]];
             const SolverBody& A = bodies[jc.a];
@@ -155,6 +174,8 @@ void prepare_joint_lanes(SolverScratch& scratch, std::uint32_t lo, std::uint32_t
             wj.inv_mass_b[l] = static_cast<float>(B.inv_mass);
             wj.inv_inertia_a.set_lane(l, A.inv_inertia);
             wj.inv_inertia_b.set_lane(l, B.inv_inertia);
+            wj.turns_a = wj.turns_a || !A.isotropic;
+            wj.turns_b = wj.turns_b || !B.isotropic;
             wj.impulse.set_lane(l, jc.linear_impulse);
             if (wj.type == JointType::SwingTwist)
                 prepare_swing_twist_lane(scratch.wide_swing_twists[wj.angular], l, jc);
@@ -167,9 +188,9 @@ namespace {
 
 // The warm start's velocity changes: the impulses the lanes' joints have so far applied to `s`.
 void apply_warm_start(const SolverScratch& scratch, const WideJoint& wj, const WideMotion& m, WideVelocities& s) {
-    if (wj.type == JointType::SwingTwist) warm_start_swing_twist_lanes(wj, scratch.wide_swing_twists[wj.angular], m, s);
-    if (wj.type == JointType::Hinge) warm_start_hinge_lanes(wj, scratch.wide_hinges[wj.angular], m, s);
-    apply(wj, s, rotate(m.dqa, wj.ra), rotate(m.dqb, wj.rb), wj.impulse);
+    if (wj.type == JointType::SwingTwist) warm_start_swing_twist_lanes(scratch.wide_swing_twists[wj.angular], m, s);
+    if (wj.type == JointType::Hinge) warm_start_hinge_lanes(scratch.wide_hinges[wj.angular], m, s);
+    apply(wj, m, s, rotate(m.dqa, wj.ra), rotate(m.dqb, wj.rb), wj.impulse);
 }
 
 // solve_joint_lanes; with kWarm, then the next substep's warm start added to `warm`.
@@ -178,10 +199,10 @@ void solve_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, cons
                  EffectCounts& counts, PushVelocity* warm) {
     counts.joints += static_cast<std::uint64_t>(wj.lanes);
     WideVelocities s = gather(wj, bodies);
-    const WideMotion m = gather_motion(wj, bodies);
-    if (wj.type == JointType::SwingTwist)
-        solve_swing_twist_lanes(wj, scratch.wide_swing_twists[wj.angular], m, s, params);
-    if (wj.type == JointType::Hinge) solve_hinge_lanes(wj, scratch.wide_hinges[wj.angular], m, s, params);
+    TurnedInertia turned_inertia[2];
+    const WideMotion m = gather_motion(wj, bodies, turned_inertia);
+    if (wj.type == JointType::SwingTwist) solve_swing_twist_lanes(scratch.wide_swing_twists[wj.angular], m, s, params);
+    if (wj.type == JointType::Hinge) solve_hinge_lanes(scratch.wide_hinges[wj.angular], m, s, params);
     solve_point(wj, s, m, params);
     scatter(wj, bodies, s);
     if constexpr (kWarm) {
@@ -195,7 +216,8 @@ void solve_lanes(SolverScratch& scratch, WideJoint& wj, SolverBody* bodies, cons
 
 void warm_start_joint_lanes(const SolverScratch& scratch, const WideJoint& wj, SolverBody* bodies) {
     WideVelocities s = gather(wj, bodies);
-    apply_warm_start(scratch, wj, gather_motion(wj, bodies), s);
+    TurnedInertia turned_inertia[2];
+    apply_warm_start(scratch, wj, gather_motion(wj, bodies, turned_inertia), s);
     scatter(wj, bodies, s);
 }
 

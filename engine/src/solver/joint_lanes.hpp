@@ -12,6 +12,13 @@ namespace spindle {
 struct WideMotion {
     Wide3 dpa, dpb;
     WideQuat dqa, dqb;
+    // The bodies' inverse inertias now: the step's start's (WideJoint's) turned by dqa, dqb,
+    // or the start's where no lane's body turns them (WideJoint::turns_a, turns_b). The anchors
+    // and axes turn with the bodies through the step, and an impulse at a turned anchor
+    // through the start's inertia would turn a body about axes it does not: a spinning disc
+    // on a pivot gained spin (and energy) from every precessing step.
+    const WideSym3& inv_inertia_a;
+    const WideSym3& inv_inertia_b;
 };
 
 // An angular row about `axis` (not necessarily unit): the turn an impulse along it gives
@@ -21,8 +28,8 @@ struct WideAngularRow {
     Wide mass{};
 };
 
-inline WideAngularRow angular_row(const WideJoint& wj, const Wide3& axis) {
-    WideAngularRow r{axis, wj.inv_inertia_a * axis, wj.inv_inertia_b * axis, {}};
+inline WideAngularRow angular_row(const WideMotion& m, const Wide3& axis) {
+    WideAngularRow r{axis, m.inv_inertia_a * axis, m.inv_inertia_b * axis, {}};
     const Wide k = dot(axis, r.ia) + dot(axis, r.ib);
     r.mass = select(k > splat(0), splat(1) / k, splat(0));
     return r;
@@ -33,9 +40,9 @@ inline void apply_row(WideVelocities& s, const WideAngularRow& r, const Wide& im
     s.wa -= impulse * r.ia;
     s.wb += impulse * r.ib;
 }
-inline void apply_angular(const WideJoint& wj, WideVelocities& s, const Wide3& impulse) {
-    s.wa -= wj.inv_inertia_a * impulse;
-    s.wb += wj.inv_inertia_b * impulse;
+inline void apply_angular(const WideMotion& m, WideVelocities& s, const Wide3& impulse) {
+    s.wa -= m.inv_inertia_a * impulse;
+    s.wb += m.inv_inertia_b * impulse;
 }
 
 // The rows' relative angular speed along a row: axis.(wb - wa).
@@ -90,16 +97,14 @@ inline Wide length(const Wide3& v) { return wide_sqrt(dot(v, v)); }
 // Swing-twist lanes (joint_swing_twist.cpp): a lane from the prepared constraint, the
 // rows' warm start and solve (before the point row), and the lane's impulses back.
 void prepare_swing_twist_lane(WideSwingTwist& w, int lane, const JointConstraint& jc);
-void warm_start_swing_twist_lanes(const WideJoint& wj, const WideSwingTwist& w, const WideMotion& m, WideVelocities& s);
-void solve_swing_twist_lanes(const WideJoint& wj, WideSwingTwist& w, const WideMotion& m, WideVelocities& s,
-                             const JointSolveParams& p);
+void warm_start_swing_twist_lanes(const WideSwingTwist& w, const WideMotion& m, WideVelocities& s);
+void solve_swing_twist_lanes(WideSwingTwist& w, const WideMotion& m, WideVelocities& s, const JointSolveParams& p);
 void store_swing_twist_lane(const WideSwingTwist& w, int lane, JointConstraint& jc);
 
 // Hinge lanes (joint_hinge.cpp), the same.
 void prepare_hinge_lane(WideHinge& w, int lane, const JointConstraint& jc);
-void warm_start_hinge_lanes(const WideJoint& wj, const WideHinge& w, const WideMotion& m, WideVelocities& s);
-void solve_hinge_lanes(const WideJoint& wj, WideHinge& w, const WideMotion& m, WideVelocities& s,
-                       const JointSolveParams& p);
+void warm_start_hinge_lanes(const WideHinge& w, const WideMotion& m, WideVelocities& s);
+void solve_hinge_lanes(WideHinge& w, const WideMotion& m, WideVelocities& s, const JointSolveParams& p);
 void store_hinge_lane(const WideHinge& w, int lane, JointConstraint& jc);
 
 }  // namespace spindle

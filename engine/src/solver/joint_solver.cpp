@@ -364,7 +364,7 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
     SolverBody& A = bodies[jc.a];
     SolverBody& B = bodies[jc.b];
     Velocities s = load(A, B);
-    apply_warm_start(jc, A, B, s);
+    apply_warm_start(jc, turned(A), turned(B), s);
     store(A, B, s);
 }
 
@@ -374,7 +374,7 @@ void relax_and_warm_start_joint(JointConstraint& jc, SolverBody* bodies, const J
     const SolverBody& A = bodies[jc.a];
     const SolverBody& B = bodies[jc.b];
     Velocities change{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-    apply_warm_start(jc, A, B, change);
+    apply_warm_start(jc, turned(A), turned(B), change);
     add_to(A, B, warm[jc.a], warm[jc.b], change);
 }
 
@@ -383,14 +383,15 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
     SolverBody& A = bodies[jc.a];
     SolverBody& B = bodies[jc.b];
     Velocities s = load(A, B);
+    const SolverBody a = turned(A), b = turned(B);
     switch (jc.type) {
-        case JointType::BallSocket: solve_point(jc, A, B, s, params); break;
-        case JointType::Hinge: solve_hinge(jc, A, B, s, params); break;
-        case JointType::Fixed: solve_fixed(jc, A, B, s, params); break;
-        case JointType::Distance: solve_distance(jc, A, B, s, params); break;
-        case JointType::SwingTwist: solve_swing_twist(jc, A, B, s, params); break;
-        case JointType::Prismatic: solve_prismatic(jc, A, B, s, params); break;
-        case JointType::Motor: solve_motor(jc, A, B, s, params); break;
+        case JointType::BallSocket: solve_point(jc, a, b, s, params); break;
+        case JointType::Hinge: solve_hinge(jc, a, b, s, params); break;
+        case JointType::Fixed: solve_fixed(jc, a, b, s, params); break;
+        case JointType::Distance: solve_distance(jc, a, b, s, params); break;
+        case JointType::SwingTwist: solve_swing_twist(jc, a, b, s, params); break;
+        case JointType::Prismatic: solve_prismatic(jc, a, b, s, params); break;
+        case JointType::Motor: solve_motor(jc, a, b, s, params); break;
     }
     store(A, B, s);
 }

@@ -162,23 +162,21 @@ void prepare_swing_twist_lane(WideSwingTwist& w, int lane, const JointConstraint
     w.upper_impulse[lane] = static_cast<float>(jc.upper_impulse);
 }
 
-void warm_start_swing_twist_lanes(const WideJoint& wj, const WideSwingTwist& w, const WideMotion& m,
-                                  WideVelocities& s) {
+void warm_start_swing_twist_lanes(const WideSwingTwist& w, const WideMotion& m, WideVelocities& s) {
     const WideAxes axes = wide_axes(w, m);
-    apply_angular(wj, s,
+    apply_angular(m, s,
                   w.friction_impulse - w.swing_impulse * axes.swing_axis +
                       (w.lower_impulse - w.upper_impulse) * axes.twist_axis);
 }
 
-void solve_swing_twist_lanes(const WideJoint& wj, WideSwingTwist& w, const WideMotion& m, WideVelocities& s,
-                             const JointSolveParams& p) {
+void solve_swing_twist_lanes(WideSwingTwist& w, const WideMotion& m, WideVelocities& s, const JointSolveParams& p) {
     {
         const Wide3 old = w.friction_impulse;
         Wide3 total = old - w.rotation_mass * (s.wb - s.wa);
         const Wide norm = length(total);
         total = select(norm > w.max_friction_impulse, w.max_friction_impulse / norm, splat(1)) * total;
         w.friction_impulse = total;
-        apply_angular(wj, s, total - old);
+        apply_angular(m, s, total - old);
     }
     const WideAxes axes = wide_axes(w, m);
     const Wide cosine = dot(axes.a, axes.b);
@@ -196,7 +194,7 @@ void solve_swing_twist_lanes(const WideJoint& wj, WideSwingTwist& w, const WideM
                               splat(0));
     const WideSoftness violated = violated_softness(p);
     if (any(w.limits_twist)) {
-        const WideAngularRow row = angular_row(wj, axes.twist_axis);
+        const WideAngularRow row = angular_row(m, axes.twist_axis);
         const Wide mass = select(w.limits_twist, row.mass, splat(0));
         const Wide lower = limit_impulse(twist - w.lower, angular_speed(s, row.axis), mass, w.lower_impulse, violated,
                                          p);
@@ -208,7 +206,7 @@ void solve_swing_twist_lanes(const WideJoint& wj, WideSwingTwist& w, const WideM
     const WideMask cone = w.limits_cone & axes.swings;
     if (any(cone)) {
         // The swing grows along a x b: the row allows swing <= cone.
-        const WideAngularRow row = angular_row(wj, axes.swing_axis);
+        const WideAngularRow row = angular_row(m, axes.swing_axis);
         const Wide impulse = limit_impulse(w.cone - swing, -angular_speed(s, row.axis),
                                            select(cone, row.mass, splat(0)), w.swing_impulse, violated, p);
         apply_row(s, row, -impulse);

@@ -30,11 +30,29 @@ struct alignas(64) SolverBody {
     // or elongated (Bodies::elongated), and no rotation lock. Kept here so the integrator
     // reads no body description.
     bool gyroscopic = false;
-    std::uint8_t sweep = 0;           // kSweepNever, kSweepWhenFast or kSweepAlways (stages/continuous.hpp)
-    Mat3 inv_inertia = Mat3::Zero();  // world, fixed for the step; zero about locked axes
+    std::uint8_t sweep = 0;  // kSweepNever, kSweepWhenFast or kSweepAlways (stages/continuous.hpp)
+    // Its inertia is the same about every axis (a ball, a cube), or it does not turn (not
+    // dynamic): turning it changes nothing (turned()).
+    bool isotropic = true;
+    Mat3 inv_inertia = Mat3::Zero();  // world, at the step's start; zero about locked axes
 };
 static_assert(sizeof(SolverBody) == 192 && offsetof(SolverBody, gyroscopic) < 128,
               "a solver body is three cache lines, with what the passes touch in the first two");
+
+// The body with its inverse inertia as it is now: the step's start's turned by dq. A joint's
+// anchors and axes turn with its bodies through the step, and an impulse at a turned anchor
+// applied through the start's inertia would turn a body about an axis it does not: a disc
+// spinning on a pivot gained spin, and energy, in every step that it precessed. A body with
+// motion locks keeps the start's (its zero rows are the locked world axes); an isotropic one
+// has nothing to turn.
+inline SolverBody turned(const SolverBody& body) {
+    SolverBody now = body;
+    if (!body.isotropic && body.locks == 0) {
+        const Mat3 r = body.dq.toRotationMatrix();
+        now.inv_inertia = r * body.inv_inertia * r.transpose();
+    }
+    return now;
+}
 
 // Push-out velocities of a solver body in the current substep (split impulse), at the
 // same index: they move the body out of overlaps in integrate_positions and are then

@@ -171,6 +171,25 @@ inline Wide3 rotate_inverse(const WideQuat& q, const Wide3& a) {
     return a - (two * q.w) * t + two * cross(q.v, t);
 }
 
+// R a R^T for the rotation R of the unit quaternion q: a symmetric matrix turned by q
+// (an inverse inertia given in the world at the step's start, turned with its body since).
+inline WideSym3 turned(const WideSym3& a, const WideQuat& q) {
+    const Wide one = splat(1), two = splat(2);
+    const Wide x = q.v.x, y = q.v.y, z = q.v.z, w = q.w;
+    const Wide r00 = one - two * (y * y + z * z), r01 = two * (x * y - w * z), r02 = two * (x * z + w * y);
+    const Wide r10 = two * (x * y + w * z), r11 = one - two * (x * x + z * z), r12 = two * (y * z - w * x);
+    const Wide r20 = two * (x * z - w * y), r21 = two * (y * z + w * x), r22 = one - two * (x * x + y * y);
+    // m = R a, by rows; then (m R^T)_ij = m_i . R_j.
+    const Wide m00 = r00 * a.xx + r01 * a.xy + r02 * a.xz, m01 = r00 * a.xy + r01 * a.yy + r02 * a.yz,
+               m02 = r00 * a.xz + r01 * a.yz + r02 * a.zz;
+    const Wide m10 = r10 * a.xx + r11 * a.xy + r12 * a.xz, m11 = r10 * a.xy + r11 * a.yy + r12 * a.yz,
+               m12 = r10 * a.xz + r11 * a.yz + r12 * a.zz;
+    const Wide m20 = r20 * a.xx + r21 * a.xy + r22 * a.xz, m21 = r20 * a.xy + r21 * a.yy + r22 * a.yz,
+               m22 = r20 * a.xz + r21 * a.yz + r22 * a.zz;
+    return {m00 * r00 + m01 * r01 + m02 * r02, m00 * r10 + m01 * r11 + m02 * r12, m00 * r20 + m01 * r21 + m02 * r22,
+            m10 * r10 + m11 * r11 + m12 * r12, m10 * r20 + m11 * r21 + m12 * r22, m20 * r20 + m21 * r21 + m22 * r22};
+}
+
 // Eight lanes of doubles, for preparing: the contact solver prepares its rows in double
 // lane by lane, as scalar code would, and keeps them in floats. The sums of three
 // products here are Eigen's (x0 + (x1 + x2): it unrolls a sum of three by halves), so a

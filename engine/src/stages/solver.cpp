@@ -94,6 +94,10 @@ void prepare_body_chunk(const World& world, SolverScratch& scratch, std::uint32_
         sb.damped = sb.dynamic && (d.linear_damping > 0 || d.angular_damping > 0);
         sb.inv_mass = b.inv_mass[i];
         sb.inv_inertia = sb.dynamic ? b.inv_inertia_world(i) : Mat3::Zero();
+        // The same about every axis: diagonal (it is symmetric) with equal entries.
+        const Mat3& local = b.inv_inertia_local[i];
+        sb.isotropic = !sb.dynamic || (local(0, 1) == 0 && local(0, 2) == 0 && local(1, 2) == 0 &&
+                                       local(0, 0) == local(1, 1) && local(1, 1) == local(2, 2));
         if (sb.dynamic) {
             chunk.least_inv_mass = std::min(chunk.least_inv_mass, sb.inv_mass);
             chunk.greatest_inv_mass = std::max(chunk.greatest_inv_mass, sb.inv_mass);
