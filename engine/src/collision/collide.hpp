@@ -181,13 +181,6 @@ inline constexpr Real kRecycleTiltSlops = 0.5;
 // n: n.(turn r - r) = 2w n.(t x r) + 2(v.n)(t.r) - 2(n.r)|t|^2, bounded term by term, the
 // first as Box3D's modified cross bounds |t x r|. A body spinning about the normal (a box
 // turning where it lies) tilts nothing.
-// Whether `turn` can have moved a point within `reach` of the centre `tolerance` along some
-// normal: tilt_reach's bound for any normal, 4 |sin(angle / 2)| |reach| (squared). A resting
-// body's turn is far below it, and no manifold need be asked.
-inline bool may_tilt(const Quat& turn, const Vec3& reach, Real tolerance) {
-    return 16 * turn.vec().squaredNorm() * reach.squaredNorm() >= tolerance * tolerance;
-}
-
 inline Real tilt_reach(const Quat& turn, const Quat& then, const Vec3& reach, const Vec3& n) {
     const Vec3 v = turn.vec();
     const Real along = v.dot(n);
@@ -195,6 +188,13 @@ inline Real tilt_reach(const Quat& turn, const Quat& then, const Vec3& reach, co
     const Vec3 local = (then.conjugate() * t).cwiseAbs();
     return 2 * (std::abs(turn.w()) * modified_cross(local, reach).norm() + std::abs(along) * local.dot(reach) +
                 t.squaredNorm() * reach.norm());
+}
+
+// Whether `turn` can have moved a point within `reach` of the centre `tolerance` along some
+// normal: tilt_reach's bound for any normal, 4 |sin(angle / 2)| |reach| (squared). A resting
+// body's turn is far below it, and no manifold need be asked.
+inline bool may_tilt(const Quat& turn, const Vec3& reach, Real tolerance) {
+    return 16 * turn.vec().squaredNorm() * reach.squaredNorm() >= tolerance * tolerance;
 }
 
 // Contact recycling keeps manifolds only while neither body has turned more than 10 degrees

@@ -13,10 +13,8 @@ struct WideMotion {
     Wide3 dpa, dpb;
     WideQuat dqa, dqb;
     // The bodies' inverse inertias now: the step's start's (WideJoint's) turned by dqa, dqb,
-    // or the start's where no lane's body turns them (WideJoint::turns_a, turns_b). The anchors
-    // and axes turn with the bodies through the step, and an impulse at a turned anchor
-    // through the start's inertia would turn a body about axes it does not: a spinning disc
-    // on a pivot gained spin (and energy) from every precessing step.
+    // or the start's where no lane's body turns them (WideJoint::turns_a, turns_b); why:
+    // solver_body.hpp's turned().
     const WideSym3& inv_inertia_a;
     const WideSym3& inv_inertia_b;
 };

@@ -364,7 +364,8 @@ void warm_start_joint(JointConstraint& jc, SolverBody* bodies) {
     SolverBody& A = bodies[jc.a];
     SolverBody& B = bodies[jc.b];
     Velocities s = load(A, B);
-    apply_warm_start(jc, turned(A), turned(B), s);
+    SolverBody copy_a, copy_b;
+    apply_warm_start(jc, turned(A, copy_a), turned(B, copy_b), s);
     store(A, B, s);
 }
 
@@ -374,7 +375,8 @@ void relax_and_warm_start_joint(JointConstraint& jc, SolverBody* bodies, const J
     const SolverBody& A = bodies[jc.a];
     const SolverBody& B = bodies[jc.b];
     Velocities change{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
-    apply_warm_start(jc, turned(A), turned(B), change);
+    SolverBody copy_a, copy_b;
+    apply_warm_start(jc, turned(A, copy_a), turned(B, copy_b), change);
     add_to(A, B, warm[jc.a], warm[jc.b], change);
 }
 
@@ -383,7 +385,9 @@ void solve_joint(JointConstraint& jc, SolverBody* bodies, const JointSolveParams
     SolverBody& A = bodies[jc.a];
     SolverBody& B = bodies[jc.b];
     Velocities s = load(A, B);
-    const SolverBody a = turned(A), b = turned(B);
+    SolverBody copy_a, copy_b;
+    const SolverBody& a = turned(A, copy_a);
+    const SolverBody& b = turned(B, copy_b);
     switch (jc.type) {
         case JointType::BallSocket: solve_point(jc, a, b, s, params); break;
         case JointType::Hinge: solve_hinge(jc, a, b, s, params); break;

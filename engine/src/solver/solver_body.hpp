@@ -44,14 +44,14 @@ static_assert(sizeof(SolverBody) == 192 && offsetof(SolverBody, gyroscopic) < 12
 // applied through the start's inertia would turn a body about an axis it does not: a disc
 // spinning on a pivot gained spin, and energy, in every step that it precessed. A body with
 // motion locks keeps the start's (its zero rows are the locked world axes); an isotropic one
-// has nothing to turn.
-inline SolverBody turned(const SolverBody& body) {
-    SolverBody now = body;
-    if (!body.isotropic && body.locks == 0) {
-        const Mat3 r = body.dq.toRotationMatrix();
-        now.inv_inertia = r * body.inv_inertia * r.transpose();
-    }
-    return now;
+// has nothing to turn: the body itself is returned, else `copy`, turned (as contact_solver.cpp's
+// scaled() does for support scales).
+inline const SolverBody& turned(const SolverBody& body, SolverBody& copy) {
+    if (body.isotropic || body.locks != 0) return body;
+    copy = body;
+    const Mat3 r = body.dq.toRotationMatrix();
+    copy.inv_inertia = r * body.inv_inertia * r.transpose();
+    return copy;
 }
 
 // Push-out velocities of a solver body in the current substep (split impulse), at the
